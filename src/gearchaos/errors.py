@@ -1,0 +1,62 @@
+"""Exceptions and status codes shared by every layer.
+
+Kernels never raise: they return a :class:`Status`. Only the top-level API turns a
+non-``OK`` status into an :class:`IntegrationError` (and only when asked to), so that a
+sweep of thousands of points keeps going past one bad point.
+"""
+
+from __future__ import annotations
+
+import enum
+
+__all__ = ["IntegrationError", "ParameterError", "Status", "StoreError"]
+
+
+class ParameterError(ValueError):
+    """A parameter violates a physical or structural rule.
+
+    The message always names the parameter (by its dotted name), the rule and the value,
+    e.g. ``backlash.sun_planet must be >= 0: got -3.0``.
+    """
+
+
+class IntegrationError(RuntimeError):
+    """The integrator stopped before the requested end time (see :class:`Status`)."""
+
+
+class StoreError(RuntimeError):
+    """A result store cannot be used as asked (wrong settings, corrupt, locked)."""
+
+
+class Status(enum.IntEnum):
+    """Integrator outcome codes. The integer values are what the numba kernels return."""
+
+    OK = 0
+    MAX_STEPS = 1
+    STEP_UNDERFLOW = 2
+    NON_FINITE = 3
+
+    @property
+    def message(self) -> str:
+        return _MESSAGES[self]
+
+    @property
+    def ok(self) -> bool:
+        return self is Status.OK
+
+
+_MESSAGES = {
+    Status.OK: "integration reached the requested end time",
+    Status.MAX_STEPS: (
+        "the step budget (max_steps) was exhausted before the end time; "
+        "raise max_steps or loosen rtol/atol"
+    ),
+    Status.STEP_UNDERFLOW: (
+        "the step size fell below the floating-point resolution of the time variable; "
+        "the problem is too stiff or discontinuous for the requested rtol/atol"
+    ),
+    Status.NON_FINITE: (
+        "the state became NaN or infinite; the response diverged "
+        "(check for negative stiffness or an unstable parameter set)"
+    ),
+}

@@ -1,0 +1,43 @@
+"""Physical layer: frozen gear-set records, TOML I/O, validation and presets."""
+
+from .io import from_toml, from_toml_string, to_toml, template_toml
+from .presets import list_presets, preset
+from .records import (
+    UNITS,
+    Backlash,
+    Clearance,
+    Damping,
+    Eccentricity,
+    GearSet,
+    Geometry,
+    Inertia,
+    Mass,
+    MeshPhasing,
+    Stiffness,
+    Teeth,
+    Torque,
+    TransmissionError,
+)
+
+__all__ = [
+    "UNITS",
+    "Backlash",
+    "Clearance",
+    "Damping",
+    "Eccentricity",
+    "GearSet",
+    "Geometry",
+    "Inertia",
+    "Mass",
+    "MeshPhasing",
+    "Stiffness",
+    "Teeth",
+    "Torque",
+    "TransmissionError",
+    "from_toml",
+    "from_toml_string",
+    "list_presets",
+    "preset",
+    "template_toml",
+    "to_toml",
+]
