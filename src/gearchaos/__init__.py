@@ -1,3 +1,49 @@
-"""gearchaos — nonlinear dynamics of geared transmissions with clearances."""
+"""gearchaos — nonlinear dynamics of geared transmissions with clearances.
+
+The central model is the transverse–torsional 2K-H planetary gear train of Sheng et al. (2016)
+in the reconstruction of ``MODEL.md``: time-varying mesh stiffness, transmission and eccentricity
+errors, sun–planet and planet–ring backlash and sun bearing clearance.
+
+>>> import gearchaos as gc
+>>> gs = gc.preset("sheng2016")
+>>> res = gc.simulate(gs, omega=1.5)          # doctest: +SKIP
+>>> res.to_dataset().delta_sp.sel(planet=1)   # doctest: +SKIP
+"""
 
 __version__ = "0.1.0"
+
+from .errors import IntegrationError, ParameterError, Status, StoreError
+from .gearset import GearSet, preset
+from .integrate import SimulationResult, integrate, open_simulation, simulate
+from .model import (
+    System,
+    backlash_oscillator,
+    duffing,
+    linear_oscillator,
+    linear_system,
+    lorenz,
+    nondimensionalise,
+    planetary_system,
+)
+
+__all__ = [
+    "GearSet",
+    "IntegrationError",
+    "ParameterError",
+    "SimulationResult",
+    "Status",
+    "StoreError",
+    "System",
+    "__version__",
+    "backlash_oscillator",
+    "duffing",
+    "integrate",
+    "linear_oscillator",
+    "linear_system",
+    "lorenz",
+    "nondimensionalise",
+    "open_simulation",
+    "planetary_system",
+    "preset",
+    "simulate",
+]

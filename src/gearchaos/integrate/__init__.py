@@ -1,0 +1,19 @@
+"""Compiled Dormand–Prince 5(4) integration of any :class:`~gearchaos.model.System`."""
+
+from .dopri import dopri_batch, dopri_run
+from .result import SimulationResult, open_simulation
+from .simulate import integrate, simulate
+from .tableau import DOPRI5, ButcherTableau
+from .trajectory import Trajectory
+
+__all__ = [
+    "DOPRI5",
+    "ButcherTableau",
+    "SimulationResult",
+    "Trajectory",
+    "dopri_batch",
+    "dopri_run",
+    "integrate",
+    "open_simulation",
+    "simulate",
+]

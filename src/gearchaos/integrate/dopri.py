@@ -1,0 +1,376 @@
+"""Compiled adaptive Dormand–Prince 5(4) integrator that lands exactly on sample times.
+
+The kernel integrates ``y' = f(τ, y)`` of any built-in system (selected by ``kind``) from τ_0,
+discards everything before the record start τ_rec, then stops *exactly* on each sample time
+τ_rec + j Δ (the step is clipped, not interpolated: 3–9× more accurate than interpolation), and
+continues to τ_end. Over [τ_rec, τ_end] it keeps the running minimum and maximum of the first
+``n_track`` observables, refining the extremum inside each accepted step by the cubic Hermite
+interpolant of the observable and its derivative (the observables come for free from the FSAL
+stage).
+
+Error control follows Hairer, Nørsett & Wanner (*Solving ODEs I*, §II.4) as in scipy's
+``RK45``: the scaled RMS norm of h Σ (b_i − b̂_i) k_i with scale atol + rtol·max(|y_n|, |y_{n+1}|),
+step factor 0.9·err^(−1/5) clipped to [0.2, 10] (no growth right after a rejection), and
+Hairer's starting-step heuristic. After a step clipped to land on a sample the pre-clip step size
+is restored, so sampling does not throttle the integration.
+
+Kernels never raise: they return a :class:`~gearchaos.errors.Status` code.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from ..model.kernels import rhs
+from .tableau import DOPRI5
+
+__all__ = ["dopri_batch", "dopri_run"]
+
+# ---------------------------------------------------------------------------- constants from data
+_A = DOPRI5.a_matrix()
+_B = [float(x) for x in DOPRI5.b]
+_E = [float(x) for x in DOPRI5.error_weights]
+_C = [float(x) for x in DOPRI5.c]
+A21 = _A[1, 0]
+A31, A32 = _A[2, 0], _A[2, 1]
+A41, A42, A43 = _A[3, 0], _A[3, 1], _A[3, 2]
+A51, A52, A53, A54 = _A[4, 0], _A[4, 1], _A[4, 2], _A[4, 3]
+A61, A62, A63, A64, A65 = _A[5, 0], _A[5, 1], _A[5, 2], _A[5, 3], _A[5, 4]
+B1, B3, B4, B5, B6 = _B[0], _B[2], _B[3], _B[4], _B[5]
+E1, E3, E4, E5, E6, E7 = _E[0], _E[2], _E[3], _E[4], _E[5], _E[6]
+C2, C3, C4, C5 = _C[1], _C[2], _C[3], _C[4]
+assert _B[1] == 0.0 and _E[1] == 0.0 and _B[6] == 0.0 and DOPRI5.fsal
+
+SAFETY = 0.9
+MIN_FACTOR = 0.2
+MAX_FACTOR = 10.0
+ERR_EXPONENT = -1.0 / 5.0  # −1/(q+1), q = 4 the lower order of the pair
+
+ST_OK = 0
+ST_MAX_STEPS = 1
+ST_UNDERFLOW = 2
+ST_NON_FINITE = 3
+
+
+@numba.njit(cache=True, inline="always")
+def _scaled_norm(v, y, ynew, rtol, atol):  # pragma: no cover - compiled
+    acc = 0.0
+    n = v.size
+    for i in range(n):
+        sc = atol + rtol * max(abs(y[i]), abs(ynew[i]))
+        r = v[i] / sc
+        acc += r * r
+    return math.sqrt(acc / n)
+
+
+@numba.njit(cache=True)
+def initial_step(kind, t, y, f0, p, rtol, atol, obs):  # pragma: no cover - compiled
+    """Hairer's starting step (HNW I, §II.4) for the 5(4) pair."""
+    n = y.size
+    d0 = 0.0
+    d1 = 0.0
+    for i in range(n):
+        sc = atol + rtol * abs(y[i])
+        d0 += (y[i] / sc) ** 2
+        d1 += (f0[i] / sc) ** 2
+    d0 = math.sqrt(d0 / n)
+    d1 = math.sqrt(d1 / n)
+    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+    y1 = y + h0 * f0
+    f1 = np.empty(n)
+    rhs(kind, t + h0, y1, p, f1, obs)
+    d2 = 0.0
+    for i in range(n):
+        sc = atol + rtol * abs(y[i])
+        d2 += ((f1[i] - f0[i]) / sc) ** 2
+    d2 = math.sqrt(d2 / n) / h0
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        h1 = max(1e-6, h0 * 1e-3)
+    else:
+        h1 = (0.01 / max(d1, d2)) ** 0.2
+    return min(100.0 * h0, h1)
+
+
+@numba.njit(cache=True, inline="always")
+def _track(obs_prev, obs, dt, n_track, omin, omax):  # pragma: no cover - compiled
+    """Update running extrema over one accepted step (values and Hermite interior extremum)."""
+    for k in range(n_track):
+        v0 = obs_prev[k]
+        v1 = obs[k]
+        if v1 < omin[k]:
+            omin[k] = v1
+        if v1 > omax[k]:
+            omax[k] = v1
+        d0 = obs_prev[n_track + k] * dt
+        d1 = obs[n_track + k] * dt
+        if d0 * d1 < 0.0:
+            # derivative of the cubic Hermite interpolant: a s² + b s + c on s ∈ [0, 1]
+            a = 6.0 * (v0 - v1) + 3.0 * (d0 + d1)
+            b = -6.0 * (v0 - v1) - 4.0 * d0 - 2.0 * d1
+            c = d0
+            if abs(a) < 1e-14 * (abs(b) + abs(c)):
+                s = -c / b
+            else:
+                disc = max(b * b - 4.0 * a * c, 0.0)
+                q = -0.5 * (b + math.copysign(math.sqrt(disc), b))
+                s1 = q / a
+                s2 = c / q if q != 0.0 else -1.0
+                s = s1 if 0.0 <= s1 <= 1.0 else s2
+            if 0.0 < s < 1.0:
+                s2_ = s * s
+                s3_ = s2_ * s
+                v = (
+                    (2.0 * s3_ - 3.0 * s2_ + 1.0) * v0
+                    + (s3_ - 2.0 * s2_ + s) * d0
+                    + (-2.0 * s3_ + 3.0 * s2_) * v1
+                    + (s3_ - s2_) * d1
+                )
+                if v < omin[k]:
+                    omin[k] = v
+                if v > omax[k]:
+                    omax[k] = v
+
+
+@numba.njit(cache=True)
+def dopri_run(
+    kind,
+    y0,
+    p,
+    t0,
+    t_rec,
+    dt_sample,
+    n_samples,
+    t_end,
+    n_obs,
+    n_track,
+    rtol,
+    atol,
+    h_init,
+    max_step,
+    max_steps,
+    out_t,
+    out_y,
+    out_obs,
+    obs_min,
+    obs_max,
+    y_final,
+    info,
+):  # pragma: no cover - compiled
+    """Integrate one system; fill the output arrays; return the status code.
+
+    Samples are taken at τ_j = t_rec + j·dt_sample, j = 0 … n_samples−1 (t_rec ≥ t0), then the
+    integration goes on to t_end ≥ τ_last. Extrema of obs[:n_track] are tracked over
+    [t_rec, t_end]. ``info`` (float64, length 4) receives accepted steps, rejected steps, the
+    final time reached and the next step size (to continue seamlessly).
+    """
+    n = y0.size
+    y = y0.copy()
+    ynew = np.empty(n)
+    yt = np.empty(n)
+    k1 = np.empty(n)
+    k2 = np.empty(n)
+    k3 = np.empty(n)
+    k4 = np.empty(n)
+    k5 = np.empty(n)
+    k6 = np.empty(n)
+    k7 = np.empty(n)
+    ev = np.empty(n)
+    obs = np.empty(n_obs)
+    obs_prev = np.empty(n_obs)
+    for k in range(n_track):
+        obs_min[k] = np.inf
+        obs_max[k] = -np.inf
+
+    t = t0
+    rhs(kind, t, y, p, k1, obs)
+    n_acc = 0
+    n_rej = 0
+    status = ST_OK
+    for i in range(n):
+        if not math.isfinite(k1[i]) or not math.isfinite(y[i]):
+            status = ST_NON_FINITE
+    h = h_init
+    if status == ST_OK and h <= 0.0:
+        h = initial_step(kind, t, y, k1, p, rtol, atol, obs)
+        rhs(kind, t, y, p, k1, obs)  # restore obs of the current point
+    if h > max_step:
+        h = max_step
+
+    j = 0
+    tracking = False
+    if status == ST_OK and n_samples > 0 and t >= t_rec:
+        out_t[0] = t
+        out_y[0, :] = y
+        out_obs[0, :] = obs
+        j = 1
+        tracking = True
+        for k in range(n_track):
+            obs_min[k] = obs[k]
+            obs_max[k] = obs[k]
+    obs_prev[:] = obs
+    last_rejected = False
+    nonfinite = False
+
+    while status == ST_OK:
+        if j < n_samples:
+            target = t_rec + j * dt_sample
+        else:
+            target = t_end
+        if j >= n_samples and t >= t_end:
+            break
+        if n_acc + n_rej >= max_steps:
+            status = ST_MAX_STEPS
+            break
+        hmin = 16.0 * 2.220446049250313e-16 * max(abs(t), abs(target))
+        if h < hmin:
+            status = ST_NON_FINITE if nonfinite else ST_UNDERFLOW
+            break
+        clipped = False
+        hs = h
+        if t + h >= target:
+            hs = target - t
+            clipped = True
+
+        for i in range(n):
+            yt[i] = y[i] + hs * A21 * k1[i]
+        rhs(kind, t + C2 * hs, yt, p, k2, obs)
+        for i in range(n):
+            yt[i] = y[i] + hs * (A31 * k1[i] + A32 * k2[i])
+        rhs(kind, t + C3 * hs, yt, p, k3, obs)
+        for i in range(n):
+            yt[i] = y[i] + hs * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
+        rhs(kind, t + C4 * hs, yt, p, k4, obs)
+        for i in range(n):
+            yt[i] = y[i] + hs * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
+        rhs(kind, t + C5 * hs, yt, p, k5, obs)
+        for i in range(n):
+            yt[i] = y[i] + hs * (
+                A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i]
+            )
+        t_new = target if clipped else t + hs
+        rhs(kind, t + hs, yt, p, k6, obs)
+        for i in range(n):
+            ynew[i] = y[i] + hs * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
+        rhs(kind, t_new, ynew, p, k7, obs)
+        for i in range(n):
+            ev[i] = hs * (
+                E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i]
+            )
+        err = _scaled_norm(ev, y, ynew, rtol, atol)
+
+        finite = math.isfinite(err)
+        if finite:
+            for i in range(n):
+                if not math.isfinite(ynew[i]):
+                    finite = False
+                    break
+        if not finite:
+            nonfinite = True
+            n_rej += 1
+            h = hs * MIN_FACTOR
+            last_rejected = True
+            continue
+        nonfinite = False
+
+        if err <= 1.0:
+            n_acc += 1
+            if err == 0.0:
+                factor = MAX_FACTOR
+            else:
+                factor = min(MAX_FACTOR, SAFETY * err**ERR_EXPONENT)
+            if last_rejected and factor > 1.0:
+                factor = 1.0
+            last_rejected = False
+            h_next = hs * factor
+            if clipped and h_next < h:
+                h_next = h  # restore the pre-clip proposal
+            h = min(h_next, max_step)
+            t = t_new
+            for i in range(n):
+                y[i] = ynew[i]
+                k1[i] = k7[i]
+            if tracking:
+                _track(obs_prev, obs, hs, n_track, obs_min, obs_max)
+            if clipped and j < n_samples:
+                out_t[j] = t
+                out_y[j, :] = y
+                out_obs[j, :] = obs
+                if not tracking:
+                    tracking = True
+                    for k in range(n_track):
+                        obs_min[k] = obs[k]
+                        obs_max[k] = obs[k]
+                j += 1
+            obs_prev[:] = obs
+        else:
+            n_rej += 1
+            h = hs * max(MIN_FACTOR, SAFETY * err**ERR_EXPONENT)
+            last_rejected = True
+
+    y_final[:] = y
+    info[0] = n_acc
+    info[1] = n_rej
+    info[2] = t
+    info[3] = h
+    return status
+
+
+@numba.njit(cache=True, parallel=True)
+def dopri_batch(
+    kind,
+    Y0,
+    P,
+    t0,
+    t_rec,
+    dt_sample,
+    n_samples,
+    t_end,
+    n_obs,
+    n_track,
+    rtol,
+    atol,
+    max_step,
+    max_steps,
+    out_t,
+    out_y,
+    out_obs,
+    obs_min,
+    obs_max,
+    y_final,
+    info,
+    status,
+):  # pragma: no cover - compiled
+    """Run many parameter vectors (rows of ``P``, initial states rows of ``Y0``) in parallel.
+
+    ``t0``, ``t_rec``, ``dt_sample`` and ``t_end`` are per-point arrays (the forcing period
+    differs between points); every output array has the point index first.
+    """
+    m = P.shape[0]
+    for i in numba.prange(m):
+        status[i] = dopri_run(
+            kind,
+            Y0[i],
+            P[i],
+            t0[i],
+            t_rec[i],
+            dt_sample[i],
+            n_samples,
+            t_end[i],
+            n_obs,
+            n_track,
+            rtol,
+            atol,
+            -1.0,
+            max_step,
+            max_steps,
+            out_t[i],
+            out_y[i],
+            out_obs[i],
+            obs_min[i],
+            obs_max[i],
+            y_final[i],
+            info[i],
+        )

@@ -1,0 +1,241 @@
+"""Result of :func:`gearchaos.simulate`: a :class:`Trajectory` that converts to xarray.
+
+Data contract of :meth:`SimulationResult.to_dataset` for the planetary model (keep these names):
+dimension ``section`` (coordinate ``tau``) and ``planet`` (1..N); variables ``delta_sp``,
+``delta_rp``, ``delta_sp_dot``, ``delta_rp_dot`` (section, planet), ``x_s``, ``y_s``,
+``x_s_dot``, ``y_s_dot`` (section), ``delta_sp_min``, ``delta_sp_max``, ``delta_rp_min``,
+``delta_rp_max`` (planet); attributes ``gearset_toml``, ``omega``, ``rtol``, ``atol``,
+``transient_periods``, ``periods``, ``status``, ``version``. With ``samples_per_period > 1``
+the full time history is added on dimension ``sample`` (coordinate ``tau_sample``) as
+``<name>_history``.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, fields
+from typing import Any
+
+import numpy as np
+
+from .trajectory import Trajectory
+
+__all__ = ["SimulationResult", "open_simulation"]
+
+_DIMLESS = "1"
+
+
+def provenance() -> dict[str, str]:
+    """Versions of gearchaos and of the numerical libraries, for result attributes."""
+    import numba
+    import scipy
+
+    from .. import __version__
+
+    return {
+        "version": __version__,
+        "numba_version": numba.__version__,
+        "numpy_version": np.__version__,
+        "scipy_version": scipy.__version__,
+    }
+
+
+@dataclass(frozen=True, eq=False)
+class SimulationResult(Trajectory):
+    """A :class:`Trajectory` plus conversion to an :class:`xarray.Dataset` and to files."""
+
+    @classmethod
+    def from_trajectory(cls, traj: Trajectory) -> SimulationResult:
+        return cls(**{f.name: getattr(traj, f.name) for f in fields(Trajectory)})
+
+    @property
+    def omega(self) -> float:
+        return self.system.omega
+
+    @property
+    def gearset(self) -> Any:
+        return getattr(self.system.model, "gearset", None)
+
+    # ------------------------------------------------------------------ xarray
+    def _attrs(self) -> dict[str, Any]:
+        s = self.settings
+        attrs: dict[str, Any] = {
+            "title": f"gearchaos simulation of {self.system.name}",
+            "model": self.system.name,
+            "omega": self.omega,
+            "rtol": s["rtol"],
+            "atol": s["atol"],
+            "transient_periods": s["transient_periods"],
+            "periods": s["periods"],
+            "samples_per_period": s["samples_per_period"],
+            "section_phase": s["section_phase"],
+            "status": self.status.name.lower(),
+            "status_message": self.status.message,
+            "steps_accepted": self.steps_accepted,
+            "steps_rejected": self.steps_rejected,
+            "initial_state": "zero" if s.get("y0") is None else "given",
+            **provenance(),
+        }
+        gs = self.gearset
+        attrs["gearset_toml"] = gs.to_toml() if gs is not None else ""
+        model = self.system.model
+        if hasattr(model, "scales"):
+            sc = model.scales
+            attrs["omega_n_rad_s"] = sc.omega_n
+            attrs["characteristic_length_m"] = sc.length
+            attrs["mesh_frequency_rad_s"] = self.omega * sc.omega_n
+        for k, v in getattr(model, "clearances", {}).items():
+            attrs[f"clearance_{k}"] = v
+        return attrs
+
+    def to_dataset(self) -> Any:
+        """The result as an :class:`xarray.Dataset` (see the module docstring for names)."""
+        if hasattr(self.system.model, "n_planets"):
+            return self._planetary_dataset()
+        return self._generic_dataset()
+
+    def _history(self, ds: Any) -> None:
+        if self.samples_per_period <= 1:
+            return
+        import xarray as xr
+
+        ds.coords["tau_sample"] = xr.DataArray(
+            self.tau, dims="sample", attrs={"long_name": "τ = ω_n t", "units": _DIMLESS}
+        )
+        for name in list(ds.data_vars):
+            if "section" not in ds[name].dims:
+                continue
+            v = ds[name]
+            full = self._series_for(name)
+            if full is None:
+                continue
+            dims = tuple("sample" if d == "section" else d for d in v.dims)
+            ds[f"{name}_history"] = xr.DataArray(full, dims=dims, attrs=v.attrs)
+
+    def _series_for(self, name: str) -> np.ndarray | None:
+        sn, on = self.system.state_names, self.system.obs_names
+        if name in sn:
+            return self.states[:, sn.index(name)]
+        if name in on:
+            return self.observables[:, on.index(name)]
+        N = getattr(self.system.model, "n_planets", 0)
+        planet_vars = {
+            "delta_sp": "delta_sp_{}",
+            "delta_rp": "delta_rp_{}",
+            "delta_sp_dot": "delta_sp_dot_{}",
+            "delta_rp_dot": "delta_rp_dot_{}",
+            "force_sp": "force_sp_{}",
+            "force_rp": "force_rp_{}",
+        }
+        if name in planet_vars:
+            cols = [on.index(planet_vars[name].format(i)) for i in range(1, N + 1)]
+            return self.observables[:, cols]
+        if name in ("p", "p_dot"):
+            suffix = "_dot" if name == "p_dot" else ""
+            cols = [sn.index(f"p_{i}{suffix}") for i in range(1, N + 1)]
+            return self.states[:, cols]
+        return None
+
+    def _planetary_dataset(self) -> Any:
+        import xarray as xr
+
+        model = self.system.model
+        N = model.n_planets
+        idx = self.section_index
+        tau = self.tau[idx]
+        coords = {
+            "tau": xr.DataArray(
+                tau, dims="section", attrs={"long_name": "τ = ω_n t at the section", "units": _DIMLESS}
+            ),
+            "planet": xr.DataArray(np.arange(1, N + 1), dims="planet", attrs={"long_name": "planet i"}),
+        }
+        ds = xr.Dataset(coords=coords, attrs=self._attrs())
+        b_sp, b_rp = model.parameters.b_sp, model.parameters.b_rp
+
+        def put(name: str, dims: tuple[str, ...], long_name: str, units: str = "b_c", **extra: Any) -> None:
+            full = self._series_for(name)
+            assert full is not None
+            ds[name] = xr.DataArray(
+                full[idx], dims=dims, attrs={"long_name": long_name, "units": units, **extra}
+            )
+
+        lu = {"units_note": "dimensionless, in units of the characteristic length b_c"}
+        put("delta_sp", ("section", "planet"), "X̄_sp = δ_sp/b_c, sun–planet mesh deflection", _DIMLESS, backlash=b_sp, **lu)
+        put("delta_rp", ("section", "planet"), "X̄_rp = δ_rp/b_c, planet–ring mesh deflection", _DIMLESS, backlash=b_rp, **lu)
+        put("delta_sp_dot", ("section", "planet"), "X̄'_sp = dX̄_sp/dτ", _DIMLESS)
+        put("delta_rp_dot", ("section", "planet"), "X̄'_rp = dX̄_rp/dτ", _DIMLESS)
+        put("force_sp", ("section", "planet"), "F̄_sp = F_sp/(k_m,sp b_c), sun–planet mesh force", _DIMLESS)
+        put("force_rp", ("section", "planet"), "F̄_rp = F_rp/(k_m,sp b_c), planet–ring mesh force", _DIMLESS)
+        put("x_s", ("section",), "x̄_s, sun centre displacement", _DIMLESS, **lu)
+        put("y_s", ("section",), "ȳ_s, sun centre displacement", _DIMLESS, **lu)
+        put("x_s_dot", ("section",), "x̄'_s", _DIMLESS)
+        put("y_s_dot", ("section",), "ȳ'_s", _DIMLESS)
+        put("p", ("section", "planet"), "p̄_i = (u_s + u_i − u_c cos α_s)/b_c", _DIMLESS)
+        put("sigma", ("section",), "σ̄ = (u_s − u_c (cos α_s + cos α_r))/b_c", _DIMLESS)
+        put("p_dot", ("section", "planet"), "p̄'_i", _DIMLESS)
+        put("sigma_dot", ("section",), "σ̄'", _DIMLESS)
+        for mesh, off in (("sp", 0), ("rp", N)):
+            for which, arr in (("min", self.obs_min), ("max", self.obs_max)):
+                ds[f"delta_{mesh}_{which}"] = xr.DataArray(
+                    arr[off : off + N],
+                    dims=("planet",),
+                    attrs={
+                        "long_name": f"{which} of X̄_{mesh} over the recorded window",
+                        "units": _DIMLESS,
+                    },
+                )
+        # dynamic load factor: max mesh force over the static mean force T̄_D/N
+        td, _ = model.parameters.loads(self.omega)
+        static = td / N
+        if static > 0:
+            for mesh in ("sp", "rp"):
+                full = self._series_for(f"force_{mesh}")
+                assert full is not None
+                ds[f"load_factor_{mesh}"] = xr.DataArray(
+                    np.nanmax(full, axis=0) / static,
+                    dims=("planet",),
+                    attrs={
+                        "long_name": f"dynamic load factor max F_{mesh}/(T_D/(N r_bs)) over the samples",
+                        "units": _DIMLESS,
+                        "note": "sampled at samples_per_period resolution",
+                    },
+                )
+        self._history(ds)
+        return ds
+
+    def _generic_dataset(self) -> Any:
+        import xarray as xr
+
+        idx = self.section_index
+        ds = xr.Dataset(
+            coords={"tau": xr.DataArray(self.tau[idx], dims="section", attrs={"units": _DIMLESS})},
+            attrs=self._attrs(),
+        )
+        for name in self.system.state_names + self.system.obs_names:
+            if name in ds:
+                continue
+            full = self._series_for(name)
+            assert full is not None
+            ds[name] = xr.DataArray(full[idx], dims=("section",), attrs={"units": _DIMLESS})
+        for k, name in enumerate(self.system.obs_names[: self.system.n_track]):
+            ds[f"{name}_min"] = float(self.obs_min[k])
+            ds[f"{name}_max"] = float(self.obs_max[k])
+        self._history(ds)
+        return ds
+
+    # ------------------------------------------------------------------ files
+    def save(self, path: str | os.PathLike[str]) -> str:
+        """Write the dataset to a netCDF-4 file (h5netcdf); returns the path."""
+        ds = self.to_dataset()
+        path = os.fspath(path)
+        tmp = path + ".partial"
+        ds.to_netcdf(tmp, engine="h5netcdf", invalid_netcdf=True)
+        os.replace(tmp, path)  # never leave a half-written file under the final name
+        return path
+
+
+def open_simulation(path: str | os.PathLike[str]) -> Any:
+    """Open a file written by :meth:`SimulationResult.save` as an :class:`xarray.Dataset`."""
+    import xarray as xr
+
+    return xr.load_dataset(os.fspath(path), engine="h5netcdf")

@@ -1,0 +1,77 @@
+"""Raw result of one integration: :class:`Trajectory`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..errors import Status
+from ..model.system import System
+
+__all__ = ["Trajectory"]
+
+
+@dataclass(frozen=True, eq=False)
+class Trajectory:
+    """Samples of one integration of a :class:`System`.
+
+    Attributes
+    ----------
+    tau : (m,) sample times; every ``samples_per_period``-th one is a Poincaré section time.
+    states : (m, n_state) states at ``tau``.
+    observables : (m, n_obs) observables (``system.obs_names``) at ``tau``.
+    obs_min, obs_max : (n_track,) extrema of the tracked observables over the recorded window.
+    """
+
+    system: System
+    tau: np.ndarray
+    states: np.ndarray
+    observables: np.ndarray
+    obs_min: np.ndarray
+    obs_max: np.ndarray
+    final_state: np.ndarray
+    status: Status
+    steps_accepted: int
+    steps_rejected: int
+    settings: dict[str, Any] = field(default_factory=dict)
+    next_step: float = 0.0
+
+    @property
+    def samples_per_period(self) -> int:
+        return int(self.settings.get("samples_per_period", 1))
+
+    @property
+    def section_index(self) -> np.ndarray:
+        """Indices of the Poincaré section samples within ``tau``."""
+        return np.arange(0, self.tau.size, self.samples_per_period)
+
+    @property
+    def section_tau(self) -> np.ndarray:
+        return self.tau[self.section_index]
+
+    def section(self, name: str) -> np.ndarray:
+        """Section values of a state or observable, by name."""
+        return self.series(name)[self.section_index]
+
+    def series(self, name: str) -> np.ndarray:
+        """All samples of a state or observable, by name."""
+        sn, on = self.system.state_names, self.system.obs_names
+        if name in sn:
+            return self.states[:, sn.index(name)]
+        if name in on:
+            return self.observables[:, on.index(name)]
+        raise KeyError(f"unknown variable {name!r}; states: {sn}; observables: {on}")
+
+    def extrema(self, name: str) -> tuple[float, float]:
+        """(min, max) of a tracked observable over the recorded window."""
+        on = self.system.obs_names[: self.system.n_track]
+        if name not in on:
+            raise KeyError(f"{name!r} is not tracked; tracked: {on}")
+        k = on.index(name)
+        return float(self.obs_min[k]), float(self.obs_max[k])
+
+    @property
+    def ok(self) -> bool:
+        return self.status is Status.OK

@@ -1,0 +1,356 @@
+"""Compiled right-hand sides of every built-in system, behind one dispatch function.
+
+Signature of every kernel: ``rhs(t, y, p, dydt, obs)`` — time, state, packed parameters, output
+derivative, output observables. ``obs`` always starts with the ``n_track`` observables whose
+running extrema the integrator records, followed by their time derivatives, then any extras
+(mesh forces). The integrator reads ``obs`` after the last stage of an accepted step, which the
+Dormand–Prince FSAL property evaluates exactly at the new point, so observables cost nothing.
+
+One dispatch function (:func:`rhs`) keeps numba's on-disk cache effective: a cached kernel that
+receives a jitted function as an argument cannot be cached, and closures over dispatchers are
+re-compiled in every process.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from .layout import (
+    B_C,
+    B_C_EPR,
+    B_C_EPS,
+    B_C_ER,
+    B_C_ES,
+    B_CE_RP,
+    B_CE_SP,
+    B_CK_RP,
+    B_CK_SP,
+    B_S,
+    B_S_EPR,
+    B_S_EPS,
+    B_S_ER,
+    B_S_ES,
+    B_SE_RP,
+    B_SE_SP,
+    B_SK_RP,
+    B_SK_SP,
+    BO_B,
+    BO_EPS,
+    BO_FA,
+    BO_FM,
+    BO_OMEGA,
+    BO_ZETA,
+    DU_ALPHA,
+    DU_BETA,
+    DU_DELTA,
+    DU_GAMMA,
+    DU_OMEGA,
+    KIND_BACKLASH_OSCILLATOR,
+    KIND_DUFFING,
+    KIND_LINEAR,
+    KIND_LORENZ,
+    KIND_PLANETARY,
+    LIN_HEADER,
+    LIN_N,
+    LIN_OMEGA,
+    LZ_BETA,
+    LZ_RHO,
+    LZ_SIGMA,
+    N_BLOCKS,
+    P_ARP,
+    P_ASP,
+    P_BRP,
+    P_BS,
+    P_BSP,
+    P_COS_AR,
+    P_COS_AS,
+    P_CRP,
+    P_CS,
+    P_CSP,
+    P_ECC,
+    P_EP,
+    P_EPS_SP,
+    P_ER,
+    P_ES,
+    P_HEADER,
+    P_INV_MU_S,
+    P_INV_MUC,
+    P_INV_MUP,
+    P_INV_MUS,
+    P_KB,
+    P_KRP_A,
+    P_KRP_M,
+    P_N,
+    P_NH_RP,
+    P_NH_SP,
+    P_OMEGA,
+    P_TD,
+    P_TL,
+    P_ZP,
+    P_ZR,
+    P_ZS,
+)
+
+__all__ = ["dead_zone", "observe_many", "rhs"]
+
+
+@numba.njit(cache=True, inline="always")
+def dead_zone(x: float, b: float) -> float:
+    """f(x; b) = x − b (x > b), 0 (|x| ≤ b), x + b (x < −b): contact law with half clearance b."""
+    if x > b:
+        return x - b
+    if x < -b:
+        return x + b
+    return 0.0
+
+
+@numba.njit(cache=True)
+def planetary_rhs(t, y, p, dydt, obs):  # pragma: no cover - compiled
+    """Minimal relative-coordinate equations of MODEL.md §7.
+
+    State y = (x̄_s, ȳ_s, p̄_1..p̄_N, σ̄, then their τ-derivatives).
+    obs = (δ̄_sp1..N, δ̄_rp1..N, δ̄'_sp1..N, δ̄'_rp1..N, F̄_sp1..N, F̄_rp1..N).
+    """
+    N = int(p[P_N])
+    n = N + 3
+    om = p[P_OMEGA]
+    th = om * t
+    c1 = math.cos(th)
+    s1 = math.sin(th)
+    x = y[0]
+    yy = y[1]
+    sig = y[N + 2]
+    xd = y[n]
+    yd = y[n + 1]
+    sigd = y[n + N + 2]
+
+    eps_sp = p[P_EPS_SP]
+    krm = p[P_KRP_M]
+    kra = p[P_KRP_A]
+    csp = p[P_CSP]
+    crp = p[P_CRP]
+    bsp = p[P_BSP]
+    brp = p[P_BRP]
+    asp = p[P_ASP]
+    arp = p[P_ARP]
+    nh_sp = int(p[P_NH_SP])
+    nh_rp = int(p[P_NH_RP])
+    h0 = P_HEADER + N_BLOCKS * N  # first harmonic amplitude
+
+    ecc = p[P_ECC] != 0.0
+    es = p[P_ES]
+    ep = p[P_EP]
+    er = p[P_ER]
+    cs_ = 0.0
+    ss_ = 0.0
+    cp_ = 0.0
+    sp_ = 0.0
+    cr_ = 0.0
+    sr_ = 0.0
+    om_s = 0.0
+    om_p = 0.0
+    om_r = 0.0
+    if ecc:
+        om_s = om / p[P_ZS]
+        om_p = om / p[P_ZP]
+        om_r = om / p[P_ZR]
+        cs_ = math.cos(om_s * t)
+        ss_ = math.sin(om_s * t)
+        cp_ = math.cos(om_p * t)
+        sp_ = math.sin(om_p * t)
+        cr_ = math.cos(om_r * t)
+        sr_ = math.sin(om_r * t)
+
+    sum_fsp = 0.0
+    sum_frp = 0.0
+    sum_fx = 0.0
+    sum_fy = 0.0
+    for i in range(N):
+        si = p[P_HEADER + B_S * N + i]
+        ci = p[P_HEADER + B_C * N + i]
+        s_i = -x * si + yy * ci
+        sd_i = -xd * si + yd * ci
+
+        # --- time-varying stiffness, angle addition from one sin/cos pair of Ωτ
+        ck = c1 * p[P_HEADER + B_CK_SP * N + i] - s1 * p[P_HEADER + B_SK_SP * N + i]
+        ksp = 1.0 + eps_sp * ck
+        if nh_sp > 0:
+            tm2 = 1.0
+            tm1 = ck
+            for h in range(nh_sp):
+                tt = 2.0 * ck * tm1 - tm2
+                ksp += p[h0 + h] * tt
+                tm2 = tm1
+                tm1 = tt
+        ckr = c1 * p[P_HEADER + B_CK_RP * N + i] - s1 * p[P_HEADER + B_SK_RP * N + i]
+        krp = krm + kra * ckr
+        if nh_rp > 0:
+            tm2 = 1.0
+            tm1 = ckr
+            for h in range(nh_rp):
+                tt = 2.0 * ckr * tm1 - tm2
+                krp += p[h0 + nh_sp + h] * tt
+                tm2 = tm1
+                tm1 = tt
+
+        # --- transmission errors and their τ-derivatives
+        cte = p[P_HEADER + B_CE_SP * N + i]
+        ste = p[P_HEADER + B_SE_SP * N + i]
+        esp = asp * (s1 * cte + c1 * ste)
+        esp_d = asp * om * (c1 * cte - s1 * ste)
+        cte = p[P_HEADER + B_CE_RP * N + i]
+        ste = p[P_HEADER + B_SE_RP * N + i]
+        erp = arp * (s1 * cte + c1 * ste)
+        erp_d = arp * om * (c1 * cte - s1 * ste)
+        if ecc:
+            ca = p[P_HEADER + B_C_ES * N + i]
+            sa = p[P_HEADER + B_S_ES * N + i]
+            esp += es * (ss_ * ca + cs_ * sa)
+            esp_d += es * om_s * (cs_ * ca - ss_ * sa)
+            ca = p[P_HEADER + B_C_EPS * N + i]
+            sa = p[P_HEADER + B_S_EPS * N + i]
+            esp += ep * (sp_ * ca + cp_ * sa)
+            esp_d += ep * om_p * (cp_ * ca - sp_ * sa)
+            ca = p[P_HEADER + B_C_EPR * N + i]
+            sa = p[P_HEADER + B_S_EPR * N + i]
+            erp += ep * (sp_ * ca + cp_ * sa)
+            erp_d += ep * om_p * (cp_ * ca - sp_ * sa)
+            # sin(−Ω_H τ + θ) = sin θ cos(Ω_H τ) − cos θ sin(Ω_H τ)
+            ca = p[P_HEADER + B_C_ER * N + i]
+            sa = p[P_HEADER + B_S_ER * N + i]
+            erp += er * (sa * cr_ - ca * sr_)
+            erp_d += er * om_r * (-sa * sr_ - ca * cr_)
+
+        pi_ = y[2 + i]
+        pid = y[n + 2 + i]
+        dsp = pi_ + s_i - esp
+        dsp_d = pid + sd_i - esp_d
+        drp = sig - pi_ - erp
+        drp_d = sigd - pid - erp_d
+        fsp = ksp * dead_zone(dsp, bsp) + csp * dsp_d
+        frp = krp * dead_zone(drp, brp) + crp * drp_d
+
+        obs[i] = dsp
+        obs[N + i] = drp
+        obs[2 * N + i] = dsp_d
+        obs[3 * N + i] = drp_d
+        obs[4 * N + i] = fsp
+        obs[5 * N + i] = frp
+        sum_fsp += fsp
+        sum_frp += frp
+        sum_fx += fsp * si
+        sum_fy -= fsp * ci
+
+    inv_mus = p[P_INV_MUS]
+    inv_mup = p[P_INV_MUP]
+    inv_muc = p[P_INV_MUC]
+    cas = p[P_COS_AS]
+    car = p[P_COS_AR]
+    qs = (p[P_TD] - sum_fsp) * inv_mus
+    qc = (cas * sum_fsp + car * sum_frp - p[P_TL]) * inv_muc
+
+    kb = p[P_KB]
+    bs = p[P_BS]
+    cb = p[P_CS]
+    inv_ms = p[P_INV_MU_S]
+    for j in range(n):
+        dydt[j] = y[n + j]
+    dydt[n] = (sum_fx - cb * xd - kb * dead_zone(x, bs)) * inv_ms
+    dydt[n + 1] = (sum_fy - cb * yd - kb * dead_zone(yy, bs)) * inv_ms
+    qcp = cas * qc
+    for i in range(N):
+        dydt[n + 2 + i] = qs + (obs[5 * N + i] - obs[4 * N + i]) * inv_mup - qcp
+    dydt[n + N + 2] = qs - (cas + car) * qc
+
+
+@numba.njit(cache=True)
+def backlash_oscillator_rhs(t, y, p, dydt, obs):  # pragma: no cover - compiled
+    """x'' + 2ζx' + (1 + ε cos Ωτ) f(x; b) = F_m + F_a Ω^q cos Ωτ; obs = (x, x', contact force)."""
+    c = math.cos(p[BO_OMEGA] * t)
+    x = y[0]
+    v = y[1]
+    fc = (1.0 + p[BO_EPS] * c) * dead_zone(x, p[BO_B])
+    dydt[0] = v
+    dydt[1] = p[BO_FM] + p[BO_FA] * c - 2.0 * p[BO_ZETA] * v - fc
+    obs[0] = x
+    obs[1] = v
+    obs[2] = fc
+
+
+@numba.njit(cache=True)
+def linear_rhs(t, y, p, dydt, obs):  # pragma: no cover - compiled
+    """y' = A y + f cos Ωτ + g sin Ωτ; obs = (y, y')."""
+    n = int(p[LIN_N])
+    om = p[LIN_OMEGA]
+    c = math.cos(om * t)
+    s = math.sin(om * t)
+    a0 = LIN_HEADER
+    f0 = a0 + n * n
+    g0 = f0 + n
+    for i in range(n):
+        acc = p[f0 + i] * c + p[g0 + i] * s
+        for j in range(n):
+            acc += p[a0 + i * n + j] * y[j]
+        dydt[i] = acc
+        obs[i] = y[i]
+        obs[n + i] = acc
+
+
+@numba.njit(cache=True)
+def duffing_rhs(t, y, p, dydt, obs):  # pragma: no cover - compiled
+    """x'' + δx' + αx + βx³ = γ cos Ωτ; obs = (x, x')."""
+    x = y[0]
+    v = y[1]
+    dydt[0] = v
+    dydt[1] = (
+        p[DU_GAMMA] * math.cos(p[DU_OMEGA] * t)
+        - p[DU_DELTA] * v
+        - p[DU_ALPHA] * x
+        - p[DU_BETA] * x * x * x
+    )
+    obs[0] = x
+    obs[1] = v
+
+
+@numba.njit(cache=True)
+def lorenz_rhs(t, y, p, dydt, obs):  # pragma: no cover - compiled
+    """Lorenz (1963): x' = σ(y − x), y' = x(ρ − z) − y, z' = xy − βz; obs = (x, y, z, x', y', z')."""
+    dydt[0] = p[LZ_SIGMA] * (y[1] - y[0])
+    dydt[1] = y[0] * (p[LZ_RHO] - y[2]) - y[1]
+    dydt[2] = y[0] * y[1] - p[LZ_BETA] * y[2]
+    for i in range(3):
+        obs[i] = y[i]
+        obs[3 + i] = dydt[i]
+
+
+@numba.njit(cache=True)
+def rhs(kind, t, y, p, dydt, obs):  # pragma: no cover - compiled
+    """Dispatch to the right-hand side of system ``kind`` (see :mod:`gearchaos.model.layout`)."""
+    if kind == KIND_PLANETARY:
+        planetary_rhs(t, y, p, dydt, obs)
+    elif kind == KIND_BACKLASH_OSCILLATOR:
+        backlash_oscillator_rhs(t, y, p, dydt, obs)
+    elif kind == KIND_LINEAR:
+        linear_rhs(t, y, p, dydt, obs)
+    elif kind == KIND_DUFFING:
+        duffing_rhs(t, y, p, dydt, obs)
+    elif kind == KIND_LORENZ:
+        lorenz_rhs(t, y, p, dydt, obs)
+
+
+@numba.njit(cache=True)
+def observe_many(kind, t, Y, p, n_obs):  # pragma: no cover - compiled
+    """Observables (and derivatives) at many states: rows of ``Y`` at times ``t``."""
+    m = Y.shape[0]
+    out = np.empty((m, n_obs))
+    d = np.empty(Y.shape[1])
+    ob = np.empty(n_obs)
+    dd = np.empty((m, Y.shape[1]))
+    for k in range(m):
+        rhs(kind, t[k], Y[k], p, d, ob)
+        out[k, :] = ob
+        dd[k, :] = d
+    return out, dd

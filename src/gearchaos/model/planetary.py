@@ -1,0 +1,310 @@
+"""The transverse–torsional 2K-H planetary gear model in minimal relative coordinates.
+
+:func:`nondimensionalise` turns a :class:`~gearchaos.gearset.GearSet` (SI) into frozen
+:class:`PlanetaryParameters` (MODEL.md §7) and :class:`Scales` to convert back;
+:class:`PlanetaryModel` packs them for the compiled right-hand side
+(:func:`gearchaos.model.kernels.planetary_rhs`); :func:`planetary_system` is the usual entry.
+
+Coordinates (MODEL.md §6): q = (x̄_s, ȳ_s, p̄_1..p̄_N, σ̄), state = (q, q'), with
+p_i = u_s + u_i − u_c cos α_s and σ = u_s − u_c (cos α_s + cos α_r); the rigid-body rotation is
+removed, so the zero state is a consistent start.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..gearset import GearSet
+from . import layout as L
+from .system import System
+
+__all__ = [
+    "PlanetaryModel",
+    "PlanetaryParameters",
+    "Scales",
+    "nondimensionalise",
+    "planetary_system",
+]
+
+
+@dataclass(frozen=True)
+class Scales:
+    """Scales that turn dimensionless quantities back into SI.
+
+    x = b_c x̄ [m]; t = τ/ω_n [s]; ẋ = b_c ω_n x̄' [m/s]; F = k_m,sp b_c F̄ [N];
+    ω = ω_n Ω [rad/s].
+    """
+
+    length: float  # b_c [m]
+    omega_n: float  # [rad/s]
+    mass: float  # m_e [kg]
+    stiffness: float  # k_m,sp [N/m]
+
+    @property
+    def time(self) -> float:
+        """1/ω_n [s]."""
+        return 1.0 / self.omega_n
+
+    @property
+    def velocity(self) -> float:
+        """b_c ω_n [m/s]."""
+        return self.length * self.omega_n
+
+    @property
+    def force(self) -> float:
+        """k_m,sp b_c [N]."""
+        return self.stiffness * self.length
+
+
+@dataclass(frozen=True)
+class PlanetaryParameters:
+    """Dimensionless parameters of MODEL.md §7 (symbols in comments).
+
+    Angles in radians. ``load_mode`` is ``constant_torque`` or ``constant_power``; for the
+    latter ``torque_input`` is T̄_D at Ω = ``omega_ref`` and T̄_D(Ω) = T̄_D Ω_ref/Ω.
+    """
+
+    n_planets: int  # N
+    teeth_sun: int  # z_s
+    teeth_planet: int  # z_p
+    teeth_ring: int  # z_r
+    alpha_s: float  # α_s
+    alpha_r: float  # α_r
+    mu_s: float  # μ_s = m_s/m_e (sun translational)
+    mu_s_star: float  # μ_s* = m_s*/m_e
+    mu_p_star: float  # μ_p* = m_p*/m_e
+    mu_c_star: float  # μ_c* = m_c*/m_e
+    damping_sun_planet: float  # c̄_sp = c_sp/(m_e ω_n) = 2ξ_sp
+    damping_planet_ring: float  # c̄_rp
+    damping_sun_bearing: float  # c̄_s
+    kappa_b: float  # κ_b = k_s/k_m,sp
+    eps_sp: float  # ε_sp = k_a,sp/k_m,sp
+    kappa_rp_mean: float  # k_m,rp/k_m,sp
+    kappa_rp_alt: float  # k_a,rp/k_m,sp
+    harmonics_sp: tuple[float, ...]  # k_h,sp/k_m,sp, h = 2, 3, …
+    harmonics_rp: tuple[float, ...]  # k_h,rp/k_m,sp
+    b_sp: float  # b̄_sp
+    b_rp: float  # b̄_rp
+    b_s: float  # b̄_s
+    torque_input: float  # T̄_D = T_D/(r_bs k_m,sp b_c)
+    torque_output: float  # T̄_L = T_L/(r_c k_m,sp b_c)
+    load_mode: str
+    omega_ref: float  # Ω_ref of constant power
+    te_sp: float  # Ā_sp
+    te_rp: float  # Ā_rp
+    te_sp_phase: float  # phase offset of e_sp relative to φ_spi
+    te_rp_phase: float
+    ecc_sun: float  # Ē_s
+    ecc_planet: float  # Ē_p
+    ecc_ring: float  # Ē_r
+    beta_s: float
+    beta_p: float
+    beta_r: float
+    psi: tuple[float, ...]  # ψ_i
+    phi_sp: tuple[float, ...]  # φ_spi
+    phi_rp: tuple[float, ...]  # φ_rpi
+
+    def loads(self, omega: float) -> tuple[float, float]:
+        """(T̄_D, T̄_L) at Ω, with the load mode applied."""
+        if self.load_mode == "constant_power":
+            s = self.omega_ref / omega
+            return self.torque_input * s, self.torque_output * s
+        return self.torque_input, self.torque_output
+
+
+def nondimensionalise(gs: GearSet) -> tuple[PlanetaryParameters, Scales]:
+    """Dimensionless parameters (MODEL.md §7) and scales of a gear set."""
+    st = gs.stiffness
+    me = gs.equivalent_mass_mesh
+    k = st.sun_planet_mean
+    wn = math.sqrt(k / me)
+    bc = gs.clearance.characteristic_length
+    msx, mpx, mcx = gs.equivalent_mass_sun, gs.equivalent_mass_planet, gs.equivalent_mass_carrier
+    b_sp, b_rp = gs.backlash_bar()
+    phi_sp, phi_rp = gs.mesh_phases()
+    te, ec = gs.transmission_error, gs.eccentricity
+    par = PlanetaryParameters(
+        n_planets=gs.n_planets,
+        teeth_sun=gs.teeth.sun,
+        teeth_planet=gs.teeth.planet,
+        teeth_ring=gs.teeth.ring,
+        alpha_s=gs.alpha_s,
+        alpha_r=gs.alpha_r,
+        mu_s=gs.mass.sun / me,
+        mu_s_star=msx / me,
+        mu_p_star=mpx / me,
+        mu_c_star=mcx / me,
+        damping_sun_planet=gs.damping_sun_planet / (me * wn),
+        damping_planet_ring=gs.damping_planet_ring / (me * wn),
+        damping_sun_bearing=gs.damping_sun_bearing / (me * wn),
+        kappa_b=st.sun_bearing / k,
+        eps_sp=st.sun_planet_alternating / k,
+        kappa_rp_mean=st.planet_ring_mean / k,
+        kappa_rp_alt=st.planet_ring_alternating / k,
+        harmonics_sp=tuple(h / k for h in st.sun_planet_harmonics),
+        harmonics_rp=tuple(h / k for h in st.planet_ring_harmonics),
+        b_sp=b_sp,
+        b_rp=b_rp,
+        b_s=gs.sun_bearing_clearance_bar(),
+        torque_input=gs.torque.input / (gs.base_radius_sun * k * bc),
+        torque_output=gs.output_torque / (gs.radius_carrier * k * bc),
+        load_mode=gs.torque.mode,
+        omega_ref=gs.torque.reference_omega,
+        te_sp=te.sun_planet / bc,
+        te_rp=te.planet_ring / bc,
+        te_sp_phase=math.radians(te.sun_planet_phase),
+        te_rp_phase=math.radians(te.planet_ring_phase),
+        ecc_sun=ec.sun / bc,
+        ecc_planet=ec.planet / bc,
+        ecc_ring=ec.ring / bc,
+        beta_s=math.radians(ec.sun_phase),
+        beta_p=math.radians(ec.planet_phase),
+        beta_r=math.radians(ec.ring_phase),
+        psi=gs.planet_angles,
+        phi_sp=phi_sp,
+        phi_rp=phi_rp,
+    )
+    return par, Scales(length=bc, omega_n=wn, mass=me, stiffness=k)
+
+
+def pack_planetary(par: PlanetaryParameters, omega: float) -> np.ndarray:
+    """Packed parameter vector for :func:`~gearchaos.model.kernels.planetary_rhs` at Ω."""
+    N = par.n_planets
+    nh_sp, nh_rp = len(par.harmonics_sp), len(par.harmonics_rp)
+    p = np.zeros(L.P_HEADER + L.N_BLOCKS * N + nh_sp + nh_rp)
+    td, tl = par.loads(omega)
+    p[L.P_N] = N
+    p[L.P_OMEGA] = omega
+    p[L.P_INV_MU_S] = 1.0 / par.mu_s
+    p[L.P_INV_MUS] = 1.0 / par.mu_s_star
+    p[L.P_INV_MUP] = 1.0 / par.mu_p_star
+    p[L.P_INV_MUC] = 1.0 / par.mu_c_star
+    p[L.P_CS] = par.damping_sun_bearing
+    p[L.P_KB] = par.kappa_b
+    p[L.P_BS] = par.b_s
+    p[L.P_CSP] = par.damping_sun_planet
+    p[L.P_CRP] = par.damping_planet_ring
+    p[L.P_BSP] = par.b_sp
+    p[L.P_BRP] = par.b_rp
+    p[L.P_EPS_SP] = par.eps_sp
+    p[L.P_KRP_M] = par.kappa_rp_mean
+    p[L.P_KRP_A] = par.kappa_rp_alt
+    p[L.P_TD] = td
+    p[L.P_TL] = tl
+    p[L.P_COS_AS] = math.cos(par.alpha_s)
+    p[L.P_COS_AR] = math.cos(par.alpha_r)
+    p[L.P_ASP] = par.te_sp
+    p[L.P_ARP] = par.te_rp
+    p[L.P_ES] = par.ecc_sun
+    p[L.P_EP] = par.ecc_planet
+    p[L.P_ER] = par.ecc_ring
+    p[L.P_ZS] = par.teeth_sun
+    p[L.P_ZP] = par.teeth_planet
+    p[L.P_ZR] = par.teeth_ring
+    p[L.P_ECC] = 1.0 if (par.ecc_sun or par.ecc_planet or par.ecc_ring) else 0.0
+    p[L.P_NH_SP] = nh_sp
+    p[L.P_NH_RP] = nh_rp
+
+    psi = np.asarray(par.psi)
+    phs = np.asarray(par.phi_sp)
+    phr = np.asarray(par.phi_rp)
+    a_s, a_r = par.alpha_s, par.alpha_r
+    blocks = {
+        L.B_S: np.sin(psi - a_s),
+        L.B_C: np.cos(psi - a_s),
+        L.B_CK_SP: np.cos(phs),
+        L.B_SK_SP: np.sin(phs),
+        L.B_CK_RP: np.cos(phr),
+        L.B_SK_RP: np.sin(phr),
+        L.B_CE_SP: np.cos(phs + par.te_sp_phase),
+        L.B_SE_SP: np.sin(phs + par.te_sp_phase),
+        L.B_CE_RP: np.cos(phr + par.te_rp_phase),
+        L.B_SE_RP: np.sin(phr + par.te_rp_phase),
+        L.B_C_ES: np.cos(par.beta_s - psi + a_s),
+        L.B_S_ES: np.sin(par.beta_s - psi + a_s),
+        L.B_C_EPS: np.full(N, math.cos(par.beta_p + a_s)),
+        L.B_S_EPS: np.full(N, math.sin(par.beta_p + a_s)),
+        L.B_C_EPR: np.full(N, math.cos(par.beta_p - a_r)),
+        L.B_S_EPR: np.full(N, math.sin(par.beta_p - a_r)),
+        L.B_C_ER: np.cos(par.beta_r - psi - a_r),
+        L.B_S_ER: np.sin(par.beta_r - psi - a_r),
+    }
+    for b, values in blocks.items():
+        p[L.P_HEADER + b * N : L.P_HEADER + (b + 1) * N] = values
+    h0 = L.P_HEADER + L.N_BLOCKS * N
+    p[h0 : h0 + nh_sp] = par.harmonics_sp
+    p[h0 + nh_sp : h0 + nh_sp + nh_rp] = par.harmonics_rp
+    return p
+
+
+@dataclass(frozen=True)
+class PlanetaryModel:
+    """The planetary gear model: dimensionless parameters, scales and the source gear set."""
+
+    parameters: PlanetaryParameters
+    scales: Scales
+    gearset: GearSet | None = None
+    kind: int = L.KIND_PLANETARY
+    name: str = "planetary"
+
+    @classmethod
+    def from_gearset(cls, gs: GearSet) -> PlanetaryModel:
+        par, sc = nondimensionalise(gs)
+        return cls(par, sc, gs, name=f"planetary[{gs.name}]")
+
+    @property
+    def n_planets(self) -> int:
+        return self.parameters.n_planets
+
+    @property
+    def n_dof(self) -> int:
+        """N + 3 elastic coordinates."""
+        return self.parameters.n_planets + 3
+
+    @property
+    def n_state(self) -> int:
+        return 2 * self.n_dof
+
+    @property
+    def state_names(self) -> tuple[str, ...]:
+        N = self.n_planets
+        q = ("x_s", "y_s", *(f"p_{i + 1}" for i in range(N)), "sigma")
+        return q + tuple(f"{s}_dot" for s in q)
+
+    @property
+    def obs_names(self) -> tuple[str, ...]:
+        N = range(1, self.n_planets + 1)
+        return (
+            *(f"delta_sp_{i}" for i in N),
+            *(f"delta_rp_{i}" for i in N),
+            *(f"delta_sp_dot_{i}" for i in N),
+            *(f"delta_rp_dot_{i}" for i in N),
+            *(f"force_sp_{i}" for i in N),
+            *(f"force_rp_{i}" for i in N),
+        )
+
+    @property
+    def n_track(self) -> int:
+        """Extrema are tracked for the 2N mesh deflections."""
+        return 2 * self.n_planets
+
+    @property
+    def clearances(self) -> dict[str, float]:
+        """Half clearances of each contact, dimensionless."""
+        par = self.parameters
+        return {"sun_planet": par.b_sp, "planet_ring": par.b_rp, "sun_bearing": par.b_s}
+
+    def pack(self, omega: float) -> np.ndarray:
+        return pack_planetary(self.parameters, omega)
+
+    def with_parameters(self, **changes: object) -> PlanetaryModel:
+        """A copy with some dimensionless parameters changed (the gear set is dropped)."""
+        return PlanetaryModel(replace(self.parameters, **changes), self.scales, None, name=self.name)
+
+
+def planetary_system(gs: GearSet, omega: float) -> System:
+    """The planetary model of ``gs`` at dimensionless mesh frequency Ω = ω/ω_n."""
+    return System(PlanetaryModel.from_gearset(gs), omega)
