@@ -1,6 +1,6 @@
 """Physical layer: frozen gear-set records, TOML I/O, validation and presets."""
 
-from .io import from_toml, from_toml_string, to_toml, template_toml
+from .io import from_toml, from_toml_string, template_toml, to_toml
 from .presets import list_presets, preset
 from .records import (
     UNITS,

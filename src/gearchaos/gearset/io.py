@@ -457,6 +457,8 @@ def _toml_value(kind: str, value: object) -> str:
 
 
 def _unit_comment(dotted: str) -> str:
+    if dotted in _META:
+        return ""
     if dotted in CHOICES:
         return "one of " + ", ".join(CHOICES[dotted])
     return f"[{UNITS[dotted]}]"
@@ -475,8 +477,10 @@ def _write(
     table_header: Callable[[str], Iterable[str]] = lambda table: (),
 ) -> str:
     lines = [*header]
-    lines.append(f"name = {_toml_string(gs.name)}")
-    lines.append(f"description = {_toml_string(gs.description)}")
+    for key in _META:
+        text = f"{key} = {_toml_string(getattr(gs, key))}"
+        note = comment(key)
+        lines.append(f"{text}  # {note}" if note else text)
     for table, cls in RECORD_CLASSES.items():
         record = getattr(gs, table)
         entries = []
@@ -611,6 +615,10 @@ _TABLE_DOC: Final[dict[str, str]] = {
 
 
 def _template_comment(dotted: str) -> str:
+    if dotted == "name":
+        return "short identifier of the gear set"
+    if dotted == "description":
+        return "one line describing it"
     symbol, meaning = _DOC[dotted]
     if dotted in CHOICES:
         return f"one of {', '.join(CHOICES[dotted])} — {meaning}"
@@ -645,14 +653,10 @@ def template_toml() -> str:
         "# Tables transmission_error, eccentricity and mesh_phasing, and keys with defaults",
         "# (pressure angles, harmonics, torque.mode, units, ...), may be left out.",
         "",
-        "# short identifier of the gear set",
     ]
-    text = _write(
+    return _write(
         gs,
         _template_comment,
         header,
         table_header=lambda table: [f"# {_TABLE_DOC[table]}"],
-    )
-    return text.replace(
-        "\ndescription = ", "\n# one line describing the gear set\ndescription = ", 1
     )

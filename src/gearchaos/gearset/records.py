@@ -18,6 +18,7 @@ E eccentricities; b half clearances.
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass, field
 
 __all__ = [
@@ -49,7 +50,7 @@ class Teeth:
 
 @dataclass(frozen=True)
 class Geometry:
-    """Number of planets N, module m [m] and pressure angles α_s (sun–planet), α_r (ring–planet) [deg]."""
+    """Planets N, module m [m], pressure angles α_s (sun–planet), α_r (ring–planet) [deg]."""
 
     planets: int
     module: float
@@ -59,7 +60,8 @@ class Geometry:
 
 @dataclass(frozen=True)
 class Mass:
-    """Translational masses [kg]: the sun's m_s (moves in x, y) and each planet's m_p (rides on the carrier)."""
+    """Translational masses [kg]: the sun's m_s (moves in x, y) and each planet's m_p
+    (rides on the carrier)."""
 
     sun: float
     planet: float
@@ -289,21 +291,26 @@ class GearSet:
     @property
     def damping_sun_planet(self) -> float:
         """c_sp = 2 ξ_sp √(k_m,sp m_e) [N s/m]."""
-        return 2.0 * self.damping.sun_planet * math.sqrt(
-            self.stiffness.sun_planet_mean * self.equivalent_mass_mesh
+        return (
+            2.0
+            * self.damping.sun_planet
+            * math.sqrt(self.stiffness.sun_planet_mean * self.equivalent_mass_mesh)
         )
 
     @property
     def damping_planet_ring(self) -> float:
         """c_rp = 2 ξ_rp √(k_m,rp m_p*) [N s/m] (fixed ring)."""
-        return 2.0 * self.damping.planet_ring * math.sqrt(
-            self.stiffness.planet_ring_mean * self.equivalent_mass_planet
+        return (
+            2.0
+            * self.damping.planet_ring
+            * math.sqrt(self.stiffness.planet_ring_mean * self.equivalent_mass_planet)
         )
 
     @property
     def damping_sun_bearing(self) -> float:
         """c_s = 2 ξ_s √(k_s m_s) [N s/m]."""
-        return 2.0 * self.damping.sun_bearing * math.sqrt(self.stiffness.sun_bearing * self.mass.sun)
+        k_s, m_s = self.stiffness.sun_bearing, self.mass.sun
+        return 2.0 * self.damping.sun_bearing * math.sqrt(k_s * m_s)
 
     @property
     def output_torque(self) -> float:
@@ -372,6 +379,7 @@ class GearSet:
 
     @property
     def has_eccentricity(self) -> bool:
+        """Whether any eccentricity E_s, E_p, E_r is non-zero (forcing no longer 1T-periodic)."""
         e = self.eccentricity
         return any(v != 0.0 for v in (e.sun, e.planet, e.ring))
 
@@ -390,7 +398,7 @@ class GearSet:
         return evolve(self, merged)
 
     @classmethod
-    def from_toml(cls, path: object) -> GearSet:
+    def from_toml(cls, path: str | os.PathLike[str]) -> GearSet:
         """Read a gear set from a TOML file (see ``gearchaos init-gearset`` for a template)."""
         from .io import from_toml
 
