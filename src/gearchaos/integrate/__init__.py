@@ -1,5 +1,6 @@
 """Compiled Dormand–Prince 5(4) integration of any :class:`~gearchaos.model.System`."""
 
+from .batch import BatchResult, integrate_batch
 from .dopri import dopri_batch, dopri_run
 from .result import SimulationResult, open_simulation
 from .simulate import integrate, simulate
@@ -7,6 +8,7 @@ from .tableau import DOPRI5, ButcherTableau
 from .trajectory import Trajectory
 
 __all__ = [
+    "BatchResult",
     "DOPRI5",
     "ButcherTableau",
     "SimulationResult",
@@ -14,6 +16,7 @@ __all__ = [
     "dopri_batch",
     "dopri_run",
     "integrate",
+    "integrate_batch",
     "open_simulation",
     "simulate",
 ]

@@ -69,6 +69,7 @@ def _scaled_norm(v, y, ynew, rtol, atol):  # pragma: no cover - compiled
 @numba.njit(cache=True)
 def initial_step(kind, t, y, f0, p, rtol, atol, obs):  # pragma: no cover - compiled
     """Hairer's starting step (HNW I, §II.4) for the 5(4) pair."""
+    numba.literally(kind)
     n = y.size
     d0 = 0.0
     d1 = 0.0
@@ -166,6 +167,7 @@ def dopri_run(
     [t_rec, t_end]. ``info`` (float64, length 4) receives accepted steps, rejected steps, the
     final time reached and the next step size (to continue seamlessly).
     """
+    numba.literally(kind)
     n = y0.size
     y = y0.copy()
     ynew = np.empty(n)
@@ -348,6 +350,7 @@ def dopri_batch(
     ``t0``, ``t_rec``, ``dt_sample`` and ``t_end`` are per-point arrays (the forcing period
     differs between points); every output array has the point index first.
     """
+    numba.literally(kind)
     m = P.shape[0]
     for i in numba.prange(m):
         status[i] = dopri_run(

@@ -16,6 +16,7 @@ import numpy as np
 
 from ..errors import IntegrationError, ParameterError, Status
 from ..model.system import System
+from .._numba import call_literal
 from .dopri import dopri_run
 from .result import SimulationResult
 from .trajectory import Trajectory
@@ -110,7 +111,8 @@ def integrate(
     omax = np.zeros(system.n_track)
     yf = np.zeros(n)
     info = np.zeros(4)
-    code = dopri_run(
+    code = call_literal(
+        dopri_run,
         system.kind,
         y,
         system.params,

@@ -17,6 +17,8 @@ import math
 
 import numba
 import numpy as np
+from numba import types
+from numba.extending import overload
 
 from .layout import (
     B_C,
@@ -100,11 +102,7 @@ __all__ = ["dead_zone", "observe_many", "rhs"]
 @numba.njit(cache=True, inline="always")
 def dead_zone(x: float, b: float) -> float:
     """f(x; b) = x − b (x > b), 0 (|x| ≤ b), x + b (x < −b): contact law with half clearance b."""
-    if x > b:
-        return x - b
-    if x < -b:
-        return x + b
-    return 0.0
+    return x - min(max(x, -b), b)  # branch-free: the contact state is unpredictable
 
 
 @numba.njit(cache=True)
@@ -326,24 +324,47 @@ def lorenz_rhs(t, y, p, dydt, obs):  # pragma: no cover - compiled
         obs[3 + i] = dydt[i]
 
 
-@numba.njit(cache=True)
-def rhs(kind, t, y, p, dydt, obs):  # pragma: no cover - compiled
-    """Dispatch to the right-hand side of system ``kind`` (see :mod:`gearchaos.model.layout`)."""
-    if kind == KIND_PLANETARY:
-        planetary_rhs(t, y, p, dydt, obs)
-    elif kind == KIND_BACKLASH_OSCILLATOR:
-        backlash_oscillator_rhs(t, y, p, dydt, obs)
-    elif kind == KIND_LINEAR:
-        linear_rhs(t, y, p, dydt, obs)
-    elif kind == KIND_DUFFING:
-        duffing_rhs(t, y, p, dydt, obs)
-    elif kind == KIND_LORENZ:
-        lorenz_rhs(t, y, p, dydt, obs)
+_KERNELS = {
+    KIND_PLANETARY: planetary_rhs,
+    KIND_BACKLASH_OSCILLATOR: backlash_oscillator_rhs,
+    KIND_LINEAR: linear_rhs,
+    KIND_DUFFING: duffing_rhs,
+    KIND_LORENZ: lorenz_rhs,
+}
+
+
+def rhs(kind, t, y, p, dydt, obs):
+    """Right-hand side of system ``kind`` (see :mod:`gearchaos.model.layout`).
+
+    Inside compiled code ``kind`` must be a compile-time literal (callers use
+    ``numba.literally(kind)``): each kind then gets its own specialised, on-disk-cached machine
+    code with a direct call and no run-time dispatch. From Python it simply dispatches.
+    """
+    _KERNELS[int(kind)](t, y, p, dydt, obs)
+
+
+@overload(rhs, inline="always")
+def _rhs_overload(kind, t, y, p, dydt, obs):  # pragma: no cover - compiled
+    if not isinstance(kind, types.IntegerLiteral):
+        raise numba.errors.TypingError(
+            "gearchaos.model.kernels.rhs: 'kind' must be a compile-time literal; "
+            "call numba.literally(kind) in the calling kernel"
+        )
+    k = kind.literal_value
+    if k not in _KERNELS:
+        raise numba.errors.TypingError(f"unknown system kind {k}")
+    fn = _KERNELS[k]
+
+    def impl(kind, t, y, p, dydt, obs):
+        fn(t, y, p, dydt, obs)
+
+    return impl
 
 
 @numba.njit(cache=True)
 def observe_many(kind, t, Y, p, n_obs):  # pragma: no cover - compiled
     """Observables (and derivatives) at many states: rows of ``Y`` at times ``t``."""
+    numba.literally(kind)
     m = Y.shape[0]
     out = np.empty((m, n_obs))
     d = np.empty(Y.shape[1])

@@ -114,19 +114,23 @@ class System:
 
     def observe(self, tau: np.ndarray, states: np.ndarray) -> np.ndarray:
         """Observables (``obs_names``) at the given times and states, shape (m, n_obs)."""
+        from .._numba import call_literal
         from .kernels import observe_many
 
         tau = np.ascontiguousarray(tau, dtype=np.float64).reshape(-1)
         states = np.ascontiguousarray(states, dtype=np.float64).reshape(tau.size, self.n_state)
-        obs, _ = observe_many(self.kind, tau, states, self.params, self.n_obs)
+        obs, _ = call_literal(observe_many, self.kind, tau, states, self.params, self.n_obs)
         return np.asarray(obs)
 
     def derivative(self, tau: float, state: np.ndarray) -> np.ndarray:
         """The right-hand side f(τ, y) evaluated once (for tests and users)."""
+        from .._numba import call_literal
         from .kernels import observe_many
 
         y = np.ascontiguousarray(state, dtype=np.float64).reshape(1, self.n_state)
-        _, d = observe_many(self.kind, np.array([float(tau)]), y, self.params, self.n_obs)
+        _, d = call_literal(
+            observe_many, self.kind, np.array([float(tau)]), y, self.params, self.n_obs
+        )
         return np.asarray(d[0])
 
     def __repr__(self) -> str:
