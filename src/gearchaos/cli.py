@@ -1,0 +1,685 @@
+"""Command-line interface: ``gearchaos simulate | info | presets | init-gearset``.
+
+Every command takes the gear set the same way: ``--preset NAME`` (default ``sheng2016``) or
+``--gearset FILE.toml`` (one of the two), then any number of ``--set NAME=VALUE`` changes by
+the dotted parameter names of :func:`gearchaos.gearset.io.field_names` (``backlash.sun_planet``,
+``teeth.sun``, the alias ``xi`` for the three damping ratios). ``omega`` (the dimensionless mesh
+frequency Ω = ω/ω_n) is a simulation setting, not a gear-set field, but is given with
+``--set omega=1.5`` as well, so that a command line reads like a point of a sweep.
+
+Exit codes: 0 success; 2 invalid input (unknown or invalid parameter, conflicting options,
+missing gear-set file) — the message names the parameter, the rule and the value and suggests
+the closest valid name; 1 the integration failed or a file could not be written. Errors are
+reported on stderr as one line, never as a traceback.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import difflib
+import json
+import math
+import sys
+import warnings
+from collections.abc import Iterator, Mapping, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated, Any, NoReturn
+
+import numpy as np
+import typer
+from rich.columns import Columns
+from rich.console import Console
+from rich.markup import escape
+from rich.table import Table
+from rich.text import Text
+
+from . import __version__
+from .errors import IntegrationError, ParameterError
+
+if TYPE_CHECKING:
+    from .gearset import GearSet
+
+__all__ = ["DEFAULT_OMEGA", "DEFAULT_PRESET", "app", "parse_sets"]
+
+#: Ω used by ``gearchaos simulate`` when no ``--set omega=...`` is given.
+DEFAULT_OMEGA = 1.5
+#: Gear set used when neither ``--preset`` nor ``--gearset`` is given.
+DEFAULT_PRESET = "sheng2016"
+
+EXIT_FAILURE = 1
+EXIT_INVALID = 2
+
+app = typer.Typer(
+    name="gearchaos",
+    help=(
+        "Nonlinear dynamics of planetary gear trains with backlash and bearing clearance: "
+        "simulate a gear set at a mesh frequency, inspect its linear properties, manage "
+        "gear-set files. Parameters are addressed by dotted names (backlash.sun_planet, "
+        "teeth.sun, xi, ...), the same as in Python and in result files."
+    ),
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+    rich_markup_mode="markdown",
+    context_settings={"help_option_names": ["-h", "--help"]},
+)
+
+
+# --------------------------------------------------------------------------- consoles, errors
+def _stdout() -> Console:
+    return Console(highlight=False)
+
+
+def _stderr() -> Console:
+    return Console(stderr=True, highlight=False)
+
+
+def _fail(message: str, code: int) -> NoReturn:
+    _stderr().print(Text("error: ", style="bold red") + Text(message), soft_wrap=True)
+    raise typer.Exit(code)
+
+
+@contextlib.contextmanager
+def _reported_errors() -> Iterator[None]:
+    """Turn the package's exceptions into one line on stderr and an exit code."""
+    try:
+        yield
+    except ParameterError as exc:
+        _fail(str(exc), EXIT_INVALID)
+    except FileNotFoundError as exc:
+        _fail(str(exc), EXIT_INVALID)
+    except IntegrationError as exc:
+        _fail(str(exc), EXIT_FAILURE)
+    except OSError as exc:
+        where = f": '{exc.filename}'" if getattr(exc, "filename", None) else ""
+        _fail(f"{exc.strerror or exc}{where}", EXIT_FAILURE)
+
+
+def _jsonable(obj: Any) -> Any:
+    """A JSON-ready copy: numpy scalars and arrays to Python, non-finite floats to null."""
+    if isinstance(obj, Mapping):
+        return {str(k): _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, np.ndarray):
+        return _jsonable(obj.tolist())
+    if isinstance(obj, (list, tuple)):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, np.generic):
+        return _jsonable(obj.item())
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    if isinstance(obj, Path):
+        return str(obj)
+    return obj
+
+
+def _print_json(obj: Any) -> None:
+    typer.echo(json.dumps(_jsonable(obj), indent=2, ensure_ascii=False, allow_nan=False))
+
+
+# --------------------------------------------------------------------------- --set parsing
+def _parse_float(name: str, raw: str) -> float:
+    try:
+        return float(raw)
+    except ValueError:
+        raise ParameterError(f"{name} must be a number: got {raw!r}") from None
+
+
+def _parse_int(name: str, raw: str) -> int:
+    try:
+        return int(raw)
+    except ValueError:
+        pass
+    try:
+        value = float(raw)
+    except ValueError:
+        value = math.nan
+    if value.is_integer():
+        return int(value)
+    raise ParameterError(f"{name} must be an integer: got {raw!r}")
+
+
+def _parse_floats(name: str, raw: str) -> tuple[float, ...]:
+    text = raw.strip()
+    if text.startswith("[") and text.endswith("]"):
+        text = text[1:-1]
+    items = [item.strip() for item in text.split(",") if item.strip()]
+    return tuple(_parse_float(f"{name}[{i}]", item) for i, item in enumerate(items))
+
+
+def _unquote(raw: str) -> str:
+    if len(raw) >= 2 and raw[0] == raw[-1] and raw[0] in "'\"":
+        return raw[1:-1]
+    return raw
+
+
+def _parse_value(key: str, raw: str) -> object:
+    """Convert the text of ``--set key=raw`` to the Python type of the field ``key``."""
+    from .gearset.io import ALIASES
+    from .gearset.validation import FIELD_KINDS, RECORD_CLASSES
+
+    kind = FIELD_KINDS.get(key)
+    if key in ALIASES:
+        kind = "float"
+    elif key in ("name", "description"):
+        kind = "str"
+    if kind == "int":
+        return _parse_int(key, raw)
+    if kind == "float":
+        return _parse_float(key, raw)
+    if kind == "floats":
+        return _parse_floats(key, raw)
+    if kind == "str":
+        return _unquote(raw)
+    if key in RECORD_CLASSES:
+        names = [n for n in FIELD_KINDS if n.startswith(key + ".")]
+        raise ParameterError(
+            f"{key} is a table, not a parameter; set one of its fields: {', '.join(names)}"
+        )
+    close = difflib.get_close_matches(key.lower(), [*FIELD_KINDS, *ALIASES, "omega"], n=1)
+    if close == ["omega"]:
+        raise ParameterError(f"unknown parameter {key!r}; did you mean 'omega'?")
+    return raw  # GearSet.evolve reports the unknown name with its own suggestion
+
+
+def parse_sets(items: Sequence[str]) -> tuple[float | None, dict[str, object]]:
+    """Split ``--set NAME=VALUE`` options into Ω and gear-set changes.
+
+    Parameters
+    ----------
+    items : sequence of str
+        The option values, e.g. ``["omega=1.5", "xi=0.05", "backlash.sun_planet=3"]``.
+        Values are parsed by the kind of the field: integers for tooth and planet numbers,
+        numbers for physical values, comma-separated numbers (optionally in brackets) for the
+        stiffness harmonics, text for ``torque.mode``, ``*.units``, ``mesh_phasing.model``,
+        ``name`` and ``description``. A name given twice keeps its last value.
+
+    Returns
+    -------
+    omega : float or None
+        The value of ``omega`` if given.
+    changes : dict
+        The other names and their parsed values, for :meth:`GearSet.evolve`, which rejects
+        unknown names with a suggestion.
+
+    Raises
+    ------
+    ParameterError
+        For an item without ``=``, a value that does not parse as its field's kind, or
+        ``omega`` not a finite number > 0.
+    """
+    omega: float | None = None
+    changes: dict[str, object] = {}
+    for item in items:
+        key, sep, raw = item.partition("=")
+        key, raw = key.strip(), raw.strip()
+        if not sep or not key:
+            raise ParameterError(f"--set expects NAME=VALUE (e.g. omega=1.5): got {item!r}")
+        if key == "omega":
+            omega = _parse_float("omega", raw)
+            if not (math.isfinite(omega) and omega > 0):
+                raise ParameterError(f"omega must be a finite number > 0: got {raw!r}")
+        else:
+            changes[key] = _parse_value(key, raw)
+    return omega, changes
+
+
+def _gearset(
+    preset: str | None, gearset_file: Path | None, changes: Mapping[str, object]
+) -> GearSet:
+    from .gearset import GearSet
+    from .gearset import preset as load_preset
+
+    if preset is not None and gearset_file is not None:
+        raise ParameterError(
+            f"--preset and --gearset are mutually exclusive: got --preset {preset} and "
+            f"--gearset {gearset_file}; give one (default: --preset {DEFAULT_PRESET})"
+        )
+    if gearset_file is not None:
+        gs = GearSet.from_toml(gearset_file)
+    else:
+        gs = load_preset(preset if preset is not None else DEFAULT_PRESET)
+    return gs.evolve(dict(changes)) if changes else gs
+
+
+# --------------------------------------------------------------------------- shared options
+PresetOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--preset",
+        "-p",
+        help=f"Built-in gear set (see `gearchaos presets`). Default: {DEFAULT_PRESET}.",
+        show_default=False,
+    ),
+]
+GearsetOpt = Annotated[
+    Path | None,
+    typer.Option(
+        "--gearset",
+        "-g",
+        help="Gear-set TOML file (start from `gearchaos init-gearset`). Excludes --preset.",
+        dir_okay=False,
+        show_default=False,
+    ),
+]
+SetOpt = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--set",
+        "-s",
+        help=(
+            "NAME=VALUE, repeatable: omega=1.5 (the dimensionless mesh frequency Ω), "
+            "xi=0.05 (all damping ratios), or any dotted gear-set parameter such as "
+            "backlash.sun_planet=3, clearance.sun_bearing=2, torque.input=1500."
+        ),
+        show_default=False,
+    ),
+]
+JsonOpt = Annotated[
+    bool, typer.Option("--json", help="Print the result as JSON on stdout, and nothing else.")
+]
+
+
+def _version_callback(value: bool) -> None:
+    if value:
+        typer.echo(f"gearchaos {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def main(
+    version: Annotated[
+        bool,
+        typer.Option(
+            "--version",
+            "-V",
+            callback=_version_callback,
+            is_eager=True,
+            help="Print the version and exit.",
+        ),
+    ] = False,
+) -> None:
+    """gearchaos: nonlinear dynamics of planetary gear trains with clearances."""
+
+
+# --------------------------------------------------------------------------- simulate
+@app.command()
+def simulate(
+    preset: PresetOpt = None,
+    gearset: GearsetOpt = None,
+    set_: SetOpt = None,
+    transient: Annotated[
+        float, typer.Option("--transient", help="Mesh periods discarded before recording.")
+    ] = 100.0,
+    periods: Annotated[
+        int, typer.Option("--periods", help="Mesh periods recorded (one Poincaré point each).")
+    ] = 200,
+    samples_per_period: Annotated[
+        int,
+        typer.Option(
+            "--samples-per-period",
+            help="Samples per mesh period of the time history (figure, spectra).",
+        ),
+    ] = 64,
+    rtol: Annotated[
+        float, typer.Option("--rtol", help="Relative tolerance (Dormand–Prince 5(4)).")
+    ] = 1e-8,
+    atol: Annotated[float, typer.Option("--atol", help="Absolute tolerance.")] = 1e-10,
+    output: Annotated[
+        Path | None,
+        typer.Option(
+            "--output",
+            "-o",
+            help=(
+                "Directory for simulation.nc (netCDF, all samples and the gear set) and "
+                "simulation.png (summary figure); created if missing. "
+                "Without -o nothing is written."
+            ),
+            file_okay=False,
+            show_default=False,
+        ),
+    ] = None,
+    json_out: JsonOpt = False,
+    plot: Annotated[
+        bool, typer.Option("--plot/--no-plot", help="Write the summary figure (with -o).")
+    ] = True,
+) -> None:
+    """Simulate a gear set at one mesh frequency and summarise the steady response.
+
+    Runs the seed paper's protocol (MODEL.md §8): zero initial state, adaptive Dormand–Prince
+    5(4), TRANSIENT mesh periods discarded, then PERIODS recorded with a Poincaré point
+    X̄_sp1 = δ_sp1/b_c at each τ_k = 2πk/Ω. Ω is set with **--set omega=...**
+    (default **1.5**). Prints the motion (nT for n distinct section points, or many), the
+    section range of X̄_sp1 and the contact regime of every mesh.
+
+    Example: **gearchaos simulate --preset sheng2016 --set omega=1.5 --set xi=0.05 -o out/**
+    """
+    with _reported_errors():
+        omega, changes = parse_sets(set_ or [])
+        gs = _gearset(preset, gearset, changes)
+        omega = DEFAULT_OMEGA if omega is None else omega
+        if output is not None:
+            output.mkdir(parents=True, exist_ok=True)
+        result, caught = _run_simulation(
+            gs,
+            omega,
+            quiet=json_out,
+            transient_periods=transient,
+            periods=periods,
+            samples_per_period=samples_per_period,
+            rtol=rtol,
+            atol=atol,
+        )
+        for w in caught:
+            _stderr().print(
+                Text("warning: ", style="bold yellow") + Text(str(w.message)), soft_wrap=True
+            )
+
+        from .analysis.summary import summarize
+
+        summary = summarize(result)
+        written: list[Path] = []
+        if output is not None:
+            nc = output / "simulation.nc"
+            result.save(nc)
+            written.append(nc)
+            if plot:
+                written.append(_save_figure(result, output / "simulation.png"))
+
+    if json_out:
+        _print_json(summary)
+        for path in written:
+            _stderr().print(f"wrote {path}")
+        return
+    from .analysis.summary import format_summary
+
+    out = _stdout()
+    out.print(format_summary(summary, title=f"gearchaos simulation of {gs.name} at Ω = {omega:g}"))
+    out.print(
+        Text(
+            f"{transient:g} transient + {periods} recorded mesh periods, "
+            f"rtol {rtol:g}, atol {atol:g}",
+            style="dim",
+        )
+    )
+    for path in written:
+        out.print(Text.assemble(("wrote ", "dim"), (str(path), "bold")))
+
+
+def _run_simulation(
+    gs: GearSet, omega: float, *, quiet: bool, **settings: Any
+) -> tuple[Any, list[warnings.WarningMessage]]:
+    """``gearchaos.simulate`` under a spinner on stderr, collecting warnings."""
+    from .integrate import simulate as run
+
+    err = _stderr()
+    spinner: contextlib.AbstractContextManager[Any] = contextlib.nullcontext()
+    if not quiet and err.is_terminal:
+        total = settings["transient_periods"] + settings["periods"]
+        spinner = err.status(f"integrating {gs.name} at Ω = {omega:g}, {total:g} mesh periods…")
+    with spinner, warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = run(gs, omega=omega, **settings)
+    return result, list(caught)
+
+
+def _save_figure(result: Any, path: Path) -> Path:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from .plot import savefig, summary_figure
+
+    fig = summary_figure(result)
+    try:
+        savefig(fig, path)
+    finally:
+        plt.close(fig)
+    return path
+
+
+# --------------------------------------------------------------------------- info
+@app.command()
+def info(
+    preset: PresetOpt = None,
+    gearset: GearsetOpt = None,
+    set_: SetOpt = None,
+    json_out: JsonOpt = False,
+) -> None:
+    """Linear properties of a gear set: radii, equivalent masses, ω_n, damping coefficients,
+    dimensionless groups, mesh phasing and natural frequencies with their mode classes.
+
+    With **--set omega=...** the operating point (mesh frequency, sun speed) is added.
+    """
+    with _reported_errors():
+        omega, changes = parse_sets(set_ or [])
+        gs = _gearset(preset, gearset, changes)
+        from .analysis.derived import gearset_info
+
+        data = dict(gearset_info(gs))
+        if omega is not None:
+            data["operating_point"] = {
+                "omega": omega,
+                "mesh_frequency_rad_s": omega * gs.omega_n,
+                "mesh_frequency_hz": omega * gs.omega_n / (2.0 * math.pi),
+                "sun_speed_rpm": gs.sun_speed_rpm(omega),
+            }
+    if json_out:
+        _print_json(data)
+        return
+    out = _stdout()
+    out.print(Text.assemble(("gear set ", "dim"), (gs.name, "bold")))
+    if gs.description:
+        out.print(Text(gs.description, style="dim"))
+    out.print()
+    for renderable in _info_renderables(data):
+        out.print(renderable)
+
+
+# Labels of the gearset_info() entries (symbols of MODEL.md); unknown keys get a label
+# made from the key, so new entries show up without a change here.
+_LABELS: dict[str, str] = {
+    "planets": "planets N",
+    "teeth.sun": "sun teeth z_s",
+    "teeth.planet": "planet teeth z_p",
+    "teeth.ring": "ring teeth z_r",
+    "omega_n_rad_s": "ω_n = √(k_m,sp/m_e) [rad/s]",
+    "omega_n_hz": "ω_n/2π [Hz]",
+    "output_torque_N_m": "output torque T_L [N m]",
+    "torque_ratio": "torque ratio T_L/T_D",
+    "load_mode": "load mode",
+    "reference_omega": "Ω_ref (constant power)",
+    "static_mesh_force_N": "static mesh force T_D/(N r_bs) [N]",
+    "mesh_phasing.model": "mesh phasing model",
+    "mesh_phasing.class": "phasing class",
+    "mesh_phasing.k": "k = z_r mod N",
+    "radii_m.sun": "r_s sun pitch",
+    "radii_m.planet": "r_p planet pitch",
+    "radii_m.ring": "r_r ring pitch",
+    "radii_m.carrier": "r_c = r_s + r_p",
+    "radii_m.base_sun": "r_bs = r_s cos α_s",
+    "radii_m.base_planet": "r_bp = r_p cos α_s",
+    "equivalent_masses_kg.sun": "m_s* = J_s/r_bs²",
+    "equivalent_masses_kg.planet": "m_p* = J_p/r_bp²",
+    "equivalent_masses_kg.carrier": "m_c* = J_c/r_c² + N m_p",
+    "equivalent_masses_kg.mesh": "m_e = m_s* m_p*/(m_s* + m_p*)",
+    "damping_coefficients_N_s_per_m.sun_planet": "c_sp = 2ξ_sp √(k_m,sp m_e)",
+    "damping_coefficients_N_s_per_m.planet_ring": "c_rp = 2ξ_rp √(k_m,rp m_p*)",
+    "damping_coefficients_N_s_per_m.sun_bearing": "c_s = 2ξ_s √(k_s m_s)",
+    "dimensionless.mu_s": "μ_s = m_s/m_e",
+    "dimensionless.mu_s_star": "μ_s* = m_s*/m_e",
+    "dimensionless.mu_p_star": "μ_p* = m_p*/m_e",
+    "dimensionless.mu_c_star": "μ_c* = m_c*/m_e",
+    "dimensionless.eps_sp": "ε_sp = k_a,sp/k_m,sp",
+    "dimensionless.kappa_rp_mean": "κ_rp mean = k_m,rp/k_m,sp",
+    "dimensionless.kappa_rp_alt": "κ_rp alternating = k_a,rp/k_m,sp",
+    "dimensionless.kappa_b": "κ_b = k_s/k_m,sp",
+    "dimensionless.damping_sun_planet": "c̄_sp = c_sp/(m_e ω_n)",
+    "dimensionless.damping_planet_ring": "c̄_rp = c_rp/(m_e ω_n)",
+    "dimensionless.damping_sun_bearing": "c̄_s = c_s/(m_e ω_n)",
+    "dimensionless.b_sp": "b̄_sp",
+    "dimensionless.b_rp": "b̄_rp",
+    "dimensionless.b_s": "b̄_s",
+    "dimensionless.torque_input": "T̄_D",
+    "dimensionless.torque_output": "T̄_L",
+    "dimensionless.te_sp": "Ā_sp",
+    "dimensionless.te_rp": "Ā_rp",
+    "dimensionless.harmonics_sp": "stiffness harmonics sp",
+    "dimensionless.harmonics_rp": "stiffness harmonics rp",
+    "static_deflection.sun_planet_m": "sun–planet F/k_m,sp [m]",
+    "static_deflection.sun_planet_bar": "sun–planet F/(k_m,sp b_c)",
+    "static_deflection.planet_ring_m": "planet–ring F/k_m,rp [m]",
+    "static_deflection.planet_ring_bar": "planet–ring F/(k_m,rp b_c)",
+    "natural_frequencies.hz": "f [Hz]",
+    "natural_frequencies.ratio": "ω/ω_n",
+    "natural_frequencies.kind": "mode class",
+    "natural_frequencies.multiplicity": "multiplicity",
+    "omega_at_resonances.mode_ratio": "mode ω/ω_n",
+    "omega_at_resonances.kind": "mode class",
+    "omega_at_resonances.harmonic": "harmonic h",
+    "omega_at_resonances.omega": "Ω = (ω/ω_n)/h",
+    "operating_point.omega": "Ω = ω/ω_n",
+    "operating_point.mesh_frequency_rad_s": "mesh frequency ω [rad/s]",
+    "operating_point.mesh_frequency_hz": "mesh frequency [Hz]",
+    "operating_point.sun_speed_rpm": "sun speed [rpm]",
+}
+_TITLES: dict[str, str] = {
+    "radii_m": "Radii [m]",
+    "equivalent_masses_kg": "Equivalent masses [kg]",
+    "damping_coefficients_N_s_per_m": "Damping [N s/m]",
+    "dimensionless": "Dimensionless groups (MODEL.md §7)",
+    "static_deflection": "Static mesh deflection",
+    "natural_frequencies": "Natural frequencies (mean stiffness, no clearance)",
+    "omega_at_resonances": "Resonances: mesh harmonic h·Ω meets a mode",
+    "operating_point": "Operating point",
+}
+#: Groups shown as rows of the overview table rather than as tables of their own.
+_OVERVIEW_GROUPS = ("teeth", "mesh_phasing")
+_UNIT_SUFFIXES = (
+    ("_N_s_per_m", "N s/m"),
+    ("_rad_s", "rad/s"),
+    ("_N_m", "N m"),
+    ("_rpm", "rpm"),
+    ("_hz", "Hz"),
+    ("_kg", "kg"),
+    ("_m", "m"),
+    ("_N", "N"),
+)
+
+
+def _label(path: str) -> str:
+    """The label of an info entry: from :data:`_LABELS`, else made from the key."""
+    if path in _LABELS:
+        return _LABELS[path]
+    key = path.rsplit(".", 1)[-1]
+    for suffix, unit in _UNIT_SUFFIXES:
+        if key.endswith(suffix) and len(key) > len(suffix):
+            return f"{key[: -len(suffix)].replace('_', ' ')} [{unit}]"
+    return key.replace("_", " ")
+
+
+def _fmt(value: Any) -> str:
+    if isinstance(value, bool) or value is None:
+        return "—" if value is None else str(value)
+    if isinstance(value, (float, np.floating)):
+        return f"{float(value):.6g}"
+    if isinstance(value, (list, tuple)):
+        return ", ".join(_fmt(v) for v in value) or "—"
+    return str(value)
+
+
+def _flatten(prefix: str, value: Mapping[str, Any]) -> Iterator[tuple[str, Any]]:
+    for k, v in value.items():
+        path = f"{prefix}.{k}" if prefix else str(k)
+        if isinstance(v, Mapping):
+            yield from _flatten(path, v)
+        else:
+            yield path, v
+
+
+def _pairs_table(title: str | None) -> Table:
+    table = Table(title=escape(title) if title else None, title_justify="left", show_header=False)
+    table.add_column("quantity", style="cyan")
+    table.add_column("value", justify="right")
+    return table
+
+
+def _info_renderables(data: Mapping[str, Any]) -> list[Any]:
+    """Rich tables of a :func:`gearset_info` dictionary: an overview of the scalars, the
+    groups of numbers side by side, then the mode and resonance lists."""
+    overview = _pairs_table(None)
+    groups: list[Table] = []
+    lists: list[Table] = []
+    for key, value in data.items():
+        if key in ("name", "description"):
+            continue
+        if isinstance(value, Mapping):
+            target = overview if key in _OVERVIEW_GROUPS else _pairs_table(_TITLES.get(key, key))
+            for path, v in _flatten(key, value):
+                target.add_row(escape(_label(path)), escape(_fmt(v)))
+            if target is not overview:
+                groups.append(target)
+        elif (
+            isinstance(value, (list, tuple))
+            and value
+            and all(isinstance(v, Mapping) for v in value)
+        ):
+            columns: list[str] = []
+            for row in value:
+                columns.extend(k for k in row if k not in columns)
+            table = Table(title=escape(_TITLES.get(key, key)), title_justify="left")
+            for col in columns:
+                table.add_column(
+                    escape(_label(f"{key}.{col}")), justify="left" if col == "kind" else "right"
+                )
+            for row in value:
+                table.add_row(*(escape(_fmt(row.get(col))) for col in columns))
+            lists.append(table)
+        else:
+            overview.add_row(escape(_label(key)), escape(_fmt(value)))
+    out: list[Any] = [overview]
+    if groups:
+        out.append(Columns(groups, padding=(0, 2)))
+    return [*out, *lists]
+
+
+# --------------------------------------------------------------------------- presets, init-gearset
+@app.command()
+def presets() -> None:
+    """List the built-in gear sets (use one with --preset NAME)."""
+    from .gearset import list_presets
+
+    table = Table(title="Built-in gear sets", title_justify="left")
+    table.add_column("name", style="bold cyan", no_wrap=True)
+    table.add_column("description")
+    for name, description in list_presets():
+        table.add_row(name, description)
+    _stdout().print(table)
+
+
+@app.command("init-gearset")
+def init_gearset(
+    file: Annotated[
+        Path, typer.Argument(help="TOML file to write.", dir_okay=False, show_default=False)
+    ],
+    force: Annotated[
+        bool, typer.Option("--force", "-f", help="Overwrite an existing file.")
+    ] = False,
+) -> None:
+    """Write a commented gear-set file to start from (the sheng2016 values, every line
+    explained); edit it, then run **gearchaos simulate --gearset FILE**."""
+    from .gearset import template_toml
+
+    if file.exists() and not force:
+        _fail(f"{file} already exists; pass --force to overwrite it", EXIT_FAILURE)
+    with _reported_errors():
+        file.write_text(template_toml(), encoding="utf-8")
+    out = _stdout()
+    out.print(Text.assemble(("wrote ", "dim"), (str(file), "bold")))
+    out.print(
+        Text(f"next: gearchaos simulate --gearset {file} --set omega=1.5 -o out/", style="dim")
+    )
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(app())
