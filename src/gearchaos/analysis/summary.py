@@ -1,0 +1,174 @@
+"""A JSON-serialisable summary of one simulation, and its table for humans.
+
+:func:`summarize` condenses a :class:`~gearchaos.SimulationResult` into the numbers a reader
+wants first: where it ran (Ω, ω_n, sun speed), what motion it found (distinct Poincaré points of
+(X̄_sp1, X̄'_sp1), named 1T, 2T, … or ``many``), the contact regime of every mesh and whether the
+integration succeeded. :func:`format_summary` renders it as a :class:`rich.table.Table`.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError
+from .contact import contact_regimes
+from .poincare import count_distinct, section_points
+
+__all__ = ["SUMMARY_KEYS", "format_summary", "motion_name", "summarize"]
+
+#: Keys every summary of a planetary result has (in this order); extras follow them.
+SUMMARY_KEYS = (
+    "omega",
+    "omega_n_rad_s",
+    "sun_speed_rpm",
+    "distinct_section_points",
+    "motion",
+    "x_sp1_section_min",
+    "x_sp1_section_max",
+    "contact",
+    "status",
+    "steps_accepted",
+    "steps_rejected",
+)
+
+
+def motion_name(n: int, max_count: int = 64) -> str:
+    """``nT`` for n distinct section points, ``many`` beyond ``max_count``, ``unknown`` for 0."""
+    if n <= 0:
+        return "unknown"
+    if n > max_count:
+        return "many"
+    return f"{n}T"
+
+
+def _num(x: Any) -> float | None:
+    """A plain float, or None for NaN/inf (JSON has no NaN)."""
+    if x is None:
+        return None
+    v = float(x)
+    return v if math.isfinite(v) else None
+
+
+def summarize(result: Any, *, tol: float = 1e-3, max_count: int = 64) -> dict[str, Any]:
+    """JSON-serialisable summary of a simulation result.
+
+    Parameters
+    ----------
+    result
+        A :class:`~gearchaos.SimulationResult` (planetary or a reference system).
+    tol, max_count
+        Passed to :func:`~gearchaos.analysis.poincare.count_distinct`.
+
+    Returns
+    -------
+    dict
+        ``omega`` (Ω), ``omega_n_rad_s`` (ω_n), ``sun_speed_rpm``, ``distinct_section_points``
+        (``max_count + 1`` means many), ``motion`` (``1T``, ``2T``, …, ``many``),
+        ``x_sp1_section_min``/``_max`` (range of the X̄_sp1 section values), ``contact`` (a list
+        of ``{"mesh": "sun_planet_1", "regime": "none|single_sided|double_sided"}``, sun–planet
+        meshes first, then planet–ring), ``status`` (lower-case :class:`~gearchaos.Status`
+        name), ``steps_accepted``, ``steps_rejected``; then the extras ``gearset``,
+        ``mesh_frequency_hz``, ``load_factor_sp_max``, ``load_factor_rp_max`` (max mesh force over
+        the static mean force T_D/(N r_bs), sampled), ``transient_periods``, ``periods``,
+        ``samples_per_period``. Quantities that do not apply (no gear set, a reference system)
+        are ``None``; for reference systems the ``x_sp1_*`` keys hold the first state.
+    """
+    system = result.system
+    model = system.model
+    planetary = hasattr(model, "n_planets")
+    x, xd = section_points(result)
+    n = count_distinct(np.column_stack([x, xd]), tol=tol, max_count=max_count)
+    finite = x[np.isfinite(x)]
+    scales = getattr(model, "scales", None)
+    gs = getattr(model, "gearset", None)
+    omega = float(system.omega)
+    try:
+        contact = [{"mesh": k, "regime": v} for k, v in contact_regimes(result).items()]
+    except ParameterError:  # no meshes (linear, Duffing, Lorenz)
+        contact = []
+    out: dict[str, Any] = {
+        "omega": omega,
+        "omega_n_rad_s": _num(scales.omega_n) if scales is not None else None,
+        "sun_speed_rpm": _num(gs.sun_speed_rpm(omega)) if gs is not None else None,
+        "distinct_section_points": int(n),
+        "motion": motion_name(n, max_count),
+        "x_sp1_section_min": _num(finite.min()) if finite.size else None,
+        "x_sp1_section_max": _num(finite.max()) if finite.size else None,
+        "contact": contact,
+        "status": result.status.name.lower(),
+        "steps_accepted": int(result.steps_accepted),
+        "steps_rejected": int(result.steps_rejected),
+    }
+    out["gearset"] = gs.name if gs is not None else None
+    out["mesh_frequency_hz"] = (
+        _num(omega * scales.omega_n / (2.0 * math.pi)) if scales is not None else None
+    )
+    out["load_factor_sp_max"] = None
+    out["load_factor_rp_max"] = None
+    if planetary:
+        N = int(model.n_planets)
+        td, _ = model.parameters.loads(omega)
+        static = td / N
+        if static > 0:
+            for mesh in ("sp", "rp"):
+                f = np.column_stack([result.series(f"force_{mesh}_{i}") for i in range(1, N + 1)])
+                f = f[np.isfinite(f)]
+                if f.size:
+                    out[f"load_factor_{mesh}_max"] = _num(f.max() / static)
+    s = result.settings
+    out["transient_periods"] = _num(s.get("transient_periods"))
+    out["periods"] = int(s.get("periods", 0))
+    out["samples_per_period"] = int(s.get("samples_per_period", 1))
+    return out
+
+
+def _fmt(v: Any) -> str:
+    if v is None:
+        return "—"
+    if isinstance(v, float):
+        return f"{v:.6g}"
+    return str(v)
+
+
+def format_summary(summary: dict[str, Any], *, title: str | None = None) -> Any:
+    """A :class:`rich.table.Table` of a summary from :func:`summarize` (for the CLI)."""
+    from rich.markup import escape
+    from rich.table import Table
+
+    if title is None:
+        gs = summary.get("gearset")
+        title = f"gearchaos simulation{f' of {gs}' if gs else ''}"
+    table = Table(title=title, show_header=True, header_style="bold")
+    table.add_column("quantity")
+    table.add_column("value", justify="right")
+    labels = {
+        "omega": "Ω = ω/ω_n",
+        "omega_n_rad_s": "ω_n [rad/s]",
+        "mesh_frequency_hz": "mesh frequency [Hz]",
+        "sun_speed_rpm": "sun speed [rpm]",
+        "distinct_section_points": "distinct section points",
+        "motion": "motion",
+        "x_sp1_section_min": "X̄_sp1 section min",
+        "x_sp1_section_max": "X̄_sp1 section max",
+        "load_factor_sp_max": "load factor sun–planet (max)",
+        "load_factor_rp_max": "load factor planet–ring (max)",
+        "status": "status",
+        "steps_accepted": "steps accepted",
+        "steps_rejected": "steps rejected",
+    }
+    for key, label in labels.items():
+        if key in summary:
+            value = summary[key]
+            if key == "distinct_section_points" and summary.get("motion") == "many":
+                value = f"> {int(value) - 1} (many)"
+            table.add_row(escape(label), escape(_fmt(value)))
+    style = {"none": "green", "single_sided": "yellow", "double_sided": "red"}
+    for c in summary.get("contact", []):
+        regime = c["regime"]
+        table.add_row(
+            escape(f"contact {c['mesh']}"), f"[{style.get(regime, 'white')}]{escape(regime)}[/]"
+        )
+    return table

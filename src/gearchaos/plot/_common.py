@@ -1,0 +1,206 @@
+"""Shared helpers of the plotting layer: variable names, symbols, axes and clearance lines."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError
+
+#: Line style of clearance markers (±b̄), so tests and users can find them by ``gid``.
+CLEARANCE_GID = "clearance"
+_CLEARANCE_STYLE: dict[str, Any] = {"color": "0.35", "linestyle": "--", "linewidth": 0.9}
+
+# planetary per-planet variables: name -> (symbol, definition, clearance key, clearance symbol)
+_PLANET_VARS: dict[str, tuple[str, str, str | None, str | None]] = {
+    "delta_sp": (r"\bar{X}_{sp%d}", r"\delta_{sp%d}/b_c", "sun_planet", r"\bar{b}_{sp}"),
+    "delta_rp": (r"\bar{X}_{rp%d}", r"\delta_{rp%d}/b_c", "planet_ring", r"\bar{b}_{rp}"),
+    "force_sp": (r"\bar{F}_{sp%d}", r"F_{sp%d}/(k_{m,sp}\,b_c)", None, None),
+    "force_rp": (r"\bar{F}_{rp%d}", r"F_{rp%d}/(k_{m,sp}\,b_c)", None, None),
+    "p": (r"\bar{p}_{%d}", r"p_{%d}/b_c", None, None),
+}
+_SUN_VARS: dict[str, tuple[str, str, str | None, str | None]] = {
+    "x_s": (r"\bar{x}_s", r"x_s/b_c", "sun_bearing", r"\bar{b}_s"),
+    "y_s": (r"\bar{y}_s", r"y_s/b_c", "sun_bearing", r"\bar{b}_s"),
+    "sigma": (r"\bar{\sigma}", r"\sigma/b_c", None, None),
+}
+
+
+@dataclass(frozen=True)
+class VarInfo:
+    """A variable of a result with its derivative, mathtext symbols and clearance."""
+
+    name: str
+    dot: str | None
+    symbol: str  # mathtext without $
+    definition: str | None
+    clearance: float | None
+    clearance_symbol: str | None
+
+    @property
+    def label(self) -> str:
+        if self.definition:
+            return f"${self.symbol} = {self.definition}$"
+        return f"${self.symbol}$"
+
+    @property
+    def dot_symbol(self) -> str:
+        return f"{self.symbol}'"
+
+    @property
+    def dot_label(self) -> str:
+        return rf"${self.dot_symbol} = \mathrm{{d}}{self.symbol}/\mathrm{{d}}\tau$"
+
+
+def is_planetary(result: Any) -> bool:
+    return hasattr(result.system.model, "n_planets")
+
+
+def _generic_symbol(name: str) -> str:
+    base, dot = (name[:-4], "'") if name.endswith("_dot") else (name, "")
+    head, sep, tail = base.partition("_")
+    sym = f"{head}_{{{tail}}}" if sep else head
+    return sym + dot
+
+
+def variable(result: Any, var: str | None = None, planet: int = 1) -> VarInfo:
+    """Resolve ``var`` (and ``planet``) into a :class:`VarInfo` for ``result``.
+
+    Planetary results: ``delta_sp`` (default), ``delta_rp``, ``force_sp``, ``force_rp``, ``p``
+    per planet, or ``x_s``, ``y_s``, ``sigma``. Other systems: any state or observable name
+    (default: the first state).
+    """
+    system = result.system
+    names = tuple(system.state_names) + tuple(system.obs_names)
+    clearances = dict(getattr(system.model, "clearances", {}))
+    if is_planetary(result):
+        var = "delta_sp" if var is None else var
+        n_planets = int(system.model.n_planets)
+        if var in _PLANET_VARS:
+            if not (isinstance(planet, int | np.integer) and 1 <= planet <= n_planets):
+                raise ParameterError(f"planet must be an integer in 1..{n_planets}: got {planet!r}")
+            sym, definition, ckey, csym = _PLANET_VARS[var]
+            name = f"{var}_{planet}"
+            dot = f"{var}_dot_{planet}" if var.startswith("delta") else f"{var}_{planet}_dot"
+            return VarInfo(
+                name,
+                dot if dot in names else None,
+                sym % planet,
+                definition % planet,
+                None if ckey is None else float(clearances[ckey]),
+                csym,
+            )
+        if var in _SUN_VARS:
+            sym, definition, ckey, csym = _SUN_VARS[var]
+            dot = f"{var}_dot"
+            return VarInfo(
+                var,
+                dot if dot in names else None,
+                sym,
+                definition,
+                None if ckey is None else float(clearances[ckey]),
+                csym,
+            )
+    else:
+        var = system.state_names[0] if var is None else var
+    if var not in names:
+        raise ParameterError(
+            f"var must name a variable of {system.name} ({', '.join(names)}): got {var!r}"
+        )
+    dot = f"{var}_dot"
+    b = clearances.get(var)
+    return VarInfo(
+        var,
+        dot if dot in names else None,
+        _generic_symbol(var),
+        None,
+        None if b is None else float(b),
+        None if b is None else r"\bar{b}" if is_planetary(result) else "b",
+    )
+
+
+def get_ax(ax: Any) -> Any:
+    """``ax`` or a new Axes on a new pyplot figure."""
+    if ax is not None:
+        return ax
+    import matplotlib.pyplot as plt
+
+    _, ax = plt.subplots()
+    return ax
+
+
+def period_axis_label(result: Any) -> str:
+    if is_planetary(result):
+        return r"$t\,/\,T_m$ (mesh periods)"
+    return r"$t\,/\,T$ (forcing periods)"
+
+
+def to_periods(result: Any, tau: np.ndarray) -> np.ndarray:
+    """τ in forcing (mesh) periods: τΩ/2π."""
+    return np.asarray(tau) * result.system.omega / (2.0 * math.pi)
+
+
+def sample_window(result: Any, periods: float | None) -> slice:
+    """Slice of the samples covering the last ``periods`` recorded periods (all if None)."""
+    if periods is None:
+        return slice(None)
+    if not (math.isfinite(periods) and periods > 0):
+        raise ParameterError(f"periods must be a number > 0 or None: got {periods!r}")
+    n = round(periods * result.samples_per_period)
+    return slice(max(result.tau.size - n, 0), None)
+
+
+def clearance_lines(ax: Any, info: VarInfo, *, vertical: bool = False) -> None:
+    """Dashed lines at ±b̄ of ``info`` (horizontal, or vertical when the variable is on x)."""
+    if info.clearance is None:
+        return
+    b = info.clearance
+    draw = ax.axvline if vertical else ax.axhline
+    for k, v in enumerate((b, -b)):
+        draw(
+            v,
+            gid=CLEARANCE_GID,
+            label=rf"$\pm {info.clearance_symbol} = \pm {b:g}$" if k == 0 else None,
+            zorder=1,
+            **_CLEARANCE_STYLE,
+        )
+
+
+def message(ax: Any, text: str) -> Any:
+    """Show ``text`` in the middle of an otherwise empty Axes."""
+    ax.text(0.5, 0.5, text, ha="center", va="center", transform=ax.transAxes, wrap=True)
+    ax.set_xticks([])
+    ax.set_yticks([])
+    return ax
+
+
+def readable_limits(ax: Any, *, rel: float = 1e-3, joint: bool = False) -> None:
+    """Keep tiny ranges in context and drop axis offsets on linear axes.
+
+    Autoscaling zooms onto the integration noise of a periodic orbit (a 1T Poincaré point
+    spread by 10⁻⁹ fills the panel and looks like structure). When an axis spans less than
+    ``rel`` times the largest magnitude it shows (with ``joint``, the largest magnitude on
+    either axis — for x–x' planes, matching :func:`~gearchaos.analysis.count_distinct`), it is
+    widened to ±5 % of that magnitude (±1 around zero); axis offsets (“1e-6 + 3.49”) are
+    turned off.
+    """
+    axes = (
+        (ax.xaxis, ax.get_xlim, ax.set_xlim),
+        (ax.yaxis, ax.get_ylim, ax.set_ylim),
+    )
+    limits = [get() for _, get, _ in axes]
+    joint_mag = max(abs(v) for lim in limits for v in lim)
+    for (axis, _, set_), (lo, hi) in zip(axes, limits, strict=True):
+        if axis.get_scale() != "linear":
+            continue
+        mag = joint_mag if joint else max(abs(lo), abs(hi))
+        if hi - lo <= rel * mag or mag == 0.0:
+            centre = 0.5 * (lo + hi)
+            half = 0.05 * mag if mag > 0 else 1.0
+            set_(centre - half, centre + half)
+        formatter = axis.get_major_formatter()
+        if hasattr(formatter, "set_useOffset"):
+            formatter.set_useOffset(False)

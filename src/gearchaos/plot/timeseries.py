@@ -1,0 +1,169 @@
+"""Time histories and amplitude spectra of simulation results."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError
+from ._common import (
+    clearance_lines,
+    get_ax,
+    is_planetary,
+    period_axis_label,
+    readable_limits,
+    sample_window,
+    to_periods,
+    variable,
+)
+
+__all__ = ["amplitude_spectrum", "spectrum", "time_history"]
+
+
+def time_history(
+    result: Any,
+    var: str | None = None,
+    planet: int = 1,
+    ax: Any = None,
+    periods: float | None = None,
+) -> Any:
+    """Plot a variable against time in mesh (forcing) periods, t/T_m = τΩ/2π.
+
+    Parameters
+    ----------
+    result
+        A :class:`~gearchaos.SimulationResult`; use ``samples_per_period`` ≫ 1 for a smooth
+        curve (with one sample per period only the section points are drawn).
+    var, planet
+        The variable: for planetary results ``delta_sp`` (default, X̄_spi), ``delta_rp``,
+        ``force_sp``, ``force_rp``, ``p`` of ``planet``, or ``x_s``, ``y_s``, ``sigma``; for
+        other systems a state or observable name (default: the first state, e.g. ``x``).
+    ax
+        Axes to draw on (default: a new figure).
+    periods
+        Show only the last ``periods`` recorded periods (default: all).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        With dashed lines at ±b̄ for variables with a clearance and dots at the Poincaré
+        section times.
+    """
+    info = variable(result, var, planet)
+    ax = get_ax(ax)
+    sl = sample_window(result, periods)
+    s = result.samples_per_period
+    t = to_periods(result, result.tau)
+    y = np.asarray(result.series(info.name))
+    if s > 1:
+        ax.plot(t[sl], y[sl], lw=0.8, color="C0", label=f"${info.symbol}$")
+    idx = np.arange(result.tau.size)[sl]
+    sec = idx[idx % s == 0]
+    ax.plot(
+        t[sec],
+        y[sec],
+        ".",
+        ms=4 if s > 1 else 3,
+        color="C3",
+        label="section points",
+        zorder=3,
+    )
+    clearance_lines(ax, info)
+    ax.set_xlabel(period_axis_label(result))
+    ax.set_ylabel(info.label)
+    readable_limits(ax)
+    return ax
+
+
+def amplitude_spectrum(
+    result: Any,
+    var: str | None = None,
+    planet: int = 1,
+    *,
+    window: str = "boxcar",
+) -> tuple[np.ndarray, np.ndarray]:
+    """One-sided amplitude spectrum of the recorded (steady) response.
+
+    The recorded window spans an integer number P of forcing periods sampled uniformly with
+    ``s = samples_per_period`` samples each, so with the default rectangular window the FFT
+    bins fall exactly on multiples 1/P of the forcing frequency and a periodic response has
+    leakage-free lines at its harmonics: for x_j = a cos(kΩτ_j + φ) the bin at ω/Ω = k holds
+    amplitude ``a``. The mean is removed first. ``window="hann"`` applies a Hann window
+    (amplitudes divided by the window's mean, so lines keep their height) for
+    non-periodic motion.
+
+    Returns
+    -------
+    (ratio, amplitude)
+        ``ratio = ω/Ω`` (multiples of the mesh frequency for the planetary model) for bins
+        1 … Ps/2 and the amplitudes, in the units of the variable.
+    """
+    info = variable(result, var, planet)
+    s = result.samples_per_period
+    if s < 4:
+        raise ParameterError(
+            f"spectrum needs samples_per_period >= 4 (a Nyquist limit of at least twice the "
+            f"forcing frequency): got {s}; simulate with samples_per_period=32 or more"
+        )
+    x = np.asarray(result.series(info.name), dtype=np.float64)
+    bad = np.flatnonzero(~np.isfinite(x))
+    n_periods = (bad[0] if bad.size else x.size) // s
+    if n_periods < 1:
+        raise ParameterError(
+            f"spectrum needs at least one whole recorded period of finite samples: got "
+            f"{bad[0] if bad.size else x.size} samples at {s} per period"
+        )
+    x = x[: n_periods * s]
+    x = x - x.mean()
+    if window == "boxcar":
+        w = np.ones(x.size)
+    elif window == "hann":
+        w = np.hanning(x.size + 1)[:-1]  # periodic Hann
+    else:
+        raise ParameterError(f"window must be 'boxcar' or 'hann': got {window!r}")
+    amp = 2.0 * np.abs(np.fft.rfft(x * w)) / w.sum()
+    k = np.arange(amp.size)
+    ratio = k / n_periods
+    if x.size % 2 == 0:
+        amp[-1] /= 2.0  # the Nyquist bin is not doubled
+    return ratio[1:], amp[1:]
+
+
+def spectrum(
+    result: Any,
+    var: str | None = None,
+    planet: int = 1,
+    ax: Any = None,
+    *,
+    max_harmonic: float | None = 5.0,
+    window: str = "boxcar",
+) -> Any:
+    """Plot the amplitude spectrum of a variable on a log scale (see :func:`amplitude_spectrum`).
+
+    The frequency axis is ω/ω_m, in multiples of the mesh frequency (forcing frequency for
+    other systems), shown up to ``max_harmonic`` (or the Nyquist limit s/2). Raises
+    :class:`~gearchaos.errors.ParameterError` unless ``samples_per_period >= 4``.
+    """
+    info = variable(result, var, planet)
+    ratio, amp = amplitude_spectrum(result, var, planet, window=window)
+    ax = get_ax(ax)
+    top = float(np.max(amp)) if amp.size else 0.0
+    floor = top * 1e-12 if top > 0 else 1e-300
+    ax.plot(ratio, np.maximum(amp, floor), lw=0.8, color="C0")
+    ax.set_yscale("log")
+    hi = ratio[-1] if max_harmonic is None else min(float(max_harmonic), float(ratio[-1]))
+    ax.set_xlim(0.0, hi)
+    if top > 0:
+        shown = amp[ratio <= hi]
+        lo = max(float(np.min(shown[shown > 0])) if np.any(shown > 0) else floor, top * 1e-9)
+        ax.set_ylim(lo / 2.0, top * 3.0)
+    for h in range(1, math.floor(hi) + 1):
+        ax.axvline(h, color="0.8", lw=0.6, zorder=0)
+    if is_planetary(result):
+        ax.set_xlabel(r"$\omega/\omega_m$ (multiples of the mesh frequency)")
+    else:
+        ax.set_xlabel(r"$\omega/\Omega$ (multiples of the forcing frequency)")
+    ax.set_ylabel(f"amplitude of ${info.symbol}$")
+    return ax

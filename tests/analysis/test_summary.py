@@ -1,0 +1,96 @@
+"""summarize(): exact keys, JSON round trip and values that follow from the model."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+import gearchaos as gc
+from gearchaos.analysis.summary import SUMMARY_KEYS, format_summary, motion_name, summarize
+
+REQUIRED = {
+    "omega",
+    "omega_n_rad_s",
+    "sun_speed_rpm",
+    "distinct_section_points",
+    "motion",
+    "x_sp1_section_min",
+    "x_sp1_section_max",
+    "contact",
+    "status",
+    "steps_accepted",
+    "steps_rejected",
+}
+
+
+@pytest.fixture(scope="module")
+def planetary() -> gc.SimulationResult:
+    return gc.simulate(
+        gc.preset("sheng2016"), omega=0.5, transient_periods=20, periods=20, samples_per_period=8
+    )
+
+
+def test_planetary_summary(planetary: gc.SimulationResult) -> None:
+    s = summarize(planetary)
+    assert set(SUMMARY_KEYS) == REQUIRED
+    assert REQUIRED <= set(s)
+    assert list(s)[: len(SUMMARY_KEYS)] == list(SUMMARY_KEYS)
+    text = json.dumps(s, allow_nan=False)
+    assert json.loads(text) == s
+    gs = gc.preset("sheng2016")
+    assert s["omega"] == 0.5
+    assert s["omega_n_rad_s"] == pytest.approx(gs.omega_n)
+    assert s["sun_speed_rpm"] == pytest.approx(gs.sun_speed_rpm(0.5))
+    assert s["distinct_section_points"] == 1
+    assert s["motion"] == "1T"
+    x = planetary.section("delta_sp_1")
+    assert s["x_sp1_section_min"] == x.min()
+    assert s["x_sp1_section_max"] == x.max()
+    N = gs.n_planets
+    assert [c["mesh"] for c in s["contact"]] == [f"sun_planet_{i}" for i in range(1, N + 1)] + [
+        f"planet_ring_{i}" for i in range(1, N + 1)
+    ]
+    assert {c["regime"] for c in s["contact"]} == {"none"}
+    assert s["status"] == "ok"
+    assert s["steps_accepted"] == planetary.steps_accepted > 0
+    assert s["steps_rejected"] == planetary.steps_rejected
+    # mesh frequency in Hz matches the gear set's kinematics at that sun speed
+    assert s["mesh_frequency_hz"] == pytest.approx(
+        gs.mesh_frequency(s["sun_speed_rpm"]) / (2 * 3.141592653589793)
+    )
+    assert s["load_factor_sp_max"] > 1.0
+
+
+def test_reference_system_summary() -> None:
+    r = gc.simulate(
+        gc.backlash_oscillator(1.0, zeta=0.1, b=1.0, f_mean=2.0, f_alt=0.3, omega_power=0),
+        transient_periods=20,
+        periods=10,
+    )
+    s = summarize(r)
+    assert REQUIRED <= set(s)
+    json.dumps(s, allow_nan=False)
+    assert s["contact"] == [{"mesh": "mesh", "regime": "none"}]
+    assert s["motion"] == "1T"
+    assert s["omega_n_rad_s"] is None and s["sun_speed_rpm"] is None
+    s = summarize(gc.simulate(gc.duffing(1.0), transient_periods=1, periods=3))
+    assert s["contact"] == []
+
+
+def test_motion_name() -> None:
+    assert motion_name(1) == "1T"
+    assert motion_name(3) == "3T"
+    assert motion_name(65) == "many"
+    assert motion_name(11, max_count=10) == "many"
+    assert motion_name(0) == "unknown"
+
+
+def test_format_summary_renders(planetary: gc.SimulationResult) -> None:
+    from rich.console import Console
+
+    console = Console(record=True, width=100)
+    console.print(format_summary(summarize(planetary)))
+    text = console.export_text()
+    assert "sun speed [rpm]" in text  # brackets survive rich markup
+    assert "sun_planet_5" in text and "none" in text
