@@ -8,8 +8,8 @@ from .tableau import DOPRI5, ButcherTableau
 from .trajectory import Trajectory
 
 __all__ = [
-    "BatchResult",
     "DOPRI5",
+    "BatchResult",
     "ButcherTableau",
     "SimulationResult",
     "Trajectory",

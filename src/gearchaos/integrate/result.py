@@ -145,14 +145,20 @@ class SimulationResult(Trajectory):
         tau = self.tau[idx]
         coords = {
             "tau": xr.DataArray(
-                tau, dims="section", attrs={"long_name": "τ = ω_n t at the section", "units": _DIMLESS}
+                tau,
+                dims="section",
+                attrs={"long_name": "τ = ω_n t at the section", "units": _DIMLESS},
             ),
-            "planet": xr.DataArray(np.arange(1, N + 1), dims="planet", attrs={"long_name": "planet i"}),
+            "planet": xr.DataArray(
+                np.arange(1, N + 1), dims="planet", attrs={"long_name": "planet i"}
+            ),
         }
         ds = xr.Dataset(coords=coords, attrs=self._attrs())
         b_sp, b_rp = model.parameters.b_sp, model.parameters.b_rp
 
-        def put(name: str, dims: tuple[str, ...], long_name: str, units: str = "b_c", **extra: Any) -> None:
+        def put(
+            name: str, dims: tuple[str, ...], long_name: str, units: str = "b_c", **extra: Any
+        ) -> None:
             full = self._series_for(name)
             assert full is not None
             ds[name] = xr.DataArray(
@@ -160,12 +166,36 @@ class SimulationResult(Trajectory):
             )
 
         lu = {"units_note": "dimensionless, in units of the characteristic length b_c"}
-        put("delta_sp", ("section", "planet"), "X̄_sp = δ_sp/b_c, sun–planet mesh deflection", _DIMLESS, backlash=b_sp, **lu)
-        put("delta_rp", ("section", "planet"), "X̄_rp = δ_rp/b_c, planet–ring mesh deflection", _DIMLESS, backlash=b_rp, **lu)
+        put(
+            "delta_sp",
+            ("section", "planet"),
+            "X̄_sp = δ_sp/b_c, sun–planet mesh deflection",
+            _DIMLESS,
+            backlash=b_sp,
+            **lu,
+        )
+        put(
+            "delta_rp",
+            ("section", "planet"),
+            "X̄_rp = δ_rp/b_c, planet–ring mesh deflection",
+            _DIMLESS,
+            backlash=b_rp,
+            **lu,
+        )
         put("delta_sp_dot", ("section", "planet"), "X̄'_sp = dX̄_sp/dτ", _DIMLESS)
         put("delta_rp_dot", ("section", "planet"), "X̄'_rp = dX̄_rp/dτ", _DIMLESS)
-        put("force_sp", ("section", "planet"), "F̄_sp = F_sp/(k_m,sp b_c), sun–planet mesh force", _DIMLESS)
-        put("force_rp", ("section", "planet"), "F̄_rp = F_rp/(k_m,sp b_c), planet–ring mesh force", _DIMLESS)
+        put(
+            "force_sp",
+            ("section", "planet"),
+            "F̄_sp = F_sp/(k_m,sp b_c), sun–planet mesh force",
+            _DIMLESS,
+        )
+        put(
+            "force_rp",
+            ("section", "planet"),
+            "F̄_rp = F_rp/(k_m,sp b_c), planet–ring mesh force",
+            _DIMLESS,
+        )
         put("x_s", ("section",), "x̄_s, sun centre displacement", _DIMLESS, **lu)
         put("y_s", ("section",), "ȳ_s, sun centre displacement", _DIMLESS, **lu)
         put("x_s_dot", ("section",), "x̄'_s", _DIMLESS)
@@ -195,7 +225,7 @@ class SimulationResult(Trajectory):
                     np.nanmax(full, axis=0) / static,
                     dims=("planet",),
                     attrs={
-                        "long_name": f"dynamic load factor max F_{mesh}/(T_D/(N r_bs)) over the samples",
+                        "long_name": f"dynamic load factor max F_{mesh}/(T_D/(N r_bs))",
                         "units": _DIMLESS,
                         "note": "sampled at samples_per_period resolution",
                     },

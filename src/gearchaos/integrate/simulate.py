@@ -14,9 +14,9 @@ from typing import Any
 
 import numpy as np
 
+from .._numba import call_literal
 from ..errors import IntegrationError, ParameterError, Status
 from ..model.system import System
-from .._numba import call_literal
 from .dopri import dopri_run
 from .result import SimulationResult
 from .trajectory import Trajectory
@@ -240,8 +240,9 @@ def simulate(
     )
     result = SimulationResult.from_trajectory(traj)
     if check and not traj.ok:
+        reached = float(np.nanmax(traj.tau, initial=0.0))
         err = IntegrationError(
-            f"simulation at omega={system.omega:g} stopped at tau={float(np.nanmax(traj.tau, initial=0.0)):.6g}: "
+            f"simulation at omega={system.omega:g} stopped after tau={reached:.6g}: "
             f"{traj.status.name}: {traj.status.message}"
         )
         err.result = result  # type: ignore[attr-defined]
@@ -249,4 +250,3 @@ def simulate(
     if not traj.ok:
         warnings.warn(f"{traj.status.name}: {traj.status.message}", RuntimeWarning, stacklevel=2)
     return result
-

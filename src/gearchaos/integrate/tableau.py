@@ -49,8 +49,10 @@ class ButcherTableau:
     @property
     def fsal(self) -> bool:
         """First same as last: the last stage is evaluated at (t + h, y_{n+1})."""
-        return self.c[-1] == 1 and tuple(self.a[-1]) == tuple(self.b[: len(self.a[-1])]) and (
-            self.b[-1] == 0
+        return (
+            self.c[-1] == 1
+            and tuple(self.a[-1]) == tuple(self.b[: len(self.a[-1])])
+            and (self.b[-1] == 0)
         )
 
     def order_residuals(self, weights: tuple[Fr, ...], order: int) -> dict[str, Fr]:
@@ -103,9 +105,9 @@ class ButcherTableau:
         for k in ("b.c3", "b.cAc", "b.Ac2", "b.AAc"):
             orders[k] = 4
         out = {}
-        for k, (v, target) in conds.items():
+        for k, (vec, target) in conds.items():
             if orders.get(k, 5) <= order:
-                out[k] = dot(b, v) - target
+                out[k] = dot(b, vec) - target
         return out
 
     def check(self) -> None:

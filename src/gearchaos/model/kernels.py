@@ -315,7 +315,8 @@ def duffing_rhs(t, y, p, dydt, obs):  # pragma: no cover - compiled
 
 @numba.njit(cache=True)
 def lorenz_rhs(t, y, p, dydt, obs):  # pragma: no cover - compiled
-    """Lorenz (1963): x' = σ(y − x), y' = x(ρ − z) − y, z' = xy − βz; obs = (x, y, z, x', y', z')."""
+    """Lorenz (1963): x' = σ(y − x), y' = x(ρ − z) − y, z' = xy − βz;
+    obs = (x, y, z, x', y', z')."""
     dydt[0] = p[LZ_SIGMA] * (y[1] - y[0])
     dydt[1] = y[0] * (p[LZ_RHO] - y[2]) - y[1]
     dydt[2] = y[0] * y[1] - p[LZ_BETA] * y[2]

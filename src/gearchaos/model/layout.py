@@ -7,14 +7,14 @@ module-level integer constants so that numba folds them into the machine code. N
 
 from __future__ import annotations
 
-# ----------------------------------------------------------------------------- system kinds
+# ---------- system kinds
 KIND_PLANETARY = 0
 KIND_BACKLASH_OSCILLATOR = 1
 KIND_LINEAR = 2
 KIND_DUFFING = 3
 KIND_LORENZ = 4
 
-# ----------------------------------------------------------------------------- planetary (kind 0)
+# ---------- planetary (kind 0)
 P_N = 0  # number of planets N
 P_OMEGA = 1  # Ω, dimensionless mesh frequency
 P_INV_MU_S = 2  # 1/μ_s   (sun translational mass)
@@ -70,7 +70,7 @@ B_S_ER = 17
 N_BLOCKS = 18
 # then NH_SP harmonic amplitudes (relative to k_m,sp) and NH_RP harmonic amplitudes
 
-# ----------------------------------------------------------------------------- backlash oscillator (kind 1)
+# ---------- backlash oscillator (kind 1)
 BO_OMEGA = 0
 BO_ZETA = 1
 BO_EPS = 2
@@ -79,12 +79,12 @@ BO_FM = 4
 BO_FA = 5  # effective amplitude: F_a Ω^q (q = 2 for transmission-error forcing, 0 for force)
 BO_SIZE = 6
 
-# ----------------------------------------------------------------------------- linear system (kind 2)
+# ---------- linear system (kind 2)
 LIN_OMEGA = 0
 LIN_N = 1
 LIN_HEADER = 2  # then A (n×n, row-major), f (n: cos forcing), g (n: sin forcing)
 
-# ----------------------------------------------------------------------------- Duffing (kind 3)
+# ---------- Duffing (kind 3)
 DU_OMEGA = 0
 DU_DELTA = 1
 DU_ALPHA = 2
@@ -92,7 +92,7 @@ DU_BETA = 3
 DU_GAMMA = 4
 DU_SIZE = 5
 
-# ----------------------------------------------------------------------------- Lorenz (kind 4)
+# ---------- Lorenz (kind 4)
 LZ_SIGMA = 0
 LZ_RHO = 1
 LZ_BETA = 2

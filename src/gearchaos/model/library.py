@@ -193,7 +193,7 @@ def backlash_oscillator(
 
 
 def linear_system(
-    matrix: np.ndarray,
+    matrix: np.ndarray | list[list[float]],
     omega: float = 1.0,
     *,
     cos_forcing: np.ndarray | None = None,
@@ -217,9 +217,7 @@ def linear_system(
     return System(model, omega)
 
 
-def linear_oscillator(
-    omega: float = 1.0, *, zeta: float = 0.05, force: float = 0.0
-) -> System:
+def linear_oscillator(omega: float = 1.0, *, zeta: float = 0.05, force: float = 0.0) -> System:
     """x'' + 2ζx' + x = F cos Ωτ as a first-order linear system."""
     return linear_system(
         [[0.0, 1.0], [-1.0, -2.0 * zeta]], omega, cos_forcing=np.array([0.0, force])

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 
@@ -300,9 +301,11 @@ class PlanetaryModel:
     def pack(self, omega: float) -> np.ndarray:
         return pack_planetary(self.parameters, omega)
 
-    def with_parameters(self, **changes: object) -> PlanetaryModel:
+    def with_parameters(self, **changes: Any) -> PlanetaryModel:
         """A copy with some dimensionless parameters changed (the gear set is dropped)."""
-        return PlanetaryModel(replace(self.parameters, **changes), self.scales, None, name=self.name)
+        return PlanetaryModel(
+            replace(self.parameters, **changes), self.scales, None, name=self.name
+        )
 
 
 def planetary_system(gs: GearSet, omega: float) -> System:
