@@ -14,7 +14,7 @@ __version__ = "0.1.0"
 
 from .errors import IntegrationError, ParameterError, Status, StoreError
 from .gearset import GearSet, preset
-from .integrate import SimulationResult, integrate, open_simulation, simulate
+from .integrate import SimulationResult, open_simulation, simulate
 from .model import (
     System,
     backlash_oscillator,
@@ -37,7 +37,6 @@ __all__ = [
     "__version__",
     "backlash_oscillator",
     "duffing",
-    "integrate",
     "linear_oscillator",
     "linear_system",
     "lorenz",

@@ -8,9 +8,11 @@ the specialisation once and then calls its entry point directly (sub-microsecond
 
 from __future__ import annotations
 
+import warnings
 from typing import Any
 
 from numba import typeof, types
+from numba.core.errors import NumbaIRAssumptionWarning
 
 __all__ = ["call_literal"]
 
@@ -23,10 +25,56 @@ def call_literal(dispatcher: Any, kind: int, *args: Any) -> Any:
     key = (dispatcher, kind, *(typeof(a) for a in args))
     entry = _ENTRIES.get(key)
     if entry is None:
-        result = dispatcher(kind, *args)  # compiles or loads the literal specialisation
+        with warnings.catch_warnings():
+            # numba's IR inliner emits an internal "pedantic" NumbaIRAssumptionWarning for the
+            # inlined right-hand side; it is harmless and not actionable for users
+            warnings.simplefilter("ignore", NumbaIRAssumptionWarning)
+            result = dispatcher(kind, *args)  # compiles or loads the literal specialisation
         sig = (types.literal(kind), *key[2:])
         cres = dispatcher.overloads.get(sig)
         if cres is not None:
             _ENTRIES[key] = cres.entry_point
         return result
     return entry(kind, *args)
+
+
+def guard_cache(dispatchers: list[Any], sources: list[str]) -> None:
+    """Drop numba's on-disk cache of ``dispatchers`` when any file in ``sources`` changed.
+
+    numba keys a cached kernel on its *own* source file only. The integrator inlines the
+    right-hand sides from another module, so an edited ``kernels.py`` would otherwise leave a
+    stale compiled integrator in place (a real hazard with editable installs). We keep a
+    fingerprint of all sources beside the cache and delete the module's cache files when it
+    differs. Failures (read-only locations, numba internals changing) are ignored: the worst
+    case is numba's own behaviour.
+    """
+    import hashlib
+    import os
+
+    h = hashlib.sha256()
+    for path in sorted(sources):
+        try:
+            with open(path, "rb") as f:
+                h.update(f.read())
+        except OSError:
+            return
+    digest = h.hexdigest()
+    for disp in dispatchers:
+        try:
+            cache_dir = disp._cache._cache_path
+            stem = os.path.splitext(os.path.basename(disp.py_func.__code__.co_filename))[0]
+            stamp = os.path.join(cache_dir, f"{stem}.gearchaos-sources.sha256")
+            old = None
+            if os.path.exists(stamp):
+                with open(stamp) as f:
+                    old = f.read().strip()
+            if old == digest:
+                continue
+            for name in os.listdir(cache_dir):
+                if name.startswith(stem + ".") and name.endswith((".nbi", ".nbc")):
+                    os.remove(os.path.join(cache_dir, name))
+            os.makedirs(cache_dir, exist_ok=True)
+            with open(stamp, "w") as f:
+                f.write(digest)
+        except Exception:  # noqa: BLE001 - best effort, never break an import
+            continue

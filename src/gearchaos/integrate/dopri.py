@@ -30,19 +30,11 @@ from .tableau import DOPRI5
 __all__ = ["dopri_batch", "dopri_run"]
 
 # ---------------------------------------------------------------------------- constants from data
-_A = DOPRI5.a_matrix()
-_B = [float(x) for x in DOPRI5.b]
-_E = [float(x) for x in DOPRI5.error_weights]
-_C = [float(x) for x in DOPRI5.c]
-A21 = _A[1, 0]
-A31, A32 = _A[2, 0], _A[2, 1]
-A41, A42, A43 = _A[3, 0], _A[3, 1], _A[3, 2]
-A51, A52, A53, A54 = _A[4, 0], _A[4, 1], _A[4, 2], _A[4, 3]
-A61, A62, A63, A64, A65 = _A[5, 0], _A[5, 1], _A[5, 2], _A[5, 3], _A[5, 4]
-B1, B3, B4, B5, B6 = _B[0], _B[2], _B[3], _B[4], _B[5]
-E1, E3, E4, E5, E6, E7 = _E[0], _E[2], _E[3], _E[4], _E[5], _E[6]
-C2, C3, C4, C5 = _C[1], _C[2], _C[3], _C[4]
-assert _B[1] == 0.0 and _E[1] == 0.0 and _B[6] == 0.0 and DOPRI5.fsal
+STAGES = DOPRI5.stages
+TAB_A = DOPRI5.a_matrix()  # frozen into the machine code as constants
+TAB_C = np.array([float(x) for x in DOPRI5.c])
+TAB_E = np.array([float(x) for x in DOPRI5.error_weights])
+assert DOPRI5.fsal  # the last row of A is b, so the last stage value is y_{n+1}
 
 SAFETY = 0.9
 MIN_FACTOR = 0.2
@@ -172,13 +164,8 @@ def dopri_run(
     y = y0.copy()
     ynew = np.empty(n)
     yt = np.empty(n)
-    k1 = np.empty(n)
-    k2 = np.empty(n)
-    k3 = np.empty(n)
-    k4 = np.empty(n)
-    k5 = np.empty(n)
-    k6 = np.empty(n)
-    k7 = np.empty(n)
+    K = np.empty((STAGES, n))
+    kbuf = np.empty(n)
     ev = np.empty(n)
     obs = np.empty(n_obs)
     obs_prev = np.empty(n_obs)
@@ -187,7 +174,9 @@ def dopri_run(
         obs_max[k] = -np.inf
 
     t = t0
-    rhs(kind, t, y, p, k1, obs)
+    rhs(kind, t, y, p, kbuf, obs)
+    k1 = K[0]
+    k1[:] = kbuf
     n_acc = 0
     n_rej = 0
     status = ST_OK
@@ -196,8 +185,9 @@ def dopri_run(
             status = ST_NON_FINITE
     h = h_init
     if status == ST_OK and h <= 0.0:
+        obs_prev[:] = obs
         h = initial_step(kind, t, y, k1, p, rtol, atol, obs)
-        rhs(kind, t, y, p, k1, obs)  # restore obs of the current point
+        obs[:] = obs_prev  # the observables of the current point
     if h > max_step:
         h = max_step
 
@@ -236,31 +226,24 @@ def dopri_run(
             hs = target - t
             clipped = True
 
-        for i in range(n):
-            yt[i] = y[i] + hs * A21 * k1[i]
-        rhs(kind, t + C2 * hs, yt, p, k2, obs)
-        for i in range(n):
-            yt[i] = y[i] + hs * (A31 * k1[i] + A32 * k2[i])
-        rhs(kind, t + C3 * hs, yt, p, k3, obs)
-        for i in range(n):
-            yt[i] = y[i] + hs * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
-        rhs(kind, t + C4 * hs, yt, p, k4, obs)
-        for i in range(n):
-            yt[i] = y[i] + hs * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
-        rhs(kind, t + C5 * hs, yt, p, k5, obs)
-        for i in range(n):
-            yt[i] = y[i] + hs * (
-                A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i]
-            )
         t_new = target if clipped else t + hs
-        rhs(kind, t + hs, yt, p, k6, obs)
+        # stages 2..7 from the tableau data; stage 7 is evaluated at (t_new, y_new) (FSAL)
+        for s in range(1, STAGES):
+            for i in range(n):
+                acc = 0.0
+                for q in range(s):
+                    acc += TAB_A[s, q] * K[q, i]
+                yt[i] = y[i] + hs * acc
+            ts = t_new if s == STAGES - 1 else t + TAB_C[s] * hs
+            rhs(kind, ts, yt, p, kbuf, obs)
+            for i in range(n):
+                K[s, i] = kbuf[i]
         for i in range(n):
-            ynew[i] = y[i] + hs * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
-        rhs(kind, t_new, ynew, p, k7, obs)
-        for i in range(n):
-            ev[i] = hs * (
-                E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i]
-            )
+            ynew[i] = yt[i]
+            acc = 0.0
+            for q in range(STAGES):
+                acc += TAB_E[q] * K[q, i]
+            ev[i] = hs * acc
         err = _scaled_norm(ev, y, ynew, rtol, atol)
 
         finite = math.isfinite(err)
@@ -293,7 +276,7 @@ def dopri_run(
             t = t_new
             for i in range(n):
                 y[i] = ynew[i]
-                k1[i] = k7[i]
+                K[0, i] = K[STAGES - 1, i]
             if tracking:
                 _track(obs_prev, obs, hs, n_track, obs_min, obs_max)
             if clipped and j < n_samples:
@@ -377,3 +360,22 @@ def dopri_batch(
             y_final[i],
             info[i],
         )
+
+
+def _guard() -> None:
+    import os
+
+    from .. import _numba
+    from ..model import kernels, layout
+
+    here = os.path.dirname(__file__)
+    sources = [
+        kernels.__file__,
+        layout.__file__,
+        os.path.join(here, "dopri.py"),
+        os.path.join(here, "tableau.py"),
+    ]
+    _numba.guard_cache([dopri_run, dopri_batch], sources)
+
+
+_guard()

@@ -105,7 +105,7 @@ def dead_zone(x: float, b: float) -> float:
     return x - min(max(x, -b), b)  # branch-free: the contact state is unpredictable
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")  # inlined at the single stage call site
 def planetary_rhs(t, y, p, dydt, obs):  # pragma: no cover - compiled
     """Minimal relative-coordinate equations of MODEL.md §7.
 
