@@ -76,5 +76,5 @@ def guard_cache(dispatchers: list[Any], sources: list[str]) -> None:
             os.makedirs(cache_dir, exist_ok=True)
             with open(stamp, "w") as f:
                 f.write(digest)
-        except Exception:  # noqa: BLE001 - best effort, never break an import
+        except Exception:  # best effort: never break an import
             continue
