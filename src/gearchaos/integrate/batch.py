@@ -104,6 +104,7 @@ def integrate_batch(
             raise ParameterError(f"y0 must have shape ({m}, {n}): got {Y0.shape}")
         if not np.all(np.isfinite(Y0)):
             raise ParameterError("y0 must be finite: got NaN or inf")
+    SW = np.ascontiguousarray(np.stack([s.switch_widths for s in systems]))
     periods_T = np.array([s.period for s in systems])
     omegas = np.array([s.omega for s in systems])
     t0 = np.zeros(m)
@@ -133,6 +134,7 @@ def integrate_batch(
         t_end,
         first.n_obs,
         first.n_track,
+        SW,
         float(rtol),
         float(atol),
         float(max_step),

@@ -41,6 +41,8 @@ MIN_FACTOR = 0.2
 MAX_FACTOR = 10.0
 ERR_EXPONENT = -1.0 / 5.0  # −1/(q+1), q = 4 the lower order of the pair
 
+SWITCH_MIN = 1e-6  # switches closer than this fraction to the step start are not re-located
+
 ST_OK = 0
 ST_MAX_STEPS = 1
 ST_UNDERFLOW = 2
@@ -127,6 +129,75 @@ def _track(obs_prev, obs, dt, n_track, omin, omax):  # pragma: no cover - compil
                     omax[k] = v
 
 
+@numba.njit(cache=True, inline="always")
+def _hermite(v0, v1, d0, d1, s):  # pragma: no cover - compiled
+    """Cubic Hermite interpolant on s ∈ [0, 1] (d0, d1 already multiplied by the step)."""
+    s2 = s * s
+    s3 = s2 * s
+    return (
+        (2.0 * s3 - 3.0 * s2 + 1.0) * v0
+        + (s3 - 2.0 * s2 + s) * d0
+        + (-2.0 * s3 + 3.0 * s2) * v1
+        + (s3 - s2) * d1
+    )
+
+
+@numba.njit(cache=True)
+def first_switch(obs_prev, obs, dt, n_track, sw):  # pragma: no cover - compiled
+    """Fraction θ ∈ (0, 1) of the step at which the first dead-zone switch obs_k = ±b_k is
+    crossed, located on the cubic Hermite interpolant of obs_k (Illinois iteration); 2.0 when
+    no observable changes contact state over the step."""
+    best = 2.0
+    for k in range(n_track):
+        b = sw[k]
+        if not b < np.inf:
+            continue
+        v0 = obs_prev[k]
+        v1 = obs[k]
+        r0 = 0 if v0 < -b else (2 if v0 > b else 1)
+        r1 = 0 if v1 < -b else (2 if v1 > b else 1)
+        if r0 == r1:
+            continue
+        if r0 == 2:
+            level = b
+        elif r0 == 0:
+            level = -b
+        else:
+            level = b if r1 == 2 else -b
+        d0 = obs_prev[n_track + k] * dt
+        d1 = obs[n_track + k] * dt
+        lo = 0.0
+        flo = v0 - level
+        hi = 1.0
+        fhi = v1 - level
+        side = 0
+        sc = 1e-15 * (abs(level) + abs(v0) + abs(v1))
+        x = 0.5
+        for _ in range(100):
+            if fhi == flo:
+                x = 0.5 * (lo + hi)
+            else:
+                x = (lo * fhi - hi * flo) / (fhi - flo)
+            fx = _hermite(v0, v1, d0, d1, x) - level
+            if abs(fx) <= sc or hi - lo < 1e-14:
+                break
+            if (fx > 0.0) == (fhi > 0.0):
+                hi = x
+                fhi = fx
+                if side == -1:
+                    flo *= 0.5
+                side = -1
+            else:
+                lo = x
+                flo = fx
+                if side == 1:
+                    fhi *= 0.5
+                side = 1
+        if x < best:
+            best = x
+    return best
+
+
 @numba.njit(cache=True)
 def dopri_run(
     kind,
@@ -139,6 +210,7 @@ def dopri_run(
     t_end,
     n_obs,
     n_track,
+    sw,
     rtol,
     atol,
     h_init,
@@ -156,8 +228,12 @@ def dopri_run(
 
     Samples are taken at τ_j = t_rec + j·dt_sample, j = 0 … n_samples−1 (t_rec ≥ t0), then the
     integration goes on to t_end ≥ τ_last. Extrema of obs[:n_track] are tracked over
-    [t_rec, t_end]. ``info`` (float64, length 4) receives accepted steps, rejected steps, the
-    final time reached and the next step size (to continue seamlessly).
+    [t_rec, t_end]. ``sw`` holds the half clearances b_k of the dead zones acting on the tracked
+    observables (``inf``: smooth); a step that crosses a switch obs_k = ±b_k is discarded and
+    retried so that it ends on the switch, so no step straddles a kink of the vector field
+    (DOPRI5's error estimate can miss a kink inside a step: 10–100× larger errors).
+    ``info`` (float64, length 4) receives accepted steps, rejected steps (including steps
+    discarded to land on a switch), the final time reached and the next step size.
     """
     numba.literally(kind)
     n = y0.size
@@ -205,6 +281,11 @@ def dopri_run(
     obs_prev[:] = obs
     last_rejected = False
     nonfinite = False
+    has_switch = False
+    for k in range(n_track):
+        if sw[k] < np.inf:
+            has_switch = True
+    h_event = -1.0
 
     while status == ST_OK:
         if j < n_samples:
@@ -221,10 +302,16 @@ def dopri_run(
             status = ST_NON_FINITE if nonfinite else ST_UNDERFLOW
             break
         clipped = False
+        event_step = False
         hs = h
-        if t + h >= target:
+        if h_event > 0.0:
+            hs = h_event
+            event_step = True
+            h_event = -1.0
+        if t + hs >= target:
             hs = target - t
             clipped = True
+            event_step = False
 
         t_new = target if clipped else t + hs
         # stages 2..7 from the tableau data; stage 7 is evaluated at (t_new, y_new) (FSAL)
@@ -260,6 +347,14 @@ def dopri_run(
             continue
         nonfinite = False
 
+        if err <= 1.0 and has_switch and not event_step:
+            theta = first_switch(obs_prev, obs, hs, n_track, sw)
+            if SWITCH_MIN < theta < 1.0:
+                # a contact switch lies inside the step: retry, ending exactly on it
+                h_event = theta * hs
+                n_rej += 1
+                continue
+
         if err <= 1.0:
             n_acc += 1
             if err == 0.0:
@@ -270,8 +365,8 @@ def dopri_run(
                 factor = 1.0
             last_rejected = False
             h_next = hs * factor
-            if clipped and h_next < h:
-                h_next = h  # restore the pre-clip proposal
+            if (clipped or event_step) and h_next < h:
+                h_next = h  # restore the proposal made before clipping to a sample or switch
             h = min(h_next, max_step)
             t = t_new
             for i in range(n):
@@ -315,6 +410,7 @@ def dopri_batch(
     t_end,
     n_obs,
     n_track,
+    SW,
     rtol,
     atol,
     max_step,
@@ -347,6 +443,7 @@ def dopri_batch(
             t_end[i],
             n_obs,
             n_track,
+            SW[i],
             rtol,
             atol,
             -1.0,

@@ -214,6 +214,15 @@ class SimulationResult(Trajectory):
                         "units": _DIMLESS,
                     },
                 )
+        for k, coord in ((2 * N, "x_s"), (2 * N + 1, "y_s")):
+            for which, arr in (("min", self.obs_min), ("max", self.obs_max)):
+                ds[f"{coord}_{which}"] = xr.DataArray(
+                    arr[k],
+                    attrs={
+                        "long_name": f"{which} of {coord} over the recorded window",
+                        "units": _DIMLESS,
+                    },
+                )
         # dynamic load factor: max mesh force over the static mean force T̄_D/N
         td, _ = model.parameters.loads(self.omega)
         static = td / N

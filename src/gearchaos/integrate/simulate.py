@@ -123,6 +123,7 @@ def integrate(
         float(t_end),
         system.n_obs,
         system.n_track,
+        system.switch_widths,
         float(rtol),
         float(atol),
         -1.0 if first_step is None else float(first_step),

@@ -110,7 +110,8 @@ def planetary_rhs(t, y, p, dydt, obs):  # pragma: no cover - compiled
     """Minimal relative-coordinate equations of MODEL.md §7.
 
     State y = (x̄_s, ȳ_s, p̄_1..p̄_N, σ̄, then their τ-derivatives).
-    obs = (δ̄_sp1..N, δ̄_rp1..N, δ̄'_sp1..N, δ̄'_rp1..N, F̄_sp1..N, F̄_rp1..N).
+    obs = (δ̄_sp1..N, δ̄_rp1..N, x̄_s, ȳ_s, then their τ-derivatives, then F̄_sp1..N, F̄_rp1..N):
+    the first 2N + 2 entries are the arguments of the dead zones (tracked and event-located).
     """
     N = int(p[P_N])
     n = N + 3
@@ -233,10 +234,10 @@ def planetary_rhs(t, y, p, dydt, obs):  # pragma: no cover - compiled
 
         obs[i] = dsp
         obs[N + i] = drp
-        obs[2 * N + i] = dsp_d
-        obs[3 * N + i] = drp_d
-        obs[4 * N + i] = fsp
-        obs[5 * N + i] = frp
+        obs[2 * N + 2 + i] = dsp_d
+        obs[3 * N + 2 + i] = drp_d
+        obs[4 * N + 4 + i] = fsp
+        obs[5 * N + 4 + i] = frp
         sum_fsp += fsp
         sum_frp += frp
         sum_fx += fsp * si
@@ -259,8 +260,12 @@ def planetary_rhs(t, y, p, dydt, obs):  # pragma: no cover - compiled
     dydt[n] = (sum_fx - cb * xd - kb * dead_zone(x, bs)) * inv_ms
     dydt[n + 1] = (sum_fy - cb * yd - kb * dead_zone(yy, bs)) * inv_ms
     qcp = cas * qc
+    obs[2 * N] = x
+    obs[2 * N + 1] = yy
+    obs[4 * N + 2] = xd
+    obs[4 * N + 3] = yd
     for i in range(N):
-        dydt[n + 2 + i] = qs + (obs[5 * N + i] - obs[4 * N + i]) * inv_mup - qcp
+        dydt[n + 2 + i] = qs + (obs[5 * N + 4 + i] - obs[4 * N + 4 + i]) * inv_mup - qcp
     dydt[n + N + 2] = qs - (cas + car) * qc
 
 

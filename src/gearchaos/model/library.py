@@ -79,6 +79,10 @@ class BacklashOscillator:
     def clearances(self) -> dict[str, float]:
         return {"x": self.b}
 
+    @property
+    def switch_widths(self) -> np.ndarray:
+        return np.array([self.b])
+
     def pack(self, omega: float) -> np.ndarray:
         p = np.zeros(L.BO_SIZE)
         p[L.BO_OMEGA] = omega

@@ -281,16 +281,27 @@ class PlanetaryModel:
         return (
             *(f"delta_sp_{i}" for i in N),
             *(f"delta_rp_{i}" for i in N),
+            "x_s",
+            "y_s",
             *(f"delta_sp_dot_{i}" for i in N),
             *(f"delta_rp_dot_{i}" for i in N),
+            "x_s_dot",
+            "y_s_dot",
             *(f"force_sp_{i}" for i in N),
             *(f"force_rp_{i}" for i in N),
         )
 
     @property
     def n_track(self) -> int:
-        """Extrema are tracked for the 2N mesh deflections."""
-        return 2 * self.n_planets
+        """Extrema are tracked, and dead-zone switches located, for the 2N mesh deflections
+        and the two sun-bearing displacements."""
+        return 2 * self.n_planets + 2
+
+    @property
+    def switch_widths(self) -> np.ndarray:
+        """Half clearances b of the dead zones f(·; b) of the tracked observables."""
+        par, N = self.parameters, self.n_planets
+        return np.array([par.b_sp] * N + [par.b_rp] * N + [par.b_s, par.b_s])
 
     @property
     def clearances(self) -> dict[str, float]:

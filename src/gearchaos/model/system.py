@@ -17,6 +17,12 @@ import numpy as np
 __all__ = ["Model", "System"]
 
 
+def _group_of(name: str) -> str | None:
+    """``"force_sp_3"`` → ``"force_sp"``; names without a planet index → None."""
+    head, _, tail = name.rpartition("_")
+    return head if tail.isdigit() else None
+
+
 @runtime_checkable
 class Model(Protocol):
     """What a dimensionless model provides to build a :class:`System`."""
@@ -102,6 +108,29 @@ class System:
     @property
     def n_track(self) -> int:
         return int(self.model.n_track)
+
+    def obs_indices(self, group: str) -> np.ndarray:
+        """Positions in ``obs_names`` of a per-planet group, e.g. ``"force_sp"`` →
+        indices of ``force_sp_1 … force_sp_N`` (in planet order); a plain name gives one index."""
+        names = self.obs_names
+        if group in names:
+            return np.array([names.index(group)])
+        idx = [k for k, nm in enumerate(names) if _group_of(nm) == group]
+        if not idx:
+            raise KeyError(f"no observable {group!r} or {group}_<i>; observables: {names}")
+        return np.array(sorted(idx, key=lambda k: int(names[k].rsplit("_", 1)[1])))
+
+    @property
+    def switch_widths(self) -> np.ndarray:
+        """Half clearances b_k of the dead zones acting on the tracked observables.
+
+        The integrator lands steps on the switches obs_k = ±b_k, where the vector field has a
+        kink; ``inf`` means the observable has no switch (smooth systems).
+        """
+        w = getattr(self.model, "switch_widths", None)
+        if w is None:
+            return np.full(self.n_track, np.inf)
+        return np.asarray(w, dtype=np.float64)
 
     @property
     def period(self) -> float:
