@@ -5,7 +5,8 @@ Run as ``python benchmarks/bench_simulate.py [--quick]``.
 The default gear set (``gearchaos.preset("sheng2016")``, N = 5) is simulated at
 Ω = 0.5, 1.5, 2.5, 3.5 with 100 transient + 100 recorded mesh periods, rtol 1e-8, atol 1e-10:
 
-* with :func:`gearchaos.simulate` (best of 3, after a warm-up run so numba compile time is
+* with :func:`gearchaos.simulate` (best of 7, the robust estimator on a shared machine,
+  after a warm-up run so numba compile time is
   excluded, pinned to one core with ``NUMBA_NUM_THREADS=1``);
 * with ``scipy.integrate.solve_ivp(method="RK45")`` on a plain, vectorised-numpy right-hand side
   of the same equations (MODEL.md §7, written here from the ``PlanetaryParameters`` of
@@ -246,7 +247,7 @@ class ScipyRun(Run):
     status: int = 0
 
 
-def run_gearchaos(gs: gearchaos.GearSet, omega: float, tr: int, rec: int, reps: int = 3) -> GcRun:
+def run_gearchaos(gs: gearchaos.GearSet, omega: float, tr: int, rec: int, reps: int = 7) -> GcRun:
     """Best of ``reps`` runs of :func:`gearchaos.simulate` (wall and CPU minimised separately)."""
     wall = cpu = math.inf
     res = None
