@@ -25,6 +25,7 @@ from .model import (
     nondimensionalise,
     planetary_system,
 )
+from .sweep import bifurcation, open_sweep
 
 __all__ = [
     "GearSet",
@@ -36,12 +37,14 @@ __all__ = [
     "System",
     "__version__",
     "backlash_oscillator",
+    "bifurcation",
     "duffing",
     "linear_oscillator",
     "linear_system",
     "lorenz",
     "nondimensionalise",
     "open_simulation",
+    "open_sweep",
     "planetary_system",
     "preset",
     "simulate",

@@ -27,7 +27,7 @@ import numpy as np
 from ..model.kernels import rhs
 from .tableau import DOPRI5
 
-__all__ = ["dopri_batch", "dopri_run"]
+__all__ = ["dopri_batch", "dopri_chains", "dopri_run"]
 
 # ---------------------------------------------------------------------------- constants from data
 STAGES = DOPRI5.stages
@@ -459,6 +459,78 @@ def dopri_batch(
         )
 
 
+@numba.njit(cache=True, parallel=True)
+def dopri_chains(
+    kind,
+    Y0,
+    P,
+    SW,
+    t_rec,
+    dt_sample,
+    n_samples,
+    t_end,
+    n_obs,
+    n_track,
+    rtol,
+    atol,
+    max_step,
+    max_steps,
+    continuation,
+    out_y,
+    out_obs,
+    obs_min,
+    obs_max,
+    y_final,
+    info,
+    status,
+):  # pragma: no cover - compiled
+    """Chains of integrations, ``numba.prange`` over chains, points of a chain in order.
+
+    Point j of chain c has parameters ``P[c, j]``; it starts from ``Y0[c]`` (fresh) or, with
+    ``continuation``, from the final state of point j−1 of the same chain (point 0 from
+    ``Y0[c]``); a failed point restarts its successor from ``Y0[c]``. Sample times are not
+    returned (they are t_rec + k·dt_sample). Every point runs :func:`dopri_run` unchanged, so
+    its result is bitwise identical to a single :func:`~gearchaos.integrate.integrate` call.
+    """
+    numba.literally(kind)
+    n_chains = P.shape[0]
+    length = P.shape[1]
+    for c in numba.prange(n_chains):
+        y = Y0[c].copy()
+        out_t = np.empty(n_samples)
+        for j in range(length):
+            st = dopri_run(
+                kind,
+                y,
+                P[c, j],
+                0.0,
+                t_rec[c, j],
+                dt_sample[c, j],
+                n_samples,
+                t_end[c, j],
+                n_obs,
+                n_track,
+                SW[c, j],
+                rtol,
+                atol,
+                -1.0,
+                max_step,
+                max_steps,
+                out_t,
+                out_y[c, j],
+                out_obs[c, j],
+                obs_min[c, j],
+                obs_max[c, j],
+                y_final[c, j],
+                info[c, j],
+            )
+            status[c, j] = st
+            if continuation and st == ST_OK:
+                y[:] = y_final[c, j]
+            else:
+                y[:] = Y0[c]
+
+
 def _guard() -> None:
     import os
 
@@ -472,7 +544,7 @@ def _guard() -> None:
         os.path.join(here, "dopri.py"),
         os.path.join(here, "tableau.py"),
     ]
-    _numba.guard_cache([dopri_run, dopri_batch], sources)
+    _numba.guard_cache([dopri_run, dopri_batch, dopri_chains], sources)
 
 
 _guard()

@@ -1,0 +1,16 @@
+"""Sweeps: bifurcation diagrams and 2-D maps over any parameter, resumable, on any executor."""
+
+from .run import bifurcation, run_sweep
+from .spec import Axis, SweepSpec, parse_axis, parse_values
+from .store import SweepStore, open_sweep
+
+__all__ = [
+    "Axis",
+    "SweepSpec",
+    "SweepStore",
+    "bifurcation",
+    "open_sweep",
+    "parse_axis",
+    "parse_values",
+    "run_sweep",
+]

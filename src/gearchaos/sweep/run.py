@@ -1,0 +1,528 @@
+"""Front door for sweeps: :func:`bifurcation`.
+
+``bifurcation(gearset, "omega=0.01:4:800", family={"xi": [0.03, 0.05, 0.07, 0.09]})`` runs one
+simulation per grid point with the seed's protocol (zero start, transient discarded, one
+Poincaré point per mesh period), in parallel, into a resumable Zarr store, and returns the
+result as an :class:`xarray.Dataset`.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import signal
+import threading
+import time
+from collections.abc import Iterator, Sequence
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError
+from .execute import InProcess, executor
+from .grid import Grid, Task
+from .spec import SweepSpec
+from .store import NOT_RUN, STATUS_MEANINGS, SweepStore
+
+__all__ = ["bifurcation", "run_sweep"]
+
+_PER_PLANET_STATES = ("p", "p_dot")
+
+
+def _resolve(system: Any, name: str, planets: Sequence[int]) -> tuple[str, np.ndarray, bool]:
+    """Where a variable lives: ("state"|"obs", column indices, per-planet?)."""
+    sn, on = system.state_names, system.obs_names
+    if name in sn:
+        return "state", np.array([sn.index(name)]), False
+    if name in on:
+        return "obs", np.array([on.index(name)]), False
+    n_pl = getattr(system.model, "n_planets", 0)
+    if n_pl and (name in _PER_PLANET_STATES or any(_group(o) == name for o in on)):
+        for p in planets:
+            if p > n_pl:
+                raise ParameterError(f"planets must be <= {n_pl} for this gear set: got {p}")
+    try:
+        cols = system.obs_indices(name)
+        return "obs", cols[np.asarray(planets) - 1], True
+    except KeyError:
+        pass
+    if n_pl and name in _PER_PLANET_STATES:
+        suffix = "_dot" if name.endswith("_dot") else ""
+        cols = np.array([sn.index(f"p_{p}{suffix}") for p in planets])
+        return "state", cols, True
+    import difflib
+
+    valid = sorted(set(sn) | set(on) | {g.rsplit("_", 1)[0] for g in on if g[-1].isdigit()})
+    close = difflib.get_close_matches(name, valid, n=1)
+    hint = f"; did you mean {close[0]!r}?" if close else ""
+    raise ParameterError(f"unknown observed variable {name!r}{hint}")
+
+
+def _group(name: str) -> str:
+    head, _, tail = name.rpartition("_")
+    return head if tail.isdigit() else name
+
+
+def _tracked_groups(system: Any) -> list[tuple[str, np.ndarray, bool]]:
+    """Tracked observables grouped: per-planet groups (delta_sp …) and scalars (x_s …)."""
+    names = system.obs_names[: system.n_track]
+    out: list[tuple[str, np.ndarray, bool]] = []
+    seen: set[str] = set()
+    for k, nm in enumerate(names):
+        head, _, tail = nm.rpartition("_")
+        if tail.isdigit():
+            if head not in seen:
+                seen.add(head)
+                idx = [j for j, m in enumerate(names) if m.rpartition("_")[0] == head]
+                out.append((head, np.array(idx), True))
+        else:
+            out.append((nm, np.array([k]), False))
+    return out
+
+
+class _Layout:
+    """Store variables of a sweep and how to fill them from kernel outputs."""
+
+    def __init__(self, grid: Grid):
+        spec, ref = grid.spec, grid.reference
+        self.grid = grid
+        self.lead_dims = grid.dims
+        self.lead_shape = grid.shape
+        self.observed = [(nm, *_resolve(ref, nm, spec.planets)) for nm in spec.observe]
+        self.tracked = _tracked_groups(ref)
+        self.n_planets = int(getattr(ref.model, "n_planets", 0))
+        self.state_names = ref.state_names
+
+    def variables(self) -> tuple[dict[str, Any], dict[str, tuple[int, ...]]]:
+        spec = self.grid.spec
+        lead, shp, ch = self.lead_dims, self.lead_shape, self.grid.chunks
+        ns, npl = int(spec.periods), len(spec.planets)
+        var: dict[str, Any] = {}
+        chunks: dict[str, tuple[int, ...]] = {}
+        for nm, _src, _cols, per_planet in self.observed:
+            dims = (*lead, "section", *(("planet",) if per_planet else ()))
+            shape = (*shp, ns, *((npl,) if per_planet else ()))
+            var[nm] = (dims, (shape, "float64"), np.nan, {"long_name": f"{nm} at the section"})
+            chunks[nm] = (*ch, ns, *((npl,) if per_planet else ()))
+        for nm, cols, per_planet in self.tracked:
+            for which in ("min", "max"):
+                dims = (*lead, *(("planet_all",) if per_planet else ()))
+                shape = (*shp, *((cols.size,) if per_planet else ()))
+                var[f"{nm}_{which}"] = (
+                    dims,
+                    (shape, "float64"),
+                    np.nan,
+                    {"long_name": f"{which} of {nm} over the recorded window"},
+                )
+                chunks[f"{nm}_{which}"] = (*ch, *((cols.size,) if per_planet else ()))
+        var["status"] = (
+            lead,
+            (shp, "int8"),
+            NOT_RUN,
+            {"flag_values": [0, 1, 2, 3, 4], "flag_meanings": STATUS_MEANINGS},
+        )
+        chunks["status"] = ch
+        for nm in ("steps_accepted", "steps_rejected"):
+            var[nm] = (lead, (shp, "int64"), -1, {"long_name": nm.replace("_", " ")})
+            chunks[nm] = ch
+        n = len(self.state_names)
+        var["final_state"] = (
+            (*lead, "state"),
+            ((*shp, n), "float64"),
+            np.nan,
+            {"long_name": "state at the end of the recorded window"},
+        )
+        chunks["final_state"] = (*ch, n)
+        return var, chunks
+
+    def extract(self, task: Task, out: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        """Block arrays of every variable for one finished task."""
+        spec = self.grid.spec
+        bshape = tuple(b.stop - b.start for b in task.block)
+        starts = tuple(b.start for b in task.block)
+        ns, npl = int(spec.periods), len(spec.planets)
+        data: dict[str, np.ndarray] = {}
+        for nm, _src, _cols, per_planet in self.observed:
+            data[nm] = np.full((*bshape, ns, *((npl,) if per_planet else ())), np.nan)
+        for nm, cols, per_planet in self.tracked:
+            for which in ("min", "max"):
+                data[f"{nm}_{which}"] = np.full(
+                    (*bshape, *((cols.size,) if per_planet else ())), np.nan
+                )
+        data["status"] = np.full(bshape, NOT_RUN, dtype=np.int8)
+        data["steps_accepted"] = np.full(bshape, -1, dtype=np.int64)
+        data["steps_rejected"] = np.full(bshape, -1, dtype=np.int64)
+        data["final_state"] = np.full((*bshape, len(self.state_names)), np.nan)
+        for c, chain in enumerate(task.chains):
+            for j, idx in enumerate(chain):
+                pos = tuple(i - s for i, s in zip(idx, starts, strict=True))
+                states = out["states"][c, j]
+                obs = out["observables"][c, j]
+                for nm, src, cols, per_planet in self.observed:
+                    v = (states if src == "state" else obs)[:, cols]
+                    data[nm][pos] = v if per_planet else v[:, 0]
+                for nm, cols, per_planet in self.tracked:
+                    lo, hi = out["obs_min"][c, j][cols], out["obs_max"][c, j][cols]
+                    data[f"{nm}_min"][pos] = lo if per_planet else lo[0]
+                    data[f"{nm}_max"][pos] = hi if per_planet else hi[0]
+                data["status"][pos] = out["status"][c, j]
+                data["steps_accepted"][pos] = int(out["info"][c, j, 0])
+                data["steps_rejected"][pos] = int(out["info"][c, j, 1])
+                data["final_state"][pos] = out["final_state"][c, j]
+        return data
+
+
+def _coords(grid: Grid, layout: _Layout) -> dict[str, tuple[tuple[str, ...], np.ndarray]]:
+    spec = grid.spec
+    c: dict[str, tuple[tuple[str, ...], np.ndarray]] = {}
+    if len(spec.directions) > 1:
+        c["direction"] = (("direction",), np.array(spec.directions, dtype="U4"))
+    for a in spec.axes:
+        c[a.name] = ((a.name,), np.array(a.values, dtype=float))
+    c["section"] = (("section",), np.arange(int(spec.periods)))
+    if any(per for *_, per in layout.observed):
+        c["planet"] = (("planet",), np.array(spec.planets, dtype=np.int64))
+    if any(per for *_, per in layout.tracked):
+        c["planet_all"] = (("planet_all",), np.arange(1, layout.n_planets + 1))
+    c["state"] = (("state",), np.array(layout.state_names, dtype="U16"))
+    return c
+
+
+def _attrs(target: Any, grid: Grid) -> dict[str, Any]:
+    from ..gearset import GearSet
+    from ..integrate.result import provenance
+
+    spec, ref = grid.spec, grid.reference
+    a: dict[str, Any] = {
+        "title": f"gearchaos sweep of {ref.name}",
+        "model": ref.model.name if not isinstance(target, GearSet) else "planetary",
+        "gearset_toml": target.to_toml() if isinstance(target, GearSet) else "",
+        "model_parameters": "" if isinstance(target, GearSet) else repr(target.model),
+        "sweep_toml": spec.to_toml(),
+        "rtol": float(spec.rtol),
+        "atol": float(spec.atol),
+        "transient_periods": float(spec.transient_periods),
+        "periods": int(spec.periods),
+        "initial_conditions": spec.initial_conditions,
+        "direction": spec.direction,
+        "dims": list(grid.dims),
+        **provenance(),
+    }
+    model = ref.model
+    if hasattr(model, "scales"):
+        a["omega_n_rad_s"] = float(model.scales.omega_n)
+        a["characteristic_length_m"] = float(model.scales.length)
+    for k, v in getattr(model, "clearances", {}).items():
+        a[f"clearance_{k}"] = float(v)
+    return a
+
+
+@contextlib.contextmanager
+def _sigterm_as_interrupt() -> Iterator[None]:
+    """SIGTERM behaves like Ctrl-C during a sweep, so finished chunks stay in the store."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def handler(signum: int, frame: Any) -> None:
+        raise KeyboardInterrupt(f"signal {signum}")
+
+    old = signal.signal(signal.SIGTERM, handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, old)
+
+
+def _merge(arrs: list[dict[str, Any]]) -> dict[str, Any]:
+    out = dict(arrs[0])
+    for k in ("Y0", "P", "SW", "t_rec", "dt", "t_end"):
+        out[k] = np.concatenate([a[k] for a in arrs], axis=0)
+    return out
+
+
+def _split(res: dict[str, np.ndarray], sizes: list[int]) -> list[dict[str, np.ndarray]]:
+    out, start = [], 0
+    for s in sizes:
+        out.append({k: v[start : start + s] for k, v in res.items()})
+        start += s
+    return out
+
+
+def run_sweep(
+    target: Any,
+    spec: SweepSpec,
+    *,
+    store: str | os.PathLike[str] | None = None,
+    overwrite: bool = False,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    dask_local: int | None = None,
+    progress: bool = True,
+    chunk_points: int | None = None,
+) -> Any:
+    """Run (or resume) a sweep described by ``spec``; return its :class:`xarray.Dataset`."""
+    grid = Grid(target, spec, chunk_points=chunk_points)
+    layout = _Layout(grid)
+    st = SweepStore(store)
+    attrs = _attrs(target, grid)
+    identity = {k: attrs[k] for k in ("model", "gearset_toml", "model_parameters", "sweep_toml")}
+    if st.exists() and overwrite:
+        st.remove()
+    if st.exists():
+        st.check_same(identity)
+        if st.attrs().get("complete"):
+            return st.open()
+    elif store is not None and os.path.exists(os.fspath(store)):
+        if overwrite:
+            st.remove()
+        else:
+            raise ParameterError(
+                f"{os.fspath(store)} exists and is not a gearchaos sweep store; "
+                "choose another path or pass overwrite=True (--overwrite)"
+            )
+    if not st.exists():
+        variables, chunks = layout.variables()
+        st.create(_coords(grid, layout), variables, chunks, attrs)
+
+    done = st.done_tasks()
+    todo = [t for t in grid.tasks() if t.index not in done]
+    n_total = int(np.prod(grid.shape))
+    n_done = n_total - sum(t.n_points for t in todo)
+    bar = _progress(progress, n_total, n_done)
+    try:
+        with (
+            _sigterm_as_interrupt(),
+            bar,
+            executor(workers, scheduler, dask_local) as (ex, fn, desc),
+        ):
+            bar.describe(desc)
+            if isinstance(ex, InProcess):
+                _run_in_process(todo, grid, layout, st, fn, bar)
+            else:
+                _run_pool(todo, grid, layout, st, ex, fn, bar, workers or dask_local or 8)
+    except KeyboardInterrupt:
+        raise
+    st.finish()
+    return st.open()
+
+
+def _run_in_process(
+    todo: list[Task], grid: Grid, layout: _Layout, st: SweepStore, fn: Any, bar: Any
+) -> None:
+    import numba
+
+    want = 2 * numba.get_num_threads()
+    i = 0
+    while i < len(todo):
+        group = [todo[i]]
+        chains = len(todo[i].chains)
+        L = max(len(c) for c in todo[i].chains)
+        i += 1
+        while i < len(todo) and chains < want and max(len(c) for c in todo[i].chains) == L:
+            group.append(todo[i])
+            chains += len(todo[i].chains)
+            i += 1
+        arrs = [grid.task_arrays(t) for t in group]
+        res = fn(_merge(arrs) if len(arrs) > 1 else arrs[0])
+        parts = _split(res, [len(t.chains) for t in group]) if len(group) > 1 else [res]
+        for t, part in zip(group, parts, strict=True):
+            st.write(t.index, t.block, layout.extract(t, part))
+            bar.advance(t.n_points, int(np.sum(part["status"] != 0)))
+
+
+def _run_pool(
+    todo: list[Task],
+    grid: Grid,
+    layout: _Layout,
+    st: SweepStore,
+    ex: Any,
+    fn: Any,
+    bar: Any,
+    width: int,
+) -> None:
+    import concurrent.futures as cf
+
+    it = iter(todo)
+    inflight: dict[Any, Task] = {}
+
+    def submit_next() -> bool:
+        t = next(it, None)
+        if t is None:
+            return False
+        inflight[ex.submit(fn, grid.task_arrays(t))] = t
+        return True
+
+    for _ in range(2 * int(width)):
+        if not submit_next():
+            break
+    try:
+        while inflight:
+            finished, _ = cf.wait(list(inflight), return_when=cf.FIRST_COMPLETED)
+            for fut in finished:
+                t = inflight.pop(fut)
+                res = fut.result()
+                st.write(t.index, t.block, layout.extract(t, res))
+                bar.advance(t.n_points, int(np.sum(res["status"] != 0)))
+                submit_next()
+    finally:
+        for fut in inflight:
+            fut.cancel()
+
+
+class _Bar:
+    """Rich progress bar (points done, points/s, ETA) on stderr; silent when disabled."""
+
+    def __init__(self, enabled: bool, total: int, done: int):
+        self.enabled = enabled
+        self.total, self.done, self.failed = total, done, 0
+        self.t0 = time.perf_counter()
+        self.started_at = done
+        self._p: Any = None
+
+    def __enter__(self) -> _Bar:
+        if self.enabled:
+            from rich.console import Console
+            from rich.progress import (
+                BarColumn,
+                MofNCompleteColumn,
+                Progress,
+                TextColumn,
+                TimeElapsedColumn,
+                TimeRemainingColumn,
+            )
+
+            self._p = Progress(
+                TextColumn("[bold]sweep[/] {task.description}"),
+                BarColumn(),
+                MofNCompleteColumn(),
+                TextColumn("points · {task.fields[rate]} points/s · failed {task.fields[failed]}"),
+                TimeElapsedColumn(),
+                TextColumn("ETA"),
+                TimeRemainingColumn(),
+                console=Console(stderr=True),
+            )
+            self._p.__enter__()
+            self._id = self._p.add_task(
+                "", total=self.total, completed=self.done, rate="–", failed=0
+            )
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        if self._p is not None:
+            self._p.__exit__(*exc)
+
+    def describe(self, text: str) -> None:
+        if self._p is not None:
+            self._p.update(self._id, description=f"({text})")
+
+    def advance(self, n: int, failed: int) -> None:
+        self.done += n
+        self.failed += failed
+        if self._p is not None:
+            dt = time.perf_counter() - self.t0
+            rate = (self.done - self.started_at) / dt if dt > 0 else 0.0
+            self._p.update(self._id, advance=n, rate=f"{rate:.1f}", failed=self.failed)
+
+
+def _progress(enabled: bool, total: int, done: int) -> _Bar:
+    return _Bar(enabled, total, done)
+
+
+def _default_observe(target: Any) -> tuple[str, ...]:
+    from ..gearset import GearSet
+
+    if isinstance(target, GearSet) or hasattr(getattr(target, "model", None), "n_planets"):
+        return ("delta_sp", "delta_sp_dot")
+    names, nt = target.obs_names, target.n_track
+    return (names[0], names[nt]) if len(names) > nt else (names[0],)
+
+
+def bifurcation(
+    target: Any,
+    vary: Any,
+    *,
+    family: Any = None,
+    fixed: dict[str, Any] | None = None,
+    observe: Sequence[str] | None = None,
+    planets: Sequence[int] = (1,),
+    initial_conditions: str = "fresh",
+    direction: str = "up",
+    transient_periods: float = 100,
+    periods: int = 100,
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    store: str | os.PathLike[str] | None = None,
+    overwrite: bool = False,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    dask_local: int | None = None,
+    progress: bool = True,
+) -> Any:
+    """Bifurcation diagram (or 2-D map) data: Poincaré sections over a parameter grid.
+
+    Parameters
+    ----------
+    target
+        A :class:`~gearchaos.gearset.GearSet` or a :class:`~gearchaos.model.System`.
+    vary
+        One or two axes: ``"omega=0.01:4:800"``, a list of such strings, or a mapping
+        ``{"backlash.planet_ring": numpy_array}``. Syntax: ``start:stop:count``,
+        ``log:start:stop:count`` or ``a,b,c``.
+    family
+        One more axis drawn as separate panels (e.g. ``{"xi": [0.03, 0.05, 0.07, 0.09]}``).
+    fixed
+        Fixed overrides by dotted name, ``omega`` included when it is not swept.
+    observe, planets
+        Variables of :func:`gearchaos.simulate`'s dataset stored at every section point, and the
+        planets of the per-planet ones. Default: X̄_sp1 and X̄'_sp1 (``delta_sp``,
+        ``delta_sp_dot``) for gear sets; the first tracked observable and its derivative (e.g.
+        ``x``, ``x_dot``) for reference systems.
+    initial_conditions, direction
+        ``fresh`` (zero state everywhere, the seed's protocol) or ``continuation`` along the
+        first varied axis, ``up``, ``down`` or ``both`` (shows hysteresis).
+    transient_periods, periods, rtol, atol
+        Protocol and tolerances, as in :func:`gearchaos.simulate`.
+    store
+        Path of a Zarr store. Written chunk by chunk; an interrupted sweep (Ctrl-C, SIGTERM,
+        SIGKILL) resumes when called again with the same arguments; other settings are refused
+        unless ``overwrite``. ``None`` keeps the result in memory.
+    workers, scheduler, dask_local
+        Executor: N local processes, a ``dask.distributed`` scheduler address, or a local Dask
+        cluster of N workers. Default: in-process on all cores. Results are bitwise identical
+        whatever the executor.
+    progress
+        Show a progress bar (points, points/s, ETA) on stderr.
+
+    Returns
+    -------
+    xarray.Dataset
+        Dimensions: (``direction``,) family axis, varied axes, ``section``, ``planet``; per
+        point ``status``, step counts, extrema of every mesh deflection and the final state.
+        Attributes carry the gear set, the sweep specification, the solver settings and versions.
+    """
+    if observe is None:
+        observe = _default_observe(target)
+    spec = SweepSpec.build(
+        vary,
+        family=family,
+        fixed=fixed,
+        observe=tuple(observe),
+        planets=tuple(planets),
+        initial_conditions=initial_conditions,
+        direction=direction,
+        transient_periods=transient_periods,
+        periods=periods,
+        rtol=rtol,
+        atol=atol,
+    )
+    return run_sweep(
+        target,
+        spec,
+        store=store,
+        overwrite=overwrite,
+        workers=workers,
+        scheduler=scheduler,
+        dask_local=dask_local,
+        progress=progress,
+    )

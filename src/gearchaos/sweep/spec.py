@@ -1,0 +1,314 @@
+"""Sweep specification: axes addressed by stable dotted names.
+
+An axis is a dotted parameter name and its values: ``omega`` (the dimensionless mesh frequency
+Ω), ``xi`` (all three damping ratios), any gear-set field (``backlash.sun_planet``,
+``backlash.planet_ring``, ``clearance.sun_bearing``, ``torque.input``,
+``transmission_error.sun_planet`` …; see :func:`gearchaos.gearset.io.field_names`) or, for a
+reference system, any field of its model (``zeta``, ``f_alt`` …).
+
+Value syntax (CLI and Python alike):
+
+* ``start:stop:count`` — ``count`` linearly spaced values including both ends;
+* ``log:start:stop:count`` — logarithmically spaced;
+* ``a,b,c`` — an explicit list.
+
+A :class:`SweepSpec` holds up to two varied axes (``vary``; two make a 2-D map), an optional
+``family`` axis (one diagram per value, like the seed's panels a–d), fixed overrides
+(``fixed``), the observed variables and planets, the initial-condition protocol and the solver
+settings. It serialises to TOML (stored in every sweep store as ``sweep_toml``) so a store can
+be checked against the command that would resume it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError
+
+__all__ = ["Axis", "SweepSpec", "parse_axis", "parse_values"]
+
+INITIAL_CONDITIONS = ("fresh", "continuation")
+DIRECTIONS = ("up", "down", "both")
+DEFAULT_OBSERVE = ("delta_sp", "delta_sp_dot")
+
+
+def parse_values(name: str, text: str | float | Sequence[float] | np.ndarray) -> tuple[float, ...]:
+    """Values of an axis from ``start:stop:count``, ``log:start:stop:count``, ``a,b,c``, a
+    number or a sequence. Errors name the axis, the rule and the value."""
+    if isinstance(text, str):
+        t = text.strip()
+        try:
+            if t.startswith("log:"):
+                a, b, n = t[4:].split(":")
+                lo, hi, cnt = float(a), float(b), int(n)
+                if lo <= 0 or hi <= 0:
+                    raise ParameterError(f"{name}: log spacing needs positive bounds: got {text!r}")
+                vals = np.geomspace(lo, hi, cnt)
+            elif ":" in t:
+                parts = t.split(":")
+                if len(parts) != 3:
+                    raise ParameterError(
+                        f"{name} must be start:stop:count, log:start:stop:count or a,b,c: "
+                        f"got {text!r}"
+                    )
+                a, b, n = parts
+                vals = np.linspace(float(a), float(b), int(n))
+                cnt = int(n)
+            else:
+                vals = np.array([float(v) for v in t.split(",") if v.strip()])
+                cnt = vals.size
+        except ValueError as exc:
+            raise ParameterError(
+                f"{name} must be start:stop:count, log:start:stop:count or a,b,c: got {text!r}"
+            ) from exc
+        if cnt < 1:
+            raise ParameterError(f"{name} needs at least one value: got {text!r}")
+    elif isinstance(text, int | float | np.floating | np.integer):
+        vals = np.array([float(text)])
+    else:
+        vals = np.asarray(text, dtype=float).ravel()
+    if vals.size < 1:
+        raise ParameterError(f"{name} needs at least one value: got {text!r}")
+    if not np.all(np.isfinite(vals)):
+        raise ParameterError(f"{name} values must be finite: got {vals.tolist()}")
+    return tuple(float(v) for v in vals)
+
+
+@dataclass(frozen=True)
+class Axis:
+    """A swept parameter: dotted ``name`` and its ``values``."""
+
+    name: str
+    values: tuple[float, ...]
+
+    def __post_init__(self) -> None:
+        if not self.name or not isinstance(self.name, str):
+            raise ParameterError(f"axis name must be a non-empty string: got {self.name!r}")
+        if len(self.values) < 1:
+            raise ParameterError(f"axis {self.name} needs at least one value")
+
+    def __len__(self) -> int:
+        return len(self.values)
+
+
+def parse_axis(item: str | tuple[str, Any] | Axis) -> Axis:
+    """``"omega=0.1:4:800"`` or ``("omega", values)`` or an :class:`Axis`."""
+    if isinstance(item, Axis):
+        return item
+    if isinstance(item, str):
+        if "=" not in item:
+            raise ParameterError(
+                f"an axis must be NAME=VALUES (e.g. omega=0.1:4:800): got {item!r}"
+            )
+        name, _, text = item.partition("=")
+        name = name.strip()
+        return Axis(name, parse_values(name, text))
+    name, vals = item
+    return Axis(str(name), parse_values(str(name), vals))
+
+
+def _axes(items: Any) -> tuple[Axis, ...]:
+    if items is None:
+        return ()
+    if isinstance(items, Mapping):
+        return tuple(parse_axis((k, v)) for k, v in items.items())
+    if isinstance(items, str | Axis):
+        return (parse_axis(items),)
+    return tuple(parse_axis(i) for i in items)
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    """Everything that defines a sweep's numbers (not how it is executed).
+
+    Parameters
+    ----------
+    vary
+        One or two axes (two give a 2-D map).
+    family
+        Optional family axis: one diagram per value; becomes the first dimension.
+    fixed
+        Fixed overrides by dotted name (``omega`` too, when it is not swept).
+    observe
+        Variables of :func:`gearchaos.simulate`'s dataset whose section values are stored.
+    planets
+        Observed planets (1-based) of the per-planet variables.
+    initial_conditions
+        ``fresh`` (zero state at every point, the seed's protocol) or ``continuation`` (each
+        point starts from the previous point's final state along the first varied axis).
+    direction
+        For continuation: ``up``, ``down`` or ``both`` (an extra ``direction`` dimension).
+    """
+
+    vary: tuple[Axis, ...]
+    family: Axis | None = None
+    fixed: tuple[tuple[str, Any], ...] = ()
+    observe: tuple[str, ...] = DEFAULT_OBSERVE
+    planets: tuple[int, ...] = (1,)
+    initial_conditions: str = "fresh"
+    direction: str = "up"
+    transient_periods: float = 100
+    periods: int = 100
+    rtol: float = 1e-8
+    atol: float = 1e-10
+    lyapunov: bool = False
+    extra: tuple[tuple[str, Any], ...] = field(default=())
+
+    def __post_init__(self) -> None:
+        if not 1 <= len(self.vary) <= 2:
+            raise ParameterError(
+                f"vary must have one or two axes (two make a 2-D map): got {len(self.vary)}"
+            )
+        names = [a.name for a in self.axes]
+        dup = {n for n in names if names.count(n) > 1}
+        if dup:
+            raise ParameterError(f"each parameter may be swept once: {sorted(dup)} repeated")
+        for k, _ in self.fixed:
+            if k in names:
+                raise ParameterError(f"{k} is both swept and fixed (--set); choose one")
+        if self.initial_conditions not in INITIAL_CONDITIONS:
+            raise ParameterError(
+                f"initial_conditions must be one of {INITIAL_CONDITIONS}: "
+                f"got {self.initial_conditions!r}"
+            )
+        if self.direction not in DIRECTIONS:
+            raise ParameterError(f"direction must be one of {DIRECTIONS}: got {self.direction!r}")
+        if self.direction != "up" and self.initial_conditions == "fresh":
+            raise ParameterError(
+                f"direction={self.direction!r} needs initial_conditions='continuation' "
+                "(fresh starts do not depend on the sweep direction)"
+            )
+        if not self.observe:
+            raise ParameterError("observe must name at least one variable")
+        if not self.planets or any(int(p) < 1 for p in self.planets):
+            raise ParameterError(f"planets must be 1-based planet numbers: got {self.planets}")
+        if not (isinstance(self.periods, int) and self.periods >= 1):
+            raise ParameterError(f"periods must be an integer >= 1: got {self.periods!r}")
+        if not (math.isfinite(self.transient_periods) and self.transient_periods >= 0):
+            raise ParameterError(f"transient_periods must be >= 0: got {self.transient_periods!r}")
+
+    @classmethod
+    def build(
+        cls,
+        vary: Any,
+        *,
+        family: Any = None,
+        fixed: Mapping[str, Any] | None = None,
+        **kwargs: Any,
+    ) -> SweepSpec:
+        """Convenience constructor from strings, mappings or sequences (see module doc)."""
+        fam = _axes(family)
+        if len(fam) > 1:
+            raise ParameterError(f"family must be a single axis: got {len(fam)}")
+        if "observe" in kwargs:
+            kwargs["observe"] = tuple(kwargs["observe"])
+        if "planets" in kwargs:
+            kwargs["planets"] = tuple(int(p) for p in kwargs["planets"])
+        return cls(
+            vary=_axes(vary),
+            family=fam[0] if fam else None,
+            fixed=tuple(sorted((fixed or {}).items())),
+            **kwargs,
+        )
+
+    # ------------------------------------------------------------------ grid
+    @property
+    def axes(self) -> tuple[Axis, ...]:
+        """Family first (if any), then the varied axes: the leading store dimensions."""
+        return ((self.family,) if self.family is not None else ()) + self.vary
+
+    @property
+    def directions(self) -> tuple[str, ...]:
+        if self.initial_conditions == "continuation" and self.direction == "both":
+            return ("up", "down")
+        return (self.direction,)
+
+    @property
+    def dims(self) -> tuple[str, ...]:
+        """Leading dimensions of the store: (``direction``,) when both, then the axes."""
+        lead = ("direction",) if len(self.directions) > 1 else ()
+        return lead + tuple(a.name for a in self.axes)
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        lead = (len(self.directions),) if len(self.directions) > 1 else ()
+        return lead + tuple(len(a) for a in self.axes)
+
+    @property
+    def n_points(self) -> int:
+        return int(np.prod(self.shape))
+
+    # ------------------------------------------------------------------ TOML
+    def to_toml(self) -> str:
+        """Canonical TOML text (values written with ``repr``: exact)."""
+
+        def val(v: Any) -> str:
+            if isinstance(v, bool):
+                return "true" if v else "false"
+            if isinstance(v, int | np.integer):
+                return str(int(v))
+            if isinstance(v, float | np.floating):
+                return repr(float(v))
+            if isinstance(v, str):
+                return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+            if isinstance(v, list | tuple):
+                return "[" + ", ".join(val(x) for x in v) + "]"
+            raise TypeError(f"cannot write {v!r} to TOML")
+
+        lines = [
+            f"initial_conditions = {val(self.initial_conditions)}",
+            f"direction = {val(self.direction)}",
+            f"transient_periods = {val(float(self.transient_periods))}",
+            f"periods = {val(self.periods)}",
+            f"rtol = {val(float(self.rtol))}",
+            f"atol = {val(float(self.atol))}",
+            f"lyapunov = {val(self.lyapunov)}",
+            f"observe = {val(list(self.observe))}",
+            f"planets = {val(list(self.planets))}",
+            "",
+        ]
+        for a in self.vary:
+            lines += ["[[vary]]", f"name = {val(a.name)}", f"values = {val(list(a.values))}", ""]
+        if self.family is not None:
+            lines += [
+                "[family]",
+                f"name = {val(self.family.name)}",
+                f"values = {val(list(self.family.values))}",
+                "",
+            ]
+        if self.fixed:
+            lines.append("[fixed]")
+            lines += [f'"{k}" = {val(v)}' for k, v in self.fixed]
+            lines.append("")
+        if self.extra:
+            lines.append("[extra]")
+            lines += [f'"{k}" = {val(v)}' for k, v in self.extra]
+            lines.append("")
+        return "\n".join(lines)
+
+    @classmethod
+    def from_toml(cls, text: str) -> SweepSpec:
+        import tomllib
+
+        d = tomllib.loads(text)
+        fam = d.get("family")
+        return cls(
+            vary=tuple(Axis(a["name"], tuple(float(x) for x in a["values"])) for a in d["vary"]),
+            family=Axis(fam["name"], tuple(float(x) for x in fam["values"])) if fam else None,
+            fixed=tuple(sorted(d.get("fixed", {}).items())),
+            observe=tuple(d["observe"]),
+            planets=tuple(int(p) for p in d["planets"]),
+            initial_conditions=d["initial_conditions"],
+            direction=d["direction"],
+            transient_periods=d["transient_periods"],
+            periods=int(d["periods"]),
+            rtol=d["rtol"],
+            atol=d["atol"],
+            lyapunov=bool(d.get("lyapunov", False)),
+            extra=tuple(sorted(d.get("extra", {}).items())),
+        )

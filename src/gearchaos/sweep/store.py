@@ -1,0 +1,201 @@
+"""The sweep result store: Zarr, written chunk by chunk, resumable after any interruption.
+
+Layout: one Zarr array per variable with dimension names for xarray, leading dimensions
+``spec.dims``, then ``section`` / ``planet`` / ``planet_all`` / ``state`` as the variable
+needs. Each task writes only its own Zarr chunks, then drops a marker file
+``_progress/<task>.done``. A task without a marker is (re)computed on resume, so a chunk half
+written when the process was killed (even with SIGKILL) is simply written again; results are
+deterministic, so the final store equals an uninterrupted run's. When every task is done the
+markers are removed and the attribute ``complete`` becomes true.
+
+Every store carries its provenance: the gear set (``gearset_toml``), the sweep specification
+(``sweep_toml``), the solver settings and the versions of gearchaos, numba and numpy.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+from typing import Any
+
+import numpy as np
+
+from ..errors import StoreError
+
+__all__ = ["SweepStore", "open_sweep"]
+
+PROGRESS = "_progress"
+STATUS_MEANINGS = "ok max_steps step_underflow non_finite not_run"
+NOT_RUN = 4
+
+
+def open_sweep(path: str | os.PathLike[str]) -> Any:
+    """Open a sweep store as an :class:`xarray.Dataset` (lazy, no dask needed)."""
+    import xarray as xr
+
+    return xr.open_zarr(os.fspath(path), chunks=None, consolidated=True)
+
+
+class SweepStore:
+    """Creates, checks and fills a sweep store."""
+
+    def __init__(self, path: str | os.PathLike[str] | None):
+        self.path = None if path is None else os.fspath(path)
+        self._memory: Any = None
+
+    # ------------------------------------------------------------------ identity
+    @property
+    def zarr_store(self) -> Any:
+        if self.path is not None:
+            return self.path
+        if self._memory is None:
+            import zarr
+
+            self._memory = zarr.storage.MemoryStore()
+        return self._memory
+
+    def exists(self) -> bool:
+        return self.path is not None and os.path.exists(os.path.join(self.path, "zarr.json"))
+
+    def attrs(self) -> dict[str, Any]:
+        import zarr
+
+        return dict(zarr.open_group(self.zarr_store, mode="r").attrs)
+
+    def check_same(self, identity: dict[str, Any]) -> None:
+        """Refuse to resume a store made with other settings (name what differs)."""
+        old = self.attrs()
+        diffs = []
+        for k, v in identity.items():
+            if old.get(k) != v:
+                if k == "sweep_toml" and isinstance(old.get(k), str):
+                    diffs.append(_toml_diff(old[k], v, "sweep"))
+                elif k == "gearset_toml" and isinstance(old.get(k), str):
+                    diffs.append(_toml_diff(old[k], v, "gear set"))
+                else:
+                    diffs.append(f"{k}: store has {old.get(k)!r}, now {v!r}")
+        if diffs:
+            raise StoreError(
+                f"{self.path} holds a sweep with other settings ("
+                + "; ".join(diffs)
+                + "). Use another output path, or overwrite=True (--overwrite) to replace it."
+            )
+
+    def remove(self) -> None:
+        if self.path is not None and os.path.exists(self.path):
+            if not os.path.isdir(self.path):
+                raise StoreError(f"{self.path} exists and is not a directory")
+            shutil.rmtree(self.path)
+
+    # ------------------------------------------------------------------ creation
+    def create(
+        self,
+        coords: dict[str, tuple[tuple[str, ...], np.ndarray]],
+        variables: dict[str, tuple[tuple[str, ...], Any, Any, dict[str, Any]]],
+        chunks: dict[str, tuple[int, ...]],
+        attrs: dict[str, Any],
+    ) -> None:
+        """Coordinates are written whole; data variables are created empty (fill value)."""
+        import xarray as xr
+        import zarr
+
+        if self.path is not None:
+            parent = os.path.dirname(os.path.abspath(self.path))
+            os.makedirs(parent, exist_ok=True)
+        ds = xr.Dataset(coords={k: (d, v) for k, (d, v) in coords.items()})
+        ds.attrs.update(attrs)
+        ds.attrs["complete"] = False
+        ds.to_zarr(self.zarr_store, mode="w", consolidated=False)
+        g = zarr.open_group(self.zarr_store, mode="a")
+        for name, (dims, shape_dtype, fill, vattrs) in variables.items():
+            shape, dtype = shape_dtype
+            g.create_array(
+                name,
+                shape=shape,
+                chunks=chunks[name],
+                dtype=dtype,
+                fill_value=fill,
+                dimension_names=list(dims),
+                attributes=vattrs,
+            )
+        zarr.consolidate_metadata(self.zarr_store)
+        if self.path is not None:
+            os.makedirs(os.path.join(self.path, PROGRESS), exist_ok=True)
+
+    # ------------------------------------------------------------------ progress
+    def done_tasks(self) -> set[int]:
+        if self.path is None:
+            return set()
+        d = os.path.join(self.path, PROGRESS)
+        if not os.path.isdir(d):
+            return set()
+        out = set()
+        for name in os.listdir(d):
+            if name.endswith(".done"):
+                try:
+                    out.add(int(name[:-5]))
+                except ValueError:
+                    continue
+        return out
+
+    def write(self, task_index: int, block: tuple[slice, ...], data: dict[str, np.ndarray]) -> None:
+        """Write a task's block of every variable, then mark the task done."""
+        import zarr
+
+        g = zarr.open_group(self.zarr_store, mode="a", use_consolidated=False)
+        for name, values in data.items():
+            arr = g[name]
+            assert isinstance(arr, zarr.Array)
+            sl = block + (slice(None),) * (arr.ndim - len(block))
+            arr[sl] = values
+        if self.path is not None:
+            marker = os.path.join(self.path, PROGRESS, f"{task_index}.done")
+            with open(marker, "w"):
+                pass
+
+    def finish(self) -> None:
+        import zarr
+
+        g = zarr.open_group(self.zarr_store, mode="a", use_consolidated=False)
+        g.attrs["complete"] = True
+        zarr.consolidate_metadata(self.zarr_store)
+        if self.path is not None:
+            shutil.rmtree(os.path.join(self.path, PROGRESS), ignore_errors=True)
+
+    def open(self) -> Any:
+        import xarray as xr
+
+        return xr.open_zarr(self.zarr_store, chunks=None, consolidated=True)
+
+
+def _toml_diff(old: str, new: str, what: str) -> str:
+    import tomllib
+
+    def flat(d: dict[str, Any], prefix: str = "") -> dict[str, Any]:
+        out: dict[str, Any] = {}
+        for k, v in d.items():
+            key = f"{prefix}{k}"
+            if isinstance(v, dict):
+                out.update(flat(v, key + "."))
+            elif isinstance(v, list) and v and isinstance(v[0], dict):
+                for i, item in enumerate(v):
+                    out.update(flat(item, f"{key}[{i}]."))
+            else:
+                out[key] = v
+        return out
+
+    try:
+        a, b = flat(tomllib.loads(old)), flat(tomllib.loads(new))
+    except Exception:
+        return f"{what} differs"
+    keys = sorted(k for k in set(a) | set(b) if a.get(k) != b.get(k))
+    shown = []
+    for k in keys[:4]:
+        va, vb = a.get(k), b.get(k)
+        if isinstance(va, list) and len(va) > 6:
+            va = f"[{len(va)} values {va[0]}..{va[-1]}]"
+        if isinstance(vb, list) and len(vb) > 6:
+            vb = f"[{len(vb)} values {vb[0]}..{vb[-1]}]"
+        shown.append(f"{k}: store has {va!r}, now {vb!r}")
+    more = f" (+{len(keys) - 4} more)" if len(keys) > 4 else ""
+    return f"{what} differs: " + ", ".join(shown) + more
