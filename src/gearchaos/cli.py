@@ -1,4 +1,5 @@
-"""Command-line interface: ``gearchaos simulate | info | presets | init-gearset``.
+"""Command-line interface: ``gearchaos simulate | bifurcation | plot | reproduce | info |
+presets | init-gearset``.
 
 Every command takes the gear set the same way: ``--preset NAME`` (default ``sheng2016``) or
 ``--gearset FILE.toml`` (one of the two), then any number of ``--set NAME=VALUE`` changes by
@@ -8,9 +9,10 @@ frequency Ω = ω/ω_n) is a simulation setting, not a gear-set field, but is gi
 ``--set omega=1.5`` as well, so that a command line reads like a point of a sweep.
 
 Exit codes: 0 success; 2 invalid input (unknown or invalid parameter, conflicting options,
-missing gear-set file) — the message names the parameter, the rule and the value and suggests
-the closest valid name; 1 the integration failed or a file could not be written. Errors are
-reported on stderr as one line, never as a traceback.
+missing gear-set file, a sweep store made with other settings) — the message names the
+parameter, the rule and the value and suggests the closest valid name; 1 the integration failed
+or a file could not be written; 130 a sweep interrupted with Ctrl-C (its store keeps every
+finished chunk). Errors are reported on stderr as one line, never as a traceback.
 """
 
 from __future__ import annotations
@@ -34,7 +36,7 @@ from rich.table import Table
 from rich.text import Text
 
 from . import __version__
-from .errors import IntegrationError, ParameterError
+from .errors import IntegrationError, ParameterError, StoreError
 
 if TYPE_CHECKING:
     from .gearset import GearSet
@@ -48,14 +50,22 @@ DEFAULT_PRESET = "sheng2016"
 
 EXIT_FAILURE = 1
 EXIT_INVALID = 2
+EXIT_INTERRUPTED = 130
+
+#: Figures of the seed paper that ``gearchaos reproduce`` knows.
+PAPER_FIGURES = ("fig4", "fig6", "fig8", "fig9", "fig11", "fig12")
+INTERRUPTED_MESSAGE = (
+    "interrupted: the store keeps every finished chunk; run the same command again to resume"
+)
 
 app = typer.Typer(
     name="gearchaos",
     help=(
         "Nonlinear dynamics of planetary gear trains with backlash and bearing clearance: "
-        "simulate a gear set at a mesh frequency, inspect its linear properties, manage "
-        "gear-set files. Parameters are addressed by dotted names (backlash.sun_planet, "
-        "teeth.sun, xi, ...), the same as in Python and in result files."
+        "simulate a gear set at a mesh frequency, sweep any parameter into bifurcation "
+        "diagrams and maps, reproduce the seed paper's figures, inspect linear properties, "
+        "manage gear-set files. Parameters are addressed by dotted names "
+        "(backlash.sun_planet, teeth.sun, xi, ...), the same as in Python and in result files."
     ),
     no_args_is_help=True,
     add_completion=False,
@@ -84,7 +94,7 @@ def _reported_errors() -> Iterator[None]:
     """Turn the package's exceptions into one line on stderr and an exit code."""
     try:
         yield
-    except ParameterError as exc:
+    except (ParameterError, StoreError) as exc:
         _fail(str(exc), EXIT_INVALID)
     except FileNotFoundError as exc:
         _fail(str(exc), EXIT_INVALID)
@@ -641,6 +651,404 @@ def _info_renderables(data: Mapping[str, Any]) -> list[Any]:
     if groups:
         out.append(Columns(groups, padding=(0, 2)))
     return [*out, *lists]
+
+
+# --------------------------------------------------------------------------- bifurcation
+QuietOpt = Annotated[
+    bool, typer.Option("--quiet", "-q", help="No progress bar and no summary (errors only).")
+]
+
+
+def _parse_planets(raw: str | None) -> tuple[int, ...]:
+    if raw is None:
+        return (1,)
+    items = [item.strip() for item in raw.split(",") if item.strip()]
+    if not items:
+        raise ParameterError(f"--planets must be planet numbers such as 1,2: got {raw!r}")
+    planets = tuple(_parse_int("--planets", item) for item in items)
+    bad = [p for p in planets if p < 1]
+    if bad:
+        raise ParameterError(f"--planets must be planet numbers >= 1: got {raw!r}")
+    return planets
+
+
+def _axis_name(item: str) -> str:
+    return item.partition("=")[0].strip()
+
+
+@contextlib.contextmanager
+def _interruptible() -> Iterator[None]:
+    """Ctrl-C (and SIGTERM, which the sweep engine turns into it) → one line and exit 130."""
+    try:
+        yield
+    except KeyboardInterrupt:
+        _fail(INTERRUPTED_MESSAGE, EXIT_INTERRUPTED)
+
+
+def _sweep_counts(ds: Any) -> tuple[int, int]:
+    """(points, failed) of a sweep dataset: every grid point, and those with status 1–3."""
+    status = np.asarray(ds["status"].values)
+    failed = int(np.sum((status != 0) & (status != 4)))
+    return int(status.size), failed
+
+
+@app.command()
+def bifurcation(
+    output: Annotated[
+        Path,
+        typer.Option(
+            "--output",
+            "-o",
+            help=(
+                "Zarr store to write (a directory, e.g. run.zarr). Written chunk by chunk; run "
+                "the same command again after an interruption to resume."
+            ),
+            show_default=False,
+        ),
+    ],
+    vary: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--vary",
+            "-v",
+            help=(
+                "NAME=VALUES, once (bifurcation diagram) or twice (2-D map): VALUES is "
+                "start:stop:count, log:start:stop:count or a,b,c; NAME is omega, xi or a "
+                "dotted gear-set parameter, e.g. omega=0.05:4:800, backlash.planet_ring=1:16:300."
+            ),
+            show_default=False,
+        ),
+    ] = None,
+    family: Annotated[
+        str | None,
+        typer.Option(
+            "--family",
+            "-f",
+            help="NAME=VALUES: one diagram per value, e.g. xi=0.03,0.05,0.07,0.09.",
+            show_default=False,
+        ),
+    ] = None,
+    preset: PresetOpt = None,
+    gearset: GearsetOpt = None,
+    set_: SetOpt = None,
+    observe: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--observe",
+            help=(
+                "Variable stored at every section point, repeatable: delta_sp, delta_sp_dot, "
+                "delta_rp, delta_rp_dot, x_s, y_s, ... Default: delta_sp and delta_sp_dot."
+            ),
+            show_default=False,
+        ),
+    ] = None,
+    planets: Annotated[
+        str | None,
+        typer.Option(
+            "--planets", help="Observed planets, comma-separated (default 1).", show_default=False
+        ),
+    ] = None,
+    ic: Annotated[
+        str,
+        typer.Option(
+            "--ic",
+            help=(
+                "Initial conditions: fresh (zero state at every point, the seed's protocol) or "
+                "continuation (each point starts from the previous point's final state)."
+            ),
+        ),
+    ] = "fresh",
+    direction: Annotated[
+        str,
+        typer.Option(
+            "--direction",
+            help="up, down or both (continuation only; both overlays the branches).",
+        ),
+    ] = "up",
+    transient: Annotated[
+        float, typer.Option("--transient", help="Mesh periods discarded at every point.")
+    ] = 100.0,
+    periods: Annotated[
+        int,
+        typer.Option("--periods", help="Mesh periods recorded at every point (section points)."),
+    ] = 100,
+    rtol: Annotated[
+        float, typer.Option("--rtol", help="Relative tolerance (Dormand–Prince 5(4)).")
+    ] = 1e-8,
+    atol: Annotated[float, typer.Option("--atol", help="Absolute tolerance.")] = 1e-10,
+    workers: Annotated[
+        int | None,
+        typer.Option(
+            "--workers",
+            "-w",
+            help="Local worker processes (default: in-process on all cores).",
+            show_default=False,
+        ),
+    ] = None,
+    scheduler: Annotated[
+        str | None,
+        typer.Option(
+            "--scheduler",
+            help="Address of a running dask.distributed scheduler, e.g. tcp://HOST:8786.",
+            show_default=False,
+        ),
+    ] = None,
+    dask_local: Annotated[
+        int | None,
+        typer.Option(
+            "--dask-local",
+            help="Start a local Dask cluster with N workers on this machine.",
+            show_default=False,
+        ),
+    ] = None,
+    overwrite: Annotated[
+        bool,
+        typer.Option("--overwrite", help="Replace an existing store made with other settings."),
+    ] = False,
+    quiet: QuietOpt = False,
+    json_out: JsonOpt = False,
+) -> None:
+    """Sweep one or two parameters and store the Poincaré section values of every point.
+
+    Every grid point is one simulation with the seed's protocol (MODEL.md §8): TRANSIENT mesh
+    periods discarded, PERIODS recorded with one section point each. The store (Zarr, opened
+    by xarray.open_zarr or gearchaos.open_sweep) holds the section values, status and step
+    counts per point and the full gear set and settings. Ω is a parameter like any other:
+    sweep it with **--vary omega=...**, or fix it with **--set omega=...**; when it is neither
+    swept nor set, Ω = **1.5**. Draw the result with **gearchaos plot STORE -o fig.png**.
+
+    Example (the seed's Fig. 4): **gearchaos bifurcation --vary omega=0.05:4:800
+    --family xi=0.03,0.05,0.07,0.09 -o fig4.zarr**
+    """
+    with _reported_errors(), _interruptible():
+        if not vary:
+            raise ParameterError(
+                "--vary is required: give NAME=VALUES once (e.g. --vary omega=0.1:4:800) "
+                "or twice for a 2-D map"
+            )
+        if len(vary) > 2:
+            raise ParameterError(
+                f"--vary may be given once or twice (two make a 2-D map): got {len(vary)}"
+            )
+        if ic not in ("fresh", "continuation"):
+            raise ParameterError(f"--ic must be fresh or continuation: got {ic!r}")
+        if direction not in ("up", "down", "both"):
+            raise ParameterError(f"--direction must be up, down or both: got {direction!r}")
+        if direction != "up" and ic != "continuation":
+            raise ParameterError(
+                f"--direction {direction} needs --ic continuation "
+                "(fresh starts do not depend on the sweep direction)"
+            )
+        omega, changes = parse_sets(set_ or [])
+        gs = _gearset(preset, gearset, {})
+        swept = {_axis_name(v) for v in vary} | ({_axis_name(family)} if family else set())
+        fixed: dict[str, Any] = dict(changes)
+        for name in swept & set(fixed):
+            raise ParameterError(f"{name} is both swept and set with --set; choose one")
+        if "omega" not in swept:
+            if omega is None:
+                omega = DEFAULT_OMEGA
+                if not (quiet or json_out):
+                    _stderr().print(
+                        Text(
+                            f"Ω = {DEFAULT_OMEGA:g} (not swept; change it with --set omega=...)",
+                            style="dim",
+                        )
+                    )
+            fixed["omega"] = omega
+        elif omega is not None:
+            raise ParameterError("omega is both swept and set with --set; choose one")
+
+        import time
+
+        from .sweep import bifurcation as run_bifurcation
+
+        t0 = time.perf_counter()
+        ds = run_bifurcation(
+            gs,
+            list(vary),
+            family=family,
+            fixed=fixed,
+            observe=tuple(observe) if observe else ("delta_sp", "delta_sp_dot"),
+            planets=_parse_planets(planets),
+            initial_conditions=ic,
+            direction=direction,
+            transient_periods=transient,
+            periods=periods,
+            rtol=rtol,
+            atol=atol,
+            store=output,
+            overwrite=overwrite,
+            workers=workers,
+            scheduler=scheduler,
+            dask_local=dask_local,
+            progress=not quiet,
+        )
+        seconds = time.perf_counter() - t0
+        points, failed = _sweep_counts(ds)
+
+    result = {"store": str(output), "points": points, "failed": failed, "seconds": seconds}
+    if json_out:
+        _print_json(result)
+        return
+    if quiet:
+        return
+    table = _pairs_table(f"gearchaos bifurcation of {gs.name}")
+    dims = [d for d in ds["status"].dims]
+    table.add_row("grid", escape(" × ".join(f"{d} ({ds.sizes[d]})" for d in dims)))
+    table.add_row("points", str(points))
+    table.add_row("failed", Text(str(failed), style="bold red" if failed else ""))
+    table.add_row("seconds", f"{seconds:.3g}")
+    if seconds > 0:
+        table.add_row("points/s", f"{points / seconds:.3g}")
+    table.add_row("store", escape(str(output)))
+    out = _stdout()
+    out.print(table)
+    out.print(
+        Text(
+            f"{transient:g} transient + {periods} recorded mesh periods, {ic} initial "
+            f"conditions, rtol {rtol:g}, atol {atol:g}",
+            style="dim",
+        )
+    )
+    out.print(Text(f"next: gearchaos plot {output} -o {output.stem}.png", style="dim"))
+
+
+# --------------------------------------------------------------------------- plot
+@app.command()
+def plot(
+    store: Annotated[
+        Path,
+        typer.Argument(help="Sweep store written by `gearchaos bifurcation`.", show_default=False),
+    ],
+    output: Annotated[
+        Path,
+        typer.Option("--output", "-o", help="Figure file: .png, .pdf or .svg.", show_default=False),
+    ],
+    var: Annotated[
+        str,
+        typer.Option(
+            "--var", help="Section variable: delta_sp (X̄_sp), delta_sp_dot, delta_rp, x_s, ..."
+        ),
+    ] = "delta_sp",
+    planet: Annotated[int, typer.Option("--planet", help="Planet of per-planet variables.")] = 1,
+    clearance: Annotated[
+        bool,
+        typer.Option("--clearance-lines", help="Dashed lines at ±b̄ of the variable's clearance."),
+    ] = False,
+    resonances: Annotated[
+        bool,
+        typer.Option(
+            "--resonances",
+            help="Vertical lines where the 1st–3rd mesh harmonic meets a natural frequency "
+            "(Ω sweeps).",
+        ),
+    ] = False,
+) -> None:
+    """Draw a sweep store: bifurcation diagrams (one panel per family value) for a 1-D sweep,
+    maps coloured by the number of distinct section points (1T, 2T, …, many) for a 2-D sweep.
+
+    Example: **gearchaos plot fig4.zarr -o fig4.png --clearance-lines**
+    """
+    from .plot.figure import SAVE_FORMATS
+
+    with _reported_errors():
+        if output.suffix.lower() not in SAVE_FORMATS:
+            raise ParameterError(
+                f"--output must end in one of {', '.join(SAVE_FORMATS)}: got {str(output)!r}"
+            )
+        ds = _open_store(store)
+        import matplotlib
+
+        matplotlib.use("Agg")
+        from .plot import savefig, sweep_figure
+
+        fig = sweep_figure(
+            ds, var=var, planet=planet, clearance_lines=clearance, resonances=resonances
+        )
+        if output.parent != Path(""):
+            output.parent.mkdir(parents=True, exist_ok=True)
+        savefig(fig, output)
+    _stdout().print(Text.assemble(("wrote ", "dim"), (str(output), "bold")))
+
+
+def _open_store(path: Path) -> Any:
+    """Open a sweep store; a missing or unreadable one is invalid input (exit 2)."""
+    if not path.exists():
+        raise ParameterError(f"store not found: {str(path)!r}")
+    from .sweep import open_sweep
+
+    try:
+        ds = open_sweep(path)
+    except Exception as exc:  # zarr raises several types for a directory that is no store
+        raise ParameterError(f"{str(path)!r} is not a readable sweep store: {exc}") from None
+    if "status" not in ds.data_vars:
+        raise ParameterError(f"{str(path)!r} is not a gearchaos sweep store (no 'status')")
+    return ds
+
+
+# --------------------------------------------------------------------------- reproduce
+@app.command()
+def reproduce(
+    figure: Annotated[
+        str,
+        typer.Argument(
+            help=f"Figure of the seed paper: {', '.join(PAPER_FIGURES)}.", show_default=False
+        ),
+    ],
+    output: Annotated[
+        Path,
+        typer.Option(
+            "--output",
+            "-o",
+            help="Directory for FIG.png and the sweep store FIG.zarr; created if missing.",
+            file_okay=False,
+        ),
+    ] = Path("."),
+    quick: Annotated[
+        bool, typer.Option("--quick", help="A coarse version (fewer points and periods), for CI.")
+    ] = False,
+    quiet: QuietOpt = False,
+    json_out: JsonOpt = False,
+) -> None:
+    """Run the exact sweep of one of the seed paper's bifurcation figures with the default gear
+    set and draw it in the paper's layout (resumable like `gearchaos bifurcation`).
+
+    fig4: Ω sweep, ξ = 0.03, 0.05, 0.07, 0.09; fig6: b̄_sp at Ω = 1.5 for four ξ; fig8: b̄_sp at
+    ξ = 0.11 for Ω = 1, 1.5, 2, 2.5; fig9: b̄_rp at Ω = 1.5 for four ξ; fig11: b̄_rp at ξ = 0.11
+    for four Ω; fig12: b̄_s at ξ = 0.05, Ω = 1.5.
+
+    Example: **gearchaos reproduce fig4 -o paper/ --quick**
+    """
+    with _reported_errors(), _interruptible():
+        name = figure.strip().lower()
+        if name not in PAPER_FIGURES:
+            close = difflib.get_close_matches(name, PAPER_FIGURES, n=1)
+            hint = f"; did you mean {close[0]!r}?" if close else ""
+            raise ParameterError(
+                f"FIG must be one of {', '.join(PAPER_FIGURES)}: got {figure!r}{hint}"
+            )
+        try:
+            from .paper.recipes import reproduce as run_recipe
+        except ImportError as exc:
+            _fail(f"the paper recipes are not available in this installation: {exc}", EXIT_FAILURE)
+        output.mkdir(parents=True, exist_ok=True)
+        result = dict(run_recipe(name, output, quick=quick, progress=not quiet))
+    if json_out:
+        _print_json(result)
+        return
+    if quiet:
+        return
+    table = _pairs_table(f"gearchaos reproduce {name}" + (" (quick)" if quick else ""))
+    for key in ("figure", "store", "points", "failed", "seconds"):
+        if key in result:
+            value = result[key]
+            text = f"{value:.3g}" if key == "seconds" and isinstance(value, float) else str(value)
+            table.add_row(key, escape(text))
+    for key, value in result.items():
+        if key not in ("figure", "store", "points", "failed", "seconds"):
+            table.add_row(escape(str(key)), escape(_fmt(value)))
+    _stdout().print(table)
 
 
 # --------------------------------------------------------------------------- presets, init-gearset

@@ -1,6 +1,6 @@
 """The sweep result store: Zarr, written chunk by chunk, resumable after any interruption.
 
-Layout: one Zarr array per variable with dimension names for xarray, leading dimensions
+Layout (Zarr format 2): one array per variable with xarray's ``_ARRAY_DIMENSIONS``, leading dimensions
 ``spec.dims``, then ``section`` / ``planet`` / ``planet_all`` / ``state`` as the variable
 needs. Each task writes only its own Zarr chunks, then drops a marker file
 ``_progress/<task>.done``. A task without a marker is (re)computed on resume, so a chunk half
@@ -55,7 +55,7 @@ class SweepStore:
         return self._memory
 
     def exists(self) -> bool:
-        return self.path is not None and os.path.exists(os.path.join(self.path, "zarr.json"))
+        return self.path is not None and os.path.exists(os.path.join(self.path, ".zgroup"))
 
     def attrs(self) -> dict[str, Any]:
         import zarr
@@ -105,8 +105,10 @@ class SweepStore:
         ds = xr.Dataset(coords={k: (d, v) for k, (d, v) in coords.items()})
         ds.attrs.update(attrs)
         ds.attrs["complete"] = False
-        ds.to_zarr(self.zarr_store, mode="w", consolidated=False)
-        g = zarr.open_group(self.zarr_store, mode="a")
+        # Zarr format 2: consolidated metadata and string coordinates are part of its
+        # specification (format 3 still flags both as unstable)
+        ds.to_zarr(self.zarr_store, mode="w", consolidated=False, zarr_format=2)
+        g = zarr.open_group(self.zarr_store, mode="a", zarr_format=2)
         for name, (dims, shape_dtype, fill, vattrs) in variables.items():
             shape, dtype = shape_dtype
             g.create_array(
@@ -115,8 +117,7 @@ class SweepStore:
                 chunks=chunks[name],
                 dtype=dtype,
                 fill_value=fill,
-                dimension_names=list(dims),
-                attributes=vattrs,
+                attributes={**vattrs, "_ARRAY_DIMENSIONS": list(dims)},
             )
         zarr.consolidate_metadata(self.zarr_store)
         if self.path is not None:
@@ -156,11 +157,11 @@ class SweepStore:
     def finish(self) -> None:
         import zarr
 
+        if self.path is not None:  # before consolidating: zarr would list it as a stray node
+            shutil.rmtree(os.path.join(self.path, PROGRESS), ignore_errors=True)
         g = zarr.open_group(self.zarr_store, mode="a", use_consolidated=False)
         g.attrs["complete"] = True
         zarr.consolidate_metadata(self.zarr_store)
-        if self.path is not None:
-            shutil.rmtree(os.path.join(self.path, PROGRESS), ignore_errors=True)
 
     def open(self) -> Any:
         import xarray as xr
