@@ -24,7 +24,7 @@ import math
 import numba
 import numpy as np
 
-from ..model.kernels import rhs
+from ..model.kernels import rhs, tangent
 from .tableau import DOPRI5
 
 __all__ = ["dopri_batch", "dopri_chains", "dopri_run"]
@@ -50,9 +50,8 @@ ST_NON_FINITE = 3
 
 
 @numba.njit(cache=True, inline="always")
-def _scaled_norm(v, y, ynew, rtol, atol):  # pragma: no cover - compiled
+def _scaled_norm(v, y, ynew, rtol, atol, n):  # pragma: no cover - compiled
     acc = 0.0
-    n = v.size
     for i in range(n):
         sc = atol + rtol * max(abs(y[i]), abs(ynew[i]))
         r = v[i] / sc
@@ -61,10 +60,9 @@ def _scaled_norm(v, y, ynew, rtol, atol):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def initial_step(kind, t, y, f0, p, rtol, atol, obs):  # pragma: no cover - compiled
-    """Hairer's starting step (HNW I, §II.4) for the 5(4) pair."""
+def initial_step(kind, t, y, f0, p, rtol, atol, obs, n):  # pragma: no cover - compiled
+    """Hairer's starting step (HNW I, §II.4) for the 5(4) pair, from the first n components."""
     numba.literally(kind)
-    n = y.size
     d0 = 0.0
     d1 = 0.0
     for i in range(n):
@@ -75,7 +73,7 @@ def initial_step(kind, t, y, f0, p, rtol, atol, obs):  # pragma: no cover - comp
     d1 = math.sqrt(d1 / n)
     h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
     y1 = y + h0 * f0
-    f1 = np.empty(n)
+    f1 = np.empty(y.size)
     rhs(kind, t + h0, y1, p, f1, obs)
     d2 = 0.0
     for i in range(n):
@@ -199,6 +197,39 @@ def first_switch(obs_prev, obs, dt, n_track, sw):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
+def _renormalize(kind, t, y, p, obs, K, kbuf, n, k, lsum, tan_on):  # pragma: no cover - compiled
+    """Tangent vectors in y[n:]: set them orthonormal (first call) or re-orthonormalise them by
+    modified Gram–Schmidt, adding log stretch factors to ``lsum``; refresh their FSAL stage."""
+    numba.literally(kind)
+    if not tan_on:
+        for r in range(k):
+            o = n + r * n
+            for i in range(n):
+                y[o + i] = 1.0 if i == r else 0.0
+    else:
+        for r in range(k):
+            o = n + r * n
+            for q in range(r):
+                oq = n + q * n
+                d = 0.0
+                for i in range(n):
+                    d += y[o + i] * y[oq + i]
+                for i in range(n):
+                    y[o + i] -= d * y[oq + i]
+            nrm = 0.0
+            for i in range(n):
+                nrm += y[o + i] * y[o + i]
+            nrm = math.sqrt(nrm)
+            lsum[r] += math.log(nrm)
+            for i in range(n):
+                y[o + i] /= nrm
+    tangent(kind, t, y, p, obs, kbuf, n, k)
+    for i in range(n, y.size):
+        K[0, i] = kbuf[i]
+    return True
+
+
+@numba.njit(cache=True)
 def dopri_run(
     kind,
     y0,
@@ -211,6 +242,7 @@ def dopri_run(
     n_obs,
     n_track,
     sw,
+    n_base,
     rtol,
     atol,
     h_init,
@@ -223,6 +255,7 @@ def dopri_run(
     obs_max,
     y_final,
     info,
+    lsum,
 ):  # pragma: no cover - compiled
     """Integrate one system; fill the output arrays; return the status code.
 
@@ -234,6 +267,13 @@ def dopri_run(
     (DOPRI5's error estimate can miss a kink inside a step: 10–100× larger errors).
     ``info`` (float64, length 4) receives accepted steps, rejected steps (including steps
     discarded to land on a switch), the final time reached and the next step size.
+
+    Lyapunov exponents: with ``k = lsum.size > 0`` the state holds ``n_base`` system
+    components followed by k tangent vectors, integrated with the variational equations
+    (:func:`~gearchaos.model.kernels.tangent`). They start orthonormal at the first sample and
+    are re-orthonormalised (modified Gram–Schmidt) at every later sample; ``lsum`` accumulates
+    the logarithms of the stretch factors. Step-size control uses the system components only,
+    so the trajectory is bitwise the same with or without tangents.
     """
     numba.literally(kind)
     n = y0.size
@@ -250,7 +290,12 @@ def dopri_run(
         obs_max[k] = -np.inf
 
     t = t0
+    n_tan = lsum.size
+    tan_on = False
+    for r in range(n_tan):
+        lsum[r] = 0.0
     rhs(kind, t, y, p, kbuf, obs)
+    kbuf[n_base:] = 0.0
     k1 = K[0]
     k1[:] = kbuf
     n_acc = 0
@@ -262,7 +307,7 @@ def dopri_run(
     h = h_init
     if status == ST_OK and h <= 0.0:
         obs_prev[:] = obs
-        h = initial_step(kind, t, y, k1, p, rtol, atol, obs)
+        h = initial_step(kind, t, y, k1, p, rtol, atol, obs, n_base)
         obs[:] = obs_prev  # the observables of the current point
     if h > max_step:
         h = max_step
@@ -270,6 +315,8 @@ def dopri_run(
     j = 0
     tracking = False
     if status == ST_OK and n_samples > 0 and t >= t_rec:
+        if n_tan > 0:
+            tan_on = _renormalize(kind, t, y, p, obs, K, kbuf, n_base, n_tan, lsum, tan_on)
         out_t[0] = t
         out_y[0, :] = y
         out_obs[0, :] = obs
@@ -323,6 +370,11 @@ def dopri_run(
                 yt[i] = y[i] + hs * acc
             ts = t_new if s == STAGES - 1 else t + TAB_C[s] * hs
             rhs(kind, ts, yt, p, kbuf, obs)
+            if n_tan > 0:
+                if tan_on:
+                    tangent(kind, ts, yt, p, obs, kbuf, n_base, n_tan)
+                else:
+                    kbuf[n_base:] = 0.0
             for i in range(n):
                 K[s, i] = kbuf[i]
         for i in range(n):
@@ -331,7 +383,7 @@ def dopri_run(
             for q in range(STAGES):
                 acc += TAB_E[q] * K[q, i]
             ev[i] = hs * acc
-        err = _scaled_norm(ev, y, ynew, rtol, atol)
+        err = _scaled_norm(ev, y, ynew, rtol, atol, n_base)
 
         finite = math.isfinite(err)
         if finite:
@@ -375,6 +427,8 @@ def dopri_run(
             if tracking:
                 _track(obs_prev, obs, hs, n_track, obs_min, obs_max)
             if clipped and j < n_samples:
+                if n_tan > 0:
+                    tan_on = _renormalize(kind, t, y, p, obs, K, kbuf, n_base, n_tan, lsum, tan_on)
                 out_t[j] = t
                 out_y[j, :] = y
                 out_obs[j, :] = obs
@@ -444,6 +498,7 @@ def dopri_batch(
             n_obs,
             n_track,
             SW[i],
+            Y0.shape[1],
             rtol,
             atol,
             -1.0,
@@ -456,6 +511,7 @@ def dopri_batch(
             obs_max[i],
             y_final[i],
             info[i],
+            np.empty(0),
         )
 
 
@@ -471,6 +527,7 @@ def dopri_chains(
     t_end,
     n_obs,
     n_track,
+    n_base,
     rtol,
     atol,
     max_step,
@@ -483,12 +540,15 @@ def dopri_chains(
     y_final,
     info,
     status,
+    LSUM,
 ):  # pragma: no cover - compiled
     """Chains of integrations, ``numba.prange`` over chains, points of a chain in order.
 
     Point j of chain c has parameters ``P[c, j]``; it starts from ``Y0[c]`` (fresh) or, with
     ``continuation``, from the final state of point j−1 of the same chain (point 0 from
-    ``Y0[c]``); a failed point restarts its successor from ``Y0[c]``. Sample times are not
+    ``Y0[c]``); a failed point restarts its successor from ``Y0[c]``. ``LSUM[c, j]`` (k ≥ 0
+    entries) receives the Lyapunov log sums when the state carries k tangent vectors after its
+    ``n_base`` system components. Sample times are not
     returned (they are t_rec + k·dt_sample). Every point runs :func:`dopri_run` unchanged, so
     its result is bitwise identical to a single :func:`~gearchaos.integrate.integrate` call.
     """
@@ -511,6 +571,7 @@ def dopri_chains(
                 n_obs,
                 n_track,
                 SW[c, j],
+                n_base,
                 rtol,
                 atol,
                 -1.0,
@@ -523,6 +584,7 @@ def dopri_chains(
                 obs_max[c, j],
                 y_final[c, j],
                 info[c, j],
+                LSUM[c, j],
             )
             status[c, j] = st
             if continuation and st == ST_OK:

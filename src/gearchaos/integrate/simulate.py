@@ -124,6 +124,7 @@ def integrate(
         system.n_obs,
         system.n_track,
         system.switch_widths,
+        n,
         float(rtol),
         float(atol),
         -1.0 if first_step is None else float(first_step),
@@ -136,6 +137,7 @@ def integrate(
         omax,
         yf,
         info,
+        np.empty(0),
     )
     status = Status(int(code))
     settings = {

@@ -96,7 +96,7 @@ from .layout import (
     P_ZS,
 )
 
-__all__ = ["dead_zone", "observe_many", "rhs"]
+__all__ = ["dead_zone", "observe_many", "rhs", "tangent"]
 
 
 @numba.njit(cache=True, inline="always")
@@ -110,8 +110,9 @@ def planetary_rhs(t, y, p, dydt, obs):  # pragma: no cover - compiled
     """Minimal relative-coordinate equations of MODEL.md §7.
 
     State y = (x̄_s, ȳ_s, p̄_1..p̄_N, σ̄, then their τ-derivatives).
-    obs = (δ̄_sp1..N, δ̄_rp1..N, x̄_s, ȳ_s, then their τ-derivatives, then F̄_sp1..N, F̄_rp1..N):
-    the first 2N + 2 entries are the arguments of the dead zones (tracked and event-located).
+    obs = (δ̄_sp1..N, δ̄_rp1..N, x̄_s, ȳ_s, then their τ-derivatives, then F̄_sp1..N, F̄_rp1..N,
+    then the mesh stiffnesses κ_sp1..N, κ_rp1..N): the first 2N + 2 entries are the arguments of
+    the dead zones (tracked and event-located); the stiffnesses feed the tangent equations.
     """
     N = int(p[P_N])
     n = N + 3
@@ -238,6 +239,8 @@ def planetary_rhs(t, y, p, dydt, obs):  # pragma: no cover - compiled
         obs[3 * N + 2 + i] = drp_d
         obs[4 * N + 4 + i] = fsp
         obs[5 * N + 4 + i] = frp
+        obs[6 * N + 4 + i] = ksp
+        obs[7 * N + 4 + i] = krp
         sum_fsp += fsp
         sum_frp += frp
         sum_fx += fsp * si
@@ -271,7 +274,8 @@ def planetary_rhs(t, y, p, dydt, obs):  # pragma: no cover - compiled
 
 @numba.njit(cache=True)
 def backlash_oscillator_rhs(t, y, p, dydt, obs):  # pragma: no cover - compiled
-    """x'' + 2ζx' + (1 + ε cos Ωτ) f(x; b) = F_m + F_a Ω^q cos Ωτ; obs = (x, x', contact force)."""
+    """x'' + 2ζx' + (1 + ε cos Ωτ) f(x; b) = F_m + F_a Ω^q cos Ωτ;
+    obs = (x, x', contact force, stiffness 1 + ε cos Ωτ)."""
     c = math.cos(p[BO_OMEGA] * t)
     x = y[0]
     v = y[1]
@@ -281,6 +285,7 @@ def backlash_oscillator_rhs(t, y, p, dydt, obs):  # pragma: no cover - compiled
     obs[0] = x
     obs[1] = v
     obs[2] = fc
+    obs[3] = 1.0 + p[BO_EPS] * c
 
 
 @numba.njit(cache=True)
@@ -328,6 +333,146 @@ def lorenz_rhs(t, y, p, dydt, obs):  # pragma: no cover - compiled
     for i in range(3):
         obs[i] = y[i]
         obs[3 + i] = dydt[i]
+
+
+# ----------------------------------------------------------------------------- tangents
+# Variational equations V' = J(τ, y) V for Lyapunov exponents. The vector fields are continuous
+# (damping acts inside the clearances, MODEL.md §4), so J is the piecewise Jacobian: the dead
+# zone contributes f'(x; b) = 1 outside the clearance and 0 inside. Each tangent kernel is called
+# right after the right-hand side at the same (τ, y) and reads the deflections and stiffnesses it
+# needs from ``obs``. V holds k tangent vectors in y[n:], row after row.
+
+
+@numba.njit(cache=True, inline="always")
+def _engaged(x: float, b: float) -> float:
+    return 1.0 if (x > b or x < -b) else 0.0
+
+
+@numba.njit(cache=True)
+def planetary_tangent(t, y, p, obs, dydt, n, k):  # pragma: no cover - compiled
+    N = int(p[P_N])
+    nd = N + 3
+    csp = p[P_CSP]
+    crp = p[P_CRP]
+    bsp = p[P_BSP]
+    brp = p[P_BRP]
+    inv_mus = p[P_INV_MUS]
+    inv_mup = p[P_INV_MUP]
+    inv_muc = p[P_INV_MUC]
+    cas = p[P_COS_AS]
+    car = p[P_COS_AR]
+    kb = p[P_KB] * _engaged(obs[2 * N], p[P_BS])
+    kby = p[P_KB] * _engaged(obs[2 * N + 1], p[P_BS])
+    cb = p[P_CS]
+    inv_ms = p[P_INV_MU_S]
+    for r in range(k):
+        o = n + r * n
+        xv = y[o]
+        yv = y[o + 1]
+        sv = y[o + N + 2]
+        xdv = y[o + nd]
+        ydv = y[o + nd + 1]
+        sdv = y[o + nd + N + 2]
+        sum_fsp = 0.0
+        sum_frp = 0.0
+        sum_fx = 0.0
+        sum_fy = 0.0
+        for i in range(N):
+            si = p[P_HEADER + B_S * N + i]
+            ci = p[P_HEADER + B_C * N + i]
+            pv = y[o + 2 + i]
+            pdv = y[o + nd + 2 + i]
+            dsp = pv - xv * si + yv * ci
+            dsp_d = pdv - xdv * si + ydv * ci
+            drp = sv - pv
+            drp_d = sdv - pdv
+            fsp = obs[6 * N + 4 + i] * _engaged(obs[i], bsp) * dsp + csp * dsp_d
+            frp = obs[7 * N + 4 + i] * _engaged(obs[N + i], brp) * drp + crp * drp_d
+            dydt[o + nd + 2 + i] = (frp - fsp) * inv_mup  # completed below
+            sum_fsp += fsp
+            sum_frp += frp
+            sum_fx += fsp * si
+            sum_fy -= fsp * ci
+        qs = -sum_fsp * inv_mus
+        qc = (cas * sum_fsp + car * sum_frp) * inv_muc
+        for j in range(nd):
+            dydt[o + j] = y[o + nd + j]
+        dydt[o + nd] = (sum_fx - cb * xdv - kb * xv) * inv_ms
+        dydt[o + nd + 1] = (sum_fy - cb * ydv - kby * yv) * inv_ms
+        for i in range(N):
+            dydt[o + nd + 2 + i] += qs - cas * qc
+        dydt[o + nd + N + 2] = qs - (cas + car) * qc
+
+
+@numba.njit(cache=True)
+def backlash_oscillator_tangent(t, y, p, obs, dydt, n, k):  # pragma: no cover - compiled
+    kx = obs[3] * _engaged(obs[0], p[BO_B])
+    for r in range(k):
+        o = n + r * n
+        dydt[o] = y[o + 1]
+        dydt[o + 1] = -kx * y[o] - 2.0 * p[BO_ZETA] * y[o + 1]
+
+
+@numba.njit(cache=True)
+def linear_tangent(t, y, p, obs, dydt, n, k):  # pragma: no cover - compiled
+    a0 = LIN_HEADER
+    for r in range(k):
+        o = n + r * n
+        for i in range(n):
+            acc = 0.0
+            for j in range(n):
+                acc += p[a0 + i * n + j] * y[o + j]
+            dydt[o + i] = acc
+
+
+@numba.njit(cache=True)
+def duffing_tangent(t, y, p, obs, dydt, n, k):  # pragma: no cover - compiled
+    kx = p[DU_ALPHA] + 3.0 * p[DU_BETA] * y[0] * y[0]
+    for r in range(k):
+        o = n + r * n
+        dydt[o] = y[o + 1]
+        dydt[o + 1] = -kx * y[o] - p[DU_DELTA] * y[o + 1]
+
+
+@numba.njit(cache=True)
+def lorenz_tangent(t, y, p, obs, dydt, n, k):  # pragma: no cover - compiled
+    s = p[LZ_SIGMA]
+    for r in range(k):
+        o = n + r * n
+        a = y[o]
+        b = y[o + 1]
+        c = y[o + 2]
+        dydt[o] = s * (b - a)
+        dydt[o + 1] = (p[LZ_RHO] - y[2]) * a - b - y[0] * c
+        dydt[o + 2] = y[1] * a + y[0] * b - p[LZ_BETA] * c
+
+
+_TANGENTS = {
+    KIND_PLANETARY: planetary_tangent,
+    KIND_BACKLASH_OSCILLATOR: backlash_oscillator_tangent,
+    KIND_LINEAR: linear_tangent,
+    KIND_DUFFING: duffing_tangent,
+    KIND_LORENZ: lorenz_tangent,
+}
+
+
+def tangent(kind, t, y, p, obs, dydt, n, k):
+    """dydt[n:] = J(τ, y[:n]) applied to the k tangent vectors stored in y[n:] (see above).
+
+    Like :func:`rhs`, ``kind`` must be a compile-time literal inside compiled code."""
+    _TANGENTS[int(kind)](t, y, p, obs, dydt, n, k)
+
+
+@overload(tangent, inline="always")
+def _tangent_overload(kind, t, y, p, obs, dydt, n, k):  # pragma: no cover - compiled
+    if not isinstance(kind, types.IntegerLiteral):
+        raise numba.errors.TypingError("tangent: 'kind' must be a compile-time literal")
+    fn = _TANGENTS[kind.literal_value]
+
+    def impl(kind, t, y, p, obs, dydt, n, k):
+        fn(t, y, p, obs, dydt, n, k)
+
+    return impl
 
 
 _KERNELS = {

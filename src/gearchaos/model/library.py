@@ -61,7 +61,7 @@ class BacklashOscillator:
     n_state: int = 2
     n_track: int = 1
     state_names: tuple[str, ...] = ("x", "x_dot")
-    obs_names: tuple[str, ...] = ("x", "x_dot", "contact_force")
+    obs_names: tuple[str, ...] = ("x", "x_dot", "contact_force", "stiffness")
 
     def __post_init__(self) -> None:
         _check("zeta", self.zeta, ">=0")

@@ -289,6 +289,8 @@ class PlanetaryModel:
             "y_s_dot",
             *(f"force_sp_{i}" for i in N),
             *(f"force_rp_{i}" for i in N),
+            *(f"stiffness_sp_{i}" for i in N),
+            *(f"stiffness_rp_{i}" for i in N),
         )
 
     @property

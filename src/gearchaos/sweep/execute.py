@@ -34,7 +34,8 @@ def run_task_arrays(a: dict[str, Any], single_thread: bool = False) -> dict[str,
         numba.set_num_threads(1)
     P = a["P"]
     C, L = P.shape[0], P.shape[1]
-    ns, n, no, nt = a["n_samples"], a["n_state"], a["n_obs"], a["n_track"]
+    ns, no, nt = a["n_samples"], a["n_obs"], a["n_track"]
+    n = a["Y0"].shape[1]  # system state, then tangent vectors when Lyapunov exponents are asked
     out_y = np.full((C, L, ns, n), np.nan)
     out_o = np.full((C, L, ns, no), np.nan)
     omin = np.zeros((C, L, nt))
@@ -42,6 +43,8 @@ def run_task_arrays(a: dict[str, Any], single_thread: bool = False) -> dict[str,
     yf = np.zeros((C, L, n))
     info = np.zeros((C, L, 4))
     status = np.zeros((C, L), dtype=np.int64)
+    k = int(a.get("n_tangent", 0))
+    lsum = np.zeros((C, L, k))
     call_literal(
         dopri_chains,
         a["kind"],
@@ -54,6 +57,7 @@ def run_task_arrays(a: dict[str, Any], single_thread: bool = False) -> dict[str,
         a["t_end"],
         no,
         nt,
+        a["n_state"],
         a["rtol"],
         a["atol"],
         np.inf,
@@ -66,6 +70,7 @@ def run_task_arrays(a: dict[str, Any], single_thread: bool = False) -> dict[str,
         yf,
         info,
         status,
+        lsum,
     )
     return {
         "states": out_y,
@@ -75,6 +80,8 @@ def run_task_arrays(a: dict[str, Any], single_thread: bool = False) -> dict[str,
         "final_state": yf,
         "info": info,
         "status": status,
+        # exponents: log stretch per unit τ over the samples after the first
+        "lyapunov": lsum / ((ns - 1) * a["dt"])[:, :, None] if ns > 1 else lsum * np.nan,
     }
 
 

@@ -203,7 +203,8 @@ class Grid:
         t_rec = spec.transient_periods * T
         return {
             "kind": ref.kind,
-            "Y0": np.zeros((C, ref.n_state)),
+            "Y0": np.zeros((C, ref.n_state * (1 + int(spec.lyapunov)))),
+            "n_tangent": int(spec.lyapunov),
             "P": P,
             "SW": SW,
             "t_rec": t_rec,

@@ -125,6 +125,17 @@ class _Layout:
         for nm in ("steps_accepted", "steps_rejected"):
             var[nm] = (lead, (shp, "int64"), -1, {"long_name": nm.replace("_", " ")})
             chunks[nm] = ch
+        if spec.lyapunov:
+            var["lle"] = (
+                lead,
+                (shp, "float64"),
+                np.nan,
+                {
+                    "long_name": "largest Lyapunov exponent λ_1 per unit τ = ω_n t",
+                    "method": "variational equations, Gram–Schmidt every forcing period",
+                },
+            )
+            chunks["lle"] = ch
         n = len(self.state_names)
         var["final_state"] = (
             (*lead, "state"),
@@ -152,7 +163,10 @@ class _Layout:
         data["status"] = np.full(bshape, NOT_RUN, dtype=np.int8)
         data["steps_accepted"] = np.full(bshape, -1, dtype=np.int64)
         data["steps_rejected"] = np.full(bshape, -1, dtype=np.int64)
-        data["final_state"] = np.full((*bshape, len(self.state_names)), np.nan)
+        n_st = len(self.state_names)
+        data["final_state"] = np.full((*bshape, n_st), np.nan)
+        if spec.lyapunov:
+            data["lle"] = np.full(bshape, np.nan)
         for c, chain in enumerate(task.chains):
             for j, idx in enumerate(chain):
                 pos = tuple(i - s for i, s in zip(idx, starts, strict=True))
@@ -168,7 +182,9 @@ class _Layout:
                 data["status"][pos] = out["status"][c, j]
                 data["steps_accepted"][pos] = int(out["info"][c, j, 0])
                 data["steps_rejected"][pos] = int(out["info"][c, j, 1])
-                data["final_state"][pos] = out["final_state"][c, j]
+                data["final_state"][pos] = out["final_state"][c, j, :n_st]
+                if spec.lyapunov:
+                    data["lle"][pos] = out["lyapunov"][c, j, 0]
         return data
 
 
@@ -452,6 +468,7 @@ def bifurcation(
     periods: int = 100,
     rtol: float = 1e-8,
     atol: float = 1e-10,
+    lyapunov: bool = False,
     store: str | os.PathLike[str] | None = None,
     overwrite: bool = False,
     workers: int | None = None,
@@ -483,6 +500,9 @@ def bifurcation(
         first varied axis, ``up``, ``down`` or ``both`` (shows hysteresis).
     transient_periods, periods, rtol, atol
         Protocol and tolerances, as in :func:`gearchaos.simulate`.
+    lyapunov
+        Also store the largest Lyapunov exponent ``lle`` of every point (variational
+        equations integrated with the trajectory; the section values are unchanged).
     store
         Path of a Zarr store. Written chunk by chunk; an interrupted sweep (Ctrl-C, SIGTERM,
         SIGKILL) resumes when called again with the same arguments; other settings are refused
@@ -515,6 +535,7 @@ def bifurcation(
         periods=periods,
         rtol=rtol,
         atol=atol,
+        lyapunov=lyapunov,
     )
     return run_sweep(
         target,

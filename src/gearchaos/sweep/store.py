@@ -1,8 +1,8 @@
 """The sweep result store: Zarr, written chunk by chunk, resumable after any interruption.
 
-Layout (Zarr format 2): one array per variable with xarray's ``_ARRAY_DIMENSIONS``, leading dimensions
-``spec.dims``, then ``section`` / ``planet`` / ``planet_all`` / ``state`` as the variable
-needs. Each task writes only its own Zarr chunks, then drops a marker file
+Layout (Zarr format 2): one array per variable with xarray's ``_ARRAY_DIMENSIONS``,
+leading dimensions ``spec.dims``, then ``section`` / ``planet`` / ``planet_all`` / ``state``
+as the variable needs. Each task writes only its own Zarr chunks, then drops a marker file
 ``_progress/<task>.done``. A task without a marker is (re)computed on resume, so a chunk half
 written when the process was killed (even with SIGKILL) is simply written again; results are
 deterministic, so the final store equals an uninterrupted run's. When every task is done the
