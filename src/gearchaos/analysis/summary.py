@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
+from .classify import classify_motion
 from .contact import contact_regimes
 from .poincare import count_distinct, section_points
 
@@ -52,7 +53,9 @@ def _num(x: Any) -> float | None:
     return v if math.isfinite(v) else None
 
 
-def summarize(result: Any, *, tol: float = 1e-3, max_count: int = 64) -> dict[str, Any]:
+def summarize(
+    result: Any, *, tol: float = 1e-3, max_count: int = 64, lle: float | None = None
+) -> dict[str, Any]:
     """JSON-serialisable summary of a simulation result.
 
     Parameters
@@ -61,12 +64,18 @@ def summarize(result: Any, *, tol: float = 1e-3, max_count: int = 64) -> dict[st
         A :class:`~gearchaos.SimulationResult` (planetary or a reference system).
     tol, max_count
         Passed to :func:`~gearchaos.analysis.poincare.count_distinct`.
+    lle
+        Largest Lyapunov exponent of the run (per unit τ), if computed
+        (:func:`~gearchaos.analysis.lyapunov.max_lyapunov`); it decides quasi-periodic vs
+        chaotic motion, confirmed by the 0–1 test and the spectrum.
 
     Returns
     -------
     dict
         ``omega`` (Ω), ``omega_n_rad_s`` (ω_n), ``sun_speed_rpm``, ``distinct_section_points``
-        (``max_count + 1`` means many), ``motion`` (``1T``, ``2T``, …, ``many``),
+        (``max_count + 1`` means many), ``motion`` (``1T``, ``2T``, …, ``QP``, ``chaos``,
+        ``unresolved``; :func:`~gearchaos.analysis.classify.classify_motion`) with ``lle``,
+        ``k01`` (0–1 test), ``indicators_agree`` and ``motion_note``,
         ``x_sp1_section_min``/``_max`` (range of the X̄_sp1 section values), ``contact`` (a list
         of ``{"mesh": "sun_planet_1", "regime": "none|single_sided|double_sided"}``, sun–planet
         meshes first, then planet–ring), ``status`` (lower-case :class:`~gearchaos.Status`
@@ -81,6 +90,12 @@ def summarize(result: Any, *, tol: float = 1e-3, max_count: int = 64) -> dict[st
     planetary = hasattr(model, "n_planets")
     x, xd = section_points(result)
     n = count_distinct(np.column_stack([x, xd]), tol=tol, max_count=max_count)
+    mc = classify_motion(
+        np.column_stack([x, xd]),
+        lle=lle,
+        run_periods=int(result.settings.get("periods", 0)) or None,
+        forcing_period=system.period,
+    )
     finite = x[np.isfinite(x)]
     scales = getattr(model, "scales", None)
     gs = getattr(model, "gearset", None)
@@ -94,7 +109,7 @@ def summarize(result: Any, *, tol: float = 1e-3, max_count: int = 64) -> dict[st
         "omega_n_rad_s": _num(scales.omega_n) if scales is not None else None,
         "sun_speed_rpm": _num(gs.sun_speed_rpm(omega)) if gs is not None else None,
         "distinct_section_points": int(n),
-        "motion": motion_name(n, max_count),
+        "motion": mc.label,
         "x_sp1_section_min": _num(finite.min()) if finite.size else None,
         "x_sp1_section_max": _num(finite.max()) if finite.size else None,
         "contact": contact,
@@ -102,6 +117,10 @@ def summarize(result: Any, *, tol: float = 1e-3, max_count: int = 64) -> dict[st
         "steps_accepted": int(result.steps_accepted),
         "steps_rejected": int(result.steps_rejected),
     }
+    out["lle"] = _num(mc.lle) if mc.lle is not None else None
+    out["k01"] = _num(mc.k01) if mc.k01 is not None else None
+    out["indicators_agree"] = bool(mc.agree)
+    out["motion_note"] = mc.note
     out["gearset"] = gs.name if gs is not None else None
     out["mesh_frequency_hz"] = (
         _num(omega * scales.omega_n / (2.0 * math.pi)) if scales is not None else None

@@ -1,5 +1,6 @@
 """Sweeps: bifurcation diagrams and 2-D maps over any parameter, resumable, on any executor."""
 
+from .classify import classify_dataset, classify_store
 from .run import bifurcation, run_sweep
 from .spec import Axis, SweepSpec, parse_axis, parse_values
 from .store import SweepStore, open_sweep
@@ -9,6 +10,8 @@ __all__ = [
     "SweepSpec",
     "SweepStore",
     "bifurcation",
+    "classify_dataset",
+    "classify_store",
     "open_sweep",
     "parse_axis",
     "parse_values",

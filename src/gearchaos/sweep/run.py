@@ -224,6 +224,8 @@ def _attrs(target: Any, grid: Grid) -> dict[str, Any]:
         "dims": list(grid.dims),
         **provenance(),
     }
+    if "omega" not in [ax.name for ax in spec.axes]:
+        a["omega_fixed"] = float(ref.omega)
     model = ref.model
     if hasattr(model, "scales"):
         a["omega_n_rad_s"] = float(model.scales.omega_n)
@@ -276,6 +278,7 @@ def run_sweep(
     dask_local: int | None = None,
     progress: bool = True,
     chunk_points: int | None = None,
+    classify: bool = True,
 ) -> Any:
     """Run (or resume) a sweep described by ``spec``; return its :class:`xarray.Dataset`."""
     grid = Grid(target, spec, chunk_points=chunk_points)
@@ -319,6 +322,16 @@ def run_sweep(
                 _run_pool(todo, grid, layout, st, ex, fn, bar, workers or dask_local or 8)
     except KeyboardInterrupt:
         raise
+    if st.path is not None:
+        import shutil
+
+        from .store import PROGRESS
+
+        shutil.rmtree(os.path.join(st.path, PROGRESS), ignore_errors=True)
+    if classify:
+        from .classify import classify_store
+
+        classify_store(st.zarr_store)
     st.finish()
     return st.open()
 

@@ -1,0 +1,139 @@
+"""Motion labels for every point of a sweep store, and the regime table.
+
+:func:`classify_store` reads the stored Poincaré sections (the first two observed variables,
+first observed planet — X̄_sp1 and X̄'_sp1 by default) and, when present, the largest Lyapunov
+exponents, labels every point with :func:`gearchaos.analysis.classify.classify_sections`
+(1T … nT, QP, chaos, unresolved; ``failed`` where the integration failed) and writes the
+variables ``motion``, ``period`` (0: none found), ``k01`` (0–1 test), ``indicators_agree`` and
+the attribute ``regime_table`` (JSON: fraction of the swept points in each regime, per family
+value when there is a family). It needs no re-simulation, so ``gearchaos classify run.zarr``
+can re-label a stored sweep with other tolerances.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from typing import Any
+
+import numpy as np
+
+from ..errors import StoreError
+
+__all__ = ["classify_dataset", "classify_store"]
+
+LABEL_DTYPE = "<U10"
+
+
+def _section_pair(ds: Any) -> np.ndarray:
+    import tomllib
+
+    spec = tomllib.loads(ds.attrs["sweep_toml"])
+    names = [n for n in spec["observe"] if n in ds.data_vars and "section" in ds[n].dims]
+    if not names:
+        raise StoreError("the store holds no section variables to classify")
+    cols = []
+    for n in names[:2]:
+        v = ds[n]
+        if "planet" in v.dims:
+            v = v.isel(planet=0)
+        cols.append(np.asarray(v.transpose(..., "section").values, dtype=float))
+    return np.stack(cols, axis=-1)
+
+
+def _forcing_period(ds: Any, lead_dims: tuple[str, ...], shape: tuple[int, ...]) -> np.ndarray:
+    if "omega" in lead_dims:
+        om = np.asarray(ds["omega"].values, dtype=float)
+        ax = lead_dims.index("omega")
+        om = om.reshape([-1 if i == ax else 1 for i in range(len(shape))])
+        return np.broadcast_to(2.0 * math.pi / om, shape)
+    omega = float(ds.attrs.get("omega_fixed", float("nan")))
+    return np.full(shape, 2.0 * math.pi / omega)
+
+
+def classify_dataset(ds: Any, *, rtol: float = 1e-3, max_period: int = 64) -> dict[str, Any]:
+    """Labels and indicators for every point of a sweep dataset (nothing written)."""
+    from ..analysis.classify import classify_sections, regime_table
+
+    pts = _section_pair(ds)
+    lead_dims = tuple(d for d in ds["status"].dims)
+    shape = tuple(int(ds.sizes[d]) for d in lead_dims)
+    kw: dict[str, Any] = {"details": True, "rtol": rtol, "max_period": max_period}
+    if "lle" in ds.data_vars:
+        kw["lle"] = np.asarray(ds["lle"].values, dtype=float)
+        kw["run_periods"] = int(ds.attrs["periods"])
+        kw["forcing_period"] = _forcing_period(ds, lead_dims, shape)
+    details = classify_sections(pts, **kw)
+    status = np.asarray(ds["status"].values)
+    labels = np.empty(shape, dtype=LABEL_DTYPE)
+    period = np.zeros(shape, dtype=np.int16)
+    k01 = np.full(shape, np.nan)
+    agree = np.ones(shape, dtype=bool)
+    for idx in np.ndindex(*shape):
+        mc: Any = details[idx]
+        labels[idx] = "failed" if status[idx] != 0 else mc.label
+        period[idx] = mc.period or 0
+        k01[idx] = np.nan if mc.k01 is None else mc.k01
+        agree[idx] = bool(mc.agree)
+    fam = _family_dim(ds)
+    table: dict[str, Any]
+    if fam is not None and fam in lead_dims:
+        ax = lead_dims.index(fam)
+        table = {
+            f"{fam}={float(v):g}": regime_table(np.take(labels, i, axis=ax).ravel())
+            for i, v in enumerate(ds[fam].values)
+        }
+    else:
+        table = {"all": regime_table(labels.ravel())}
+    return {
+        "dims": lead_dims,
+        "motion": labels,
+        "period": period,
+        "k01": k01,
+        "indicators_agree": agree,
+        "regime_table": table,
+    }
+
+
+def _family_dim(ds: Any) -> str | None:
+    import tomllib
+
+    fam = tomllib.loads(ds.attrs["sweep_toml"]).get("family")
+    return fam["name"] if fam else None
+
+
+def classify_store(
+    store: str | os.PathLike[str] | Any, *, rtol: float = 1e-3, max_period: int = 64
+) -> dict[str, Any]:
+    """Label every point of a sweep store in place; returns the regime table."""
+    import xarray as xr
+    import zarr
+
+    zstore = os.fspath(store) if isinstance(store, str | os.PathLike) else store
+    ds = xr.open_zarr(zstore, chunks=None, consolidated=False)
+    res = classify_dataset(ds, rtol=rtol, max_period=max_period)
+    g = zarr.open_group(zstore, mode="a", use_consolidated=False)
+    dims = list(res["dims"])
+    docs = {
+        "motion": ("1T…nT, QP, chaos, unresolved or failed", ""),
+        "period": ("period n of the section sequence (0: none ≤ max_period)", 0),
+        "k01": ("0–1 test for chaos K (Gottwald & Melbourne)", np.nan),
+        "indicators_agree": ("whether every available indicator agrees with the label", False),
+    }
+    for name, (doc, fill) in docs.items():
+        values = res[name]
+        arr = g.create_array(
+            name,
+            shape=values.shape,
+            chunks=values.shape if values.size else "auto",
+            dtype=values.dtype,
+            fill_value=fill,
+            attributes={"long_name": doc, "_ARRAY_DIMENSIONS": dims},
+            overwrite=True,
+        )
+        arr[...] = values
+    g.attrs["regime_table"] = json.dumps(res["regime_table"])
+    g.attrs["classification_rtol"] = float(rtol)
+    zarr.consolidate_metadata(zstore)
+    return dict(res["regime_table"])
