@@ -1008,6 +1008,19 @@ def reproduce(
     quick: Annotated[
         bool, typer.Option("--quick", help="A coarse version (fewer points and periods), for CI.")
     ] = False,
+    workers: Annotated[
+        int | None,
+        typer.Option(
+            "--workers",
+            "-w",
+            help="Local worker processes (default: in-process on all cores).",
+            show_default=False,
+        ),
+    ] = None,
+    overwrite: Annotated[
+        bool,
+        typer.Option("--overwrite", help="Replace an existing store made with other settings."),
+    ] = False,
     quiet: QuietOpt = False,
     json_out: JsonOpt = False,
 ) -> None:
@@ -1033,7 +1046,16 @@ def reproduce(
         except ImportError as exc:
             _fail(f"the paper recipes are not available in this installation: {exc}", EXIT_FAILURE)
         output.mkdir(parents=True, exist_ok=True)
-        result = dict(run_recipe(name, output, quick=quick, progress=not quiet))
+        result = dict(
+            run_recipe(
+                name,
+                output,
+                quick=quick,
+                progress=not quiet,
+                workers=workers,
+                overwrite=overwrite,
+            )
+        )
     if json_out:
         _print_json(result)
         return
