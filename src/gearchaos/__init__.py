@@ -49,3 +49,14 @@ __all__ = [
     "preset",
     "simulate",
 ]
+
+_LAZY_SUBPACKAGES = ("analysis", "plot", "paper")
+
+
+def __getattr__(name: str) -> object:
+    """``gearchaos.plot`` etc. import on first use (matplotlib only when plotting)."""
+    if name in _LAZY_SUBPACKAGES:
+        import importlib
+
+        return importlib.import_module(f"{__name__}.{name}")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

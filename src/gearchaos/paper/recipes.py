@@ -1,0 +1,371 @@
+"""The seed paper's bifurcation figures as data, and the one call that redraws each of them.
+
+Sheng et al. (2016) show six bifurcation studies of the sun–planet mesh deflection X̄_sp1 at
+the Poincaré section τ = kT (T = 2π/Ω), each a sweep of one parameter with one panel per value
+of a second one:
+
+======  ==============================  ===========================  ==============================
+figure  swept (x axis)                  panels (family)              fixed
+======  ==============================  ===========================  ==============================
+Fig. 4  Ω ∈ [0, 4]                      ξ = 0.03, 0.05, 0.07, 0.09   b̄_sp = 3, b̄_rp = 3.5, b̄_s = 2
+Fig. 6  b̄_sp ∈ [1, 10]                  ξ = 0.03, 0.05, 0.07, 0.09   Ω = 1.5, b̄_rp = 3.5, b̄_s = 2
+Fig. 8  b̄_sp ∈ [1, 10]                  Ω = 1, 1.5, 2, 2.5           ξ = 0.11, b̄_rp = 3.5, b̄_s = 2
+Fig. 9  b̄_rp ∈ [1, 16]                  ξ = 0.03, 0.05, 0.07, 0.09   Ω = 1.5, b̄_sp = 3, b̄_s = 2
+Fig. 11 b̄_rp ∈ [1, 11]                  Ω = 1, 1.5, 2, 2.5           ξ = 0.11, b̄_sp = 3, b̄_s = 2
+Fig. 12 b̄_s ∈ [1, 10]                   Ω = 1.5 (one panel)          ξ = 0.05, b̄_sp = 3, b̄_rp = 3.5
+======  ==============================  ===========================  ==============================
+
+Every sweep starts each point from the zero state (the seed's protocol), integrates 100
+transient mesh periods and records 100 section points, on the default gear set
+(``gearchaos.preset("sheng2016")``). Dotted parameter names: ``omega``, ``xi`` (all three
+damping ratios), ``backlash.sun_planet``, ``backlash.planet_ring``, ``clearance.sun_bearing``.
+
+:func:`reproduce` runs one recipe into a resumable Zarr store and draws it as a PNG; ``quick``
+runs a coarse version (12 points per panel, 20 + 16 periods) for CI.
+
+Limits: the seed's Table 1 was lost and ``sheng2016`` is a physically consistent stand-in
+(MODEL.md §9), so the diagrams reproduce the seed's protocol and layout, not its exact
+bifurcation points.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError
+
+__all__ = ["PRESET", "QUICK_PERIODS", "RECIPES", "FamilyAxis", "Recipe", "VaryAxis", "reproduce"]
+
+#: Gear set every recipe runs on.
+PRESET = "sheng2016"
+#: (transient, recorded) mesh periods of the full sweeps: the seed's protocol.
+FULL_PERIODS = (100, 100)
+#: (transient, recorded) mesh periods of the ``quick`` sweeps.
+QUICK_PERIODS = (20, 16)
+#: Points per panel of the ``quick`` sweeps.
+QUICK_POINTS = 12
+
+# dotted name -> (unicode symbol, mathtext symbol)
+_SYMBOLS: dict[str, tuple[str, str]] = {
+    "omega": ("Ω", r"\Omega"),
+    "xi": ("ξ", r"\xi"),
+    "backlash.sun_planet": ("b̄_sp", r"\bar{b}_{sp}"),
+    "backlash.planet_ring": ("b̄_rp", r"\bar{b}_{rp}"),
+    "clearance.sun_bearing": ("b̄_s", r"\bar{b}_{s}"),
+}
+_CLEARANCES = ("backlash.sun_planet", "backlash.planet_ring", "clearance.sun_bearing")
+
+
+def _num(v: float) -> str:
+    return f"{v:g}"
+
+
+@dataclass(frozen=True)
+class VaryAxis:
+    """The swept parameter: ``count`` (full) or ``quick_count`` linearly spaced values from
+    ``start`` to ``stop``, both included."""
+
+    name: str
+    start: float
+    stop: float
+    count: int
+    quick_count: int = QUICK_POINTS
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.start) and math.isfinite(self.stop) and self.start < self.stop):
+            raise ParameterError(
+                f"{self.name}: start must be finite and below stop: got {self.start}, {self.stop}"
+            )
+        for what, n in (("count", self.count), ("quick_count", self.quick_count)):
+            if n < 2:
+                raise ParameterError(f"{self.name}: {what} must be >= 2: got {n}")
+
+    def values(self, quick: bool = False) -> np.ndarray:
+        return np.linspace(self.start, self.stop, self.quick_count if quick else self.count)
+
+
+@dataclass(frozen=True)
+class FamilyAxis:
+    """The panel parameter: one bifurcation diagram per value, like the seed's panels (a)–(d)."""
+
+    name: str
+    values: tuple[float, ...]
+
+
+@dataclass(frozen=True)
+class Recipe:
+    """One bifurcation figure of the seed paper.
+
+    Attributes
+    ----------
+    name
+        ``fig4`` … ``fig12``.
+    caption
+        The seed's caption, shortened (panel list left out), in plain text.
+    vary
+        The swept parameter and its range.
+    family
+        The panel parameter and its values.
+    fixed
+        Fixed overrides by dotted name (read-only mapping).
+    notes
+        Where and why the recipe departs from, or interprets, the seed.
+    """
+
+    name: str
+    caption: str
+    vary: VaryAxis
+    family: FamilyAxis
+    fixed: Mapping[str, float] = field(hash=False)
+    notes: str = ""
+    transient_periods: int = FULL_PERIODS[0]
+    periods: int = FULL_PERIODS[1]
+    observe: tuple[str, ...] = field(default=("delta_sp", "delta_sp_dot"))
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "fixed", MappingProxyType(dict(self.fixed)))
+
+    @property
+    def clearance_sweep(self) -> bool:
+        """Whether the swept parameter is a backlash or clearance (draw ±b̄ lines)."""
+        return self.vary.name in _CLEARANCES
+
+    @property
+    def frequency_sweep(self) -> bool:
+        """Whether the swept parameter is Ω (mark resonances)."""
+        return self.vary.name == "omega"
+
+    def sweep_kwargs(self, quick: bool = False) -> dict[str, Any]:
+        """Keyword arguments of :func:`gearchaos.bifurcation` (all but target and store)."""
+        tr, rec = QUICK_PERIODS if quick else (self.transient_periods, self.periods)
+        return {
+            "vary": {self.vary.name: self.vary.values(quick)},
+            "family": {self.family.name: list(self.family.values)},
+            "fixed": dict(self.fixed),
+            "observe": self.observe,
+            "planets": (1,),
+            "initial_conditions": "fresh",
+            "transient_periods": tr,
+            "periods": rec,
+        }
+
+    def title(self, quick: bool = False) -> str:
+        """Figure title in matplotlib mathtext, built from the recipe's own numbers."""
+        number = self.name.removeprefix("fig")
+        given = ", ".join(f"${_SYMBOLS[k][1]} = {_num(v)}$" for k, v in self.fixed.items())
+        fam = _SYMBOLS[self.family.name][1]
+        values = ", ".join(_num(v) for v in self.family.values)
+        plural = "s" if len(self.family.values) > 1 else ""
+        text = (
+            f"Fig. {number}: bifurcation diagram{plural} of $\\bar{{X}}_{{sp1}}$ versus "
+            f"${_SYMBOLS[self.vary.name][1]}$\nat {given}, ${fam} = {values}$"
+        )
+        if quick:
+            text += (
+                f"\n(quick: {self.vary.quick_count} points per panel, "
+                f"{QUICK_PERIODS[0]} + {QUICK_PERIODS[1]} periods)"
+            )
+        return text
+
+
+def _recipes() -> dict[str, Recipe]:
+    xis = (0.03, 0.05, 0.07, 0.09)
+    omegas = (1.0, 1.5, 2.0, 2.5)
+    stand_in = (
+        "The default gear set stands in for the seed's lost Table 1, so bifurcation points differ "
+        "from the seed's; protocol, ranges and layout are the seed's."
+    )
+    items = [
+        Recipe(
+            name="fig4",
+            caption=(
+                "Bifurcation diagrams of X̄_sp1 versus Ω at given b̄_sp = 3, b̄_rp = 3.5, "
+                "b̄_s = 2 and different ξ values (ξ = 0.03, 0.05, 0.07, 0.09)"
+            ),
+            vary=VaryAxis("omega", 0.01, 4.0, 400),
+            family=FamilyAxis("xi", xis),
+            fixed={
+                "backlash.sun_planet": 3.0,
+                "backlash.planet_ring": 3.5,
+                "clearance.sun_bearing": 2.0,
+            },
+            notes=(
+                "The seed's range is 0 ≤ Ω ≤ 4; Ω starts at 0.01 because the mesh period "
+                "2π/Ω is unbounded at Ω = 0 (points near Ω = 0.01 are the costliest: the "
+                "integration time grows as 1/Ω). " + stand_in
+            ),
+        ),
+        Recipe(
+            name="fig6",
+            caption=(
+                "Bifurcation diagrams of X̄_sp1 versus b̄_sp at given Ω = 1.5, b̄_rp = 3.5, "
+                "b̄_s = 2 and different ξ values (ξ = 0.03, 0.05, 0.07, 0.09)"
+            ),
+            vary=VaryAxis("backlash.sun_planet", 1.0, 10.0, 300),
+            family=FamilyAxis("xi", xis),
+            fixed={"omega": 1.5, "backlash.planet_ring": 3.5, "clearance.sun_bearing": 2.0},
+            notes=stand_in,
+        ),
+        Recipe(
+            name="fig8",
+            caption=(
+                "Bifurcation diagrams of X̄_sp1 versus b̄_sp at given ξ = 0.11, b̄_rp = 3.5, "
+                "b̄_s = 2 and different Ω values (Ω = 1, 1.5, 2, 2.5)"
+            ),
+            vary=VaryAxis("backlash.sun_planet", 1.0, 10.0, 300),
+            family=FamilyAxis("omega", omegas),
+            fixed={"xi": 0.11, "backlash.planet_ring": 3.5, "clearance.sun_bearing": 2.0},
+            notes=(
+                "The seed's text does not restate the b̄_sp range of Fig. 8; [1, 10] as in "
+                "Fig. 6 (its discussion reaches b̄_sp = 9.37). " + stand_in
+            ),
+        ),
+        Recipe(
+            name="fig9",
+            caption=(
+                "Bifurcation diagrams of X̄_sp1 versus b̄_rp at given Ω = 1.5, b̄_sp = 3, "
+                "b̄_s = 2 and different ξ values (ξ = 0.03, 0.05, 0.07, 0.09)"
+            ),
+            vary=VaryAxis("backlash.planet_ring", 1.0, 16.0, 300),
+            family=FamilyAxis("xi", xis),
+            fixed={"omega": 1.5, "backlash.sun_planet": 3.0, "clearance.sun_bearing": 2.0},
+            notes=stand_in,
+        ),
+        Recipe(
+            name="fig11",
+            caption=(
+                "Bifurcation diagrams of X̄_sp1 versus b̄_rp at given ξ = 0.11, b̄_sp = 3, "
+                "b̄_s = 2 and different Ω values (Ω = 1, 1.5, 2, 2.5)"
+            ),
+            vary=VaryAxis("backlash.planet_ring", 1.0, 11.0, 300),
+            family=FamilyAxis("omega", omegas),
+            fixed={"xi": 0.11, "backlash.sun_planet": 3.0, "clearance.sun_bearing": 2.0},
+            notes=stand_in,
+        ),
+        Recipe(
+            name="fig12",
+            caption=(
+                "Bifurcation diagram of X̄_sp1 versus b̄_s at given ξ = 0.05, b̄_sp = 3, "
+                "b̄_rp = 3.5 and Ω = 1.5"
+            ),
+            vary=VaryAxis("clearance.sun_bearing", 1.0, 10.0, 300),
+            family=FamilyAxis("omega", (1.5,)),
+            fixed={"xi": 0.05, "backlash.sun_planet": 3.0, "backlash.planet_ring": 3.5},
+            notes="A single panel: Ω = 1.5 is a one-value family. " + stand_in,
+        ),
+    ]
+    return {r.name: r for r in items}
+
+
+#: The seed's bifurcation figures by name (``fig4``, ``fig6``, ``fig8``, ``fig9``, ``fig11``,
+#: ``fig12``).
+RECIPES: dict[str, Recipe] = _recipes()
+
+
+def get_recipe(name: str) -> Recipe:
+    """The recipe called ``name`` (``fig4``, ``Fig4`` and ``4`` alike)."""
+    key = str(name).strip().lower()
+    if key.isdigit():
+        key = "fig" + key
+    try:
+        return RECIPES[key]
+    except KeyError:
+        raise ParameterError(f"figure must be one of {', '.join(RECIPES)}: got {name!r}") from None
+
+
+def reproduce(
+    name: str,
+    outdir: str | os.PathLike[str] = ".",
+    *,
+    quick: bool = False,
+    progress: bool = True,
+    workers: int | None = None,
+    overwrite: bool = False,
+) -> dict[str, Any]:
+    """Run the sweep of the seed's figure ``name`` and draw it in the seed's layout.
+
+    The sweep goes into ``outdir/<name>.zarr`` (``<name>-quick.zarr`` with ``quick``) through
+    :func:`gearchaos.bifurcation`: running again with the same arguments resumes an
+    interrupted sweep (nothing already written is recomputed) and a finished one is only
+    redrawn. The figure — one panel per family value, ±b̄ clearance lines when a clearance is
+    swept, resonance markers when Ω is swept, the caption as title — is written to
+    ``outdir/<name>.png`` (``<name>-quick.png``), so a quick run never replaces a full one.
+
+    Parameters
+    ----------
+    name
+        One of :data:`RECIPES` (``fig4``, ``fig6``, ``fig8``, ``fig9``, ``fig11``, ``fig12``).
+    outdir
+        Directory of the store and the figure (created if missing).
+    quick
+        Coarse version for CI: 12 points per panel, 20 transient + 16 recorded periods.
+    progress
+        Show a progress bar.
+    workers
+        Worker count of the sweep (default: all cores).
+    overwrite
+        Replace an existing store made with other settings (otherwise refused with a
+        :class:`~gearchaos.errors.StoreError`).
+
+    Returns
+    -------
+    dict
+        ``{"figure": PNG path, "store": Zarr path, "points": grid points, "failed": points
+        whose status is not OK, "seconds": wall time of the call}``.
+
+    Raises
+    ------
+    ParameterError
+        ``name`` is not a recipe.
+    """
+    recipe = get_recipe(name)
+    from .. import bifurcation  # the sweep layer sits below paper/
+    from ..gearset import preset
+    from ..plot import savefig
+    from ..plot.bifurcation import bifurcation_figure
+
+    t0 = time.perf_counter()
+    out = Path(os.fspath(outdir))
+    out.mkdir(parents=True, exist_ok=True)
+    stem = recipe.name + ("-quick" if quick else "")
+    store = out / f"{stem}.zarr"
+    png = out / f"{stem}.png"
+    ds = bifurcation(
+        preset(PRESET),
+        **recipe.sweep_kwargs(quick),
+        store=str(store),
+        overwrite=overwrite,
+        workers=workers,
+        progress=progress,
+    )
+    fig = bifurcation_figure(
+        ds,
+        var="delta_sp",
+        planet=1,
+        clearance_lines=recipe.clearance_sweep,
+        resonances=recipe.frequency_sweep,
+    )
+    fig.suptitle(recipe.title(quick), fontsize="medium")
+    try:
+        savefig(fig, png)
+    finally:
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)
+    status = np.asarray(ds["status"].values)
+    return {
+        "figure": str(png),
+        "store": str(store),
+        "points": int(status.size),
+        "failed": int(np.count_nonzero(status != 0)),
+        "seconds": time.perf_counter() - t0,
+    }
