@@ -226,7 +226,8 @@ def _attrs(target: Any, grid: Grid) -> dict[str, Any]:
     }
     if "omega" not in [ax.name for ax in spec.axes]:
         a["omega_fixed"] = float(ref.omega)
-    model = ref.model
+    # clearances and scales of the base gear set with the fixed overrides (not of a grid point)
+    model = grid._build_model({k: v for k, v in grid.fixed.items() if k != "omega"})
     if hasattr(model, "scales"):
         a["omega_n_rad_s"] = float(model.scales.omega_n)
         a["characteristic_length_m"] = float(model.scales.length)

@@ -73,7 +73,7 @@ class SweepStore:
                 elif k == "gearset_toml" and isinstance(old.get(k), str):
                     diffs.append(_toml_diff(old[k], v, "gear set"))
                 else:
-                    diffs.append(f"{k}: store has {old.get(k)!r}, now {v!r}")
+                    diffs.append(f"{k}: store has {_short(old.get(k))}, now {_short(v)}")
         if diffs:
             raise StoreError(
                 f"{self.path} holds a sweep with other settings ("
@@ -95,33 +95,52 @@ class SweepStore:
         chunks: dict[str, tuple[int, ...]],
         attrs: dict[str, Any],
     ) -> None:
-        """Coordinates are written whole; data variables are created empty (fill value)."""
+        """Coordinates are written whole; float variables are created empty (NaN fill value);
+        integer variables are written with their "not run" value and carry no fill value, so
+        xarray keeps their integer type.
+
+        On disk the store is built under a temporary name and renamed into place, so a store
+        path either holds a complete, resumable layout or nothing (a kill during creation
+        leaves only a ``*.creating-*`` directory, removed by the next run).
+        """
         import xarray as xr
         import zarr
 
+        target: Any = self.zarr_store
+        tmp = None
         if self.path is not None:
             parent = os.path.dirname(os.path.abspath(self.path))
             os.makedirs(parent, exist_ok=True)
+            base = os.path.basename(self.path)
+            for stale in os.listdir(parent):
+                if stale.startswith(base + ".creating-"):
+                    shutil.rmtree(os.path.join(parent, stale), ignore_errors=True)
+            tmp = f"{self.path}.creating-{os.getpid()}"
+            target = tmp
         ds = xr.Dataset(coords={k: (d, v) for k, (d, v) in coords.items()})
         ds.attrs.update(attrs)
         ds.attrs["complete"] = False
         # Zarr format 2: consolidated metadata and string coordinates are part of its
         # specification (format 3 still flags both as unstable)
-        ds.to_zarr(self.zarr_store, mode="w", consolidated=False, zarr_format=2)
-        g = zarr.open_group(self.zarr_store, mode="a", zarr_format=2)
+        ds.to_zarr(target, mode="w", consolidated=False, zarr_format=2)
+        g = zarr.open_group(target, mode="a", zarr_format=2)
         for name, (dims, shape_dtype, fill, vattrs) in variables.items():
             shape, dtype = shape_dtype
-            g.create_array(
+            integer = np.issubdtype(np.dtype(dtype), np.integer)
+            arr = g.create_array(
                 name,
                 shape=shape,
                 chunks=chunks[name],
                 dtype=dtype,
-                fill_value=fill,
+                fill_value=None if integer else fill,
                 attributes={**vattrs, "_ARRAY_DIMENSIONS": list(dims)},
             )
-        zarr.consolidate_metadata(self.zarr_store)
-        if self.path is not None:
-            os.makedirs(os.path.join(self.path, PROGRESS), exist_ok=True)
+            if integer:
+                arr[...] = np.full(shape, fill, dtype=dtype)
+        zarr.consolidate_metadata(target)
+        if tmp is not None and self.path is not None:
+            os.makedirs(os.path.join(tmp, PROGRESS), exist_ok=True)
+            os.rename(tmp, self.path)
 
     # ------------------------------------------------------------------ progress
     def done_tasks(self) -> set[int]:
@@ -150,8 +169,9 @@ class SweepStore:
             sl = block + (slice(None),) * (arr.ndim - len(block))
             arr[sl] = values
         if self.path is not None:
-            marker = os.path.join(self.path, PROGRESS, f"{task_index}.done")
-            with open(marker, "w"):
+            d = os.path.join(self.path, PROGRESS)
+            os.makedirs(d, exist_ok=True)
+            with open(os.path.join(d, f"{task_index}.done"), "w"):
                 pass
 
     def finish(self) -> None:
@@ -167,6 +187,11 @@ class SweepStore:
         import xarray as xr
 
         return xr.open_zarr(self.zarr_store, chunks=None, consolidated=True)
+
+
+def _short(v: Any, limit: int = 80) -> str:
+    r = repr(v)
+    return r if len(r) <= limit else r[: limit - 3] + "..."
 
 
 def _toml_diff(old: str, new: str, what: str) -> str:
@@ -188,11 +213,15 @@ def _toml_diff(old: str, new: str, what: str) -> str:
     try:
         a, b = flat(tomllib.loads(old)), flat(tomllib.loads(new))
     except Exception:
-        return f"{what} differs"
+        return f"{what} differs (the stored text is not readable TOML)"
     keys = sorted(k for k in set(a) | set(b) if a.get(k) != b.get(k))
     shown = []
     for k in keys[:4]:
         va, vb = a.get(k), b.get(k)
+        head, dot, field = k.rpartition(".")
+        if dot and (head.startswith("vary[") or head == "family"):
+            axis = b.get(f"{head}.name") or a.get(f"{head}.name")
+            k = f"{head.split('[')[0]} axis {axis!r} {field}"
         if isinstance(va, list) and len(va) > 6:
             va = f"[{len(va)} values {va[0]}..{va[-1]}]"
         if isinstance(vb, list) and len(vb) > 6:
