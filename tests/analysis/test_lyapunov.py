@@ -117,15 +117,18 @@ def test_lorenz_spectrum() -> None:
 
 
 def test_max_lyapunov_is_the_first_exponent_of_the_spectrum() -> None:
-    """Gram–Schmidt keeps the first k vectors independent of the others, and the step control
-    ignores the tangents: the leading exponents do not depend on how many are computed."""
+    """Gram–Schmidt keeps the first k vectors independent of the others: the leading exponents
+    do not depend on how many are computed (to the accuracy of the finite-time estimate: the
+    tangents take part in the step control, so the step sequences differ)."""
     system = gc.lorenz(sample_interval=0.1)
-    kw = {"transient_periods": 10, "periods": 500, "y0": [1.0, 1.0, 1.0]}
+    kw = {"transient_periods": 10, "periods": 10_000, "y0": [1.0, 1.0, 1.0]}
     full = lyapunov_spectrum(system, **kw).exponents
     two = lyapunov_spectrum(system, n_exponents=2, **kw).exponents
     assert two.shape == (2,)
-    np.testing.assert_allclose(two, full[:2], rtol=1e-13, atol=0)
-    assert max_lyapunov(system, **kw) == pytest.approx(full[0], rel=1e-13, abs=0)
+    # finite-time estimates over t = 1000 of a chaotic flow: agree to ~1 %, the zero one to 0.02
+    assert two[0] == pytest.approx(full[0], rel=0.02)
+    assert abs(two[1] - full[1]) < 0.02
+    assert max_lyapunov(system, **kw) == pytest.approx(full[0], rel=0.02)
 
 
 def test_invalid_arguments_are_named() -> None:
@@ -198,13 +201,9 @@ def test_linear_exponents_are_real_parts_of_eigenvalues(name: str) -> None:
     assert res.duration > 12_000  # so the last check holds to 4e-4
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="known bug: the step size is controlled on the system state only; once an unstable "
-    "mode dominates the state, the steps grow and the tangent vectors of the decaying modes are "
-    "integrated inaccurately (exponents 2-3 off by 0.06 here; a max_step of 0.3 fixes them)",
-)
 def test_linear_with_an_unstable_mode_matches_exact_tangent_map() -> None:
+    """Regression: with step control on the state only, the tangents of the decaying modes were
+    integrated with steps sized for the unstable mode (exponents 2-3 off by 0.06)."""
     rng = np.random.default_rng(1)
     b = np.zeros((4, 4))
     b[:2, :2] = [[-0.05, 1.3], [-1.3, -0.05]]
@@ -319,7 +318,7 @@ def test_tangent_map_matches_finite_differences(sheng: gc.GearSet, case: str) ->
     y0 = gc.simulate(system, transient_periods=100, periods=1, rtol=1e-10, atol=1e-12).final_state
     one = gc.simulate(system, y0=y0, transient_periods=0, periods=2, rtol=1e-12, atol=1e-14)
     assert set(contact_regimes(one).values()) - {"none"}, "no contact change in the period"
-    res = lyapunov_spectrum(system, y0=y0, transient_periods=0, periods=2, rtol=1e-12, atol=1e-14)
+    res = lyapunov_spectrum(system, y0=y0, transient_periods=0, periods=2, rtol=1e-11, atol=1e-13)
     assert res.renormalizations == 1
     assert res.duration == pytest.approx(system.period, rel=1e-14)
     ref = _fd_log_stretches(system, y0, h=1e-5)
@@ -337,9 +336,11 @@ def test_sweep_lle_equals_max_lyapunov(sheng: gc.GearSet) -> None:
     for om in ds["omega"].values:
         expected = max_lyapunov(gc.planetary_system(gs, float(om)), **kw)
         assert float(ds["lle"].sel(omega=om)) == pytest.approx(expected, rel=1e-12, abs=1e-14)
-    # the tangents do not touch the trajectory: bitwise the same sections, extrema, steps
-    for name in ("delta_sp", "delta_sp_dot", "delta_sp_min", "delta_rp_max", "steps_accepted"):
-        np.testing.assert_array_equal(ds[name].values, plain[name].values, err_msg=name)
+    # the tangents share the error control, so the trajectory agrees with the plain sweep to
+    # the tolerance where the motion is regular (Ω = 0.5 is 1T; chaos amplifies differences)
+    for name in ("delta_sp", "delta_sp_dot", "delta_sp_min", "delta_rp_max"):
+        a, b = ds[name].sel(omega=0.5).values, plain[name].sel(omega=0.5).values
+        np.testing.assert_allclose(a, b, rtol=1e-5, atol=1e-6, err_msg=name)
 
 
 def test_continuation_sweep_lle_equals_max_lyapunov_from_previous_state(

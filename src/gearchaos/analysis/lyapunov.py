@@ -3,8 +3,8 @@
 The tangent vectors obey V' = J(τ, y) V with the piecewise Jacobian of the dead zones — valid
 because every vector field here is continuous (damping acts inside the clearances, MODEL.md §4),
 so no saltation matrix is needed at contact changes. They are integrated with the trajectory by
-the same compiled Dormand–Prince kernel (step control on the system state only, so the
-trajectory is unchanged), started orthonormal after the transient and re-orthonormalised by
+the same compiled Dormand–Prince kernel (with error control on the tangent vectors too),
+started orthonormal after the transient and re-orthonormalised by
 modified Gram–Schmidt at every sample (Benettin et al. 1980; Shimada & Nagashima 1979):
 λ_j = (1/t) Σ log ‖v_j‖ over the recorded window.
 
@@ -73,7 +73,7 @@ def lyapunov_spectrum(
         Forcing periods discarded, then averaged over. The statistical error of a chaotic
         estimate decays like 1/√(periods); a regular orbit's like log(·)/periods.
     rtol, atol
-        Tolerances of the system state (the tangent vectors follow the same steps).
+        Tolerances of the system state and of the (normalised) tangent vectors.
     """
     n = system.n_state
     k = n if n_exponents is None else int(n_exponents)

@@ -516,7 +516,8 @@ def bifurcation(
         Protocol and tolerances, as in :func:`gearchaos.simulate`.
     lyapunov
         Also store the largest Lyapunov exponent ``lle`` of every point (variational
-        equations integrated with the trajectory; the section values are unchanged).
+        equations integrated with the trajectory, under the same error control, so section
+        values agree with a sweep without it to the tolerance, not bitwise).
     store
         Path of a Zarr store. Written chunk by chunk; an interrupted sweep (Ctrl-C, SIGTERM,
         SIGKILL) resumes when called again with the same arguments; other settings are refused
