@@ -1,5 +1,5 @@
-"""Command-line interface: ``gearchaos simulate | bifurcation | plot | reproduce | info |
-presets | init-gearset``.
+"""Command-line interface: ``gearchaos simulate | bifurcation | classify | plot | poincare |
+reproduce | info | presets | init-gearset``.
 
 Every command takes the gear set the same way: ``--preset NAME`` (default ``sheng2016``) or
 ``--gearset FILE.toml`` (one of the two), then any number of ``--set NAME=VALUE`` changes by
@@ -52,8 +52,11 @@ EXIT_FAILURE = 1
 EXIT_INVALID = 2
 EXIT_INTERRUPTED = 130
 
-#: Figures of the seed paper that ``gearchaos reproduce`` knows.
-PAPER_FIGURES = ("fig4", "fig6", "fig8", "fig9", "fig11", "fig12")
+#: Figures of the seed paper that ``gearchaos reproduce`` knows: bifurcation diagrams
+#: (:mod:`gearchaos.paper.recipes`) and Poincaré galleries (:data:`GALLERY_FIGURES`).
+PAPER_FIGURES = ("fig4", "fig5", "fig6", "fig7", "fig8", "fig9", "fig10", "fig11", "fig12")
+#: The Poincaré galleries among them (:mod:`gearchaos.paper.galleries`).
+GALLERY_FIGURES = ("fig5", "fig7", "fig10")
 INTERRUPTED_MESSAGE = (
     "interrupted: the store keeps every finished chunk; run the same command again to resume"
 )
@@ -352,13 +355,24 @@ def simulate(
     plot: Annotated[
         bool, typer.Option("--plot/--no-plot", help="Write the summary figure (with -o).")
     ] = True,
+    lyapunov: Annotated[
+        bool,
+        typer.Option(
+            "--lyapunov",
+            help=(
+                "Also compute the largest Lyapunov exponent (same transient, periods and "
+                "tolerances); it decides quasi-periodic vs chaotic motion."
+            ),
+        ),
+    ] = False,
 ) -> None:
     """Simulate a gear set at one mesh frequency and summarise the steady response.
 
     Runs the seed paper's protocol (MODEL.md §8): zero initial state, adaptive Dormand–Prince
     5(4), TRANSIENT mesh periods discarded, then PERIODS recorded with a Poincaré point
     X̄_sp1 = δ_sp1/b_c at each τ_k = 2πk/Ω. Ω is set with **--set omega=...**
-    (default **1.5**). Prints the motion (nT for n distinct section points, or many), the
+    (default **1.5**). Prints the motion label (1T … nT, QP, chaos or unresolved, with the
+    0–1 test K and, with **--lyapunov**, the largest Lyapunov exponent λ₁ that decides it), the
     section range of X̄_sp1 and the contact regime of every mesh.
 
     Example: **gearchaos simulate --preset sheng2016 --set omega=1.5 --set xi=0.05 -o out/**
@@ -386,7 +400,12 @@ def simulate(
 
         from .analysis.summary import summarize
 
-        summary = summarize(result)
+        lle = (
+            _largest_exponent(result, transient=transient, periods=periods, rtol=rtol, atol=atol)
+            if lyapunov
+            else None
+        )
+        summary = summarize(result, lle=lle)
         written: list[Path] = []
         if output is not None:
             nc = output / "simulation.nc"
@@ -403,7 +422,9 @@ def simulate(
     from .analysis.summary import format_summary
 
     out = _stdout()
-    out.print(format_summary(summary, title=f"gearchaos simulation of {gs.name} at Ω = {omega:g}"))
+    table = format_summary(summary, title=f"gearchaos simulation of {gs.name} at Ω = {omega:g}")
+    _add_motion_rows(table, summary)
+    out.print(table)
     out.print(
         Text(
             f"{transient:g} transient + {periods} recorded mesh periods, "
@@ -413,6 +434,54 @@ def simulate(
     )
     for path in written:
         out.print(Text.assemble(("wrote ", "dim"), (str(path), "bold")))
+
+
+def _largest_exponent(
+    result: Any, *, transient: float, periods: int, rtol: float, atol: float
+) -> float | None:
+    """λ₁ of a simulated system at the run's settings (None, with a warning, if it fails)."""
+    from .analysis.lyapunov import lyapunov_spectrum
+
+    if not result.status.ok:
+        return None
+    err = _stderr()
+    spinner: contextlib.AbstractContextManager[Any] = contextlib.nullcontext()
+    if err.is_terminal:
+        spinner = err.status("largest Lyapunov exponent…")
+    with spinner:
+        lr = lyapunov_spectrum(
+            result.system,
+            n_exponents=1,
+            transient_periods=transient,
+            periods=periods,
+            rtol=rtol,
+            atol=atol,
+        )
+    value = float(lr.largest)
+    if not (lr.status.ok and math.isfinite(value)):
+        err.print(
+            Text("warning: ", style="bold yellow")
+            + Text(f"the Lyapunov exponent could not be computed: {lr.status.message}"),
+            soft_wrap=True,
+        )
+        return None
+    return value
+
+
+def _add_motion_rows(table: Table, summary: Mapping[str, Any]) -> None:
+    """The motion indicators of a summary as rows of its table."""
+    lle = summary.get("lle")
+    k01 = summary.get("k01")
+    table.add_row("largest Lyapunov exponent λ₁", "—" if lle is None else f"{lle:.4g}")
+    table.add_row("0–1 test K", "—" if k01 is None else f"{k01:.3f}")
+    agree = summary.get("indicators_agree")
+    if agree is not None:
+        table.add_row(
+            "indicators agree", Text("yes" if agree else "no", style="" if agree else "bold red")
+        )
+    note = summary.get("motion_note")
+    if note:
+        table.add_row("motion note", escape(str(note)))
 
 
 def _run_simulation(
@@ -805,6 +874,16 @@ def bifurcation(
         bool,
         typer.Option("--overwrite", help="Replace an existing store made with other settings."),
     ] = False,
+    lyapunov: Annotated[
+        bool,
+        typer.Option(
+            "--lyapunov",
+            help=(
+                "Also store the largest Lyapunov exponent lle of every point; the motion "
+                "labels then tell quasi-periodic from chaotic motion by it."
+            ),
+        ),
+    ] = False,
     quiet: QuietOpt = False,
     json_out: JsonOpt = False,
 ) -> None:
@@ -813,9 +892,11 @@ def bifurcation(
     Every grid point is one simulation with the seed's protocol (MODEL.md §8): TRANSIENT mesh
     periods discarded, PERIODS recorded with one section point each. The store (Zarr, opened
     by xarray.open_zarr or gearchaos.open_sweep) holds the section values, status and step
-    counts per point and the full gear set and settings. Ω is a parameter like any other:
-    sweep it with **--vary omega=...**, or fix it with **--set omega=...**; when it is neither
-    swept nor set, Ω = **1.5**. Draw the result with **gearchaos plot STORE -o fig.png**.
+    counts per point and the full gear set and settings, and labels every point (motion 1T …
+    nT, QP, chaos, unresolved, failed; the regime table is printed at the end). Ω is a
+    parameter like any other: sweep it with **--vary omega=...**, or fix it with
+    **--set omega=...**; when it is neither swept nor set, Ω = **1.5**. Draw the result with
+    **gearchaos plot STORE -o fig.png**.
 
     Example (the seed's Fig. 4): **gearchaos bifurcation --vary omega=0.05:4:800
     --family xi=0.03,0.05,0.07,0.09 -o fig4.zarr**
@@ -877,6 +958,7 @@ def bifurcation(
             periods=periods,
             rtol=rtol,
             atol=atol,
+            lyapunov=lyapunov,
             store=output,
             overwrite=overwrite,
             workers=workers,
@@ -907,11 +989,68 @@ def bifurcation(
     out.print(
         Text(
             f"{transient:g} transient + {periods} recorded mesh periods, {ic} initial "
-            f"conditions, rtol {rtol:g}, atol {atol:g}",
+            f"conditions, rtol {rtol:g}, atol {atol:g}"
+            + (", largest Lyapunov exponents" if lyapunov else ""),
             style="dim",
         )
     )
+    regimes = _stored_regime_table(ds)
+    if regimes:
+        out.print(_regime_table(regimes, title="motion regimes (fraction of the swept points)"))
     out.print(Text(f"next: gearchaos plot {output} -o {output.stem}.png", style="dim"))
+
+
+# --------------------------------------------------------------------------- regime tables
+def _stored_regime_table(ds: Any) -> dict[str, dict[str, float]]:
+    """The ``regime_table`` attribute of a sweep store (empty when it has none)."""
+    raw = ds.attrs.get("regime_table")
+    if not raw:
+        return {}
+    try:
+        table = json.loads(raw) if isinstance(raw, str) else dict(raw)
+    except (TypeError, ValueError):
+        return {}
+    return {str(k): {str(r): float(f) for r, f in v.items()} for k, v in table.items()}
+
+
+_SYMBOLS = {
+    "omega": "Ω",
+    "xi": "ξ",
+    "backlash.sun_planet": "b̄_sp",
+    "backlash.planet_ring": "b̄_rp",
+    "clearance.sun_bearing": "b̄_s",
+}
+
+
+def _column_title(key: str) -> str:
+    """``xi=0.03`` → ``ξ = 0.03``; ``all`` → ``all points``."""
+    if key == "all":
+        return "all points"
+    name, sep, value = key.partition("=")
+    if not sep:
+        return key
+    return f"{_SYMBOLS.get(name, name)} = {value}"
+
+
+def _regime_table(table: Mapping[str, Mapping[str, float]], *, title: str | None) -> Table:
+    """A rich table of a regime table: one row per regime (with its palette colour), one
+    column per family value, fractions in %."""
+    from .analysis.classify import sort_labels
+    from .plot.regimes import regime_colour
+
+    labels = sort_labels(label for column in table.values() for label in column)
+    out = Table(title=escape(title) if title else None, title_justify="left")
+    out.add_column("regime", no_wrap=True)
+    for key in table:
+        out.add_column(escape(_column_title(key)), justify="right")
+    for label in labels:
+        cells = []
+        for column in table.values():
+            f = column.get(label)
+            cells.append("—" if f is None else f"{100.0 * f:.1f} %")
+        swatch = Text("■ ", style=regime_colour(label)) + Text(label)
+        out.add_row(swatch, *cells)
+    return out
 
 
 # --------------------------------------------------------------------------- plot
@@ -987,6 +1126,234 @@ def _open_store(path: Path) -> Any:
     return ds
 
 
+# --------------------------------------------------------------------------- classify
+@app.command()
+def classify(
+    store: Annotated[
+        Path,
+        typer.Argument(help="Sweep store written by `gearchaos bifurcation`.", show_default=False),
+    ],
+    rtol: Annotated[
+        float,
+        typer.Option(
+            "--rtol",
+            help=(
+                "Tolerance of period detection, relative to the attractor's size: section "
+                "points closer than this repeat."
+            ),
+        ),
+    ] = 1e-3,
+    max_period: Annotated[
+        int, typer.Option("--max-period", help="Longest period n recognised as nT.")
+    ] = 64,
+    json_out: JsonOpt = False,
+) -> None:
+    """(Re)label every point of a sweep store without re-simulating: 1T … nT (period of the
+    stored section sequence), QP or chaos (by the stored largest Lyapunov exponent when the
+    sweep ran with --lyapunov, confirmed by the 0–1 test and the spectrum), unresolved, failed.
+
+    Rewrites the store's motion, period, k01 and indicators_agree variables and its
+    regime_table attribute, and prints the regime table: the fraction of the swept points in
+    each regime, per family value. **--json** prints that table as a dictionary
+    (family value → regime → fraction).
+
+    Example: **gearchaos classify fig4.zarr --rtol 1e-4**
+    """
+    with _reported_errors():
+        if not (math.isfinite(rtol) and 0.0 < rtol < 1.0):
+            raise ParameterError(f"--rtol must be a number in (0, 1): got {rtol!r}")
+        if max_period < 1:
+            raise ParameterError(f"--max-period must be an integer >= 1: got {max_period!r}")
+        _open_store(store)
+        from .sweep import classify_store
+
+        table = classify_store(store, rtol=rtol, max_period=max_period)
+    if json_out:
+        _print_json(table)
+        return
+    out = _stdout()
+    out.print(_regime_table(table, title=f"motion regimes of {store} (fraction of the points)"))
+    out.print(
+        Text(
+            f"period tolerance {rtol:g} of the attractor size, periods up to {max_period}",
+            style="dim",
+        )
+    )
+
+
+# --------------------------------------------------------------------------- poincare
+@app.command()
+def poincare(
+    vary: Annotated[
+        str | None,
+        typer.Option(
+            "--vary",
+            "-v",
+            help=(
+                "NAME=VALUES: one panel per value, VALUES a,b,c or start:stop:count; NAME is "
+                "omega, xi or a dotted gear-set parameter, e.g. "
+                "omega=1.2,1.35,1.5,1.7,1.875,1.926,2.02,2.3 or backlash.sun_planet=1:6:12."
+            ),
+            show_default=False,
+        ),
+    ] = None,
+    output: Annotated[
+        Path | None,
+        typer.Option("--output", "-o", help="Figure file: .png, .pdf or .svg.", show_default=False),
+    ] = None,
+    preset: PresetOpt = None,
+    gearset: GearsetOpt = None,
+    set_: SetOpt = None,
+    transient: Annotated[
+        float, typer.Option("--transient", help="Mesh periods discarded for every value.")
+    ] = 100.0,
+    periods: Annotated[
+        int, typer.Option("--periods", help="Mesh periods recorded (Poincaré points) per value.")
+    ] = 300,
+    with_: Annotated[
+        str | None,
+        typer.Option(
+            "--with",
+            help="Extra rows under each map: phase, spectrum or phase,spectrum.",
+            show_default=False,
+        ),
+    ] = None,
+    planet: Annotated[int, typer.Option("--planet", help="Planet of X̄_sp.")] = 1,
+    rtol: Annotated[
+        float, typer.Option("--rtol", help="Relative tolerance (Dormand–Prince 5(4)).")
+    ] = 1e-8,
+    atol: Annotated[float, typer.Option("--atol", help="Absolute tolerance.")] = 1e-10,
+    quiet: QuietOpt = False,
+    json_out: JsonOpt = False,
+) -> None:
+    """A gallery of Poincaré maps (X̄_sp1 against X̄'_sp1) along a parameter path, each panel
+    titled with the value, its motion label and its largest Lyapunov exponent λ₁.
+
+    Every value is one simulation with the seed's protocol (TRANSIENT mesh periods discarded,
+    PERIODS recorded) plus a Lyapunov run at the same settings; the label (1T … nT, QP, chaos,
+    unresolved) uses that λ₁. Prints a table of the values (value, motion, λ₁, K of the 0–1
+    test, distinct points); **--json** prints them as rows.
+
+    Example: **gearchaos poincare --vary omega=1.2,1.35,1.5,1.7,1.875,1.926,2.02,2.3
+    --with phase -o gallery.png**
+    """
+    from .plot.figure import SAVE_FORMATS
+
+    with _reported_errors():
+        if not vary:
+            raise ParameterError(
+                "--vary is required: give NAME=VALUES, e.g. --vary omega=1.2,1.5,1.875"
+            )
+        if output is None:
+            raise ParameterError("--output is required: the figure file, e.g. -o gallery.png")
+        if output.suffix.lower() not in SAVE_FORMATS:
+            raise ParameterError(
+                f"--output must end in one of {', '.join(SAVE_FORMATS)}: got {str(output)!r}"
+            )
+        from .plot.gallery import parse_extras
+        from .sweep.spec import parse_axis
+
+        try:
+            extras = parse_extras(with_)
+        except ParameterError:
+            raise ParameterError(
+                f"--with must be phase, spectrum or phase,spectrum: got {with_!r}"
+            ) from None
+        axis = parse_axis(vary)
+        omega, changes = parse_sets(set_ or [])
+        fixed: dict[str, Any] = dict(changes)
+        if axis.name in fixed or (axis.name == "omega" and omega is not None):
+            raise ParameterError(f"{axis.name} is both varied and set with --set; choose one")
+        if axis.name != "omega":
+            if omega is None:
+                omega = DEFAULT_OMEGA
+                if not (quiet or json_out):
+                    _stderr().print(
+                        Text(
+                            f"Ω = {DEFAULT_OMEGA:g} (not varied; change it with --set omega=...)",
+                            style="dim",
+                        )
+                    )
+            fixed["omega"] = omega
+        gs = _gearset(preset, gearset, {})
+
+        import time
+
+        import matplotlib
+
+        matplotlib.use("Agg")
+        from .paper.galleries import run_gallery
+        from .plot import savefig
+
+        t0 = time.perf_counter()
+        fig, rows = run_gallery(
+            gs,
+            axis.name,
+            axis.values,
+            fixed=fixed,
+            transient=transient,
+            periods=periods,
+            with_=extras,
+            progress=not (quiet or json_out),
+            rtol=rtol,
+            atol=atol,
+            planet=planet,
+        )
+        if output.parent != Path(""):
+            output.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            savefig(fig, output)
+        finally:
+            import matplotlib.pyplot as plt
+
+            plt.close(fig)
+        seconds = time.perf_counter() - t0
+    if json_out:
+        _print_json(
+            {
+                "figure": str(output),
+                "param": axis.name,
+                "fixed": fixed,
+                "transient_periods": transient,
+                "periods": periods,
+                "seconds": seconds,
+                "rows": rows,
+            }
+        )
+        return
+    if quiet:
+        return
+    out = _stdout()
+    out.print(_gallery_rows_table(rows, axis.name, title=f"Poincaré gallery of {gs.name}"))
+    out.print(Text.assemble(("wrote ", "dim"), (str(output), "bold")))
+
+
+def _gallery_rows_table(rows: Sequence[Mapping[str, Any]], param: str, *, title: str) -> Table:
+    """One row per value: value, motion (in its palette colour), λ₁, K, agree, points."""
+    from .plot.regimes import regime_colour
+
+    table = Table(title=escape(title), title_justify="left")
+    table.add_column(escape(_SYMBOLS.get(param, param)), justify="right")
+    table.add_column("motion", no_wrap=True)
+    table.add_column("λ₁", justify="right")
+    table.add_column("0–1 K", justify="right")
+    table.add_column("agree", justify="center")
+    table.add_column("distinct points", justify="right")
+    for r in rows:
+        motion = str(r["motion"])
+        lle, k01 = r.get("lle"), r.get("k01")
+        agree = bool(r.get("indicators_agree", True))
+        table.add_row(
+            f"{float(r['value']):g}",
+            Text("■ ", style=regime_colour(motion)) + Text(motion),
+            "—" if lle is None else f"{lle:.3g}",
+            "—" if k01 is None else f"{k01:.3f}",
+            Text("yes" if agree else "no", style="" if agree else "bold red"),
+            str(r.get("distinct_section_points", "—")),
+        )
+    return table
+
+
 # --------------------------------------------------------------------------- reproduce
 @app.command()
 def reproduce(
@@ -1001,7 +1368,10 @@ def reproduce(
         typer.Option(
             "--output",
             "-o",
-            help="Directory for FIG.png and the sweep store FIG.zarr; created if missing.",
+            help=(
+                "Directory for FIG.png and the sweep store FIG.zarr (galleries: FIG.json and "
+                "FIG.csv); created if missing."
+            ),
             file_okay=False,
         ),
     ] = Path("."),
@@ -1025,11 +1395,16 @@ def reproduce(
     json_out: JsonOpt = False,
 ) -> None:
     """Run the exact sweep of one of the seed paper's bifurcation figures with the default gear
-    set and draw it in the paper's layout (resumable like `gearchaos bifurcation`).
+    set and draw it in the paper's layout (resumable like `gearchaos bifurcation`), or draw one
+    of its Poincaré galleries.
 
-    fig4: Ω sweep, ξ = 0.03, 0.05, 0.07, 0.09; fig6: b̄_sp at Ω = 1.5 for four ξ; fig8: b̄_sp at
-    ξ = 0.11 for Ω = 1, 1.5, 2, 2.5; fig9: b̄_rp at Ω = 1.5 for four ξ; fig11: b̄_rp at ξ = 0.11
-    for four Ω; fig12: b̄_s at ξ = 0.05, Ω = 1.5.
+    Bifurcation diagrams — fig4: Ω sweep, ξ = 0.03, 0.05, 0.07, 0.09; fig6: b̄_sp at Ω = 1.5 for
+    four ξ; fig8: b̄_sp at ξ = 0.11 for Ω = 1, 1.5, 2, 2.5; fig9: b̄_rp at Ω = 1.5 for four ξ;
+    fig11: b̄_rp at ξ = 0.11 for four Ω; fig12: b̄_s at ξ = 0.05, Ω = 1.5.
+
+    Poincaré galleries (FIG.png, FIG.json and FIG.csv with value, motion, λ₁, K, distinct
+    points) — fig5: Ω path at ξ = 0.03; fig7: b̄_sp ∈ [1, 6] at Ω = 1.5, ξ = 0.05; fig10:
+    b̄_rp ∈ [1, 9] at Ω = 1.5, ξ = 0.05, at the values the seed's text names.
 
     Example: **gearchaos reproduce fig4 -o paper/ --quick**
     """
@@ -1041,26 +1416,55 @@ def reproduce(
             raise ParameterError(
                 f"FIG must be one of {', '.join(PAPER_FIGURES)}: got {figure!r}{hint}"
             )
-        try:
-            from .paper.recipes import reproduce as run_recipe
-        except ImportError as exc:
-            _fail(f"the paper recipes are not available in this installation: {exc}", EXIT_FAILURE)
-        output.mkdir(parents=True, exist_ok=True)
-        result = dict(
-            run_recipe(
-                name,
-                output,
-                quick=quick,
-                progress=not quiet,
-                workers=workers,
-                overwrite=overwrite,
+        if name in GALLERY_FIGURES:
+            if workers is not None and not (quiet or json_out):
+                _stderr().print(
+                    Text(
+                        f"--workers does not apply to {name} (a gallery runs its "
+                        f"{name} values one after the other)",
+                        style="dim",
+                    )
+                )
+            import matplotlib
+
+            matplotlib.use("Agg")
+            from .paper.galleries import reproduce_gallery
+
+            output.mkdir(parents=True, exist_ok=True)
+            result = dict(
+                reproduce_gallery(name, output, quick=quick, progress=not (quiet or json_out))
             )
-        )
+        else:
+            try:
+                from .paper.recipes import reproduce as run_recipe
+            except ImportError as exc:
+                _fail(
+                    f"the paper recipes are not available in this installation: {exc}",
+                    EXIT_FAILURE,
+                )
+            output.mkdir(parents=True, exist_ok=True)
+            result = dict(
+                run_recipe(
+                    name,
+                    output,
+                    quick=quick,
+                    progress=not quiet,
+                    workers=workers,
+                    overwrite=overwrite,
+                )
+            )
     if json_out:
         _print_json(result)
         return
     if quiet:
         return
+    rows = result.pop("rows", None)
+    if rows is not None:
+        from .paper.galleries import get_gallery
+
+        _stdout().print(
+            _gallery_rows_table(rows, get_gallery(name).param, title=f"Poincaré gallery {name}")
+        )
     table = _pairs_table(f"gearchaos reproduce {name}" + (" (quick)" if quick else ""))
     for key in ("figure", "store", "points", "failed", "seconds"):
         if key in result:

@@ -179,7 +179,7 @@ def test_plot_refuses_a_directory_that_is_no_store(runner: CliRunner, tmp_path: 
 
 
 def test_reproduce_unknown_figure(runner: CliRunner, tmp_path: Path) -> None:
-    result = runner.invoke(app, ["reproduce", "fig5", "-o", str(tmp_path)])
+    result = runner.invoke(app, ["reproduce", "fig3", "-o", str(tmp_path)])
     assert result.exit_code == 2
     assert "error:" in result.stderr
     for name in PAPER_FIGURES:

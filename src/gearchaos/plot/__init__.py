@@ -2,24 +2,41 @@
 
 Every plotting function takes ``ax=None`` (a new figure when not given) and returns the Axes:
 :func:`time_history`, :func:`phase_portrait`, :func:`poincare_map`, :func:`spectrum`,
-:func:`sun_orbit`, and for sweeps :func:`bifurcation` and :func:`distinct_map`.
-:func:`summary_figure` puts a simulation on one page, :func:`bifurcation_figure` and
-:func:`sweep_figure` a sweep (one panel per family value); :func:`savefig` writes PNG, PDF
-or SVG by suffix. Symbols follow the seed: X̄_sp1 = δ_sp1/b_c, time in mesh periods τΩ/2π.
+:func:`sun_orbit`, and for sweeps :func:`bifurcation`, :func:`distinct_map`,
+:func:`regime_band` and :func:`regime_map` (motion labels in the one palette
+:data:`REGIME_COLOURS`). :func:`summary_figure` puts a simulation on one page,
+:func:`poincare_gallery` several (Poincaré maps titled with value, motion and LLE),
+:func:`bifurcation_figure` and :func:`sweep_figure` a sweep (one panel per family value);
+:func:`savefig` writes PNG, PDF or SVG by suffix. Symbols follow the seed:
+X̄_sp1 = δ_sp1/b_c, time in mesh periods τΩ/2π.
 """
 
 from .bifurcation import bifurcation, bifurcation_figure, distinct_map, sweep_figure
 from .figure import savefig, summary_figure
+from .gallery import poincare_gallery
 from .phase import phase_portrait, poincare_map, sun_orbit
+from .regimes import (
+    REGIME_COLOURS,
+    regime_band,
+    regime_colour,
+    regime_legend,
+    regime_map,
+)
 from .timeseries import amplitude_spectrum, spectrum, time_history
 
 __all__ = [
+    "REGIME_COLOURS",
     "amplitude_spectrum",
     "bifurcation",
     "bifurcation_figure",
     "distinct_map",
     "phase_portrait",
+    "poincare_gallery",
     "poincare_map",
+    "regime_band",
+    "regime_colour",
+    "regime_legend",
+    "regime_map",
     "savefig",
     "spectrum",
     "summary_figure",

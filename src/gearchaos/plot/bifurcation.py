@@ -12,7 +12,9 @@ and never simulate:
   seed's figures; up and down continuation branches overlaid in two colours;
 * :func:`distinct_map` — a 2-D sweep coloured by the number of distinct section points of
   every grid point (1T, 2T, …, many);
-* :func:`sweep_figure` — whichever of the two fits the dataset.
+* :func:`sweep_figure` — whichever of the two fits the dataset; with motion labels (every
+  store has them) 1-D panels get a regime band and 2-D sweeps become regime maps
+  (:mod:`gearchaos.plot.regimes`).
 """
 
 from __future__ import annotations
@@ -630,6 +632,7 @@ def bifurcation_figure(
     planet: int = 1,
     clearance_lines: bool = False,
     resonances: bool = False,
+    regimes: bool | None = None,
     figsize: tuple[float, float] | None = None,
 ) -> Any:
     """Bifurcation diagrams of a 1-D sweep, one panel per family value.
@@ -637,6 +640,11 @@ def bifurcation_figure(
     Panels are titled ``(a) ξ = 0.03``, ``(b) ξ = 0.05`` … like the seed's figures (no letter
     when there is one panel); for ``direction="both"`` each panel overlays the up (C0) and
     down (C3) branches. Options as in :func:`bifurcation`.
+
+    With ``regimes`` (default: when the dataset has ``motion`` labels, as every store written
+    by :func:`gearchaos.bifurcation` does) each panel gets a thin band below it coloured by
+    the motion label of every swept value (:func:`~gearchaos.plot.regimes.regime_band`), and
+    the figure one legend, under all panels, naming exactly the regimes present.
 
     Returns
     -------
@@ -654,13 +662,35 @@ def bifurcation_figure(
             f"bifurcation_figure needs a 1-D sweep: the dataset varies {', '.join(lay.vary)}; "
             "use distinct_map (or sweep_figure) for 2-D sweeps"
         )
+    if regimes is None:
+        regimes = "motion" in ds.data_vars
+    elif regimes and "motion" not in ds.data_vars:
+        raise ParameterError(
+            "regimes=True needs motion labels (variable 'motion'); label the store with "
+            "`gearchaos classify STORE` or pass regimes=False"
+        )
     family = lay.family
     values = list(np.asarray(ds[family].values)) if family else [None]
     nrows, ncols = _grid(len(values))
+    band = (0.14 if lay.directions else 0.075) if regimes else 0.0
     if figsize is None:
-        figsize = (7.0, 5.0) if len(values) == 1 else (5.5 * ncols, 3.6 * nrows + 0.8)
+        extra = (0.45 * nrows + 0.5) if regimes else 0.0
+        figsize = (
+            (7.0, 5.0 + extra) if len(values) == 1 else (5.5 * ncols, 3.6 * nrows + 0.8 + extra)
+        )
     fig = Figure(figsize=figsize, layout="constrained")
-    axs = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False)).ravel()
+    if regimes:
+        grid = fig.add_gridspec(2 * nrows, ncols, height_ratios=[1.0, band] * nrows)
+        axs = np.array(
+            [fig.add_subplot(grid[2 * (k // ncols), k % ncols]) for k in range(nrows * ncols)]
+        )
+        bands = [
+            fig.add_subplot(grid[2 * (k // ncols) + 1, k % ncols], sharex=axs[k])
+            for k in range(len(values))
+        ]
+    else:
+        axs = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False)).ravel()
+        bands = []
     for k, value in enumerate(values):
         ax = axs[k]
         select = {family: value} if family else None
@@ -675,8 +705,28 @@ def bifurcation_figure(
         )
         if family:
             ax.set_title(_panel_title(k, family, value, letters=len(values) > 1), loc="left")
+        if regimes:
+            from .regimes import regime_band
+
+            regime_band(ds, bands[k], select=select)
+            ax.set_xlabel("")
+            ax.tick_params(axis="x", labelbottom=False)
     for ax in axs[len(values) :]:
         ax.set_visible(False)
+    if regimes:
+        from .regimes import regime_categories, regime_handles
+
+        cats = np.asarray(regime_categories(ds).values, dtype=object).ravel()
+        handles = regime_handles(cats)
+        fig.legend(
+            handles=handles,
+            loc="outside lower center",
+            ncols=min(len(handles), 8),
+            fontsize="small",
+            frameon=False,
+            title="motion",
+            title_fontsize="small",
+        )
     fig.suptitle(
         _suptitle(ds, "bifurcation diagram" + ("s" if len(values) > 1 else "")),
         fontsize="medium",
@@ -854,12 +904,17 @@ def sweep_figure(
     clearance_lines: bool = False,
     resonances: bool = False,
     max_count: int = 16,
+    regimes: bool | None = None,
     figsize: tuple[float, float] | None = None,
 ) -> Any:
-    """The figure of a sweep: :func:`bifurcation_figure` for a 1-D sweep, one
-    :func:`distinct_map` per family value (and per direction) for a 2-D sweep.
+    """The figure of a sweep: :func:`bifurcation_figure` for a 1-D sweep, one map per family
+    value (and per direction) for a 2-D sweep.
 
-    ``clearance_lines`` applies to bifurcation diagrams only; ``max_count`` to maps only.
+    With ``regimes`` (default: when the dataset has ``motion`` labels) 1-D sweeps get regime
+    bands under their panels and 2-D sweeps are drawn as regime maps
+    (:func:`~gearchaos.plot.regimes.regime_map`, one categorical legend for the figure);
+    without, 2-D sweeps are :func:`distinct_map` s. ``clearance_lines`` applies to bifurcation
+    diagrams only; ``max_count`` to distinct-point maps only.
 
     Returns
     -------
@@ -878,8 +933,11 @@ def sweep_figure(
             planet=planet,
             clearance_lines=clearance_lines,
             resonances=resonances,
+            regimes=regimes,
             figsize=figsize,
         )
+    if regimes is None:
+        regimes = "motion" in ds.data_vars
     selects: list[dict[str, Any]] = [{}]
     if lay.directions:
         selects = [{"direction": d} for d in lay.directions]
@@ -891,15 +949,20 @@ def sweep_figure(
     fig = Figure(figsize=figsize, layout="constrained")
     axs = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False)).ravel()
     for k, sel in enumerate(selects):
-        ax = distinct_map(
-            ds,
-            axs[k],
-            var=var,
-            planet=planet,
-            max_count=max_count,
-            select=sel or None,
-            resonances=resonances,
-        )
+        if regimes:
+            from .regimes import regime_map
+
+            ax = regime_map(ds, axs[k], select=sel or None, legend=False, resonances=resonances)
+        else:
+            ax = distinct_map(
+                ds,
+                axs[k],
+                var=var,
+                planet=planet,
+                max_count=max_count,
+                select=sel or None,
+                resonances=resonances,
+            )
         if sel:
             parts = [
                 f"{axis_symbol(d)} = {_fmt(v)}" if d != "direction" else str(v)
@@ -909,5 +972,15 @@ def sweep_figure(
             ax.set_title(prefix + ", ".join(parts), loc="left")
     for ax in axs[len(selects) :]:
         ax.set_visible(False)
-    fig.suptitle(_suptitle(ds, "distinct Poincaré points"), fontsize="medium")
+    if regimes:
+        from .regimes import regime_categories, regime_legend
+
+        regime_legend(
+            fig,
+            np.asarray(regime_categories(ds).values, dtype=object).ravel(),
+            loc="outside right upper",
+        )
+        fig.suptitle(_suptitle(ds, "motion regimes"), fontsize="medium")
+    else:
+        fig.suptitle(_suptitle(ds, "distinct Poincaré points"), fontsize="medium")
     return fig

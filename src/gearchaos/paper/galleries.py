@@ -1,0 +1,508 @@
+"""The seed paper's Poincaré galleries (Figs. 5, 7, 10) and the runner of ``gearchaos poincare``.
+
+Sheng et al. (2016) follow the motion along a parameter path with grids of Poincaré maps of
+X̄_sp1 against X̄'_sp1 and name the motion of each map by eye. :func:`run_gallery` runs one
+simulation per value (the seed's protocol: zero initial state, the transient discarded, one
+section point per mesh period), computes the largest Lyapunov exponent of each
+(:func:`~gearchaos.analysis.lyapunov.max_lyapunov`, same settings) and labels it
+(:func:`~gearchaos.analysis.summarize` with that LLE: 1T … nT, QP, chaos, unresolved), then
+draws :func:`~gearchaos.plot.gallery.poincare_gallery`.
+
+The recipes :data:`GALLERIES` hold the values the seed's text names for its three galleries:
+
+======  =====================  =========================================================
+figure  path                   fixed
+======  =====================  =========================================================
+Fig. 5  Ω (12 values)          ξ = 0.03, b̄_sp = 3, b̄_rp = 3.5, b̄_s = 2
+Fig. 7  b̄_sp ∈ [1, 6] (12)     Ω = 1.5, ξ = 0.05, b̄_rp = 3.5, b̄_s = 2
+Fig. 10 b̄_rp ∈ [1, 9] (14)     Ω = 1.5, ξ = 0.05, b̄_sp = 3, b̄_s = 2
+======  =====================  =========================================================
+
+The seed's panels (a)–(x) are not listed with their values; its text names some of them (the
+bifurcation points it discusses). Each recipe's ``notes`` say which values are named and which
+fill the named range. Limits: the default gear set stands in for the seed's lost Table 1
+(MODEL.md §9), so the motion at a given value can differ from the seed's.
+"""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import json
+import math
+import os
+import time
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
+
+from ..errors import ParameterError
+
+__all__ = [
+    "GALLERIES",
+    "PRESET",
+    "QUICK_PERIODS",
+    "ROW_KEYS",
+    "Gallery",
+    "get_gallery",
+    "reproduce_gallery",
+    "run_gallery",
+]
+
+#: Gear set every gallery runs on (as the bifurcation recipes).
+PRESET = "sheng2016"
+#: (transient, recorded) mesh periods of the full galleries (the seed discards 100).
+FULL_PERIODS = (100, 500)
+#: (transient, recorded) mesh periods of ``quick`` galleries (the 0–1 test needs ≥ 100 points).
+QUICK_PERIODS = (50, 100)
+#: Keys of every row of :func:`run_gallery` (and columns of the recipes' CSV), in order.
+ROW_KEYS = (
+    "value",
+    "motion",
+    "lle",
+    "k01",
+    "indicators_agree",
+    "distinct_section_points",
+    "status",
+    "motion_note",
+)
+
+# dotted name -> (unicode symbol, mathtext symbol) for captions
+_SYMBOLS: dict[str, tuple[str, str]] = {
+    "omega": ("Ω", r"\Omega"),
+    "xi": ("ξ", r"\xi"),
+    "backlash.sun_planet": ("b̄_sp", r"\bar{b}_{sp}"),
+    "backlash.planet_ring": ("b̄_rp", r"\bar{b}_{rp}"),
+    "clearance.sun_bearing": ("b̄_s", r"\bar{b}_{s}"),
+}
+
+
+# --------------------------------------------------------------------------- runner
+def _point(target: Any, vals: Mapping[str, Any]) -> tuple[Any, float | None]:
+    """(what :func:`gearchaos.simulate` takes, Ω) of one point: a gear set with the changes
+    applied, or a reference system with its model fields replaced."""
+    from ..gearset import GearSet
+    from ..model.system import System
+
+    changes = dict(vals)
+    omega = changes.pop("omega", None)
+    if isinstance(target, GearSet):
+        if omega is None:
+            raise ParameterError(
+                "omega must be varied or fixed (e.g. fixed={'omega': 1.5} or --set omega=1.5)"
+            )
+        return (target.evolve(changes) if changes else target), float(omega)
+    if isinstance(target, System):
+        model = target.model
+        if changes:
+            try:
+                model = dataclasses.replace(model, **changes)
+            except TypeError:
+                names = ", ".join(sorted(changes))
+                raise ParameterError(f"unknown parameter of {target.name}: got {names}") from None
+        return System(model, float(omega) if omega is not None else target.omega), None
+    raise ParameterError(f"target must be a GearSet or a System: got {type(target).__name__}")
+
+
+def _finite(v: Any) -> float | None:
+    if v is None:
+        return None
+    f = float(v)
+    return f if math.isfinite(f) else None
+
+
+def _progress(enabled: bool, total: int) -> Any:
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    return Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        console=Console(stderr=True),
+        transient=True,
+        disable=not enabled,
+    )
+
+
+def run_gallery(
+    gs: Any,
+    param: str,
+    values: Sequence[float],
+    *,
+    fixed: Mapping[str, Any] | None = None,
+    transient: float = 100,
+    periods: int = 300,
+    with_: Iterable[str] | str | None = (),
+    progress: bool = True,
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    planet: int = 1,
+    title: str | None = None,
+) -> tuple[Any, list[dict[str, Any]]]:
+    """Simulate, measure and label every value of a parameter path and draw the gallery.
+
+    Parameters
+    ----------
+    gs
+        A :class:`~gearchaos.gearset.GearSet` (or a reference :class:`~gearchaos.model.System`,
+        whose model fields are then the parameters).
+    param, values
+        The varied parameter by dotted name (``omega``, ``xi``, ``backlash.sun_planet``, …) and
+        its values, in panel order.
+    fixed
+        Other parameters by dotted name, ``omega`` included when it is not varied (required for
+        a gear set).
+    transient, periods
+        Mesh periods discarded, then recorded (one Poincaré point each) — for the simulation
+        and for the Lyapunov exponent alike.
+    with_
+        ``"phase"`` and/or ``"spectrum"`` rows under each map; the simulations then record 64
+        samples per period (else one, the section points only).
+    progress
+        A progress bar on stderr.
+    rtol, atol, planet, title
+        Tolerances; planet of X̄_sp; figure title (default: the gallery's own).
+
+    Returns
+    -------
+    (figure, rows)
+        The :func:`~gearchaos.plot.gallery.poincare_gallery` figure and one dictionary per value
+        with the keys :data:`ROW_KEYS`: ``value``, ``motion`` (``failed`` when the integration
+        failed), ``lle`` (per unit τ; None when not computable), ``k01`` (0–1 test),
+        ``indicators_agree``, ``distinct_section_points``, ``status`` and ``motion_note``.
+
+    Raises
+    ------
+    ParameterError
+        An unknown or invalid parameter name or value (checked for every value before anything
+        runs), ``param`` also in ``fixed``, no Ω, or invalid ``with_``.
+    """
+    from ..analysis.lyapunov import lyapunov_spectrum
+    from ..analysis.summary import summarize
+    from ..integrate import simulate
+    from ..plot.bifurcation import axis_symbol
+    from ..plot.gallery import parse_extras, poincare_gallery
+
+    fixed = dict(fixed or {})
+    if param in fixed:
+        raise ParameterError(f"{param} is both varied and fixed; choose one")
+    vals = [float(v) for v in values]
+    if not vals:
+        raise ParameterError(f"{param} needs at least one value: got none")
+    extras = parse_extras(with_)
+    # build every point first: a bad name or value fails before anything runs
+    points = [_point(gs, {**fixed, param: v}) for v in vals]
+    spp = 64 if extras else 1
+    results: list[Any] = []
+    summaries: list[dict[str, Any]] = []
+    rows: list[dict[str, Any]] = []
+    sym = _SYMBOLS.get(param, (param, param))[0]
+    with _progress(progress, len(vals)) as bar:
+        task = bar.add_task("Poincaré gallery", total=len(vals))
+        for v, (target, omega) in zip(vals, points, strict=True):
+            bar.update(task, description=f"{sym} = {v:g}")
+            res = simulate(
+                target,
+                omega=omega,
+                transient_periods=transient,
+                periods=periods,
+                samples_per_period=spp,
+                rtol=rtol,
+                atol=atol,
+                check=False,
+            )
+            lle = None
+            if res.status.ok:
+                lr = lyapunov_spectrum(
+                    res.system,
+                    n_exponents=1,
+                    transient_periods=transient,
+                    periods=periods,
+                    rtol=rtol,
+                    atol=atol,
+                )
+                lle = _finite(lr.largest) if lr.status.ok else None
+            summary = summarize(res, lle=lle)
+            if not res.status.ok:
+                summary["motion"] = "failed"
+            results.append(res)
+            summaries.append(summary)
+            rows.append(
+                {
+                    "value": v,
+                    "motion": summary["motion"],
+                    "lle": _finite(summary.get("lle")),
+                    "k01": _finite(summary.get("k01")),
+                    "indicators_agree": bool(summary.get("indicators_agree", True)),
+                    "distinct_section_points": int(summary["distinct_section_points"]),
+                    "status": summary["status"],
+                    "motion_note": summary.get("motion_note", ""),
+                }
+            )
+            bar.advance(task)
+    if title is None:
+        given = [f"{axis_symbol(k)} = {_fmt(fv)}" for k, fv in fixed.items() if _is_number(fv)]
+        title = f"Poincaré maps of $\\bar{{X}}_{{sp{planet}}}$ versus $\\bar{{X}}'_{{sp{planet}}}$"
+        title += f" at different {axis_symbol(param)}"
+        if given:
+            title += "\nat " + ", ".join(given)
+        title += f"\n{transient:g} transient + {periods} recorded periods, zero initial state"
+    fig = poincare_gallery(
+        results, summaries, param=param, values=vals, with_=extras, planet=planet, title=title
+    )
+    return fig, rows
+
+
+def _fmt(v: Any) -> str:
+    return f"{float(v):g}"
+
+
+def _is_number(v: Any) -> bool:
+    return isinstance(v, int | float) and not isinstance(v, bool)
+
+
+# --------------------------------------------------------------------------- recipes
+@dataclass(frozen=True)
+class Gallery:
+    """One Poincaré gallery of the seed paper.
+
+    Attributes
+    ----------
+    name
+        ``fig5``, ``fig7`` or ``fig10``.
+    caption
+        The seed's caption in plain text.
+    param, values
+        The varied parameter and the values drawn, in panel order.
+    named
+        The values among ``values`` that the seed's text names (the others fill its range).
+    fixed
+        Fixed parameters by dotted name (read-only mapping).
+    notes
+        Where the values come from.
+    """
+
+    name: str
+    caption: str
+    param: str
+    values: tuple[float, ...]
+    named: tuple[float, ...]
+    fixed: Mapping[str, float] = field(hash=False)
+    notes: str = ""
+    transient_periods: int = FULL_PERIODS[0]
+    periods: int = FULL_PERIODS[1]
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "fixed", MappingProxyType(dict(self.fixed)))
+        missing = [v for v in self.named if v not in self.values]
+        if missing:
+            raise ParameterError(f"{self.name}: named values must be drawn: missing {missing}")
+
+    def title(self, quick: bool = False) -> str:
+        """Figure title in mathtext, built from the recipe's own numbers."""
+        number = self.name.removeprefix("fig")
+        given = ", ".join(f"${_SYMBOLS[k][1]} = {_fmt(v)}$" for k, v in self.fixed.items())
+        tr, rec = QUICK_PERIODS if quick else (self.transient_periods, self.periods)
+        text = (
+            f"Fig. {number}: Poincaré maps of $\\bar{{X}}_{{sp1}}$ versus "
+            f"$\\bar{{X}}'_{{sp1}}$ at {given} and different ${_SYMBOLS[self.param][1]}$\n"
+            f"{tr} transient + {rec} recorded mesh periods, zero initial state"
+        )
+        return text + (" (quick)" if quick else "")
+
+
+_FIG10_VALUES = (1.0, 1.9, 3.7, 4.41, 4.79, 4.84, 4.91, 5.39, 5.47, 5.55, 5.93, 6.0, 7.5, 9.0)
+
+
+def _galleries() -> dict[str, Gallery]:
+    stand_in = (
+        "The default gear set stands in for the seed's lost Table 1, so the motion at a value "
+        "can differ from the seed's panels."
+    )
+    items = [
+        Gallery(
+            name="fig5",
+            caption=(
+                "Poincaré maps of X̄_sp1 versus X̄'_sp1 at given ξ = 0.03, b̄_sp = 3, b̄_rp = 3.5, "
+                "b̄_s = 2 and different Ω values"
+            ),
+            param="omega",
+            values=(1.2, 1.35, 1.5, 1.69, 1.696, 1.875, 1.926, 2.02, 2.45, 2.62, 3.03, 3.58),
+            named=(1.35, 1.69, 1.696, 1.875, 1.926, 2.02, 2.45, 2.62, 3.03, 3.58),
+            fixed={
+                "xi": 0.03,
+                "backlash.sun_planet": 3.0,
+                "backlash.planet_ring": 3.5,
+                "clearance.sun_bearing": 2.0,
+            },
+            notes=(
+                "Named in the text of Sec. 3.1: 1.35 (end of 1T), 1.69 and 1.696 (QP → 1T), "
+                "1.875 (2T), 1.926 (Hopf), 2.02 (1T, entry to chaos), 2.45 and 2.62 (chaotic "
+                "window), 3.03 (2T), 3.58 (back to 1T). Added: 1.2 (inside the 1T range "
+                "0 ≤ Ω ≤ 1.35) and 1.5 (inside 1.36 ≤ Ω ≤ 2.45, the Ω of the other figures). "
+                + stand_in
+            ),
+        ),
+        Gallery(
+            name="fig7",
+            caption=(
+                "Poincaré maps of X̄_sp1 versus X̄'_sp1 at given Ω = 1.5, ξ = 0.05, b̄_rp = 3.5, "
+                "b̄_s = 2 and different b̄_sp values"
+            ),
+            param="backlash.sun_planet",
+            values=(1.0, 1.5, 2.0, 2.4, 2.81, 2.85, 3.3, 3.8, 4.3, 4.83, 5.4, 6.0),
+            named=(1.0, 2.81, 2.85, 4.83, 6.0),
+            fixed={
+                "omega": 1.5,
+                "xi": 0.05,
+                "backlash.planet_ring": 3.5,
+                "clearance.sun_bearing": 2.0,
+            },
+            notes=(
+                "Named in the text of Sec. 3.2: the range 1 ≤ b̄_sp ≤ 6, 2.81 (Hopf) and the "
+                "period-doubling range 2.85 ≤ b̄_sp ≤ 4.83. The other values fill the range "
+                "(1T → QP → 3T → 1T below 2.81, 2T/4T/8T/16T inside the doubling range, chaos "
+                "above it, in the seed). " + stand_in
+            ),
+        ),
+        Gallery(
+            name="fig10",
+            caption=(
+                "Poincaré maps of X̄_sp1 versus X̄'_sp1 at given ξ = 0.05, Ω = 1.5, b̄_sp = 3, "
+                "b̄_s = 2 and different b̄_rp values"
+            ),
+            param="backlash.planet_ring",
+            values=_FIG10_VALUES,
+            named=(1.0, 1.9, 3.7, 4.41, 4.79, 4.84, 4.91, 5.39, 5.47, 5.55, 5.93, 6.0, 9.0),
+            fixed={
+                "omega": 1.5,
+                "xi": 0.05,
+                "backlash.sun_planet": 3.0,
+                "clearance.sun_bearing": 2.0,
+            },
+            notes=(
+                "Named in the text of Sec. 3.3: the range 1 ≤ b̄_rp ≤ 9, 1.9 (end of 1T), 3.7 "
+                "and 4.41 (chaos), 4.79 (6T), 4.84 (3T), 4.91 (QP), 5.39 (chaos), 5.47 (8T), "
+                "5.55 (4T), 5.93 and 6 (chaos/Hopf switching). Added: 7.5 (the final "
+                "period-doubling route, panels (u)–(x)). " + stand_in
+            ),
+        ),
+    ]
+    return {g.name: g for g in items}
+
+
+#: The seed's Poincaré galleries by name (``fig5``, ``fig7``, ``fig10``).
+GALLERIES: dict[str, Gallery] = _galleries()
+
+
+def get_gallery(name: str) -> Gallery:
+    """The gallery called ``name`` (``fig5``, ``Fig5`` and ``5`` alike)."""
+    key = str(name).strip().lower()
+    if key.isdigit():
+        key = "fig" + key
+    try:
+        return GALLERIES[key]
+    except KeyError:
+        raise ParameterError(
+            f"gallery must be one of {', '.join(GALLERIES)}: got {name!r}"
+        ) from None
+
+
+def _write_json(path: Path, obj: Any) -> None:
+    tmp = path.with_name(path.name + ".partial")
+    tmp.write_text(json.dumps(obj, indent=2, ensure_ascii=False, allow_nan=False) + "\n")
+    os.replace(tmp, path)
+
+
+def _write_csv(path: Path, rows: Sequence[Mapping[str, Any]]) -> None:
+    tmp = path.with_name(path.name + ".partial")
+    with tmp.open("w", newline="", encoding="utf-8") as fh:
+        writer = csv.DictWriter(fh, fieldnames=list(ROW_KEYS))
+        writer.writeheader()
+        for row in rows:
+            writer.writerow({k: "" if row.get(k) is None else row.get(k) for k in ROW_KEYS})
+    os.replace(tmp, path)
+
+
+def reproduce_gallery(
+    name: str,
+    outdir: str | os.PathLike[str] = ".",
+    *,
+    quick: bool = False,
+    progress: bool = True,
+) -> dict[str, Any]:
+    """Draw the seed's Poincaré gallery ``name`` with the default gear set.
+
+    Writes ``outdir/<name>.png`` (the grid), ``outdir/<name>.json`` (settings, gear set and the
+    rows of :func:`run_gallery`) and ``outdir/<name>.csv`` (the rows); with ``quick`` the stem
+    is ``<name>-quick`` (so a quick run never replaces a full one) and every value runs
+    50 transient + 100 recorded periods instead of 100 + 500.
+
+    Returns
+    -------
+    dict
+        ``{"figure", "json", "table" (the CSV), "points", "failed", "seconds", "rows"}``.
+    """
+    from .. import __version__
+    from ..gearset import preset
+    from ..plot import savefig
+
+    g = get_gallery(name)
+    t0 = time.perf_counter()
+    out = Path(os.fspath(outdir))
+    out.mkdir(parents=True, exist_ok=True)
+    stem = g.name + ("-quick" if quick else "")
+    tr, rec = QUICK_PERIODS if quick else (g.transient_periods, g.periods)
+    gs = preset(PRESET)
+    fig, rows = run_gallery(
+        gs,
+        g.param,
+        g.values,
+        fixed=dict(g.fixed),
+        transient=tr,
+        periods=rec,
+        progress=progress,
+        title=g.title(quick),
+    )
+    png = out / f"{stem}.png"
+    try:
+        savefig(fig, png)
+    finally:
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)
+    table = out / f"{stem}.csv"
+    _write_csv(table, rows)
+    meta = out / f"{stem}.json"
+    _write_json(
+        meta,
+        {
+            "figure": g.name,
+            "caption": g.caption,
+            "param": g.param,
+            "values": list(g.values),
+            "named_values": list(g.named),
+            "fixed": dict(g.fixed),
+            "gearset": gs.name,
+            "gearset_toml": gs.to_toml(),
+            "transient_periods": tr,
+            "periods": rec,
+            "quick": quick,
+            "notes": g.notes,
+            "version": __version__,
+            "rows": rows,
+        },
+    )
+    return {
+        "figure": str(png),
+        "json": str(meta),
+        "table": str(table),
+        "points": len(rows),
+        "failed": sum(r["status"] != "ok" for r in rows),
+        "seconds": time.perf_counter() - t0,
+        "rows": rows,
+    }

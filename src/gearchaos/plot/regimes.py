@@ -1,0 +1,350 @@
+"""Motion regimes in colour: one fixed categorical palette, regime bands and regime maps.
+
+Every sweep store carries a motion label per point (``motion``: ``1T`` … ``nT``, ``QP``,
+``chaos``, ``unresolved``, ``failed``; :func:`gearchaos.sweep.classify_store`). This module
+draws them with one palette used by every figure of the package (bands, maps, Poincaré
+galleries, the CLI's regime tables), so a colour means the same regime everywhere:
+
+* :data:`REGIME_COLOURS` — the palette, by display category (:data:`REGIME_ORDER`); periods
+  beyond 8T are grouped as ``≥ 9T``; a point of an interrupted store that was never run is
+  ``not run``;
+* :func:`regime_band` — a thin coloured strip under a 1-D bifurcation panel with the label of
+  every swept value (two rows for up/down continuation branches);
+* :func:`regime_map` — a 2-D sweep (Ω × ξ, Ω × b̄_rp, …) as a categorical map;
+* :func:`regime_legend` / :func:`regime_handles` — a legend that names exactly the regimes
+  present.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from types import MappingProxyType
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError
+from ._common import get_ax
+
+__all__ = [
+    "NOT_RUN",
+    "REGIME_COLOURS",
+    "REGIME_GID",
+    "REGIME_ORDER",
+    "regime_band",
+    "regime_categories",
+    "regime_category",
+    "regime_colour",
+    "regime_handles",
+    "regime_legend",
+    "regime_map",
+]
+
+#: Largest period shown in a colour of its own; longer ones are grouped as ``≥ 9T``.
+MAX_OWN_PERIOD = 8
+#: Display category of a point of an interrupted store that was never computed (status 4).
+NOT_RUN = "not run"
+#: ``gid`` prefix of the artists drawn by :func:`regime_band` and :func:`regime_map`.
+REGIME_GID = "regime"
+
+_LONG_PERIODS = f"≥ {MAX_OWN_PERIOD + 1}T"
+
+#: Display categories in legend order.
+REGIME_ORDER: tuple[str, ...] = (
+    *(f"{n}T" for n in range(1, MAX_OWN_PERIOD + 1)),
+    _LONG_PERIODS,
+    "QP",
+    "chaos",
+    "unresolved",
+    "failed",
+    NOT_RUN,
+)
+
+#: The palette: display category → colour (hex). Periodic orbits in blues, greens and earth
+#: tones, quasi-periodic orange, chaos red, unresolved grey, failed black, not run white.
+REGIME_COLOURS: Mapping[str, str] = MappingProxyType(
+    {
+        "1T": "#1f77b4",
+        "2T": "#17becf",
+        "3T": "#2ca02c",
+        "4T": "#bcbd22",
+        "5T": "#8c564b",
+        "6T": "#e377c2",
+        "7T": "#9edae5",
+        "8T": "#98df8a",
+        _LONG_PERIODS: "#c5b0d5",
+        "QP": "#ff7f0e",
+        "chaos": "#d62728",
+        "unresolved": "#7f7f7f",
+        "failed": "#000000",
+        NOT_RUN: "#ffffff",
+    }
+)
+
+_NOT_RUN_STATUS = 4
+
+
+# --------------------------------------------------------------------------- categories
+def regime_category(label: Any) -> str:
+    """Display category of a motion label: ``1T`` … ``8T`` as they are, ``9T`` and longer as
+    ``≥ 9T``, ``QP``, ``chaos``, ``unresolved``, ``failed``; an empty label is ``not run``,
+    anything else (e.g. the old ``many``) ``unresolved``."""
+    s = str(label).strip()
+    if s.endswith("T") and s[:-1].isdigit() and int(s[:-1]) >= 1:
+        return s if int(s[:-1]) <= MAX_OWN_PERIOD else _LONG_PERIODS
+    if s in REGIME_COLOURS:
+        return s
+    if not s:
+        return NOT_RUN
+    return "unresolved"
+
+
+def regime_colour(label: Any) -> str:
+    """The palette colour of a motion label (see :func:`regime_category`)."""
+    return REGIME_COLOURS[regime_category(label)]
+
+
+def _ordered(categories: Iterable[str]) -> list[str]:
+    present = set(categories)
+    return [c for c in REGIME_ORDER if c in present]
+
+
+def regime_handles(labels: Iterable[Any]) -> list[Any]:
+    """Legend patches for the display categories of ``labels``, in :data:`REGIME_ORDER`
+    (each category once, only those present)."""
+    from matplotlib.patches import Patch
+
+    return [
+        Patch(facecolor=REGIME_COLOURS[c], edgecolor="0.3", linewidth=0.5, label=c)
+        for c in _ordered(regime_category(x) for x in labels)
+    ]
+
+
+def regime_legend(target: Any, labels: Iterable[Any], **kwargs: Any) -> Any:
+    """A legend on ``target`` (an Axes or a Figure) naming exactly the regimes of ``labels``.
+
+    Keyword arguments go to ``target.legend``; the defaults are a ``motion`` title and a small
+    font. Returns the legend (None when ``labels`` is empty).
+    """
+    handles = regime_handles(labels)
+    if not handles:
+        return None
+    opts: dict[str, Any] = {"title": "motion", "fontsize": "small", "title_fontsize": "small"}
+    opts.update(kwargs)
+    return target.legend(handles=handles, **opts)
+
+
+def regime_categories(ds: Any, *, select: Mapping[str, Any] | None = None) -> Any:
+    """Display categories of every point of a sweep dataset (a DataArray of ``motion``'s
+    dimensions), after fixing the dimensions in ``select``; points with status 4 (never run,
+    an interrupted store) are ``not run``.
+
+    Raises
+    ------
+    ParameterError
+        The dataset has no ``motion`` labels (label a store with ``gearchaos classify STORE``
+        or :func:`gearchaos.sweep.classify_store`).
+    """
+    from .bifurcation import _select
+
+    if "motion" not in ds.data_vars:
+        raise ParameterError(
+            "the dataset has no motion labels (variable 'motion'); label a store with "
+            "`gearchaos classify STORE` or gearchaos.sweep.classify_store(STORE)"
+        )
+    sub = _select(ds, select)
+    motion = sub["motion"]
+    cats = np.vectorize(regime_category, otypes=[object])(np.asarray(motion.values, dtype=str))
+    cats = np.asarray(cats, dtype=object).reshape(motion.shape)
+    if "status" in sub.data_vars and sub["status"].dims == motion.dims:
+        cats = np.where(np.asarray(sub["status"].values) == _NOT_RUN_STATUS, NOT_RUN, cats)
+    return motion.copy(data=cats)
+
+
+def _swept_dims(sub: Any) -> tuple[tuple[str, ...], str | None, tuple[str, ...]]:
+    """(directions, family, varied) of a sweep dataset, read from its ``motion`` variable."""
+    from .bifurcation import _layout
+
+    lay = _layout(sub, "motion")
+    return lay.directions, lay.family, lay.vary
+
+
+def _runs(cats: list[str]) -> list[tuple[int, int, str]]:
+    """Maximal runs (start, stop, category) of equal neighbours."""
+    out: list[tuple[int, int, str]] = []
+    start = 0
+    for i in range(1, len(cats) + 1):
+        if i == len(cats) or cats[i] != cats[start]:
+            out.append((start, i, cats[start]))
+            start = i
+    return out
+
+
+# --------------------------------------------------------------------------- band
+def regime_band(
+    ds: Any,
+    ax: Any = None,
+    *,
+    select: Mapping[str, Any] | None = None,
+    legend: bool = False,
+) -> Any:
+    """A thin strip coloured by the motion label of every value of the swept parameter.
+
+    Meant to sit under a :func:`~gearchaos.plot.bifurcation` panel with a shared x axis
+    (:func:`~gearchaos.plot.bifurcation_figure` does that): each swept value owns the cell from
+    the midpoint to its left neighbour to the midpoint to its right one, so the colours line up
+    with the dots above; runs of one label are drawn as one bar (``gid="regime:<category>"``).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        A sweep dataset with ``motion`` labels (every store written by
+        :func:`gearchaos.bifurcation`; older ones after ``gearchaos classify STORE``).
+    ax
+        Axes to draw on (default: a new figure).
+    select
+        Values of the other leading dimensions, as for :func:`~gearchaos.plot.bifurcation`
+        (e.g. ``{"xi": 0.05}``); exactly one swept dimension must remain. A remaining
+        ``direction`` dimension is drawn as two rows, up above down.
+    legend
+        Add a legend naming the regimes present (figures put one legend under all panels
+        instead).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        y ticks hidden (or naming the branches), x label the swept parameter, x limits the
+        outer cell edges.
+    """
+    from .bifurcation import _edges, _fmt, _select, axis_label
+
+    sub = _select(ds, select)
+    cats_da = regime_categories(sub)
+    directions, family, vary = _swept_dims(sub)
+    rest = ([family] if family else []) + list(vary)
+    if len(rest) != 1:
+        if not rest:
+            raise ParameterError("nothing left to draw along: select fixed every swept dimension")
+        raise ParameterError(
+            f"a regime band needs one swept dimension: the dataset has {', '.join(rest)}; fix "
+            f"the others with select, e.g. select={{{rest[0]!r}: {_fmt(sub[rest[0]].values[0])}}}"
+        )
+    x_name = rest[0]
+    x = np.asarray(sub[x_name].values, dtype=np.float64)
+    order = np.argsort(x, kind="stable")
+    edges = _edges(x[order])
+    rows: list[tuple[str | None, Any]]
+    if directions:
+        rows = [(d, cats_da.isel(direction=i)) for i, d in enumerate(directions)]
+    else:
+        rows = [(None, cats_da)]
+    ax = get_ax(ax)
+    n_rows = len(rows)
+    seen: list[str] = []
+    for r, (_, da) in enumerate(rows):
+        cats = [str(c) for c in np.asarray(da.transpose(x_name).values)[order]]
+        y0 = n_rows - 1 - r  # first row on top
+        spans: dict[str, list[tuple[float, float]]] = {}
+        for i, j, cat in _runs(cats):
+            spans.setdefault(cat, []).append((float(edges[i]), float(edges[j] - edges[i])))
+        for cat in _ordered(spans):
+            ax.broken_barh(
+                spans[cat],
+                (y0, 1.0),
+                facecolors=REGIME_COLOURS[cat],
+                edgecolors="none",
+                gid=f"{REGIME_GID}:{cat}",
+                label=cat if cat not in seen else None,
+                rasterized=len(x) > 200,
+            )
+            seen.append(cat)
+    ax.set_ylim(0.0, float(n_rows))
+    ax.set_xlim(float(edges[0]), float(edges[-1]))
+    if directions:
+        ax.set_yticks([n_rows - 0.5 - r for r in range(n_rows)], [d for d, _ in rows])
+        ax.tick_params(axis="y", labelsize="x-small", length=0)
+    else:
+        ax.set_yticks([])
+    ax.set_xlabel(axis_label(x_name))
+    formatter = ax.xaxis.get_major_formatter()
+    if hasattr(formatter, "set_useOffset"):
+        formatter.set_useOffset(False)
+    if legend:
+        regime_legend(ax, seen, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+    return ax
+
+
+# --------------------------------------------------------------------------- map
+def regime_map(
+    ds: Any,
+    ax: Any = None,
+    *,
+    select: Mapping[str, Any] | None = None,
+    legend: bool = True,
+    resonances: bool = False,
+) -> Any:
+    """A 2-D sweep (Ω × ξ, Ω × b̄_rp, …) as a map coloured by the motion label of every point.
+
+    The first varied parameter is on x, the second on y; every grid point is one cell
+    (``pcolormesh``, ``gid="regime"``) coloured from :data:`REGIME_COLOURS`. A family or
+    direction dimension must be fixed with ``select``. With ``legend`` a categorical legend
+    right of the map names exactly the regimes present; with ``resonances`` and Ω on x,
+    vertical lines mark where a mesh harmonic meets a natural frequency (as in
+    :func:`~gearchaos.plot.bifurcation`).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The mesh's data are indices into the categories present (in :data:`REGIME_ORDER`), so
+        ``mesh.to_rgba(mesh.get_array())`` gives each cell's colour.
+    """
+    from matplotlib.colors import BoundaryNorm, ListedColormap
+
+    from .bifurcation import _edges, _fmt, _resonance_lines, _select, axis_label
+
+    sub = _select(ds, select)
+    cats_da = regime_categories(sub)
+    directions, family, vary = _swept_dims(sub)
+    left = [*(["direction"] if directions else []), *([family] if family else [])]
+    if left:
+        raise ParameterError(
+            f"regime_map draws one 2-D grid: fix {', '.join(left)} with select, e.g. "
+            f"select={{{left[0]!r}: {_fmt(sub[left[0]].values[0])!r}}}"
+        )
+    if len(vary) != 2:
+        raise ParameterError(
+            f"regime_map needs a 2-D sweep: the dataset varies {', '.join(vary) or 'nothing'}"
+            "; use regime_band under a bifurcation diagram for 1-D sweeps"
+        )
+    xname, yname = vary
+    cats = np.asarray(cats_da.transpose(yname, xname).values, dtype=object)
+    present = _ordered(str(c) for c in cats.ravel())
+    index = {c: k for k, c in enumerate(present)}
+    codes = np.vectorize(index.__getitem__, otypes=[np.int64])(cats) if cats.size else cats
+    x = np.asarray(sub[xname].values, dtype=np.float64)
+    y = np.asarray(sub[yname].values, dtype=np.float64)
+    ox, oy = np.argsort(x, kind="stable"), np.argsort(y, kind="stable")
+    codes = np.asarray(codes)[np.ix_(oy, ox)]
+    cmap = ListedColormap([REGIME_COLOURS[c] for c in present])
+    norm = BoundaryNorm(np.arange(-0.5, len(present) + 0.5, 1.0), cmap.N)
+    ax = get_ax(ax)
+    ax.pcolormesh(
+        _edges(x[ox]),
+        _edges(y[oy]),
+        codes,
+        cmap=cmap,
+        norm=norm,
+        rasterized=True,
+        gid=REGIME_GID,
+    )
+    ax.set_xlabel(axis_label(xname))
+    ax.set_ylabel(axis_label(yname))
+    if resonances and xname == "omega" and x.size:
+        _resonance_lines(ax, ds, float(np.min(x)), float(np.max(x)))
+    for axis in (ax.xaxis, ax.yaxis):
+        formatter = axis.get_major_formatter()
+        if hasattr(formatter, "set_useOffset"):
+            formatter.set_useOffset(False)
+    if legend:
+        regime_legend(ax, present, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)
+    return ax
