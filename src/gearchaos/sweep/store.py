@@ -42,6 +42,7 @@ class SweepStore:
     def __init__(self, path: str | os.PathLike[str] | None):
         self.path = None if path is None else os.fspath(path)
         self._memory: Any = None
+        self._arrays: dict[str, Any] | None = None
 
     # ------------------------------------------------------------------ identity
     @property
@@ -162,10 +163,15 @@ class SweepStore:
         """Write a task's block of every variable, then mark the task done."""
         import zarr
 
-        g = zarr.open_group(self.zarr_store, mode="a", use_consolidated=False)
+        if self._arrays is None:  # open once: reopening costs tens of ms per task
+            g = zarr.open_group(self.zarr_store, mode="a", use_consolidated=False)
+            self._arrays = {}
+            for name in data:
+                arr = g[name]
+                assert isinstance(arr, zarr.Array)
+                self._arrays[name] = arr
         for name, values in data.items():
-            arr = g[name]
-            assert isinstance(arr, zarr.Array)
+            arr = self._arrays[name]
             sl = block + (slice(None),) * (arr.ndim - len(block))
             arr[sl] = values
         if self.path is not None:
