@@ -71,7 +71,8 @@ def test_reference_system_summary() -> None:
     s = summarize(r)
     assert REQUIRED <= set(s)
     json.dumps(s, allow_nan=False)
-    assert s["contact"] == [{"mesh": "mesh", "regime": "none"}]
+    # separation fraction needs a time history (samples_per_period > 1): None here
+    assert s["contact"] == [{"mesh": "mesh", "regime": "none", "separation_fraction": None}]
     assert s["motion"] == "1T"
     assert s["omega_n_rad_s"] is None and s["sun_speed_rpm"] is None
     s = summarize(gc.simulate(gc.duffing(1.0), transient_periods=1, periods=3))

@@ -79,7 +79,7 @@ def test_json_keys_and_values_match_the_python_api(runner: CliRunner) -> None:
     assert out["x_sp1_section_max"] <= float(ds.delta_sp_max.sel(planet=1))
     n = gs.n_planets
     assert len(out["contact"]) == 2 * n
-    assert all(set(c) == {"mesh", "regime"} for c in out["contact"])
+    assert all(set(c) == {"mesh", "regime", "separation_fraction"} for c in out["contact"])
     assert len({c["mesh"] for c in out["contact"]}) == 2 * n
     assert {c["regime"] for c in out["contact"]} <= REGIMES
 

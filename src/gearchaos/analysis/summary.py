@@ -15,7 +15,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from .classify import classify_motion
-from .contact import contact_regimes
+from .contact import contact_regimes, separation_fraction
 from .poincare import count_distinct, section_points
 
 __all__ = ["SUMMARY_KEYS", "format_summary", "motion_name", "summarize"]
@@ -101,7 +101,12 @@ def summarize(
     gs = getattr(model, "gearset", None)
     omega = float(system.omega)
     try:
-        contact = [{"mesh": k, "regime": v} for k, v in contact_regimes(result).items()]
+        regimes = contact_regimes(result)
+        sep = separation_fraction(result) if result.samples_per_period > 1 else {}
+        contact = [
+            {"mesh": k, "regime": v, "separation_fraction": _num(sep[k]) if k in sep else None}
+            for k, v in regimes.items()
+        ]
     except ParameterError:  # no meshes (linear, Duffing, Lorenz)
         contact = []
     out: dict[str, Any] = {

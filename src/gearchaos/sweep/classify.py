@@ -4,10 +4,12 @@
 first observed planet — X̄_sp1 and X̄'_sp1 by default) and, when present, the largest Lyapunov
 exponents, labels every point with :func:`gearchaos.analysis.classify.classify_sections`
 (1T … nT, QP, chaos, unresolved; ``failed`` where the integration failed) and writes the
-variables ``motion``, ``period`` (0: none found), ``k01`` (0–1 test), ``indicators_agree`` and
-the attribute ``regime_table`` (JSON: fraction of the swept points in each regime, per family
-value when there is a family). It needs no re-simulation, so ``gearchaos classify run.zarr``
-can re-label a stored sweep with other tolerances.
+variables ``motion``, ``period`` (0: none found), ``k01`` (0–1 test), ``indicators_agree``,
+``contact_sp`` and ``contact_rp`` (contact regime of every mesh, MODEL.md §8: 0 none, 1
+single-sided, 2 double-sided impact) and the attribute ``regime_table`` (JSON: fraction of
+the swept points in each regime, per family value when there is a family). It needs no
+re-simulation, so ``gearchaos classify run.zarr`` can re-label a stored sweep with other
+tolerances.
 """
 
 from __future__ import annotations
@@ -86,14 +88,57 @@ def classify_dataset(ds: Any, *, rtol: float = 1e-3, max_period: int = 64) -> di
         }
     else:
         table = {"all": regime_table(labels.ravel())}
+    contact = _contact(ds, lead_dims, shape)
     return {
         "dims": lead_dims,
+        **contact,
         "motion": labels,
         "period": period,
         "k01": k01,
         "indicators_agree": agree,
         "regime_table": table,
     }
+
+
+CONTACT_CODES = {"none": 0, "single_sided": 1, "double_sided": 2}
+_BACKLASH_FIELDS = {"sp": "backlash.sun_planet", "rp": "backlash.planet_ring"}
+
+
+def _half_clearance(ds: Any, mesh: str, lead_dims: tuple[str, ...], shape: tuple[int, ...]) -> Any:
+    """b̄ of a mesh at every grid point: swept axis, fixed override or the base gear set."""
+    import tomllib
+
+    from ..gearset import GearSet
+
+    name = _BACKLASH_FIELDS[mesh]
+    if name in lead_dims:
+        b = np.asarray(ds[name].values, dtype=float)
+        ax = lead_dims.index(name)
+        b = b.reshape([-1 if i == ax else 1 for i in range(len(shape))])
+        gs = GearSet.from_toml_string(ds.attrs["gearset_toml"])
+        if gs.backlash.units == "m":
+            b = b / gs.clearance.characteristic_length
+        return np.broadcast_to(b, shape)
+    fixed = tomllib.loads(ds.attrs["sweep_toml"]).get("fixed", {})
+    gs = GearSet.from_toml_string(ds.attrs["gearset_toml"])
+    if name in fixed:
+        gs = gs.evolve({name: fixed[name]})
+    b_sp, b_rp = gs.backlash_bar()
+    return np.full(shape, b_sp if mesh == "sp" else b_rp)
+
+
+def _contact(ds: Any, lead_dims: tuple[str, ...], shape: tuple[int, ...]) -> dict[str, Any]:
+    """Contact regime codes per mesh (MODEL.md §8) from the stored minimum deflections."""
+    out: dict[str, Any] = {}
+    if not ds.attrs.get("gearset_toml") or "delta_sp_min" not in ds.data_vars:
+        return out
+    for mesh in ("sp", "rp"):
+        dmin = np.asarray(ds[f"delta_{mesh}_min"].transpose(*lead_dims, "planet_all").values)
+        b = _half_clearance(ds, mesh, lead_dims, shape)[..., None]
+        code = np.where(dmin > b, 0, np.where(dmin >= -b, 1, 2)).astype(np.int8)
+        code[np.isnan(dmin)] = -1
+        out[f"contact_{mesh}"] = code
+    return out
 
 
 def _family_dim(ds: Any) -> str | None:
@@ -115,6 +160,25 @@ def classify_store(
     res = classify_dataset(ds, rtol=rtol, max_period=max_period)
     g = zarr.open_group(zstore, mode="a", use_consolidated=False)
     dims = list(res["dims"])
+    for mesh, label in (("sp", "sun–planet"), ("rp", "planet–ring")):
+        name = f"contact_{mesh}"
+        if name not in res:
+            continue
+        arr = g.create_array(
+            name,
+            shape=res[name].shape,
+            chunks=res[name].shape,
+            dtype="int8",
+            fill_value=None,
+            attributes={
+                "long_name": f"contact regime of each {label} mesh over the recorded window",
+                "flag_values": [-1, 0, 1, 2],
+                "flag_meanings": "unknown none single_sided double_sided",
+                "_ARRAY_DIMENSIONS": [*dims, "planet_all"],
+            },
+            overwrite=True,
+        )
+        arr[...] = res[name]
     docs = {
         "motion": ("1T…nT, QP, chaos, unresolved or failed", ""),
         "period": ("period n of the section sequence (0: none ≤ max_period)", 0),
