@@ -101,3 +101,19 @@ def test_continuation_is_executor_independent(tmp_path):
         system, {"omega": "0.6:1.2:13"}, store=tmp_path / "b.zarr", workers=2, **kw
     )
     assert_bitwise_equal(pool.load(), here.load())
+
+
+def test_existing_dask_scheduler_gives_the_same_store() -> None:
+    """``scheduler="tcp://…"`` (an existing dask.distributed cluster) equals in-process."""
+    distributed = pytest.importorskip("dask.distributed")
+    gs = gc.preset("sheng2016")
+    kw = {"transient_periods": 5, "periods": 8, "progress": False}
+    local = gc.bifurcation(gs, "omega=0.5:3:6", **kw).load()
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, dashboard_address=None
+    ) as cluster:
+        remote = gc.bifurcation(gs, "omega=0.5:3:6", scheduler=cluster.scheduler_address, **kw)
+        remote = remote.load()
+    for name in local.data_vars:
+        a, b = local[name].values, remote[name].values
+        assert np.array_equal(a, b, equal_nan=a.dtype.kind == "f"), name
