@@ -57,7 +57,7 @@ def test_oscillator_without_separation_is_1T_with_no_separation(omega: float, ze
     s = summarize(result, lle=lle)
     assert s["motion"] == "1T"
     assert s["distinct_section_points"] == 1
-    assert s["contact"] == [{"mesh": "mesh", "regime": "none"}]
+    assert s["contact"] == [{"mesh": "mesh", "regime": "none", "separation_fraction": 0.0}]
     assert s["lle"] == pytest.approx(-zeta, abs=1e-3)
     assert s["indicators_agree"] is True
     assert contact_fractions(result)["mesh"] == {"drive": 1.0, "gap": 0.0, "back": 0.0}
@@ -98,7 +98,8 @@ def test_oscillator_with_back_flank_contact_is_double_sided() -> None:
     assert lo <= result.obs_min[0] <= hi  # the tracked minimum lies in the proved interval
     assert contact_regimes(result) == {"mesh": "double_sided"}
     s = summarize(result)
-    assert s["contact"] == [{"mesh": "mesh", "regime": "double_sided"}]
+    assert [(c["mesh"], c["regime"]) for c in s["contact"]] == [("mesh", "double_sided")]
+    assert 0.0 < s["contact"][0]["separation_fraction"] < 1.0
     x = result.series("x")
     assert contact_fractions(result)["mesh"]["back"] == pytest.approx(np.mean(x < -b))
     assert 0.0 < contact_fractions(result)["mesh"]["back"] < 1.0

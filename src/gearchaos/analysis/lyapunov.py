@@ -16,15 +16,12 @@ for 1/s.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from .._numba import call_literal
 from ..errors import ParameterError, Status
-from ..integrate.dopri import dopri_run
-from ..integrate.simulate import _default_max_steps, check_settings
+from ..integrate.simulate import integrate
 from ..model.system import System
 
 __all__ = ["LyapunovResult", "lyapunov_spectrum", "max_lyapunov"]
@@ -79,74 +76,29 @@ def lyapunov_spectrum(
     k = n if n_exponents is None else int(n_exponents)
     if not 1 <= k <= n:
         raise ParameterError(f"n_exponents must be between 1 and {n}: got {n_exponents!r}")
-    check_settings(
+    if periods * renormalizations_per_period < 2:
+        raise ParameterError("periods × renormalizations_per_period must be >= 2")
+    traj = integrate(
+        system,
+        y0=y0,
         transient_periods=transient_periods,
         periods=periods,
         samples_per_period=renormalizations_per_period,
         rtol=rtol,
         atol=atol,
+        max_steps=max_steps,
+        n_tangent=k,
     )
-    if periods * renormalizations_per_period < 2:
-        raise ParameterError("periods × renormalizations_per_period must be >= 2")
-    y = np.zeros(n * (1 + k))
-    if y0 is not None:
-        y0a = np.asarray(y0, dtype=float).ravel()
-        if y0a.size != n or not np.all(np.isfinite(y0a)):
-            raise ParameterError(f"y0 must be {n} finite numbers: got {y0!r}")
-        y[:n] = y0a
-    T = system.period
     ns = periods * renormalizations_per_period
-    dt = T / renormalizations_per_period
-    t_rec = transient_periods * T
-    t_end = t_rec + periods * T
-    if max_steps is None:
-        max_steps = _default_max_steps(transient_periods + periods)
-    out_t = np.full(ns, np.nan)
-    out_y = np.full((ns, y.size), np.nan)
-    out_o = np.full((ns, system.n_obs), np.nan)
-    omin = np.zeros(system.n_track)
-    omax = np.zeros(system.n_track)
-    yf = np.zeros(y.size)
-    info = np.zeros(4)
-    lsum = np.zeros(k)
-    code = call_literal(
-        dopri_run,
-        system.kind,
-        y,
-        system.params,
-        0.0,
-        float(t_rec),
-        float(dt),
-        ns,
-        float(t_end),
-        system.n_obs,
-        system.n_track,
-        system.switch_widths,
-        n,
-        float(rtol),
-        float(atol),
-        -1.0,
-        math.inf,
-        int(max_steps),
-        out_t,
-        out_y,
-        out_o,
-        omin,
-        omax,
-        yf,
-        info,
-        lsum,
-    )
-    duration = (ns - 1) * dt
-    status = Status(int(code))
-    ex = lsum / duration if status.ok else np.full(k, np.nan)
+    duration = (ns - 1) * system.period / renormalizations_per_period
+    ex = traj.tangent_log_sums / duration if traj.ok else np.full(k, np.nan)
     return LyapunovResult(
         exponents=ex,
         duration=duration,
         renormalizations=ns - 1,
-        status=status,
-        steps_accepted=int(info[0]),
-        steps_rejected=int(info[1]),
+        status=traj.status,
+        steps_accepted=traj.steps_accepted,
+        steps_rejected=traj.steps_rejected,
     )
 
 

@@ -70,12 +70,18 @@ def integrate(
     max_steps: int | None = None,
     max_step: float = math.inf,
     first_step: float | None = None,
+    n_tangent: int = 0,
 ) -> Trajectory:
     """Integrate any :class:`System` with the compiled Dormand–Prince 5(4) kernel.
 
     Samples land exactly on τ = t0 + (2π(k + transient_periods) + section_phase)/Ω + j T/s for
     k = 0 … periods−1 and j = 0 … s−1 (s = ``samples_per_period``). Never raises on solver
     failure: check :attr:`Trajectory.status`.
+
+    With ``n_tangent = k > 0`` the variational equations of k tangent vectors ride along
+    (orthonormal from the first sample, re-orthonormalised at every later one) and
+    :attr:`Trajectory.tangent_log_sums` holds their accumulated log stretch factors — the raw
+    material of :func:`gearchaos.analysis.lyapunov.lyapunov_spectrum`.
     """
     check_settings(
         transient_periods=transient_periods,
@@ -103,18 +109,23 @@ def integrate(
     t_end = t_rec + periods * T
     if max_steps is None:
         max_steps = _default_max_steps(transient_periods + periods)
+    k = int(n_tangent)
+    if not 0 <= k <= n:
+        raise ParameterError(f"n_tangent must be between 0 and {n}: got {n_tangent!r}")
+    y_full = np.concatenate([y, np.zeros(n * k)])
     # unreached samples stay NaN, never zeros that look like data
     out_t = np.full(ns, np.nan)
-    out_y = np.full((ns, n), np.nan)
+    out_y = np.full((ns, y_full.size), np.nan)
     out_o = np.full((ns, system.n_obs), np.nan)
     omin = np.zeros(system.n_track)
     omax = np.zeros(system.n_track)
-    yf = np.zeros(n)
+    yf = np.zeros(y_full.size)
     info = np.zeros(4)
+    lsum = np.zeros(k)
     code = call_literal(
         dopri_run,
         system.kind,
-        y,
+        y_full,
         system.params,
         float(t0),
         float(t_rec),
@@ -137,7 +148,7 @@ def integrate(
         omax,
         yf,
         info,
-        np.empty(0),
+        lsum,
     )
     status = Status(int(code))
     settings = {
@@ -154,16 +165,17 @@ def integrate(
     return Trajectory(
         system=system,
         tau=out_t,
-        states=out_y,
+        states=out_y[:, :n],
         observables=out_o,
         obs_min=omin,
         obs_max=omax,
-        final_state=yf,
+        final_state=yf[:n],
         status=status,
         steps_accepted=int(info[0]),
         steps_rejected=int(info[1]),
         settings=settings,
         next_step=float(info[3]),
+        tangent_log_sums=lsum,
     )
 
 

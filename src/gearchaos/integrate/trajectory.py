@@ -37,6 +37,7 @@ class Trajectory:
     steps_rejected: int
     settings: dict[str, Any] = field(default_factory=dict)
     next_step: float = 0.0
+    tangent_log_sums: np.ndarray = field(default_factory=lambda: np.empty(0))
 
     @property
     def samples_per_period(self) -> int:
