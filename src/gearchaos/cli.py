@@ -1358,11 +1358,22 @@ def _gallery_rows_table(rows: Sequence[Mapping[str, Any]], param: str, *, title:
 @app.command()
 def reproduce(
     figure: Annotated[
-        str,
+        str | None,
         typer.Argument(
-            help=f"Figure of the seed paper: {', '.join(PAPER_FIGURES)}.", show_default=False
+            help=f"Figure of the seed paper: {', '.join(PAPER_FIGURES)} (or --all).",
+            show_default=False,
         ),
-    ],
+    ] = None,
+    all_figures: Annotated[
+        bool,
+        typer.Option(
+            "--all",
+            help=(
+                "Run every figure, check the paper's conclusions and landmarks and write "
+                "OUTPUT/index.html (the reproduction report)."
+            ),
+        ),
+    ] = False,
     output: Annotated[
         Path,
         typer.Option(
@@ -1406,8 +1417,29 @@ def reproduce(
     points) — fig5: Ω path at ξ = 0.03; fig7: b̄_sp ∈ [1, 6] at Ω = 1.5, ξ = 0.05; fig10:
     b̄_rp ∈ [1, 9] at Ω = 1.5, ξ = 0.05, at the values the seed's text names.
 
-    Example: **gearchaos reproduce fig4 -o paper/ --quick**
+    --all runs every figure into OUTPUT, checks the conclusions of the seed's Section 4 and its
+    landmarks against the runs and writes the report OUTPUT/index.html (resumable; about 10
+    minutes on 2 cores, --quick about a minute).
+
+    Example: **gearchaos reproduce fig4 -o paper/ --quick**;
+    **gearchaos reproduce --all -o report/**
     """
+    if all_figures:
+        if figure is not None:
+            _fail("give either FIG or --all, not both", EXIT_INVALID)
+        with _reported_errors(), _interruptible():
+            from .paper.report import build_report
+
+            index = build_report(
+                output, quick=quick, progress=not (quiet or json_out), workers=workers
+            )
+        if json_out:
+            _print_json({"report": str(index)})
+        elif not quiet:
+            _stdout().print(escape(str(index)))
+        return
+    if figure is None:
+        _fail("give a figure (FIG) or --all", EXIT_INVALID)
     with _reported_errors(), _interruptible():
         name = figure.strip().lower()
         if name not in PAPER_FIGURES:
@@ -1513,6 +1545,121 @@ def init_gearset(
     out.print(
         Text(f"next: gearchaos simulate --gearset {file} --set omega=1.5 -o out/", style="dim")
     )
+
+
+# --------------------------------------------------------------------------- calibrate
+@app.command()
+def calibrate(
+    landmarks: Annotated[
+        Path | None,
+        typer.Option(
+            "--landmarks",
+            help="Landmarks file (default: the packaged paper/landmarks.toml).",
+            dir_okay=False,
+            show_default=False,
+        ),
+    ] = None,
+    out: Annotated[
+        Path,
+        typer.Option(
+            "--out",
+            help=(
+                "JSON-lines file, one line per evaluated candidate; re-used on restart. "
+                "best.toml is written beside it."
+            ),
+            dir_okay=False,
+        ),
+    ] = Path("calibration.jsonl"),
+    budget_minutes: Annotated[
+        float, typer.Option("--budget-minutes", help="Stop evaluating after this many minutes.")
+    ] = 110.0,
+    max_candidates: Annotated[
+        int | None,
+        typer.Option(
+            "--max-candidates",
+            help="Stop when the candidate sequence (resumed ones included) reaches N.",
+            show_default=False,
+        ),
+    ] = None,
+    seed: Annotated[int, typer.Option("--seed", help="Seed of the candidate sequence.")] = 0,
+    quick: Annotated[
+        bool, typer.Option("--quick", help="3 candidates on tiny sweeps, for CI.")
+    ] = False,
+    quiet: QuietOpt = False,
+    json_out: JsonOpt = False,
+) -> None:
+    """Search the quantities of the seed's lost Table 1 (N and tooth numbers, input torque,
+    transmission-error amplitude, stiffness ratios, mass ratios, b_c, load mode) for the gear set
+    whose coarse sweeps reproduce the most landmarks of the seed's text. Resumable: candidates
+    already in --out are not evaluated again. See docs/reproduction.md.
+
+    Example: **gearchaos calibrate --landmarks paper/landmarks.toml --budget-minutes 110**
+    """
+    from .paper.calibrate import calibrate as run_calibration
+
+    show = not (quiet or json_out)
+    err = _stderr()
+
+    def on_record(rec: Mapping[str, Any], now: bool) -> None:
+        if show:
+            what = f"{rec['seconds']:.0f} s" if now else "resumed"
+            err.print(
+                Text(
+                    f"candidate {rec['index']} ({rec['origin']}): score {rec['score']:.2f} "
+                    f"[{what}]",
+                    style="dim",
+                )
+            )
+
+    with _reported_errors():
+        if landmarks is not None and not landmarks.exists():
+            raise FileNotFoundError(f"landmarks file not found: '{landmarks}'")
+        if out.parent and not out.parent.exists():
+            out.parent.mkdir(parents=True, exist_ok=True)
+        result = run_calibration(
+            landmarks,
+            out,
+            budget_minutes=budget_minutes,
+            max_candidates=max_candidates,
+            seed=seed,
+            quick=quick,
+            on_record=on_record,
+        )
+    summary = {
+        "out": str(out),
+        "best_toml": str(result.best_toml) if result.best_toml else None,
+        "evaluated": result.evaluated,
+        "resumed": result.reused,
+        "stopped": result.stopped,
+        "plausible": result.plausible,
+        "problems": result.problems,
+        "best": result.best,
+        "top": result.top(3),
+    }
+    if json_out:
+        _print_json(summary)
+    elif not quiet:
+        table = _pairs_table("gearchaos calibrate: best candidate" + (" (quick)" if quick else ""))
+        best = result.best or {}
+        table.add_row("score", escape(_fmt(best.get("score"))))
+        for key, value in (best.get("variables") or {}).items():
+            table.add_row(escape(str(key)), escape(_fmt(value)))
+        table.add_row("evaluated / resumed", f"{result.evaluated} / {result.reused}")
+        table.add_row("stopped", escape(result.stopped))
+        table.add_row("best.toml", escape(str(result.best_toml)))
+        verdict = (
+            "yes: inside every range, no validation warnings"
+            if result.plausible
+            else "no: " + "; ".join(result.problems)
+        )
+        table.add_row("physically plausible", escape(verdict))
+        _stdout().print(table)
+    if result.stopped == "interrupted":
+        _fail(
+            f"interrupted: every finished candidate is in {out}; run the same command again "
+            "to resume",
+            EXIT_INTERRUPTED,
+        )
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -1,0 +1,706 @@
+"""The seed paper's conclusions (Sheng et al. 2016, Section 4, items 1–8) as checks on our runs.
+
+Every verdict is computed from sweep datasets (the stores :func:`gearchaos.paper.reproduce`
+writes, with their ``motion`` labels and section values), never written by hand. Each check
+returns a :class:`Verdict`: ``holds``, ``partly``, ``does not hold`` or ``not evaluated`` (the
+runs needed are missing, or too few of their points could be labelled), with the numbers it
+rests on in ``evidence`` (text) and ``measured`` (a JSON-able dict).
+
+A sweep dataset here is any :class:`xarray.Dataset` with a ``motion`` variable of dimensions
+``(family, vary)`` or ``(vary,)`` (labels ``1T`` … ``nT``, ``QP``, ``chaos``, ``unresolved``,
+``failed``) and, for the checks that need them, section values ``delta_sp`` with a ``section``
+dimension (and optionally ``planet``). The helpers work on synthetic datasets built that way,
+which is how the tests check each verdict against a known answer.
+
+Conventions
+-----------
+* ``unresolved`` and ``failed`` points carry no information about the motion; the route and
+  window checks drop them from the sequence along the swept axis, and a sweep with fewer than
+  :data:`MIN_RESOLVED` of its points labelled is not used.
+* A *route to chaos* is read at every onset of chaos along the swept axis (a ``chaos`` point
+  whose previous labelled point is not chaotic), from the labels just before it:
+  ``period doubling`` (the periodic points before it double their period at least twice, or
+  once to ≥ 4T, e.g. 1T → 2T → 4T), ``3T channel`` (a 3T or 6T window just before),
+  ``Hopf`` (quasi-periodic motion just before — a Neimark–Sacker bifurcation), ``crisis``
+  (the attractor — the spread of the section values — at least doubles at the onset and grows
+  by at least 5 % of the sweep's largest attractor), else ``abrupt`` (no jump, no precursor).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import re
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+__all__ = [
+    "CONCLUSIONS",
+    "MIN_RESOLVED",
+    "VERDICTS",
+    "Verdict",
+    "attractor_size",
+    "chaos_onsets",
+    "chaotic_fraction",
+    "evaluate_conclusions",
+    "label_fraction",
+    "panels",
+    "qp_near_3t",
+    "section_spread",
+]
+
+VERDICTS = ("holds", "partly", "does not hold", "not evaluated")
+#: Fraction of a sweep's points that must carry a motion label for the sweep to be used.
+MIN_RESOLVED = 0.5
+#: Onset is a crisis when the attractor grows by this factor …
+CRISIS_RATIO = 2.0
+#: … and by at least this fraction of the sweep's largest attractor.
+CRISIS_FLOOR = 0.05
+#: Ratio of the b̄_s spread to the b̄_rp spread below which b̄_s "couples weakly".
+WEAK_COUPLING_RATIO = 0.2
+
+_UNINFORMATIVE = ("unresolved", "failed", "")
+_PERIODIC = re.compile(r"^(\d+)T$")
+
+Stores = Mapping[str, Any]
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """The check of one conclusion of the seed's Section 4."""
+
+    conclusion_id: int
+    statement: str
+    verdict: str
+    evidence: str
+    measured: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if self.verdict not in VERDICTS:
+            raise ValueError(f"verdict must be one of {VERDICTS}: got {self.verdict!r}")
+
+
+# --------------------------------------------------------------------------- statements
+STATEMENTS: dict[int, str] = {
+    1: (
+        "A transverse-torsional model with backlash and bearing clearance is proposed; bifurcation "
+        "and chaos are obtained with variable-step Runge-Kutta integration under the bifurcation "
+        "parameters Ω, b̄_sp, b̄_rp and b̄_s."
+    ),
+    2: (
+        "The model takes time-varying mesh stiffness, transverse displacements and radial "
+        "clearance of the sun, comprehensive transmission error and sun-planet and planet-ring "
+        "backlash into account."
+    ),
+    3: (
+        "Increasing damping suppresses the non-periodic motion effectively (the chaotic fraction "
+        "of every ξ sweep shrinks as ξ grows)."
+    ),
+    4: "The route of crisis to chaos is observed under the meshing frequency Ω (Fig. 4).",
+    5: (
+        "The routes of crisis and period doubling to chaos are identified under the sun-planet "
+        "backlash b̄_sp (Figs. 6, 8)."
+    ),
+    6: (
+        "Several routes to chaos coexist under the planet-ring backlash b̄_rp — period doubling, "
+        "crisis, Hopf bifurcation and 3T-periodic channel (Figs. 9, 11)."
+    ),
+    7: (
+        "The sun's bearing clearance b̄_s couples weakly: no bifurcation and no chaos under b̄_s "
+        "(Fig. 12), while b̄_rp couples strongly."
+    ),
+    8: (
+        "Quasi-periodic motion is found under all the bifurcation parameters and is closely "
+        "related to 3T-periodic motion."
+    ),
+}
+
+
+# --------------------------------------------------------------------------- helpers
+def _labels(ds: Any) -> np.ndarray:
+    return np.asarray(ds["motion"].values).astype(str)
+
+
+def _dims(ds: Any) -> tuple[str | None, str]:
+    """(family dimension or None, swept dimension) of a sweep dataset's ``motion``."""
+    dims = tuple(ds["motion"].dims)
+    if len(dims) == 1:
+        return None, dims[0]
+    if len(dims) == 2:
+        return dims[0], dims[1]
+    raise ValueError(f"motion must have 1 or 2 dimensions: got {dims}")
+
+
+def panels(ds: Any) -> list[tuple[float | None, np.ndarray, np.ndarray, np.ndarray | None]]:
+    """One ``(family value, swept values, labels, sections)`` per panel of a sweep.
+
+    ``sections`` has shape (swept points, sections) — X̄_sp1 of the first stored planet — or is
+    ``None`` when the dataset holds no ``delta_sp``.
+    """
+    fam, vary = _dims(ds)
+    x = np.asarray(ds[vary].values, dtype=float)
+    labels = _labels(ds)
+    sec: np.ndarray | None = None
+    if "delta_sp" in ds.data_vars:
+        v = ds["delta_sp"]
+        if "planet" in v.dims:
+            v = v.isel(planet=0)
+        order = [d for d in (fam, vary, "section") if d is not None]
+        sec = np.asarray(v.transpose(*order).values, dtype=float)
+    out: list[tuple[float | None, np.ndarray, np.ndarray, np.ndarray | None]] = []
+    if fam is None:
+        out.append((None, x, labels, sec))
+    else:
+        for i, fv in enumerate(np.asarray(ds[fam].values, dtype=float)):
+            out.append((float(fv), x, labels[i], None if sec is None else sec[i]))
+    return out
+
+
+def _resolved(labels: np.ndarray) -> np.ndarray:
+    return ~np.isin(labels, _UNINFORMATIVE)
+
+
+def _period(label: str) -> int | None:
+    m = _PERIODIC.match(label)
+    return int(m.group(1)) if m else None
+
+
+def label_fraction(labels: np.ndarray, which: Callable[[str], bool]) -> float:
+    """Fraction of the labelled points (``unresolved`` / ``failed`` left out) where ``which``."""
+    lab = np.asarray(labels).astype(str).ravel()
+    lab = lab[_resolved(lab)]
+    if lab.size == 0:
+        return math.nan
+    return float(np.mean([which(str(s)) for s in lab]))
+
+
+def chaotic_fraction(ds: Any) -> dict[float, float]:
+    """Chaotic fraction of the labelled points per family value (key ``nan`` without family)."""
+    return {
+        (math.nan if fv is None else fv): label_fraction(lab, lambda s: s == "chaos")
+        for fv, _, lab, _ in panels(ds)
+    }
+
+
+def _nonperiodic(s: str) -> bool:
+    return s in ("chaos", "QP")
+
+
+def attractor_size(sections: np.ndarray) -> np.ndarray:
+    """Spread (max − min) of the section values of each point: the attractor's size."""
+    s = np.asarray(sections, dtype=float)
+    with np.errstate(all="ignore"):
+        size = np.nanmax(s, axis=-1) - np.nanmin(s, axis=-1)
+    return np.where(np.isfinite(size), size, np.nan)
+
+
+def _route(before: list[str], size_before: float, size_at: float, scale: float) -> str:
+    periods: list[int] = []
+    for s in reversed(before):  # the periodic run just before the onset, nearest first
+        p = _period(s)
+        if p is None:
+            break
+        if not periods or periods[-1] != p:
+            periods.append(p)
+    periods.reverse()
+    doublings = sum(1 for a, b in itertools.pairwise(periods) if b == 2 * a)
+    if periods and (doublings >= 2 or (doublings >= 1 and periods[-1] >= 4)):
+        return "period doubling"
+    last = before[-1] if before else ""
+    if _period(last) in (3, 6):
+        return "3T channel"
+    if last == "QP":
+        return "Hopf"
+    if (
+        math.isfinite(size_before)
+        and math.isfinite(size_at)
+        and size_at >= CRISIS_RATIO * size_before
+        and size_at - size_before >= CRISIS_FLOOR * scale
+    ):
+        return "crisis"
+    return "abrupt"
+
+
+def chaos_onsets(
+    x: np.ndarray, labels: np.ndarray, sections: np.ndarray | None = None, *, history: int = 6
+) -> list[dict[str, Any]]:
+    """Every onset of chaos along one panel, with its route (see the module's conventions).
+
+    Returns ``[{"at": swept value, "route": ..., "before": [labels], "size_before",
+    "size_at"}]``; unlabelled points are dropped from the sequence first.
+    """
+    lab = np.asarray(labels).astype(str)
+    keep = np.flatnonzero(_resolved(lab))
+    sizes = (
+        attractor_size(np.asarray(sections)[keep])
+        if sections is not None
+        else np.full(keep.size, np.nan)
+    )
+    scale = float(np.nanmax(sizes)) if np.isfinite(sizes).any() else math.nan
+    seq = [str(s) for s in lab[keep]]
+    out: list[dict[str, Any]] = []
+    for j in range(1, len(seq)):
+        if seq[j] == "chaos" and seq[j - 1] != "chaos":
+            before = seq[max(0, j - history) : j]
+            sb, sa = float(sizes[j - 1]), float(sizes[j])
+            out.append(
+                {
+                    "at": float(np.asarray(x)[keep[j]]),
+                    "route": _route(before, sb, sa, scale),
+                    "before": before,
+                    "size_before": sb,
+                    "size_at": sa,
+                }
+            )
+    return out
+
+
+def section_spread(ds: Any, family_value: float | None = None) -> float:
+    """Standard deviation of all X̄_sp1 section values of one panel (all points pooled)."""
+    for fv, _, lab, sec in panels(ds):
+        if family_value is None or (fv is not None and math.isclose(fv, family_value)):
+            if sec is None:
+                return math.nan
+            ok = np.asarray(lab).astype(str) != "failed"
+            vals = sec[ok].ravel()
+            vals = vals[np.isfinite(vals)]
+            return float(np.std(vals)) if vals.size else math.nan
+    return math.nan
+
+
+def qp_near_3t(x: np.ndarray, labels: np.ndarray, tol: float) -> tuple[int, int]:
+    """(quasi-periodic points, those with a 3T/6T point within ``tol`` along the swept axis)."""
+    lab = np.asarray(labels).astype(str)
+    xs = np.asarray(x, dtype=float)
+    qp = xs[lab == "QP"]
+    three = xs[np.isin(lab, ("3T", "6T"))]
+    near = int(sum(1 for q in qp if three.size and np.min(np.abs(three - q)) <= tol))
+    return int(qp.size), near
+
+
+def _informative(ds: Any) -> bool:
+    lab = _labels(ds).ravel()
+    return bool(lab.size) and float(np.mean(_resolved(lab))) >= MIN_RESOLVED
+
+
+def _fmt(v: float | None) -> str:
+    if v is None or (isinstance(v, float) and not math.isfinite(v)):
+        return "—"
+    return f"{v:.3g}"
+
+
+def _family_name(ds: Any) -> str:
+    fam, _ = _dims(ds)
+    return fam or ""
+
+
+def _verdict(cid: int, verdict: str, evidence: str, measured: dict[str, Any]) -> Verdict:
+    return Verdict(cid, STATEMENTS[cid], verdict, evidence, measured)
+
+
+def _missing(cid: int, names: Sequence[str]) -> Verdict:
+    return _verdict(cid, "not evaluated", f"needs the run(s) {', '.join(names)}", {})
+
+
+# --------------------------------------------------------------------------- conclusions
+_BIFURCATION_PARAMS = {
+    "omega": "Ω",
+    "backlash.sun_planet": "b̄_sp",
+    "backlash.planet_ring": "b̄_rp",
+    "clearance.sun_bearing": "b̄_s",
+}
+
+
+def conclusion_1(stores: Stores) -> Verdict:
+    """All four bifurcation parameters swept with a variable-step integrator, points succeed."""
+    swept: dict[str, list[str]] = {}
+    total = failed = 0
+    steps: list[float] = []
+    for name, ds in stores.items():
+        _, vary = _dims(ds)
+        if vary in _BIFURCATION_PARAMS:
+            swept.setdefault(_BIFURCATION_PARAMS[vary], []).append(name)
+        lab = _labels(ds)
+        total += lab.size
+        failed += int(np.count_nonzero(lab == "failed"))
+        if "steps_accepted" in ds.data_vars:
+            steps.extend(np.asarray(ds["steps_accepted"].values, dtype=float).ravel().tolist())
+    if not stores:
+        return _missing(1, ["fig4", "fig6", "fig9", "fig12"])
+    frac_failed = failed / total if total else math.nan
+    n = len(swept)
+    measured: dict[str, Any] = {
+        "parameters_swept": sorted(swept),
+        "points": total,
+        "failed_fraction": frac_failed,
+        "steps_per_point_median": float(np.median(steps)) if steps else None,
+    }
+    evidence = (
+        f"{n} of 4 bifurcation parameters swept ({', '.join(sorted(swept)) or 'none'}); "
+        f"{total} points, {_fmt(100 * frac_failed)} % failed; adaptive Dormand–Prince 5(4), "
+        f"median {_fmt(measured['steps_per_point_median'])} accepted steps per point"
+    )
+    if n == 4 and frac_failed <= 0.01:
+        verdict = "holds"
+    elif n >= 1 and frac_failed <= 0.1:
+        verdict = "partly"
+    else:
+        verdict = "does not hold"
+    return _verdict(1, verdict, evidence, measured)
+
+
+def conclusion_2(stores: Stores) -> Verdict:
+    """Every model ingredient is present in the gear set and excited in the runs."""
+    from ..gearset import GearSet
+
+    ds = next((d for d in stores.values() if d.attrs.get("gearset_toml")), None)
+    if ds is None:
+        return _missing(2, ["any figure with its gear set"])
+    gs = GearSet.from_toml_string(ds.attrs["gearset_toml"])
+    st, te, bl = gs.stiffness, gs.transmission_error, gs.backlash
+    parts = {
+        "time-varying mesh stiffness": st.sun_planet_alternating > 0
+        and st.planet_ring_alternating > 0,
+        "sun transverse displacement (bearing stiffness)": st.sun_bearing > 0,
+        "sun radial clearance": gs.clearance.sun_bearing > 0,
+        "transmission error": te.sun_planet > 0 or te.planet_ring > 0,
+        "sun-planet and planet-ring backlash": bl.sun_planet > 0 and bl.planet_ring > 0,
+    }
+    xs = 0.0
+    for d in stores.values():
+        for v in ("x_s_max", "x_s_min", "y_s_max", "y_s_min"):
+            if v in d.data_vars:
+                with np.errstate(all="ignore"):
+                    m = float(np.nanmax(np.abs(np.asarray(d[v].values, dtype=float))))
+                if math.isfinite(m):
+                    xs = max(xs, m)
+    bs = float(gs.sun_bearing_clearance_bar())
+    excited = xs > 1e-6 * max(bs, 1.0)
+    measured = {
+        "ingredients": parts,
+        "max_sun_translation": xs,
+        "sun_translation_excited": excited,
+        "mesh_phasing": gs.mesh_phasing.model,
+    }
+    have = [k for k, v in parts.items() if v]
+    evidence = (
+        f"{len(have)} of {len(parts)} ingredients in the gear set ({', '.join(have)}); "
+        f"largest sun translation |x̄_s|, |ȳ_s| over all runs = {_fmt(xs)} "
+        f"(mesh phasing {gs.mesh_phasing.model}"
+        + (
+            ": in-phase meshes cancel the net mesh force on the sun, so its translation and "
+            "bearing clearance stay idle)"
+            if not excited
+            else ")"
+        )
+    )
+    if len(have) == len(parts) and excited:
+        verdict = "holds"
+    elif len(have) >= len(parts) - 1:
+        verdict = "partly"
+    else:
+        verdict = "does not hold"
+    return _verdict(2, verdict, evidence, measured)
+
+
+DAMPING_FIGURES = ("fig4", "fig6", "fig9")
+
+
+def conclusion_3(stores: Stores, figures: Sequence[str] = DAMPING_FIGURES) -> Verdict:
+    """Chaotic fraction per ξ in every ξ-family sweep: monotone non-increasing?"""
+    present = [f for f in figures if f in stores and _family_name(stores[f]) == "xi"]
+    if not present:
+        return _missing(3, list(figures))
+    measured: dict[str, Any] = {}
+    ok = used = 0
+    parts = []
+    for f in present:
+        ds = stores[f]
+        frac = chaotic_fraction(ds)
+        xi = sorted(frac)
+        chaos = [frac[k] for k in xi]
+        metric, what = chaos, "chaotic"
+        if all(not (c > 0) for c in chaos):  # no chaos at all: use QP + chaos
+            metric = [
+                label_fraction(lab, _nonperiodic) for _, _, lab, _ in sorted(panels(ds), key=_k0)
+            ]
+            what = "non-periodic (QP + chaos)"
+        finite = [m for m in metric if math.isfinite(m)]
+        informative = len(finite) >= 2 and any(m > 0 for m in finite) and _informative(ds)
+        mono = all(b <= a + 1e-12 for a, b in itertools.pairwise(finite))
+        measured[f] = {
+            "xi": xi,
+            "chaotic_fraction": chaos,
+            "metric": what,
+            "fraction": metric,
+            "monotone": mono,
+            "informative": informative,
+        }
+        fr = ", ".join(f"ξ={k:g}: {_fmt(m)}" for k, m in zip(xi, metric, strict=True))
+        if informative:
+            used += 1
+            ok += int(mono)
+            parts.append(
+                f"{f} {what} fraction {fr} → {'non-increasing' if mono else 'NOT monotone'}"
+            )
+        else:
+            parts.append(f"{f}: too few labelled or no non-periodic points ({fr}), not used")
+    evidence = "; ".join(parts)
+    if used == 0:
+        verdict = "not evaluated"
+    elif ok == used:
+        verdict = "holds"
+    elif ok > used / 2:
+        verdict = "partly"
+    else:
+        verdict = "does not hold"
+    measured["sweeps_used"] = used
+    measured["sweeps_monotone"] = ok
+    return _verdict(3, verdict, evidence, measured)
+
+
+def _k0(p: tuple[Any, ...]) -> float:
+    return -math.inf if p[0] is None else float(p[0])
+
+
+def _routes(ds: Any) -> list[dict[str, Any]]:
+    out = []
+    for fv, x, lab, sec in panels(ds):
+        for o in chaos_onsets(x, lab, sec):
+            out.append({**o, "panel": fv})
+    return out
+
+
+def _route_counts(onsets: list[dict[str, Any]]) -> dict[str, int]:
+    counts: dict[str, int] = {}
+    for o in onsets:
+        counts[o["route"]] = counts.get(o["route"], 0) + 1
+    return counts
+
+
+def _onset_text(onsets: list[dict[str, Any]], family: str, limit: int = 8) -> str:
+    items = [
+        f"{o['route']} at {o['at']:.3g}"
+        + ("" if o["panel"] is None else f" ({family}={o['panel']:g})")
+        for o in onsets[:limit]
+    ]
+    more = f" … (+{len(onsets) - limit})" if len(onsets) > limit else ""
+    return "; ".join(items) + more
+
+
+def _gather_routes(stores: Stores, figures: Sequence[str]) -> tuple[list[Any], list[str], bool]:
+    onsets: list[dict[str, Any]] = []
+    texts = []
+    informative = True  # every sweep of the group must be mostly labelled
+    for f in figures:
+        if f not in stores:
+            continue
+        ds = stores[f]
+        informative = informative and _informative(ds)
+        o = _routes(ds)
+        for item in o:
+            item["figure"] = f
+        onsets.extend(o)
+        texts.append(
+            f"{f}: {len(o)} onset(s) of chaos"
+            + (f" — {_onset_text(o, _family_name(ds))}" if o else "")
+        )
+    return onsets, texts, informative
+
+
+def conclusion_4(stores: Stores, figures: Sequence[str] = ("fig4",)) -> Verdict:
+    """Onsets of chaos along Ω: is crisis (a jump of the attractor) among their routes?"""
+    if not any(f in stores for f in figures):
+        return _missing(4, list(figures))
+    onsets, texts, informative = _gather_routes(stores, figures)
+    counts = _route_counts(onsets)
+    measured = {"route_counts": counts, "onsets": onsets}
+    evidence = "; ".join(texts) + f"; routes: {counts or 'none'}"
+    crisis = counts.get("crisis", 0)
+    if not onsets:
+        verdict = "does not hold" if informative else "not evaluated"
+    elif crisis and crisis >= max(counts.values()):
+        verdict = "holds"
+    elif crisis:
+        verdict = "partly"
+    else:
+        verdict = "does not hold"
+    return _verdict(4, verdict, evidence, measured)
+
+
+def conclusion_5(stores: Stores, figures: Sequence[str] = ("fig6", "fig8")) -> Verdict:
+    """Onsets of chaos along b̄_sp: both crisis and period doubling found?"""
+    if not any(f in stores for f in figures):
+        return _missing(5, list(figures))
+    onsets, texts, informative = _gather_routes(stores, figures)
+    counts = _route_counts(onsets)
+    found = [r for r in ("crisis", "period doubling") if counts.get(r)]
+    measured = {"route_counts": counts, "onsets": onsets, "found": found}
+    evidence = "; ".join(texts) + f"; routes: {counts or 'none'}"
+    if not onsets:
+        verdict = "does not hold" if informative else "not evaluated"
+    elif len(found) == 2:
+        verdict = "holds"
+    elif found:
+        verdict = "partly"
+    else:
+        verdict = "does not hold"
+    return _verdict(5, verdict, evidence, measured)
+
+
+ROUTE_TYPES = ("period doubling", "crisis", "Hopf", "3T channel")
+
+
+def conclusion_6(stores: Stores, figures: Sequence[str] = ("fig9", "fig11")) -> Verdict:
+    """Onsets of chaos along b̄_rp: how many of the paper's four route types coexist?"""
+    if not any(f in stores for f in figures):
+        return _missing(6, list(figures))
+    onsets, texts, informative = _gather_routes(stores, figures)
+    counts = _route_counts(onsets)
+    kinds = [r for r in ROUTE_TYPES if counts.get(r)]
+    measured = {"route_counts": counts, "route_types": kinds, "onsets": onsets}
+    evidence = (
+        "; ".join(texts)
+        + f"; {len(kinds)} of the paper's 4 route types found ({', '.join(kinds) or 'none'})"
+    )
+    if not onsets and not informative:
+        verdict = "not evaluated"
+    elif len(kinds) >= 3:
+        verdict = "holds"
+    elif len(kinds) == 2:
+        verdict = "partly"
+    else:
+        verdict = "does not hold"
+    return _verdict(6, verdict, evidence, measured)
+
+
+def conclusion_7(
+    stores: Stores, weak: str = "fig12", strong: str = "fig9", strong_panel: float = 0.05
+) -> Verdict:
+    """b̄_s sweep: no bifurcation, no chaos, and X̄_sp1 spread ≪ that of the b̄_rp sweep."""
+    if weak not in stores:
+        return _missing(7, [weak])
+    ds = stores[weak]
+    lab = _labels(ds).ravel()
+    res = lab[_resolved(lab)]
+    kinds = sorted(set(res.tolist()))
+    no_chaos = "chaos" not in kinds and "QP" not in kinds
+    no_bif = len(kinds) <= 1
+    s_weak = section_spread(ds)
+    s_strong = math.nan
+    if strong in stores:
+        sds = stores[strong]
+        s_strong = section_spread(sds, strong_panel if _family_name(sds) else None)
+        if not math.isfinite(s_strong):
+            s_strong = section_spread(sds)
+    ratio = s_weak / s_strong if s_strong and math.isfinite(s_strong) else math.nan
+    weakly = math.isfinite(ratio) and ratio < WEAK_COUPLING_RATIO
+    measured = {
+        "labels_bs": kinds,
+        "spread_bs": s_weak,
+        "spread_brp": s_strong,
+        "ratio": ratio,
+        "no_chaos": no_chaos,
+        "no_bifurcation": no_bif,
+    }
+    evidence = (
+        f"{weak} (b̄_s sweep) motion types {kinds or ['none labelled']}; std of X̄_sp1 section "
+        f"values across the b̄_s sweep {_fmt(s_weak)} vs across the b̄_rp sweep ({strong}, "
+        f"ξ={strong_panel:g}) {_fmt(s_strong)}: ratio {_fmt(ratio)} "
+        f"(weak if < {WEAK_COUPLING_RATIO:g})"
+    )
+    if res.size < MIN_RESOLVED * max(lab.size, 1) or not math.isfinite(ratio):
+        verdict = "not evaluated"
+    elif no_chaos and no_bif and weakly:
+        verdict = "holds"
+    elif (no_chaos and no_bif) or weakly:
+        verdict = "partly"
+    else:
+        verdict = "does not hold"
+    return _verdict(7, verdict, evidence, measured)
+
+
+QP_GROUPS: dict[str, tuple[str, ...]] = {
+    "Ω": ("fig4",),
+    "b̄_sp": ("fig6", "fig8"),
+    "b̄_rp": ("fig9", "fig11"),
+}
+
+
+def conclusion_8(
+    stores: Stores, groups: Mapping[str, Sequence[str]] = QP_GROUPS, tol_fraction: float = 0.05
+) -> Verdict:
+    """QP under every bifurcation parameter, near (within 5 % of the range, at least one grid
+    step) a 3T window."""
+    measured: dict[str, Any] = {}
+    parts = []
+    with_qp = near = used = 0
+    for param, figs in groups.items():
+        have = [f for f in figs if f in stores]
+        if not have:
+            continue
+        used += 1
+        n_qp = n_near = 0
+        for f in have:
+            for _, x, lab, _ in panels(stores[f]):
+                # near: within tol_fraction of the range, and never less than one grid step
+                step = float(np.median(np.abs(np.diff(x)))) if x.size > 1 else 0.0
+                tol = max(tol_fraction * float(np.ptp(x)), 1.01 * step) if x.size > 1 else 0.0
+                q, n = qp_near_3t(x, lab, tol)
+                n_qp += q
+                n_near += n
+        measured[param] = {"figures": have, "qp_points": n_qp, "qp_near_3t": n_near}
+        with_qp += int(n_qp > 0)
+        near += int(n_near > 0)
+        parts.append(f"{param} ({', '.join(have)}): {n_qp} QP point(s), {n_near} near a 3T/6T")
+    if not used:
+        return _missing(8, [f for g in groups.values() for f in g])
+    evidence = (
+        "; ".join(parts)
+        + f" (near: within {tol_fraction:.0%} of the swept range or one grid step). "
+        "b̄_s is left out: the paper's own conclusion 7 and Fig. 12 report no non-periodic "
+        "motion under b̄_s"
+    )
+    measured["parameters"] = used
+    if near == used:
+        verdict = "holds"
+    elif with_qp:
+        verdict = "partly"
+    else:
+        informative = all(
+            _informative(stores[f]) for g in groups.values() for f in g if f in stores
+        )
+        verdict = "does not hold" if informative else "not evaluated"
+    return _verdict(8, verdict, evidence, measured)
+
+
+CONCLUSIONS: dict[int, Callable[[Stores], Verdict]] = {
+    1: conclusion_1,
+    2: conclusion_2,
+    3: conclusion_3,
+    4: conclusion_4,
+    5: conclusion_5,
+    6: conclusion_6,
+    7: conclusion_7,
+    8: conclusion_8,
+}
+
+
+def evaluate_conclusions(stores: Stores) -> list[Verdict]:
+    """Every conclusion of the seed's Section 4 checked on ``stores`` (figure name → dataset).
+
+    A check that raises gives ``not evaluated`` with the error as evidence, so one broken store
+    never hides the other verdicts.
+    """
+    out = []
+    for cid, fn in CONCLUSIONS.items():
+        try:
+            out.append(fn(stores))
+        except Exception as exc:
+            out.append(
+                _verdict(cid, "not evaluated", f"check failed: {type(exc).__name__}: {exc}", {})
+            )
+    return out

@@ -1,0 +1,69 @@
+"""`gearchaos reproduce --all --quick`: every figure and the HTML report with its verdict tables."""
+
+from __future__ import annotations
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import json
+from pathlib import Path
+
+from typer.testing import CliRunner
+
+from gearchaos.cli import app
+from gearchaos.paper.report import FIGURES, HONESTY
+
+FIGS = ("fig4", "fig5", "fig6", "fig7", "fig8", "fig9", "fig10", "fig11", "fig12")
+
+
+def test_reproduce_all_quick_writes_every_figure_and_the_report(tmp_path: Path) -> None:
+    assert FIGURES == FIGS
+    out = tmp_path / "report"
+    res = CliRunner().invoke(app, ["reproduce", "--all", "-o", str(out), "--quick", "-w", "2"])
+    assert res.exit_code == 0, res.output
+    index = out / "index.html"
+    assert str(index) in res.output.replace("\n", "")
+    page = index.read_text(encoding="utf-8")
+    for fig in FIGS:
+        assert (out / f"{fig}-quick.png").is_file(), fig
+        assert f"src='{fig}-quick.png'" in page  # relative path: the page is self-contained
+        assert f"id='{fig}'" in page
+    assert "id='conclusions'" in page
+    for cid in range(1, 9):
+        assert f"<td>C{cid}</td>" in page
+    assert "Honesty" in page
+    for title, _ in HONESTY:
+        assert title in page
+    assert "Gear set TOML" in page
+    summary = json.loads((out / "report.json").read_text(encoding="utf-8"))
+    assert [c["id"] for c in summary["conclusions"]] == list(range(1, 9))
+    verdicts = {"holds", "partly", "does not hold", "not evaluated"}
+    assert {c["verdict"] for c in summary["conclusions"]} <= verdicts
+    assert all(not f.get("error") for f in summary["figures"].values())
+
+
+def test_reproduce_needs_a_figure_or_all(tmp_path: Path) -> None:
+    res = CliRunner().invoke(app, ["reproduce", "-o", str(tmp_path)])
+    assert res.exit_code == 2
+    res = CliRunner().invoke(app, ["reproduce", "fig4", "--all", "-o", str(tmp_path)])
+    assert res.exit_code == 2
+
+
+def test_html_escapes_text(tmp_path: Path) -> None:
+    from gearchaos.paper.conclusions import Verdict
+    from gearchaos.paper.report import render_html
+
+    v = Verdict(1, "<script>x</script>", "holds", "a < b & c", {})
+    page = render_html(
+        quick=True,
+        results={},
+        stores={},
+        verdicts=[v],
+        landmark_rows=[],
+        landmark_note="",
+        total_seconds=0.0,
+        outdir=tmp_path,
+    )
+    assert "<script>x" not in page
+    assert "&lt;script&gt;" in page and "a &lt; b &amp; c" in page
