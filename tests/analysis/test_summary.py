@@ -95,3 +95,12 @@ def test_format_summary_renders(planetary: gc.SimulationResult) -> None:
     text = console.export_text()
     assert "sun speed [rpm]" in text  # brackets survive rich markup
     assert "sun_planet_5" in text and "none" in text
+
+
+def test_format_summary_shows_many_distinct_points() -> None:
+    """More than 64 distinct section points (count 65) reads as "many", whatever the label."""
+    from rich.console import Console
+
+    console = Console(record=True, width=120)
+    console.print(format_summary({"distinct_section_points": 65, "motion": "chaos"}))
+    assert "> 64 (many)" in console.export_text()

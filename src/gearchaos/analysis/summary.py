@@ -186,7 +186,7 @@ def format_summary(summary: dict[str, Any], *, title: str | None = None) -> Any:
     for key, label in labels.items():
         if key in summary:
             value = summary[key]
-            if key == "distinct_section_points" and summary.get("motion") == "many":
+            if key == "distinct_section_points" and motion_name(int(value)) == "many":
                 value = f"> {int(value) - 1} (many)"
             table.add_row(escape(label), escape(_fmt(value)))
     style = {"none": "green", "single_sided": "yellow", "double_sided": "red"}

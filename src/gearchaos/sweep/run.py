@@ -309,26 +309,19 @@ def run_sweep(
     todo = [t for t in grid.tasks() if t.index not in done]
     n_total = int(np.prod(grid.shape))
     n_done = n_total - sum(t.n_points for t in todo)
-    bar = _progress(progress, n_total, n_done)
-    try:
-        with (
-            _sigterm_as_interrupt(),
-            bar,
-            executor(workers, scheduler, dask_local) as (ex, fn, desc),
-        ):
-            bar.describe(desc)
-            if isinstance(ex, InProcess):
-                _run_in_process(todo, grid, layout, st, fn, bar)
-            else:
-                _run_pool(todo, grid, layout, st, ex, fn, bar, workers or dask_local or 8)
-    except KeyboardInterrupt:
-        raise
-    if st.path is not None:
-        import shutil
-
-        from .store import PROGRESS
-
-        shutil.rmtree(os.path.join(st.path, PROGRESS), ignore_errors=True)
+    bar = _Bar(progress, n_total, n_done)
+    with (
+        _sigterm_as_interrupt(),
+        bar,
+        executor(workers, scheduler, dask_local) as (ex, fn, desc),
+    ):
+        bar.describe(desc)
+        if isinstance(ex, InProcess):
+            _run_in_process(todo, grid, layout, st, fn, bar)
+        else:
+            _run_pool(todo, grid, layout, st, ex, fn, bar, workers or dask_local or 8)
+    # every task is written: drop the markers before classification consolidates the metadata
+    st.clear_progress()
     if classify:
         from .classify import classify_store
 
@@ -453,10 +446,6 @@ class _Bar:
             dt = time.perf_counter() - self.t0
             rate = (self.done - self.started_at) / dt if dt > 0 else 0.0
             self._p.update(self._id, advance=n, rate=f"{rate:.1f}", failed=self.failed)
-
-
-def _progress(enabled: bool, total: int, done: int) -> _Bar:
-    return _Bar(enabled, total, done)
 
 
 def _default_observe(target: Any) -> tuple[str, ...]:

@@ -180,11 +180,16 @@ class SweepStore:
             with open(os.path.join(d, f"{task_index}.done"), "w"):
                 pass
 
+    def clear_progress(self) -> None:
+        """Remove the task markers (all tasks written). Must precede any metadata
+        consolidation: zarr would list the marker folder as a stray node."""
+        if self.path is not None:
+            shutil.rmtree(os.path.join(self.path, PROGRESS), ignore_errors=True)
+
     def finish(self) -> None:
+        """Mark the store complete (after :meth:`clear_progress`)."""
         import zarr
 
-        if self.path is not None:  # before consolidating: zarr would list it as a stray node
-            shutil.rmtree(os.path.join(self.path, PROGRESS), ignore_errors=True)
         g = zarr.open_group(self.zarr_store, mode="a", use_consolidated=False)
         g.attrs["complete"] = True
         zarr.consolidate_metadata(self.zarr_store)
