@@ -1402,12 +1402,14 @@ def reproduce(
         bool,
         typer.Option("--overwrite", help="Replace an existing store made with other settings."),
     ] = False,
+    preset: PresetOpt = None,
+    gearset: GearsetOpt = None,
     quiet: QuietOpt = False,
     json_out: JsonOpt = False,
 ) -> None:
     """Run the exact sweep of one of the seed paper's bifurcation figures with the default gear
-    set and draw it in the paper's layout (resumable like `gearchaos bifurcation`), or draw one
-    of its Poincaré galleries.
+    set (or --preset / --gearset) and draw it in the paper's layout (resumable like
+    `gearchaos bifurcation`), or draw one of its Poincaré galleries.
 
     Bifurcation diagrams — fig4: Ω sweep, ξ = 0.03, 0.05, 0.07, 0.09; fig6: b̄_sp at Ω = 1.5 for
     four ξ; fig8: b̄_sp at ξ = 0.11 for Ω = 1, 1.5, 2, 2.5; fig9: b̄_rp at Ω = 1.5 for four ξ;
@@ -1424,6 +1426,12 @@ def reproduce(
     Example: **gearchaos reproduce fig4 -o paper/ --quick**;
     **gearchaos reproduce --all -o report/**
     """
+    gs = None
+    label = None
+    if preset is not None or gearset is not None:
+        with _reported_errors():
+            gs = _gearset(preset, gearset, {})
+        label = f"preset {preset}" if preset is not None else f"file {gearset} ({gs.name})"
     if all_figures:
         if figure is not None:
             _fail("give either FIG or --all, not both", EXIT_INVALID)
@@ -1431,7 +1439,12 @@ def reproduce(
             from .paper.report import build_report
 
             index = build_report(
-                output, quick=quick, progress=not (quiet or json_out), workers=workers
+                output,
+                quick=quick,
+                progress=not (quiet or json_out),
+                workers=workers,
+                gearset=gs,
+                gearset_label=label,
             )
         if json_out:
             _print_json({"report": str(index)})
@@ -1464,7 +1477,9 @@ def reproduce(
 
             output.mkdir(parents=True, exist_ok=True)
             result = dict(
-                reproduce_gallery(name, output, quick=quick, progress=not (quiet or json_out))
+                reproduce_gallery(
+                    name, output, quick=quick, progress=not (quiet or json_out), gearset=gs
+                )
             )
         else:
             try:
@@ -1483,6 +1498,7 @@ def reproduce(
                     progress=not quiet,
                     workers=workers,
                     overwrite=overwrite,
+                    gearset=gs,
                 )
             )
     if json_out:

@@ -193,6 +193,7 @@ def test_reproduce_calls_the_recipe_and_prints_json(
 ) -> None:
     recipes = pytest.importorskip("gearchaos.paper.recipes")
     calls: list[tuple] = []
+    gearsets: list[object] = []
 
     def fake(
         name: str,
@@ -202,8 +203,10 @@ def test_reproduce_calls_the_recipe_and_prints_json(
         progress: bool,
         workers: int | None = None,
         overwrite: bool = False,
+        gearset: object = None,
     ) -> dict:
         calls.append((name, Path(str(outdir)), quick, progress, workers, overwrite))
+        gearsets.append(gearset)
         return {
             "figure": str(tmp_path / f"{name}.png"),
             "store": str(tmp_path / f"{name}.zarr"),
@@ -224,6 +227,28 @@ def test_reproduce_calls_the_recipe_and_prints_json(
     assert result.exit_code == 0
     assert calls[-1] == ("fig4", tmp_path, False, False, 2, True)
     assert result.stdout == ""
+    assert gearsets == [None, None]  # the recipe's default preset
+
+    # --preset and --gearset reach the recipe as a GearSet; both at once is refused
+    import gearchaos
+
+    result = runner.invoke(
+        app, ["reproduce", "fig4", "-o", str(tmp_path), "-q", "-p", "hindawi2021"]
+    )
+    assert result.exit_code == 0, result.output
+    assert gearsets[-1] == gearchaos.preset("hindawi2021")
+    custom = gearchaos.preset("hindawi2021").evolve({"torque.input": 500.0, "name": "mine"})
+    file = tmp_path / "mine.toml"
+    file.write_text(custom.to_toml())
+    result = runner.invoke(app, ["reproduce", "fig4", "-o", str(tmp_path), "-q", "-g", str(file)])
+    assert result.exit_code == 0, result.output
+    assert gearsets[-1] == custom
+    n = len(calls)
+    result = runner.invoke(
+        app, ["reproduce", "fig4", "-o", str(tmp_path), "-p", "sheng2016", "-g", str(file)]
+    )
+    assert result.exit_code != 0 and "mutually exclusive" in result.stderr
+    assert len(calls) == n
 
     def interrupted(*args: object, **kwargs: object) -> dict:
         raise KeyboardInterrupt

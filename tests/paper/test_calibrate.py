@@ -94,10 +94,10 @@ def test_teeth_enumeration_matches_a_hand_count() -> None:
     assert enumerate_teeth((6,), (20, 20), (40, 40)) == ()
 
 
-def test_base_candidate_is_the_default_gear_set() -> None:
+def test_base_candidate_is_the_model_md_gear_set() -> None:
     import gearchaos
 
-    gs0 = gearchaos.preset("sheng2016")
+    gs0 = gearchaos.preset("hindawi2021")
     gs = build_gearset(base_candidate())
     for table in (
         "teeth",

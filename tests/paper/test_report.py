@@ -20,7 +20,8 @@ FIGS = ("fig4", "fig5", "fig6", "fig7", "fig8", "fig9", "fig10", "fig11", "fig12
 def test_reproduce_all_quick_writes_every_figure_and_the_report(tmp_path: Path) -> None:
     assert FIGURES == FIGS
     out = tmp_path / "report"
-    res = CliRunner().invoke(app, ["reproduce", "--all", "-o", str(out), "--quick", "-w", "2"])
+    args = ["reproduce", "--all", "-o", str(out), "--quick", "-w", "2", "-p", "hindawi2021"]
+    res = CliRunner().invoke(app, args)
     assert res.exit_code == 0, res.output
     index = out / "index.html"
     assert str(index) in res.output.replace("\n", "")
@@ -36,7 +37,11 @@ def test_reproduce_all_quick_writes_every_figure_and_the_report(tmp_path: Path) 
     for title, _ in HONESTY:
         assert title in page
     assert "Gear set TOML" in page
+    # the chosen gear set ran (its name is in the stored TOML) and the page says which
+    assert "<code>preset hindawi2021</code>" in page
+    assert "name = &quot;hindawi2021&quot;" in page
     summary = json.loads((out / "report.json").read_text(encoding="utf-8"))
+    assert summary["gearset"] == "preset hindawi2021"
     assert [c["id"] for c in summary["conclusions"]] == list(range(1, 9))
     verdicts = {"holds", "partly", "does not hold", "not evaluated"}
     assert {c["verdict"] for c in summary["conclusions"]} <= verdicts
@@ -67,3 +72,4 @@ def test_html_escapes_text(tmp_path: Path) -> None:
     )
     assert "<script>x" not in page
     assert "&lt;script&gt;" in page and "a &lt; b &amp; c" in page
+    assert "<code>preset sheng2016</code>" in page  # the default gear set is named

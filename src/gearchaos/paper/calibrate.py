@@ -58,6 +58,7 @@ import numpy as np
 from ..errors import ParameterError
 
 __all__ = [
+    "BASE_PRESET",
     "DEFAULT_SPACE",
     "CalibrationResult",
     "Candidate",
@@ -78,6 +79,10 @@ __all__ = [
     "read_results",
     "sweep_plan",
 ]
+
+#: The gear set every candidate starts from (MODEL.md §9). Fixed by name so that a calibration
+#: log stays valid whatever the default preset becomes.
+BASE_PRESET = "hindawi2021"
 
 #: Significant digits kept of every continuous variable (keys and TOML stay clean).
 DIGITS = 6
@@ -282,7 +287,7 @@ def candidate_key(variables: Mapping[str, Any]) -> str:
 def _base() -> Any:
     from ..gearset import preset
 
-    return preset("sheng2016")
+    return preset(BASE_PRESET)
 
 
 def base_candidate(base: Any = None, space: SearchSpace = DEFAULT_SPACE) -> Candidate:

@@ -434,8 +434,9 @@ def reproduce_gallery(
     *,
     quick: bool = False,
     progress: bool = True,
+    gearset: Any = None,
 ) -> dict[str, Any]:
-    """Draw the seed's Poincaré gallery ``name`` with the default gear set.
+    """Draw the seed's Poincaré gallery ``name`` with the default gear set (or ``gearset``).
 
     Writes ``outdir/<name>.png`` (the grid), ``outdir/<name>.json`` (settings, gear set and the
     rows of :func:`run_gallery`) and ``outdir/<name>.csv`` (the rows); with ``quick`` the stem
@@ -457,7 +458,7 @@ def reproduce_gallery(
     out.mkdir(parents=True, exist_ok=True)
     stem = g.name + ("-quick" if quick else "")
     tr, rec = QUICK_PERIODS if quick else (g.transient_periods, g.periods)
-    gs = preset(PRESET)
+    gs = preset(PRESET) if gearset is None else gearset
     fig, rows = run_gallery(
         gs,
         g.param,

@@ -293,6 +293,7 @@ def reproduce(
     progress: bool = True,
     workers: int | None = None,
     overwrite: bool = False,
+    gearset: Any = None,
 ) -> dict[str, Any]:
     """Run the sweep of the seed's figure ``name`` and draw it in the seed's layout.
 
@@ -318,6 +319,9 @@ def reproduce(
     overwrite
         Replace an existing store made with other settings (otherwise refused with a
         :class:`~gearchaos.errors.StoreError`).
+    gearset
+        The gear set (default: the :data:`PRESET` preset). Its fixed parameters are replaced by
+        the recipe's (Ω or ξ and the clearances as the figure sets them).
 
     Returns
     -------
@@ -343,7 +347,7 @@ def reproduce(
     store = out / f"{stem}.zarr"
     png = out / f"{stem}.png"
     ds = bifurcation(
-        preset(PRESET),
+        preset(PRESET) if gearset is None else gearset,
         **recipe.sweep_kwargs(quick),
         store=str(store),
         overwrite=overwrite,

@@ -96,7 +96,7 @@ def _e(text: Any) -> str:
 
 
 def _run_figures(
-    outdir: Path, quick: bool, progress: bool, workers: int | None
+    outdir: Path, quick: bool, progress: bool, workers: int | None, gearset: Any = None
 ) -> dict[str, dict[str, Any]]:
     from .galleries import GALLERIES, reproduce_gallery
     from .recipes import reproduce
@@ -106,9 +106,20 @@ def _run_figures(
         t0 = time.perf_counter()
         try:
             if name in GALLERIES:
-                res = dict(reproduce_gallery(name, outdir, quick=quick, progress=progress))
+                res = dict(
+                    reproduce_gallery(name, outdir, quick=quick, progress=progress, gearset=gearset)
+                )
             else:
-                res = dict(reproduce(name, outdir, quick=quick, progress=progress, workers=workers))
+                res = dict(
+                    reproduce(
+                        name,
+                        outdir,
+                        quick=quick,
+                        progress=progress,
+                        workers=workers,
+                        gearset=gearset,
+                    )
+                )
         except Exception as exc:
             res = {"error": f"{type(exc).__name__}: {exc}"}
         res["seconds"] = float(res.get("seconds", time.perf_counter() - t0))
@@ -217,6 +228,7 @@ def render_html(
     landmark_note: str,
     total_seconds: float,
     outdir: Path,
+    gearset_label: str | None = None,
 ) -> str:
     """The report page (see the module docstring)."""
     from .. import __version__
@@ -269,7 +281,8 @@ def render_html(
             f"{_e(attrs.get('rtol'))}, atol {_e(attrs.get('atol'))}; plotted X̄_sp1 = "
             "δ_sp1/b_c.</li>"
         )
-    p.append(f"<li>Gear set: preset <code>{_e(PRESET)}</code> (a stand-in, see Honesty)</li>")
+    label = gearset_label or f"preset {PRESET}"
+    p.append(f"<li>Gear set: <code>{_e(label)}</code> (see Honesty)</li>")
     p.append(f"<li>Total wall time: {total_seconds:.1f} s</li></ul>")
     rows = "".join(
         f"<tr><td>{_e(n)}</td><td>{_e(r.get('points', '—'))}</td>"
@@ -350,11 +363,15 @@ def build_report(
     quick: bool = False,
     progress: bool = True,
     workers: int | None = None,
+    gearset: Any = None,
+    gearset_label: str | None = None,
 ) -> Path:
     """Run every figure of the seed into ``outdir`` and write ``outdir/index.html``.
 
     Resumable: the sweep stores stay in ``outdir`` and a second call only redraws and
     re-checks. A figure that fails is reported in the page (the others still run).
+    ``gearset`` replaces the default preset (e.g. a calibration candidate); ``gearset_label``
+    names it in the page (default: the gear set's name).
 
     Returns
     -------
@@ -365,11 +382,12 @@ def build_report(
 
     matplotlib.use("Agg")
     from .conclusions import evaluate_conclusions
+    from .recipes import PRESET as DEFAULT_PRESET
 
     out = Path(os.fspath(outdir))
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
-    results = _run_figures(out, quick, progress, workers)
+    results = _run_figures(out, quick, progress, workers, gearset)
     stores = _open_stores(results)
     verdicts = evaluate_conclusions(stores)
     lm_rows, lm_note = _landmark_rows(stores)
@@ -382,6 +400,8 @@ def build_report(
         landmark_note=lm_note,
         total_seconds=time.perf_counter() - t0,
         outdir=out,
+        gearset_label=gearset_label
+        or (f"gear set {gearset.name}" if gearset is not None else None),
     )
     index = out / "index.html"
     tmp = index.with_name(index.name + ".partial")
@@ -389,6 +409,8 @@ def build_report(
     os.replace(tmp, index)
     summary = {
         "quick": quick,
+        "gearset": gearset_label
+        or (gearset.name if gearset is not None else f"preset {DEFAULT_PRESET}"),
         "seconds": time.perf_counter() - t0,
         "figures": {n: {k: v for k, v in r.items() if k != "rows"} for n, r in results.items()},
         "conclusions": [
