@@ -2,8 +2,8 @@
 
 Run as ``python benchmarks/bench_sweep.py [--points 1000] [--quick]``.
 
-The sweep: Ω ∈ [0.1, 4] in ``--points`` linearly spaced values, the default gear set
-(``gearchaos.preset("sheng2016")``), fresh zero initial state at every point, 100 transient +
+The sweep: Ω ∈ [0.1, 4] in ``--points`` linearly spaced values, the MODEL.md §9 gear set
+(``gearchaos.preset("hindawi2021")``), fresh zero initial state at every point, 100 transient +
 100 recorded mesh periods, rtol 1e-8, atol 1e-10, run by :func:`gearchaos.bifurcation` with its
 default executor (in-process, all cores) into a temporary Zarr store.
 
@@ -134,7 +134,7 @@ def child(points: int, tr: int, rec: int, store: str) -> dict[str, Any]:
     """Warm up, then run the sweep into ``store``; returns the measurements."""
     import gearchaos
 
-    gs = gearchaos.preset("sheng2016")
+    gs = gearchaos.preset("hindawi2021")
     common: dict[str, Any] = {"transient_periods": tr, "periods": rec, "rtol": RTOL, "atol": ATOL}
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory() as d:
@@ -211,7 +211,7 @@ def scipy_points(omegas: np.ndarray, tr: int, rec: int) -> list[Any]:
     import gearchaos
 
     bs = _bench_simulate()
-    gs = gearchaos.preset("sheng2016")
+    gs = gearchaos.preset("hindawi2021")
     print("right-hand side check (numpy vs compiled System.derivative, 20 random states each):")
     for om in omegas:
         err = bs.check_rhs(gs, float(om))
@@ -279,7 +279,7 @@ def main(argv: list[str] | None = None) -> int:
 
     print(
         f"gearchaos.bifurcation: {points}-point Ω sweep over [{OMEGA_RANGE[0]:g}, "
-        f"{OMEGA_RANGE[1]:g}], preset sheng2016, fresh starts"
+        f"{OMEGA_RANGE[1]:g}], preset hindawi2021, fresh starts"
     )
     print(f"protocol: {tr} transient + {rec} recorded mesh periods, rtol {RTOL:g}, atol {ATOL:g}")
     machine()

@@ -76,7 +76,7 @@ def test_gap_without_back_contact_is_single_sided() -> None:
 
 
 def test_planetary_keys_and_order() -> None:
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("hindawi2021")
     r = gc.simulate(gs, omega=0.5, transient_periods=20, periods=10)
     regimes = contact_regimes(r)
     N = gs.n_planets

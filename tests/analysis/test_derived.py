@@ -1,5 +1,5 @@
-"""``gearset_info``: derived quantities of the sheng2016 preset, recomputed here from the
-MODEL.md formulas (§1, §2, §4, §7, §9, §10.1) and the preset's table values."""
+"""``gearset_info``: derived quantities of the hindawi2021 preset (MODEL.md §9), recomputed
+here from the MODEL.md formulas (§1, §2, §4, §7, §9, §10.1) and the preset's table values."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ import pytest
 import gearchaos as gc
 from gearchaos.analysis.derived import gearset_info
 
-# MODEL.md §9 table values of the sheng2016 preset.
+# MODEL.md §9 table values of the hindawi2021 preset.
 N = 5
 ZS, ZP, ZR = 34, 31, 96
 MODULE = 0.004
@@ -36,7 +36,7 @@ REL = 1e-9  # the preset stores J = m* r_b² to 16 digits
 
 @pytest.fixture(scope="module")
 def info() -> dict:
-    return gearset_info(gc.preset("sheng2016"))
+    return gearset_info(gc.preset("hindawi2021"))
 
 
 def test_json_round_trip(info: dict) -> None:
@@ -45,7 +45,7 @@ def test_json_round_trip(info: dict) -> None:
 
 
 def test_identity_and_geometry(info: dict) -> None:
-    assert info["name"] == "sheng2016"
+    assert info["name"] == "hindawi2021"
     assert info["planets"] == N
     assert info["teeth"] == {"sun": ZS, "planet": ZP, "ring": ZR}
     radii = info["radii_m"]
@@ -135,7 +135,7 @@ def test_mesh_phasing(info: dict) -> None:
     # 96 mod 5 = 1: sequential phasing; the preset itself uses the in-phase model (MODEL.md §9).
     assert info["mesh_phasing"] == {"model": "in_phase", "class": "sequential", "k": 1}
     other = gearset_info(
-        gc.preset("sheng2016").evolve(
+        gc.preset("hindawi2021").evolve(
             {
                 "geometry.planets": 3,
                 "teeth.sun": 30,
@@ -172,7 +172,7 @@ def test_natural_frequencies_and_resonances(info: dict) -> None:
 
 
 def test_zero_torque_is_well_defined() -> None:
-    info = gearset_info(gc.preset("sheng2016").evolve({"torque.input": 0.0}))
+    info = gearset_info(gc.preset("hindawi2021").evolve({"torque.input": 0.0}))
     assert info["torque_ratio"] == pytest.approx(1 + 96 / 34, rel=1e-12)
     assert info["static_mesh_force_N"] == 0.0
     json.dumps(info)

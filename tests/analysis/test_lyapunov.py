@@ -94,7 +94,7 @@ def three_planets(gs: gc.GearSet) -> gc.GearSet:
 
 @pytest.fixture(scope="module")
 def sheng() -> gc.GearSet:
-    return gc.preset("sheng2016")
+    return gc.preset("hindawi2021")
 
 
 # ----------------------------------------------------------------------------------- Lorenz

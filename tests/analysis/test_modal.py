@@ -25,7 +25,7 @@ TEETH = {
     2: (34, 31, 96),  # 130/2 = 65
     3: (30, 33, 96),  # 126/3 = 42
     4: (34, 30, 94),  # 128/4 = 32
-    5: (34, 31, 96),  # 130/5 = 26 (the sheng2016 preset)
+    5: (34, 31, 96),  # 130/5 = 26 (the hindawi2021 preset, MODEL.md §9)
     6: (30, 33, 96),  # 126/6 = 21
 }
 
@@ -39,7 +39,7 @@ def gearset(n: int, **changes: object) -> gc.GearSet:
         "teeth.ring": zr,
     }
     base.update({k.replace("__", "."): v for k, v in changes.items()})
-    return gc.preset("sheng2016").evolve(base)
+    return gc.preset("hindawi2021").evolve(base)
 
 
 class Ref:
@@ -288,7 +288,7 @@ def test_accidental_degeneracy_is_split_by_family() -> None:
 
 
 def test_modes_table_contract() -> None:
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("hindawi2021")
     table = modes_table(gs)
     assert json.loads(json.dumps(table)) == table
     modes = natural_frequencies(gs)

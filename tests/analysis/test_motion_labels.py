@@ -119,7 +119,7 @@ def test_oscillator_with_separation_only_is_single_sided() -> None:
 
 def test_planetary_with_back_flank_contact_is_double_sided() -> None:
     """Light load and small clearances: every planet–ring mesh reaches its back flank."""
-    gs = gc.preset("sheng2016").evolve(
+    gs = gc.preset("hindawi2021").evolve(
         {"torque.input": 50.0, "backlash.sun_planet": 0.1, "backlash.planet_ring": 0.1}
     )
     result = gc.simulate(gs, omega=0.5, transient_periods=100, periods=20, samples_per_period=128)

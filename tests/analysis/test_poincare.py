@@ -86,7 +86,7 @@ def test_bad_shape() -> None:
 
 
 def test_section_points_of_the_planetary_model() -> None:
-    r = gc.simulate(gc.preset("sheng2016"), omega=0.5, transient_periods=20, periods=20)
+    r = gc.simulate(gc.preset("hindawi2021"), omega=0.5, transient_periods=20, periods=20)
     x, xd = section_points(r)
     np.testing.assert_array_equal(x, r.to_dataset().delta_sp.sel(planet=1).values)
     np.testing.assert_array_equal(xd, r.to_dataset().delta_sp_dot.sel(planet=1).values)

@@ -27,7 +27,7 @@ REQUIRED = {
 @pytest.fixture(scope="module")
 def planetary() -> gc.SimulationResult:
     return gc.simulate(
-        gc.preset("sheng2016"), omega=0.5, transient_periods=20, periods=20, samples_per_period=8
+        gc.preset("hindawi2021"), omega=0.5, transient_periods=20, periods=20, samples_per_period=8
     )
 
 
@@ -38,7 +38,7 @@ def test_planetary_summary(planetary: gc.SimulationResult) -> None:
     assert list(s)[: len(SUMMARY_KEYS)] == list(SUMMARY_KEYS)
     text = json.dumps(s, allow_nan=False)
     assert json.loads(text) == s
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("hindawi2021")
     assert s["omega"] == 0.5
     assert s["omega_n_rad_s"] == pytest.approx(gs.omega_n)
     assert s["sun_speed_rpm"] == pytest.approx(gs.sun_speed_rpm(0.5))

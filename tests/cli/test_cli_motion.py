@@ -26,7 +26,7 @@ def store(tmp_path_factory: pytest.TempPathFactory) -> Path:
     0-1 test runs on every point without a period."""
     path = tmp_path_factory.mktemp("motion") / "run.zarr"
     gc.bifurcation(
-        gc.preset("sheng2016"),
+        gc.preset("hindawi2021"),
         "omega=0.5:2.5:8",
         family={"xi": [0.03, 0.09]},
         transient_periods=20,

@@ -96,7 +96,7 @@ ANY_SIGN = [
 
 @pytest.fixture(scope="module")
 def base() -> GearSet:
-    return preset("sheng2016")
+    return preset("hindawi2021")
 
 
 def raises_exactly(message: str) -> pytest.RaisesExc[ParameterError]:

@@ -10,7 +10,7 @@ from gearchaos.integrate import integrate, integrate_batch
 
 @pytest.fixture(scope="module")
 def systems():
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("hindawi2021")
     return [gc.planetary_system(gs, om) for om in (0.5, 1.5, 2.5)]
 
 

@@ -94,7 +94,7 @@ def test_forced_linear_system_matches_variation_of_constants() -> None:
 
 @pytest.mark.parametrize("rtol", [1e-8, 1e-11])
 def test_restart_one_period_at_a_time_is_identical(rtol: float) -> None:
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("hindawi2021")
     system = gc.planetary_system(gs, 1.5)
     K = 6
     full = integrate(system, transient_periods=0, periods=K, rtol=rtol, atol=1e-12)

@@ -156,7 +156,7 @@ CASES = {
 @pytest.mark.parametrize("case", ["omega0.5", "omega2.5"])
 def test_integrator_matches_scipy_on_compiled_rhs(case: str) -> None:
     omega, periods, changes = CASES[case]
-    gs = gc.preset("sheng2016").evolve(changes)
+    gs = gc.preset("hindawi2021").evolve(changes)
     system = gc.planetary_system(gs, omega)
     tr = _gearchaos(system, periods)
     ref = _scipy(system.derivative, system.n_state, tr.tau)
@@ -168,7 +168,7 @@ def test_integrator_matches_scipy_on_compiled_rhs(case: str) -> None:
 @pytest.mark.parametrize("case", list(CASES))
 def test_compiled_rhs_matches_independent_model_md(case: str) -> None:
     omega, periods, changes = CASES[case]
-    gs = gc.preset("sheng2016").evolve(changes)
+    gs = gc.preset("hindawi2021").evolve(changes)
     par, _ = gc.nondimensionalise(gs)
     system = gc.planetary_system(gs, omega)
     fun = model_md_rhs(par, omega)

@@ -67,7 +67,7 @@ def _static_expectation(gs):
 
 @pytest.mark.parametrize("phasing", ["in_phase", "parker"])
 def test_static_equilibrium_is_a_rest_point(phasing: str) -> None:
-    gs = gc.preset("sheng2016").evolve(NO_EXCITATION, mesh_phasing__model=phasing)
+    gs = gc.preset("hindawi2021").evolve(NO_EXCITATION, mesh_phasing__model=phasing)
     F_bar, d_sp, d_rp = _static_expectation(gs)
     N = gs.n_planets
     system = gc.planetary_system(gs, 1.3)
@@ -82,7 +82,7 @@ def test_static_equilibrium_is_a_rest_point(phasing: str) -> None:
 
 
 def test_static_equilibrium_is_the_long_time_solution() -> None:
-    gs = gc.preset("sheng2016").evolve(NO_EXCITATION, xi=0.05)
+    gs = gc.preset("hindawi2021").evolve(NO_EXCITATION, xi=0.05)
     F_bar, d_sp, d_rp = _static_expectation(gs)
     N = gs.n_planets
     system = gc.planetary_system(gs, 1.0)
@@ -104,7 +104,7 @@ def test_static_equilibrium_is_the_long_time_solution() -> None:
 
 # ------------------------------------------------------------------------------- fact 2
 def test_kinematics_and_torque_balance() -> None:
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("hindawi2021")
     z = gs.teeth
     rpm = 1500.0
     w_s = rpm * 2 * math.pi / 60
@@ -138,7 +138,7 @@ def _only_eccentricity(member: str):
     changes["eccentricity.planet_phase"] = -40.0
     changes["eccentricity.ring_phase"] = 70.0
     changes["mesh_phasing.model"] = "parker"
-    return gc.preset("sheng2016").evolve(changes)
+    return gc.preset("hindawi2021").evolve(changes)
 
 
 @pytest.mark.parametrize("member", list(ECCENTRIC))
@@ -198,7 +198,7 @@ def _clearance_case(**changes):
     # a large transmission error makes the meshes separate (clearances active)
     base = {"transmission_error.sun_planet": 8e-6, "transmission_error.planet_ring": 8e-6}
     base.update(changes)
-    return gc.preset("sheng2016").evolve(base)
+    return gc.preset("hindawi2021").evolve(base)
 
 
 def test_in_phase_symmetry_keeps_sun_centred_and_planets_equal() -> None:
@@ -349,7 +349,7 @@ def _energy(em, y):
 
 
 def test_rigid_mode_and_velocity_reconstruction() -> None:
-    em = _energy_model(gc.preset("sheng2016").evolve(CONSERVATIVE))
+    em = _energy_model(gc.preset("hindawi2021").evolve(CONSERVATIVE))
     N = em["N"]
     # the rigid rotation leaves every p_i and σ unchanged ...
     np.testing.assert_allclose(em["M"][: N + 1] @ em["phi"], 0.0, atol=1e-15)
@@ -367,7 +367,7 @@ def test_rigid_mode_and_velocity_reconstruction() -> None:
 
 @pytest.mark.parametrize("omega", [0.9, 2.2])
 def test_energy_is_conserved_with_impacts(omega: float) -> None:
-    gs = gc.preset("sheng2016").evolve(CONSERVATIVE)
+    gs = gc.preset("hindawi2021").evolve(CONSERVATIVE)
     em = _energy_model(gs)
     N = em["N"]
     system = gc.planetary_system(gs, omega)

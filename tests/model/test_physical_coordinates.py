@@ -210,7 +210,7 @@ CASES = {
 @pytest.mark.parametrize("case", list(CASES))
 def test_minimal_model_equals_physical_si_model(case: str) -> None:
     omega, changes = CASES[case]
-    gs = gc.preset("sheng2016").evolve(changes)
+    gs = gc.preset("hindawi2021").evolve(changes)
     phys = PhysicalModel(gs, omega)
     N = phys.N
     system = gc.planetary_system(gs, omega)

@@ -237,7 +237,7 @@ def test_records_carry_params_and_best_toml_round_trips(tmp_path: Path) -> None:
     assert res.best_toml == tmp_path / "best.toml"
     gs = GearSet.from_toml(res.best_toml)
     assert res.best is not None
-    best = cal._candidate_from_record(res.best, DEFAULT_SPACE)
+    best = cal.candidate_from_record(res.best, DEFAULT_SPACE)
     assert gs == build_gearset(best)
     assert res.plausible
     assert res.best["score"] == max(r["score"] for r in res.records)
@@ -317,3 +317,61 @@ def test_cli_calibrate_quick_end_to_end(tmp_path: Path) -> None:
     again = CliRunner().invoke(app, ["calibrate", "--quick", "--out", str(out), "--json"])
     assert again.exit_code == 0, again.output
     assert json.loads(again.stdout)["evaluated"] == 0
+
+
+# --------------------------------------------------------------------------- the shipped preset
+LOG = Path(__file__).resolve().parents[2] / "paper" / "calibration.jsonl"
+
+
+@pytest.mark.skipif(not LOG.is_file(), reason="paper/calibration.jsonl not in this checkout")
+def test_default_preset_is_the_calibrations_best_candidate() -> None:
+    """sheng2016 is the highest-scoring line of the committed calibration log, built on the
+    MODEL.md §9 set (hindawi2021) with only the search variables changed."""
+    import gearchaos
+    from gearchaos.paper.calibrate import record_gearset
+
+    rows = [json.loads(x) for x in LOG.read_text().splitlines() if x.strip()]
+    best = min(rows, key=lambda r: (-r["score"], r["index"]))
+    assert all(r["score"] <= best["score"] for r in rows)
+    v = best["variables"]
+    gs = gearchaos.preset("sheng2016")
+    base = gearchaos.preset("hindawi2021")
+    assert plausibility(cal.candidate_from_record(best)) == []
+    assert gs == record_gearset(best, name=gs.name, description=gs.description)
+    # the calibrated quantities, straight from the log's variables
+    assert (gs.n_planets, gs.teeth.sun, gs.teeth.planet, gs.teeth.ring) == (
+        v["geometry.planets"],
+        v["teeth.sun"],
+        v["teeth.planet"],
+        v["teeth.ring"],
+    )
+    assert gs.teeth.ring == gs.teeth.sun + 2 * gs.teeth.planet
+    assert (gs.teeth.sun + gs.teeth.ring) % gs.n_planets == 0
+    assert gs.torque.input == v["torque.input"] and gs.torque.mode == v["torque.mode"]
+    a = v["transmission_error.amplitude"]
+    assert gs.transmission_error.sun_planet == gs.transmission_error.planet_ring == a
+    assert gs.clearance.characteristic_length == v["clearance.characteristic_length"]
+    st = gs.stiffness
+    assert st.sun_planet_alternating / st.sun_planet_mean == pytest.approx(
+        v["stiffness.epsilon_sp"], rel=1e-3
+    )
+    assert st.planet_ring_alternating / st.planet_ring_mean == pytest.approx(
+        v["stiffness.epsilon_rp"], rel=1e-3
+    )
+    assert st.planet_ring_mean / st.sun_planet_mean == pytest.approx(
+        v["stiffness.rp_sp_ratio"], rel=1e-3
+    )
+    # equivalent masses: MODEL.md §9's 6.21 kg, 4.89 kg and 10.0 kg times the log's scales
+    assert gs.equivalent_mass_sun == pytest.approx(6.21 * v["inertia.sun_scale"], rel=1e-9)
+    assert gs.equivalent_mass_planet == pytest.approx(4.89 * v["inertia.planet_scale"], rel=1e-9)
+    assert gs.inertia.carrier / gs.radius_carrier**2 == pytest.approx(
+        10.0 * v["inertia.carrier_scale"], rel=1e-9
+    )
+    # everything the calibration does not search is MODEL.md §9's
+    for table in ("damping", "backlash", "eccentricity", "mesh_phasing"):
+        assert getattr(gs, table) == getattr(base, table), table
+    assert gs.geometry.module == base.geometry.module
+    assert gs.geometry.pressure_angle_sun == base.geometry.pressure_angle_sun
+    assert st.sun_planet_mean == base.stiffness.sun_planet_mean
+    assert st.sun_bearing == base.stiffness.sun_bearing
+    assert gs.clearance.sun_bearing == base.clearance.sun_bearing

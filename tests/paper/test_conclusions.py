@@ -297,7 +297,7 @@ def test_conclusion_2_reads_the_gear_set() -> None:
     from gearchaos.gearset import preset
 
     ds = sweep([["1T"] * 4])
-    ds.attrs["gearset_toml"] = preset("sheng2016").to_toml()
+    ds.attrs["gearset_toml"] = preset("hindawi2021").to_toml()
     ds["x_s_max"] = (("xi", "omega"), np.zeros((1, 4)))
     v = conclusion_2({"fig4": ds})
     assert v.verdict == "partly"  # every ingredient, but the sun never moves

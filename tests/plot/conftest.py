@@ -18,9 +18,10 @@ def _close_figures():
 
 @pytest.fixture(scope="session")
 def planetary() -> gc.SimulationResult:
-    """1T response of the sheng2016 set below its first resonance, 32 samples per period."""
+    """1T response of the hindawi2021 (MODEL.md §9) set below its first resonance, 32 samples
+    per period."""
     return gc.simulate(
-        gc.preset("sheng2016"), omega=0.5, transient_periods=20, periods=20, samples_per_period=32
+        gc.preset("hindawi2021"), omega=0.5, transient_periods=20, periods=20, samples_per_period=32
     )
 
 

@@ -60,7 +60,7 @@ def sweep_dataset(
         coords["direction"] = np.array(["up", "down"])
     coords["section"] = np.arange(SECTIONS)
     coords["planet"] = np.array([1])
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("hindawi2021")
     vary = {n: v for n, v in axes.items() if n != family}
     spec = SweepSpec.build(
         vary,
@@ -167,7 +167,7 @@ def test_resonance_lines_at_harmonics_meeting_natural_frequencies() -> None:
     ds = sweep_dataset(np.ones(5, int), {"omega": omega})
     ax = bifurcation(ds, resonances=True)
     got = sorted(float(line.get_xdata()[0]) for line in gid_lines(ax, "resonance"))
-    res = gearset_info(gc.preset("sheng2016"))["omega_at_resonances"]
+    res = gearset_info(gc.preset("hindawi2021"))["omega_at_resonances"]
     want = sorted(r["omega"] for r in res if 0.4 <= r["omega"] <= 2.0)
     assert got == pytest.approx(want)
     assert len(want) >= 5
@@ -199,7 +199,7 @@ def test_family_needs_select_and_figure_has_one_panel_per_value() -> None:
         r"(c) $\xi$ = 0.07",
         r"(d) $\xi$ = 0.09",
     ]
-    assert "sheng2016" in fig.get_suptitle()
+    assert "hindawi2021" in fig.get_suptitle()
     assert r"$\bar b_{sp}$ = 3" in fig.get_suptitle()
 
 

@@ -109,7 +109,7 @@ def test_runner_labels_every_value_of_a_reference_system() -> None:
 
 
 def test_runner_checks_every_point_before_running() -> None:
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("hindawi2021")
     with pytest.raises(ParameterError, match=r"backlash\.sun_planet"):
         run_gallery(gs, "backlash.sun_planet", [1.0, -2.0], fixed={"omega": 1.5}, progress=False)
     with pytest.raises(ParameterError, match="omega"):

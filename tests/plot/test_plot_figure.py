@@ -13,7 +13,7 @@ from gearchaos.plot import savefig, summary_figure
 def test_summary_figure_png(planetary: gc.SimulationResult, tmp_path) -> None:
     fig = summary_figure(planetary)
     assert len(fig.axes) == 6
-    assert "sheng2016" in fig.get_suptitle()
+    assert "hindawi2021" in fig.get_suptitle()
     text = " ".join(t.get_text() for t in fig.axes[5].texts)
     assert "1T" in text and "sun–planet" in text and "status: ok" in text
     path = savefig(fig, tmp_path / "summary.png")
@@ -41,7 +41,7 @@ def test_savefig_rejects_unknown_suffix(planetary: gc.SimulationResult, tmp_path
 
 
 def test_summary_figure_with_one_sample_per_period(tmp_path) -> None:
-    r = gc.simulate(gc.preset("sheng2016"), omega=0.5, transient_periods=20, periods=20)
+    r = gc.simulate(gc.preset("hindawi2021"), omega=0.5, transient_periods=20, periods=20)
     fig = summary_figure(r)
     assert any("samples_per_period" in t.get_text() for t in fig.axes[3].texts)
     savefig(fig, tmp_path / "one.png")

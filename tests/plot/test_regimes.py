@@ -72,7 +72,7 @@ def sweep_dataset(
         },
         coords=coords,
         attrs={
-            "gearset_toml": gc.preset("sheng2016").to_toml(),
+            "gearset_toml": gc.preset("hindawi2021").to_toml(),
             "sweep_toml": spec.to_toml(),
             "transient_periods": 10.0,
             "periods": SECTIONS,

@@ -11,4 +11,4 @@ pytest.register_assert_rewrite("sweep_helpers")
 
 @pytest.fixture(scope="session")
 def sheng() -> gc.GearSet:
-    return gc.preset("sheng2016")
+    return gc.preset("hindawi2021")

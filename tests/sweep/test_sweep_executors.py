@@ -106,7 +106,7 @@ def test_continuation_is_executor_independent(tmp_path):
 def test_existing_dask_scheduler_gives_the_same_store() -> None:
     """``scheduler="tcp://…"`` (an existing dask.distributed cluster) equals in-process."""
     distributed = pytest.importorskip("dask.distributed")
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("hindawi2021")
     kw = {"transient_periods": 5, "periods": 8, "progress": False}
     local = gc.bifurcation(gs, "omega=0.5:3:6", **kw).load()
     with distributed.LocalCluster(

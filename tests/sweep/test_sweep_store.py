@@ -29,7 +29,7 @@ LEAD = ("xi", "omega", "backlash.sun_planet")
 
 @pytest.fixture(scope="module")
 def target():
-    return gc.preset("sheng2016").evolve({"backlash.planet_ring": 4.0})
+    return gc.preset("hindawi2021").evolve({"backlash.planet_ring": 4.0})
 
 
 @pytest.fixture(scope="module")

@@ -627,7 +627,8 @@ def _template_comment(dotted: str) -> str:
 
 
 def template_toml() -> str:
-    """A commented gear-set file to start from: the ``sheng2016`` values, every line explained.
+    """A commented gear-set file to start from: the values of the default preset ``sheng2016``
+    (the calibrated stand-in for the seed's Table 1), every line explained.
 
     Returns
     -------
@@ -645,9 +646,11 @@ def template_toml() -> str:
         },
     )
     header = [
-        "# gearchaos gear-set file (TOML). Start from these values (the sheng2016 preset,",
-        "# MODEL.md §9) and edit. Every parameter has a dotted name, e.g. backlash.sun_planet,",
-        "# the same in Python (GearSet.evolve), on the command line and in sweep results.",
+        "# gearchaos gear-set file (TOML). Start from these values (the sheng2016 preset, the",
+        "# default: MODEL.md §9 calibrated against the seed paper, docs/reproduction.md; the",
+        "# uncalibrated §9 set is preset hindawi2021) and edit. Every parameter has a dotted",
+        "# name, e.g. backlash.sun_planet, the same in Python (GearSet.evolve), on the command",
+        "# line and in sweep results.",
         "# Units are SI with angles in degrees; clearances are in units of",
         '# clearance.characteristic_length (b_c) when their table\'s `units` is "dimensionless".',
         "# Tables transmission_error, eccentricity and mesh_phasing, and keys with defaults",

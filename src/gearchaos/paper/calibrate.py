@@ -70,6 +70,7 @@ __all__ = [
     "base_candidate",
     "build_gearset",
     "calibrate",
+    "candidate_from_record",
     "candidate_key",
     "enumerate_teeth",
     "gearset_changes",
@@ -77,6 +78,7 @@ __all__ = [
     "plausibility",
     "propose",
     "read_results",
+    "record_gearset",
     "sweep_plan",
 ]
 
@@ -354,17 +356,35 @@ def gearset_changes(candidate: Candidate, base: Any = None) -> dict[str, Any]:
     }
 
 
-def build_gearset(candidate: Candidate, base: Any = None, name: str = "calibrated") -> Any:
+CALIBRATED_DESCRIPTION = (
+    "2K-H planetary gear set calibrated against the seed paper's landmarks (gearchaos calibrate)"
+)
+
+
+def build_gearset(
+    candidate: Candidate,
+    base: Any = None,
+    name: str = "calibrated",
+    description: str = CALIBRATED_DESCRIPTION,
+) -> Any:
     """The validated :class:`~gearchaos.gearset.GearSet` of ``candidate`` (raises
     :class:`~gearchaos.errors.ParameterError` for an invalid combination)."""
     gs = base if base is not None else _base()
     changes = gearset_changes(candidate, gs)
     changes["name"] = name
-    changes["description"] = (
-        "2K-H planetary gear set calibrated against the seed paper's landmarks "
-        "(gearchaos calibrate)"
-    )
+    changes["description"] = description
     return gs.evolve(changes)
+
+
+def record_gearset(
+    record: Mapping[str, Any],
+    *,
+    name: str = "calibrated",
+    description: str = CALIBRATED_DESCRIPTION,
+    space: SearchSpace = DEFAULT_SPACE,
+) -> Any:
+    """The gear set of one line of a calibration log (see :func:`read_results`)."""
+    return build_gearset(candidate_from_record(record, space), None, name, description)
 
 
 def plausibility(candidate: Candidate, space: SearchSpace = DEFAULT_SPACE) -> list[str]:
@@ -706,7 +726,8 @@ class CalibrationResult:
         return [self.records[i] for i in order[:k]]
 
 
-def _candidate_from_record(rec: Mapping[str, Any], space: SearchSpace) -> Candidate:
+def candidate_from_record(rec: Mapping[str, Any], space: SearchSpace = DEFAULT_SPACE) -> Candidate:
+    """The :class:`Candidate` of one line of a calibration log."""
     v = rec["variables"]
     return Candidate(
         tuple((r.name, float(v[r.name])) for r in space.ranges),
@@ -846,7 +867,7 @@ def calibrate(
     best_toml: Path | None = None
     problems: list[str] = []
     if best is not None:
-        cand = _candidate_from_record(best, space)
+        cand = candidate_from_record(best, space)
         problems = plausibility(cand, space)
         gs = build_gearset(cand, base)
         best_toml = out_path.with_name("best.toml")

@@ -21,7 +21,8 @@ Fig. 10 b̄_rp ∈ [1, 9] (14)     Ω = 1.5, ξ = 0.05, b̄_sp = 3, b̄_s = 2
 The seed's panels (a)–(x) are not listed with their values; its text names some of them (the
 bifurcation points it discusses). Each recipe's ``notes`` say which values are named and which
 fill the named range. Limits: the default gear set stands in for the seed's lost Table 1
-(MODEL.md §9), so the motion at a given value can differ from the seed's.
+(MODEL.md §9 calibrated against the seed's landmarks, docs/reproduction.md), so the motion at a
+given value can differ from the seed's.
 """
 
 from __future__ import annotations

@@ -23,8 +23,9 @@ damping ratios), ``backlash.sun_planet``, ``backlash.planet_ring``, ``clearance.
 :func:`reproduce` runs one recipe into a resumable Zarr store and draws it as a PNG; ``quick``
 runs a coarse version (12 points per panel, 20 + 16 periods) for CI.
 
-Limits: the seed's Table 1 was lost and ``sheng2016`` is a physically consistent stand-in
-(MODEL.md §9), so the diagrams reproduce the seed's protocol and layout, not its exact
+Limits: the seed's Table 1 was lost and ``sheng2016`` is a stand-in — the MODEL.md §9 set
+(preset ``hindawi2021``) calibrated against the landmarks of the seed's text
+(docs/reproduction.md) — so the diagrams reproduce the seed's protocol and layout, not its exact
 bifurcation points.
 """
 

@@ -41,10 +41,15 @@ HONESTY: tuple[tuple[str, str], ...] = (
     (
         "Table 1 was lost",
         "The seed's gear-set parameters (its Table 1) and equations did not survive extraction. "
-        "The sheng2016 preset is a physically consistent stand-in (MODEL.md §9: a published "
-        "gear set with mean and alternating mesh stiffness, completed with estimates), not the "
-        "paper's gear set. Protocol, ranges and layout are the seed's; bifurcation points, "
-        "amplitudes and even the motion at a given parameter value can differ.",
+        "The sheng2016 preset is a stand-in, not the paper's gear set: the MODEL.md §9 set (a "
+        "published gear set with mean and alternating mesh stiffness, completed with "
+        "estimates; preset hindawi2021) with the quantities Table 1 would have fixed — number "
+        "of planets and teeth, input torque, transmission-error amplitude, stiffness and mass "
+        "ratios, b_c, load mode — calibrated inside physically plausible ranges to reproduce "
+        "as many landmarks of the seed's text as possible (gearchaos calibrate, "
+        "docs/reproduction.md). Protocol, ranges and layout are the seed's; bifurcation points, "
+        "amplitudes and even the motion at a given parameter value can differ, as the landmark "
+        "table below shows.",
     ),
     (
         "Minimal instead of redundant coordinates",
@@ -69,8 +74,10 @@ HONESTY: tuple[tuple[str, str], ...] = (
         "The preset sets all mesh phases to zero (in_phase). The source table does, and it "
         "explains the seed's finding that the sun's bearing clearance hardly matters: in-phase "
         "meshes cancel the net mesh force on the sun, so the sun's centre stays (numerically) at "
-        "rest and b̄_s never comes into play. Parker phasing would make this set sequentially "
-        "phased and load the sun bearing strongly.",
+        "rest and b̄_s never comes into play. With Parker phasing (the phases the tooth numbers "
+        "imply) hindawi2021's 34/31/96 would be sequentially phased, its meshes would excite the "
+        "sun's translation and load the bearing; sheng2016's 33/32/97 would be counter-phased at "
+        "the mesh frequency, where the net force on the sun cancels as well.",
     ),
     (
         "Numerical differences",
