@@ -10,13 +10,14 @@ escaped text) with how it was made, each figure beside the paper's caption with 
 table, one row per conclusion and per landmark with the measured evidence and the verdict, and
 an Honesty section saying what differs from the paper and why.
 
-Motion labels come from the stored sections (period detection and the 0–1 test for chaos,
-:mod:`gearchaos.sweep.classify`); the bifurcation recipes do not integrate the variational
-equations, so the largest Lyapunov exponent is measured in the galleries only.
+Motion labels come from the stored sections and the largest Lyapunov exponent, which every
+recipe and gallery integrates with the variational equations (period detection, the 0–1 test
+for chaos and λ₁, :mod:`gearchaos.sweep.classify`).
 
 Cost: the full run is 6 700 sweep points of 200 mesh periods plus 38 gallery values of 600
-periods; on the 2-core reference machine about 0.05 s per sweep point, i.e. roughly 6–10
-minutes in all (within the 30-minute target). ``quick`` (CI) takes about a minute.
+periods; on the 2-core reference machine 4–8 minutes in all (3 min 56 s for ``sheng2016``,
+5–8 min for ``hindawi2021``, whose chaotic points take more steps), within the 30-minute target.
+``quick`` (CI) takes about a minute.
 """
 
 from __future__ import annotations
