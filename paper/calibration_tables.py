@@ -12,12 +12,13 @@ re-run.
 from __future__ import annotations
 
 import argparse
-import json
 from collections import Counter
 from pathlib import Path
 
 import numpy as np
 from scipy.stats import spearmanr
+
+from gearchaos.paper.calibrate import ranked, read_results
 
 SHORT = {
     "torque.input": ("T_D (N·m)", 1.0, "{:.0f}"),
@@ -49,8 +50,7 @@ def main() -> None:
     ap.add_argument("log", nargs="?", default=str(Path(__file__).with_name("calibration.jsonl")))
     ap.add_argument("--top", type=int, default=8)
     args = ap.parse_args()
-    rows = [json.loads(x) for x in Path(args.log).read_text().splitlines() if x.strip()]
-    rows.sort(key=lambda r: r["index"])
+    rows = sorted(read_results(args.log).values(), key=lambda r: r["index"])
     phases = Counter("refine" if r["origin"].startswith("refine") else r["origin"] for r in rows)
     secs = np.array([r["seconds"] for r in rows])
     print(
@@ -59,8 +59,8 @@ def main() -> None:
     )
     scores = np.array([r["score"] for r in rows])
     base = next(r for r in rows if r["origin"] == "base")
-    ranked = sorted(rows, key=lambda r: (-r["score"], r["index"]))
-    base_rank = 1 + ranked.index(base)
+    order = ranked(rows)
+    base_rank = 1 + order.index(base)
     print(
         f"scores: max {scores.max():.2f}, median {np.median(scores):.2f}, min {scores.min():.2f}; "
         f"base {base['score']:.2f} (rank {base_rank} of {len(rows)})\n"
@@ -69,7 +69,7 @@ def main() -> None:
     head.append("load")
     print("| " + " | ".join(head) + " |")
     print("|" + "---|" * len(head))
-    for i, r in enumerate(ranked[: args.top]):
+    for i, r in enumerate(order[: args.top]):
         print(_row(str(i + 1), r))
     print(_row(str(base_rank), base))
     print("\nSpearman rank correlation of each variable with the score (all candidates):\n")
@@ -85,7 +85,7 @@ def main() -> None:
         f"| load mode (constant power = 1) | {spearmanr(power, scores)[0]:+.2f} | "
         f"{spearmanr(power, scores)[1]:.2g} |"
     )
-    best = ranked[0]
+    best = order[0]
     print(f"\nLandmarks, best (#{best['index']}) against base:\n")
     print("| landmark | base | best |")
     print("|---|---|---|")
@@ -93,7 +93,7 @@ def main() -> None:
         a, b = base["landmarks"].get(lid, 0.0), best["landmarks"][lid]
         if abs(a - b) > 0.05:
             print(f"| {lid} | {a:.2f} | {b:.2f} |")
-    top10 = ranked[:10]
+    top10 = order[:10]
     always = [
         lid for lid in best["landmarks"] if all(r["landmarks"].get(lid, 0) >= 0.8 for r in rows)
     ]

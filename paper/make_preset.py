@@ -11,14 +11,15 @@ saying where it comes from. ``--check`` writes nothing and exits 1 if the shippe
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 
 from gearchaos.paper.calibrate import (
     BASE_PRESET,
+    best_record,
     candidate_from_record,
     plausibility,
+    read_results,
     record_gearset,
 )
 
@@ -31,13 +32,12 @@ DESCRIPTION = (
 )
 
 
-def best_record(log: Path) -> dict:
-    rows = [json.loads(x) for x in log.read_text(encoding="utf-8").splitlines() if x.strip()]
-    return min(rows, key=lambda r: (-r["score"], r["index"])), len(rows)
-
-
 def preset_text(log: Path) -> str:
-    rec, n = best_record(log)
+    records = read_results(log)
+    rec = best_record(records.values())
+    if rec is None:
+        raise SystemExit(f"{log}: no finished candidate")
+    n = len(records)
     problems = plausibility(candidate_from_record(rec))
     if problems:
         raise SystemExit(f"best candidate #{rec['index']} is not plausible: {problems}")

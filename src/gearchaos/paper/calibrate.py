@@ -48,10 +48,10 @@ import math
 import os
 import time
 import warnings
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -68,6 +68,7 @@ __all__ = [
     "SweepSettings",
     "TeethChoice",
     "base_candidate",
+    "best_record",
     "build_gearset",
     "calibrate",
     "candidate_from_record",
@@ -77,6 +78,7 @@ __all__ = [
     "landmark_objective",
     "plausibility",
     "propose",
+    "ranked",
     "read_results",
     "record_gearset",
     "sweep_plan",
@@ -689,6 +691,23 @@ def read_results(path: str | os.PathLike[str]) -> dict[str, dict[str, Any]]:
     return out
 
 
+_R = TypeVar("_R", bound=Mapping[str, Any])
+
+
+def _rank_key(record: Mapping[str, Any]) -> tuple[float, int]:
+    return -float(record["score"]), int(record["index"])
+
+
+def ranked(records: Iterable[_R]) -> list[_R]:
+    """Calibration records best first: highest score, the earlier candidate on a tie."""
+    return sorted(records, key=_rank_key)
+
+
+def best_record(records: Iterable[_R]) -> _R | None:
+    """The best of ``records`` (highest score, the earliest on a tie), or ``None``."""
+    return min(records, key=_rank_key, default=None)
+
+
 def _append(path: Path, record: Mapping[str, Any]) -> None:
     # a torn line from an earlier kill must not glue onto this one
     needs_newline = path.exists() and path.stat().st_size > 0
@@ -722,8 +741,7 @@ class CalibrationResult:
         return self.best is not None and not self.problems
 
     def top(self, k: int = 3) -> list[dict[str, Any]]:
-        order = sorted(range(len(self.records)), key=lambda i: (-self.records[i]["score"], i))
-        return [self.records[i] for i in order[:k]]
+        return ranked(self.records)[:k]
 
 
 def candidate_from_record(rec: Mapping[str, Any], space: SearchSpace = DEFAULT_SPACE) -> Candidate:
@@ -861,9 +879,7 @@ def calibrate(
                 on_record(rec, now)
     except KeyboardInterrupt:
         stopped = "interrupted"
-    best = max(records, key=lambda r: r["score"], default=None) if records else None
-    if best is not None:
-        best = min((r for r in records if r["score"] == best["score"]), key=lambda r: r["index"])
+    best = best_record(records)
     best_toml: Path | None = None
     problems: list[str] = []
     if best is not None:

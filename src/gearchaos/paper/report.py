@@ -379,7 +379,8 @@ def build_report(
     Resumable: the sweep stores stay in ``outdir`` and a second call only redraws and
     re-checks. A figure that fails is reported in the page (the others still run).
     ``gearset`` replaces the default preset (e.g. a calibration candidate); ``gearset_label``
-    names it in the page (default: the gear set's name).
+    names it in the page and in ``report.json`` (default: ``"gear set NAME"``, or
+    ``"preset sheng2016"`` without ``gearset``).
 
     Returns
     -------
@@ -392,6 +393,9 @@ def build_report(
     from .conclusions import evaluate_conclusions
     from .recipes import PRESET as DEFAULT_PRESET
 
+    label = gearset_label or (
+        f"gear set {gearset.name}" if gearset is not None else f"preset {DEFAULT_PRESET}"
+    )
     out = Path(os.fspath(outdir))
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
@@ -408,8 +412,7 @@ def build_report(
         landmark_note=lm_note,
         total_seconds=time.perf_counter() - t0,
         outdir=out,
-        gearset_label=gearset_label
-        or (f"gear set {gearset.name}" if gearset is not None else None),
+        gearset_label=label,
     )
     index = out / "index.html"
     tmp = index.with_name(index.name + ".partial")
@@ -417,8 +420,7 @@ def build_report(
     os.replace(tmp, index)
     summary = {
         "quick": quick,
-        "gearset": gearset_label
-        or (gearset.name if gearset is not None else f"preset {DEFAULT_PRESET}"),
+        "gearset": label,
         "seconds": time.perf_counter() - t0,
         "figures": {n: {k: v for k, v in r.items() if k != "rows"} for n, r in results.items()},
         "conclusions": [
