@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from reference_maps import henon, logistic, rotation
 
 from gearchaos.analysis.classify import (
     LLE_C,
@@ -26,34 +27,9 @@ from gearchaos.analysis.classify import (
 )
 from gearchaos.errors import ParameterError
 
-GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
 T = 2 * math.pi / 1.5  # forcing period at Ω = 1.5
 RUN: dict[str, Any] = {"run_periods": 200, "forcing_period": T}
 THETA = LLE_C / (200 * T)
-
-
-def logistic(n: int, r: float = 4.0, x: float = 0.1234, skip: int = 100) -> np.ndarray:
-    out = np.empty(n)
-    for i in range(n + skip):
-        x = r * x * (1.0 - x)
-        if i >= skip:
-            out[i - skip] = x
-    return out
-
-
-def henon(n: int, a: float = 1.4, b: float = 0.3, skip: int = 100) -> np.ndarray:
-    x, y = 0.1, 0.1
-    out = np.empty((n, 2))
-    for i in range(n + skip):
-        x, y = 1.0 - a * x * x + y, b * x
-        if i >= skip:
-            out[i - skip] = (x, y)
-    return out
-
-
-def rotation(n: int, alpha: float = GOLDEN) -> np.ndarray:
-    k = np.arange(n)
-    return np.column_stack([np.cos(2 * math.pi * k * alpha), np.sin(2 * math.pi * k * alpha)])
 
 
 def cycle(n: int, m: int, noise: float = 1e-6, seed: int = 0) -> np.ndarray:
