@@ -96,14 +96,14 @@ def _cpu_seconds() -> float:
 def _instrument() -> dict[str, float]:
     """Time the compiled kernel calls and the store writes of the in-process executor.
 
-    Wraps ``gearchaos.sweep.execute.run_task_arrays`` and ``SweepStore.write`` when they exist
+    Wraps ``gearchaos.sweep.execute.run_chains`` and ``SweepStore.write`` when they exist
     (engine internals: the breakdown is left out if they move)."""
     acc = {"kernel_wall": 0.0, "kernel_cpu": 0.0, "kernel_calls": 0.0, "write_wall": 0.0}
     try:
         from gearchaos.sweep import execute, store
     except ImportError:
         return {}
-    run = getattr(execute, "run_task_arrays", None)
+    run = getattr(execute, "run_chains", None)
     cls = getattr(store, "SweepStore", None)
     write = getattr(cls, "write", None)
     if run is None or write is None:
@@ -125,7 +125,7 @@ def _instrument() -> dict[str, float]:
         finally:
             acc["write_wall"] += time.perf_counter() - t0
 
-    execute.run_task_arrays = timed_run
+    execute.run_chains = timed_run
     cls.write = timed_write  # type: ignore[union-attr]
     return acc
 

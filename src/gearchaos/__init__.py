@@ -10,8 +10,7 @@ errors, sun–planet and planet–ring backlash and sun bearing clearance.
 >>> res.to_dataset().delta_sp.sel(planet=1)   # doctest: +SKIP
 """
 
-__version__ = "0.1.0"
-
+from ._version import __version__
 from .errors import IntegrationError, ParameterError, Status, StoreError
 from .gearset import GearSet, preset
 from .integrate import SimulationResult, open_simulation, simulate

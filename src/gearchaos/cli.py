@@ -36,7 +36,7 @@ from rich.table import Table
 from rich.text import Text
 
 from . import __version__
-from .errors import IntegrationError, ParameterError, StoreError
+from .errors import IntegrationError, ParameterError, Status, StoreError
 
 if TYPE_CHECKING:
     from .gearset import GearSet
@@ -433,7 +433,7 @@ def simulate(
         )
     )
     for path in written:
-        out.print(Text.assemble(("wrote ", "dim"), (str(path), "bold")))
+        out.print(Text.assemble(("wrote ", "dim"), (str(path), "bold")), soft_wrap=True)
 
 
 def _largest_exponent(
@@ -757,7 +757,7 @@ def _interruptible() -> Iterator[None]:
 def _sweep_counts(ds: Any) -> tuple[int, int]:
     """(points, failed) of a sweep dataset: every grid point, and those with status 1–3."""
     status = np.asarray(ds["status"].values)
-    failed = int(np.sum((status != 0) & (status != 4)))
+    failed = int(np.sum((status != Status.OK) & (status != Status.NOT_RUN)))
     return int(status.size), failed
 
 
@@ -1108,7 +1108,7 @@ def plot(
         if output.parent != Path(""):
             output.parent.mkdir(parents=True, exist_ok=True)
         savefig(fig, output)
-    _stdout().print(Text.assemble(("wrote ", "dim"), (str(output), "bold")))
+    _stdout().print(Text.assemble(("wrote ", "dim"), (str(output), "bold")), soft_wrap=True)
 
 
 def _open_store(path: Path) -> Any:
@@ -1325,7 +1325,7 @@ def poincare(
         return
     out = _stdout()
     out.print(_gallery_rows_table(rows, axis.name, title=f"Poincaré gallery of {gs.name}"))
-    out.print(Text.assemble(("wrote ", "dim"), (str(output), "bold")))
+    out.print(Text.assemble(("wrote ", "dim"), (str(output), "bold")), soft_wrap=True)
 
 
 def _gallery_rows_table(rows: Sequence[Mapping[str, Any]], param: str, *, title: str) -> Table:
@@ -1557,7 +1557,7 @@ def init_gearset(
     with _reported_errors():
         file.write_text(template_toml(), encoding="utf-8")
     out = _stdout()
-    out.print(Text.assemble(("wrote ", "dim"), (str(file), "bold")))
+    out.print(Text.assemble(("wrote ", "dim"), (str(file), "bold")), soft_wrap=True)
     out.print(
         Text(f"next: gearchaos simulate --gearset {file} --set omega=1.5 -o out/", style="dim")
     )

@@ -29,12 +29,14 @@ class StoreError(RuntimeError):
 
 
 class Status(enum.IntEnum):
-    """Integrator outcome codes. The integer values are what the numba kernels return."""
+    """Integrator outcome codes. The integer values are what the numba kernels return
+    (0–3) and what sweep stores hold per point (4: not computed yet)."""
 
     OK = 0
     MAX_STEPS = 1
     STEP_UNDERFLOW = 2
     NON_FINITE = 3
+    NOT_RUN = 4  # a sweep point not computed yet (an interrupted store); never a kernel result
 
     @property
     def message(self) -> str:
@@ -43,6 +45,16 @@ class Status(enum.IntEnum):
     @property
     def ok(self) -> bool:
         return self is Status.OK
+
+    @property
+    def failed(self) -> bool:
+        """An integration that ran and failed (not ``OK``, not ``NOT_RUN``)."""
+        return self not in (Status.OK, Status.NOT_RUN)
+
+    @classmethod
+    def meanings(cls) -> str:
+        """The members' names in code order, for the CF ``flag_meanings`` of status arrays."""
+        return " ".join(s.name.lower() for s in cls)
 
 
 _MESSAGES = {
@@ -58,5 +70,8 @@ _MESSAGES = {
     Status.NON_FINITE: (
         "the state became NaN or infinite; the response diverged "
         "(check for negative stiffness or an unstable parameter set)"
+    ),
+    Status.NOT_RUN: (
+        "not computed yet (an interrupted sweep); run the same command again to resume"
     ),
 }

@@ -24,7 +24,7 @@ NO_EXCITATION = {
 
 def _cols(system, *groups: str) -> np.ndarray:
     """Observable columns by name (e.g. "force_sp" → force_sp_1..N), independent of layout."""
-    return np.concatenate([system.obs_indices(g) for g in groups])
+    return np.concatenate([system.observable(g).columns for g in groups])
 
 
 def _geometry(gs):

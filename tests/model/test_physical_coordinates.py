@@ -240,7 +240,7 @@ def test_minimal_model_equals_physical_si_model(case: str) -> None:
     obs = tr.observables
     np.testing.assert_allclose(obs[:, :N], d_sp / phys.b_c, rtol=0, atol=1e-7)
     np.testing.assert_allclose(obs[:, N : 2 * N], d_rp / phys.b_c, rtol=0, atol=1e-7)
-    f_sp, f_rp = system.obs_indices("force_sp"), system.obs_indices("force_rp")
+    f_sp, f_rp = system.observable("force_sp").columns, system.observable("force_rp").columns
     np.testing.assert_allclose(obs[:, f_sp], F_sp / force_scale, rtol=0, atol=1e-6)
     np.testing.assert_allclose(obs[:, f_rp], F_rp / force_scale, rtol=0, atol=1e-6)
 

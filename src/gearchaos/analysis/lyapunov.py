@@ -17,10 +17,13 @@ for 1/s.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
+from .._checks import check_int
 from ..errors import ParameterError, Status
+from ..integrate.settings import SolverSettings
 from ..integrate.simulate import integrate
 from ..model.system import System
 
@@ -47,17 +50,18 @@ class LyapunovResult:
         return float(np.sum(self.exponents))
 
 
+#: Lyapunov runs average over more periods than a simulation records by default.
+LYAPUNOV_SETTINGS = SolverSettings(periods=500)
+
+
 def lyapunov_spectrum(
     system: System,
+    settings: SolverSettings | None = None,
     *,
     n_exponents: int | None = None,
-    transient_periods: float = 100,
-    periods: int = 500,
     renormalizations_per_period: int = 1,
-    rtol: float = 1e-8,
-    atol: float = 1e-10,
     y0: np.ndarray | None = None,
-    max_steps: int | None = None,
+    **solver: Any,
 ) -> LyapunovResult:
     """The ``n_exponents`` largest Lyapunov exponents (all by default) of ``system``.
 
@@ -66,30 +70,22 @@ def lyapunov_spectrum(
     system
         Any :class:`~gearchaos.model.System`; its forcing period T = 2π/Ω sets the
         renormalisation interval T / ``renormalizations_per_period``.
-    transient_periods, periods
-        Forcing periods discarded, then averaged over. The statistical error of a chaotic
-        estimate decays like 1/√(periods); a regular orbit's like log(·)/periods.
-    rtol, atol
-        Tolerances of the system state and of the (normalised) tangent vectors.
+    settings, **solver
+        :class:`~gearchaos.integrate.settings.SolverSettings` (default: 100 transient periods,
+        500 periods averaged over) and/or its fields by name: ``transient_periods``,
+        ``periods`` (the statistical error of a chaotic estimate decays like 1/√(periods); a
+        regular orbit's like log(·)/periods), ``rtol`` and ``atol`` (of the state and of the
+        normalised tangent vectors), ``max_steps``.
     """
-    n = system.n_state
-    k = n if n_exponents is None else int(n_exponents)
-    if not 1 <= k <= n:
-        raise ParameterError(f"n_exponents must be between 1 and {n}: got {n_exponents!r}")
-    if periods * renormalizations_per_period < 2:
-        raise ParameterError("periods × renormalizations_per_period must be >= 2")
-    traj = integrate(
-        system,
-        y0=y0,
-        transient_periods=transient_periods,
-        periods=periods,
-        samples_per_period=renormalizations_per_period,
-        rtol=rtol,
-        atol=atol,
-        max_steps=max_steps,
-        n_tangent=k,
+    cfg = SolverSettings.build(settings or LYAPUNOV_SETTINGS, **solver).replace(
+        samples_per_period=renormalizations_per_period
     )
-    ns = periods * renormalizations_per_period
+    n = system.n_state
+    k = n if n_exponents is None else check_int("n_exponents", n_exponents, lo=1, hi=n)
+    if cfg.n_samples < 2:
+        raise ParameterError("periods × renormalizations_per_period must be >= 2")
+    traj = integrate(system, cfg, y0=y0, n_tangent=k)
+    ns = cfg.n_samples
     duration = (ns - 1) * system.period / renormalizations_per_period
     ex = traj.tangent_log_sums / duration if traj.ok else np.full(k, np.nan)
     return LyapunovResult(

@@ -93,7 +93,7 @@ def summarize(
     mc = classify_motion(
         np.column_stack([x, xd]),
         lle=lle,
-        run_periods=int(result.settings.get("periods", 0)) or None,
+        run_periods=int(result.solver.periods),
         forcing_period=system.period,
     )
     finite = x[np.isfinite(x)]
@@ -142,10 +142,10 @@ def summarize(
                 f = f[np.isfinite(f)]
                 if f.size:
                     out[f"load_factor_{mesh}_max"] = _num(f.max() / static)
-    s = result.settings
-    out["transient_periods"] = _num(s.get("transient_periods"))
-    out["periods"] = int(s.get("periods", 0))
-    out["samples_per_period"] = int(s.get("samples_per_period", 1))
+    s = result.solver
+    out["transient_periods"] = _num(s.transient_periods)
+    out["periods"] = int(s.periods)
+    out["samples_per_period"] = int(s.samples_per_period)
     return out
 
 

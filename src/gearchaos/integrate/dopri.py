@@ -27,7 +27,7 @@ import numpy as np
 from ..model.kernels import rhs, tangent
 from .tableau import DOPRI5
 
-__all__ = ["dopri_batch", "dopri_chains", "dopri_run"]
+__all__ = ["dopri_chains", "dopri_run"]
 
 # ---------------------------------------------------------------------------- constants from data
 STAGES = DOPRI5.stages
@@ -455,74 +455,12 @@ def dopri_run(
 
 
 @numba.njit(cache=True, parallel=True)
-def dopri_batch(
-    kind,
-    Y0,
-    P,
-    t0,
-    t_rec,
-    dt_sample,
-    n_samples,
-    t_end,
-    n_obs,
-    n_track,
-    SW,
-    rtol,
-    atol,
-    max_step,
-    max_steps,
-    out_t,
-    out_y,
-    out_obs,
-    obs_min,
-    obs_max,
-    y_final,
-    info,
-    status,
-):  # pragma: no cover - compiled
-    """Run many parameter vectors (rows of ``P``, initial states rows of ``Y0``) in parallel.
-
-    ``t0``, ``t_rec``, ``dt_sample`` and ``t_end`` are per-point arrays (the forcing period
-    differs between points); every output array has the point index first.
-    """
-    numba.literally(kind)
-    m = P.shape[0]
-    for i in numba.prange(m):
-        status[i] = dopri_run(
-            kind,
-            Y0[i],
-            P[i],
-            t0[i],
-            t_rec[i],
-            dt_sample[i],
-            n_samples,
-            t_end[i],
-            n_obs,
-            n_track,
-            SW[i],
-            Y0.shape[1],
-            rtol,
-            atol,
-            -1.0,
-            max_step,
-            max_steps,
-            out_t[i],
-            out_y[i],
-            out_obs[i],
-            obs_min[i],
-            obs_max[i],
-            y_final[i],
-            info[i],
-            np.empty(0),
-        )
-
-
-@numba.njit(cache=True, parallel=True)
 def dopri_chains(
     kind,
     Y0,
     P,
     SW,
+    t0,
     t_rec,
     dt_sample,
     n_samples,
@@ -532,9 +470,11 @@ def dopri_chains(
     n_base,
     rtol,
     atol,
+    h_init,
     max_step,
     max_steps,
     continuation,
+    out_t,
     out_y,
     out_obs,
     obs_min,
@@ -544,28 +484,28 @@ def dopri_chains(
     status,
     LSUM,
 ):  # pragma: no cover - compiled
-    """Chains of integrations, ``numba.prange`` over chains, points of a chain in order.
+    """Chains of integrations, ``numba.prange`` over chains, points of a chain in order: the
+    one compiled entry point of the integrator (single runs are chains of length one).
 
-    Point j of chain c has parameters ``P[c, j]``; it starts from ``Y0[c]`` (fresh) or, with
-    ``continuation``, from the final state of point j−1 of the same chain (point 0 from
-    ``Y0[c]``); a failed point restarts its successor from ``Y0[c]``. ``LSUM[c, j]`` (k ≥ 0
-    entries) receives the Lyapunov log sums when the state carries k tangent vectors after its
-    ``n_base`` system components. Sample times are not
-    returned (they are t_rec + k·dt_sample). Every point runs :func:`dopri_run` unchanged, so
-    its result is bitwise identical to a single :func:`~gearchaos.integrate.integrate` call.
+    Point j of chain c has parameters ``P[c, j]`` and runs from τ = ``t0[c, j]``; it starts
+    from ``Y0[c]`` (fresh) or, with ``continuation``, from the final state of point j−1 of the
+    same chain (point 0 from ``Y0[c]``); a failed point restarts its successor from ``Y0[c]``.
+    ``LSUM[c, j]`` (k ≥ 0 entries) receives the Lyapunov log sums when the state carries k
+    tangent vectors after its ``n_base`` system components. Every point runs
+    :func:`dopri_run` unchanged, so its result does not depend on the chain it runs in, on the
+    other chains or on the number of threads.
     """
     numba.literally(kind)
     n_chains = P.shape[0]
     length = P.shape[1]
     for c in numba.prange(n_chains):
         y = Y0[c].copy()
-        out_t = np.empty(n_samples)
         for j in range(length):
             st = dopri_run(
                 kind,
                 y,
                 P[c, j],
-                0.0,
+                t0[c, j],
                 t_rec[c, j],
                 dt_sample[c, j],
                 n_samples,
@@ -576,10 +516,10 @@ def dopri_chains(
                 n_base,
                 rtol,
                 atol,
-                -1.0,
+                h_init,
                 max_step,
                 max_steps,
-                out_t,
+                out_t[c, j],
                 out_y[c, j],
                 out_obs[c, j],
                 obs_min[c, j],
@@ -608,7 +548,7 @@ def _guard() -> None:
         os.path.join(here, "dopri.py"),
         os.path.join(here, "tableau.py"),
     ]
-    _numba.guard_cache([dopri_run, dopri_batch, dopri_chains], sources)
+    _numba.guard_cache([dopri_run, dopri_chains], sources)
 
 
 _guard()

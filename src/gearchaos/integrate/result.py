@@ -18,26 +18,13 @@ from typing import Any
 
 import numpy as np
 
+from .._version import provenance
+from ..errors import ParameterError
 from .trajectory import Trajectory
 
 __all__ = ["SimulationResult", "open_simulation"]
 
 _DIMLESS = "1"
-
-
-def provenance() -> dict[str, str]:
-    """Versions of gearchaos and of the numerical libraries, for result attributes."""
-    import numba
-    import scipy
-
-    from .. import __version__
-
-    return {
-        "version": __version__,
-        "numba_version": numba.__version__,
-        "numpy_version": np.__version__,
-        "scipy_version": scipy.__version__,
-    }
 
 
 @dataclass(frozen=True, eq=False)
@@ -58,22 +45,16 @@ class SimulationResult(Trajectory):
 
     # ------------------------------------------------------------------ xarray
     def _attrs(self) -> dict[str, Any]:
-        s = self.settings
         attrs: dict[str, Any] = {
             "title": f"gearchaos simulation of {self.system.name}",
             "model": self.system.name,
             "omega": self.omega,
-            "rtol": s["rtol"],
-            "atol": s["atol"],
-            "transient_periods": s["transient_periods"],
-            "periods": s["periods"],
-            "samples_per_period": s["samples_per_period"],
-            "section_phase": s["section_phase"],
+            **self.solver.attrs(),
             "status": self.status.name.lower(),
             "status_message": self.status.message,
             "steps_accepted": self.steps_accepted,
             "steps_rejected": self.steps_rejected,
-            "initial_state": "zero" if s.get("y0") is None else "given",
+            "initial_state": "zero" if self.y0 is None else "given",
             **provenance(),
         }
         gs = self.gearset
@@ -113,28 +94,10 @@ class SimulationResult(Trajectory):
             ds[f"{name}_history"] = xr.DataArray(full, dims=dims, attrs=v.attrs)
 
     def _series_for(self, name: str) -> np.ndarray | None:
-        sn, on = self.system.state_names, self.system.obs_names
-        if name in sn:
-            return self.states[:, sn.index(name)]
-        if name in on:
-            return self.observables[:, on.index(name)]
-        N = getattr(self.system.model, "n_planets", 0)
-        planet_vars = {
-            "delta_sp": "delta_sp_{}",
-            "delta_rp": "delta_rp_{}",
-            "delta_sp_dot": "delta_sp_dot_{}",
-            "delta_rp_dot": "delta_rp_dot_{}",
-            "force_sp": "force_sp_{}",
-            "force_rp": "force_rp_{}",
-        }
-        if name in planet_vars:
-            cols = [on.index(planet_vars[name].format(i)) for i in range(1, N + 1)]
-            return self.observables[:, cols]
-        if name in ("p", "p_dot"):
-            suffix = "_dot" if name == "p_dot" else ""
-            cols = [sn.index(f"p_{i}{suffix}") for i in range(1, N + 1)]
-            return self.states[:, cols]
-        return None
+        try:
+            return self.series(name)
+        except ParameterError:
+            return None
 
     def _planetary_dataset(self) -> Any:
         import xarray as xr

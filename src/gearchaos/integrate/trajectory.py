@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 
 from ..errors import Status
 from ..model.system import System
+from .settings import SolverSettings
 
 __all__ = ["Trajectory"]
 
@@ -23,6 +23,9 @@ class Trajectory:
     states : (m, n_state) states at ``tau``.
     observables : (m, n_obs) observables (``system.obs_names``) at ``tau``.
     obs_min, obs_max : (n_track,) extrema of the tracked observables over the recorded window.
+    solver : the :class:`~gearchaos.integrate.settings.SolverSettings` of the run.
+    t0, y0 : start time and initial state (``None``: the zero state).
+    tau_reached : where the integration stopped (the end time when it succeeded).
     """
 
     system: System
@@ -35,13 +38,16 @@ class Trajectory:
     status: Status
     steps_accepted: int
     steps_rejected: int
-    settings: dict[str, Any] = field(default_factory=dict)
+    solver: SolverSettings = field(default_factory=SolverSettings)
+    t0: float = 0.0
+    y0: np.ndarray | None = None
     next_step: float = 0.0
+    tau_reached: float = float("nan")
     tangent_log_sums: np.ndarray = field(default_factory=lambda: np.empty(0))
 
     @property
     def samples_per_period(self) -> int:
-        return int(self.settings.get("samples_per_period", 1))
+        return int(self.solver.samples_per_period)
 
     @property
     def section_index(self) -> np.ndarray:
@@ -57,13 +63,9 @@ class Trajectory:
         return self.series(name)[self.section_index]
 
     def series(self, name: str) -> np.ndarray:
-        """All samples of a state or observable, by name."""
-        sn, on = self.system.state_names, self.system.obs_names
-        if name in sn:
-            return self.states[:, sn.index(name)]
-        if name in on:
-            return self.observables[:, on.index(name)]
-        raise KeyError(f"unknown variable {name!r}; states: {sn}; observables: {on}")
+        """All samples of a variable by name (:meth:`System.observable`): a state, an
+        observable, or a per-planet group such as ``delta_sp`` (one column per planet)."""
+        return self.system.observable(name).take(self.states, self.observables)
 
     def extrema(self, name: str) -> tuple[float, float]:
         """(min, max) of a tracked observable over the recorded window."""

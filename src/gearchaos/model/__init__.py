@@ -19,10 +19,14 @@ from .planetary import (
     nondimensionalise,
     planetary_system,
 )
-from .system import Model, System
+from .system import Model, Observable, System
+from .target import DEFAULT_OMEGA, OMEGA, resolve
 
 __all__ = [
+    "DEFAULT_OMEGA",
+    "OMEGA",
     "Model",
+    "Observable",
     "PlanetaryModel",
     "PlanetaryParameters",
     "Scales",
@@ -34,4 +38,5 @@ __all__ = [
     "lorenz",
     "nondimensionalise",
     "planetary_system",
+    "resolve",
 ]

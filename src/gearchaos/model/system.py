@@ -9,18 +9,50 @@ integrator and the analyses know nothing about gears; they only see this.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
-__all__ = ["Model", "System"]
+__all__ = ["Model", "Observable", "System"]
 
 
 def _group_of(name: str) -> str | None:
-    """``"force_sp_3"`` → ``"force_sp"``; names without a planet index → None."""
+    """``"force_sp_3"`` → ``"force_sp"``, ``"p_3_dot"`` → ``"p_dot"``; names without a planet
+    index → None."""
     head, _, tail = name.rpartition("_")
-    return head if tail.isdigit() else None
+    if tail.isdigit():
+        return head
+    if tail == "dot":
+        inner, _, index = head.rpartition("_")
+        if index.isdigit():
+            return f"{inner}_dot"
+    return None
+
+
+def _planet_of(name: str) -> int:
+    """The planet index of a per-planet name (``delta_sp_3`` and ``p_3_dot`` → 3)."""
+    parts = name.split("_")
+    return int(parts[-1] if parts[-1].isdigit() else parts[-2])
+
+
+@dataclass(frozen=True, eq=False)
+class Observable:
+    """A variable located in the kernel's outputs: ``source`` ``"state"`` or ``"obs"``,
+    the ``columns`` there, and whether it is a per-planet group (one column per planet)."""
+
+    name: str
+    source: str
+    columns: np.ndarray
+    per_planet: bool
+
+    def take(self, states: np.ndarray, observables: np.ndarray) -> np.ndarray:
+        """Its values from state and observable arrays (samples on the leading axes): the
+        columns on the last axis for a group, else that axis dropped."""
+        arr = states if self.source == "state" else observables
+        values = arr[..., self.columns]
+        return values if self.per_planet else values[..., 0]
 
 
 @runtime_checkable
@@ -109,16 +141,49 @@ class System:
     def n_track(self) -> int:
         return int(self.model.n_track)
 
-    def obs_indices(self, group: str) -> np.ndarray:
-        """Positions in ``obs_names`` of a per-planet group, e.g. ``"force_sp"`` →
-        indices of ``force_sp_1 … force_sp_N`` (in planet order); a plain name gives one index."""
-        names = self.obs_names
-        if group in names:
-            return np.array([names.index(group)])
-        idx = [k for k, nm in enumerate(names) if _group_of(nm) == group]
-        if not idx:
-            raise KeyError(f"no observable {group!r} or {group}_<i>; observables: {names}")
-        return np.array(sorted(idx, key=lambda k: int(names[k].rsplit("_", 1)[1])))
+    def observable(self, name: str, planets: Sequence[int] | None = None) -> Observable:
+        """Where a variable lives in the kernel's outputs, by name.
+
+        ``name`` is a state (``x_s``, ``sigma``) or an observable (``delta_sp_1``), or a
+        per-planet group: ``delta_sp`` → ``delta_sp_1 … delta_sp_N`` (observables, in planet
+        order), ``p`` / ``p_dot`` → ``p_1 … p_N`` / ``p_1_dot …`` (states). ``planets``
+        (1-based) picks planets of a group (default: all).
+
+        Raises
+        ------
+        ParameterError
+            For an unknown name (suggesting the closest one) or a planet out of range.
+        """
+        from ..errors import ParameterError
+
+        sn, on = self.state_names, self.obs_names
+        if name in sn:
+            return Observable(name, "state", np.array([sn.index(name)]), False)
+        if name in on:
+            return Observable(name, "obs", np.array([on.index(name)]), False)
+        source, names = "obs", on
+        cols = [k for k, nm in enumerate(on) if _group_of(nm) == name]
+        if not cols:
+            source, names = "state", sn
+            cols = [k for k, nm in enumerate(sn) if _group_of(nm) == name]
+        if not cols:
+            import difflib
+
+            groups = {g for g in map(_group_of, (*sn, *on)) if g is not None}
+            valid = sorted(set(sn) | set(on) | groups)
+            close = difflib.get_close_matches(name, valid, n=1)
+            hint = f"; did you mean {close[0]!r}?" if close else ""
+            raise ParameterError(f"unknown observed variable {name!r}{hint}")
+        cols.sort(key=lambda k: _planet_of(names[k]))
+        if planets is not None:
+            n_pl = len(cols)
+            for p in planets:
+                if not 1 <= int(p) <= n_pl:
+                    raise ParameterError(
+                        f"planets must be between 1 and {n_pl} for this gear set: got {p}"
+                    )
+            cols = [cols[int(p) - 1] for p in planets]
+        return Observable(name, source, np.array(cols), True)
 
     @property
     def switch_widths(self) -> np.ndarray:

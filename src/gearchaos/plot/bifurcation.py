@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import ParameterError, Status
 from ._common import _CLEARANCE_STYLE, CLEARANCE_GID, get_ax
 
 __all__ = [
@@ -243,7 +243,7 @@ def _planet_sel(da: Any, planet: int) -> Any:
 
 
 #: ``status`` of a point not yet computed (an interrupted store); 1-3 are integration failures.
-_NOT_RUN = 4
+_NOT_RUN = int(Status.NOT_RUN)
 
 
 def _status(ds: Any, dims: tuple[str, ...]) -> np.ndarray | None:

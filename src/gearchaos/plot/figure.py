@@ -70,10 +70,10 @@ def _text_lines(result: Any, summary: dict[str, Any]) -> list[str]:
         f"status: {summary['status']}  (steps {summary['steps_accepted']} accepted, "
         f"{summary['steps_rejected']} rejected)"
     )
-    s = result.settings
+    s = result.solver
     lines.append(
-        f"transient {s.get('transient_periods')} + recorded {s.get('periods')} periods, "
-        f"{s.get('samples_per_period')} samples/period"
+        f"transient {s.transient_periods} + recorded {s.periods} periods, "
+        f"{s.samples_per_period} samples/period"
     )
     return lines
 
@@ -118,14 +118,14 @@ def summary_figure(
     axs = fig.subplots(2, 3)
     planetary = is_planetary(result)
     var = "delta_sp" if planetary else None
-    periods = min(float(history_periods), float(result.settings.get("periods", history_periods)))
+    periods = min(float(history_periods), float(result.solver.periods))
 
     ax = time_history(result, var, planet, ax=axs[0, 0], periods=periods)
     ax.set_title(f"time history (last {periods:g} periods)")
     ax.legend(loc="best", fontsize="small", framealpha=0.9)
 
     try:
-        orbit_periods = min(5.0 * periods, float(result.settings.get("periods", 1)))
+        orbit_periods = min(5.0 * periods, float(result.solver.periods))
         ax = phase_portrait(result, var, planet, ax=axs[0, 1], periods=orbit_periods)
         if result.samples_per_period > 1:
             ax.set_title(f"phase portrait (orbit: last {orbit_periods:g} periods)")
@@ -154,7 +154,7 @@ def summary_figure(
         axs[1, 0].set_title("amplitude spectrum")
 
     if planetary:
-        sun_periods = min(5.0 * periods, float(result.settings.get("periods", 1)))
+        sun_periods = min(5.0 * periods, float(result.solver.periods))
         ax = sun_orbit(result, ax=axs[1, 1], periods=sun_periods)
         ax.set_title(f"sun centre orbit (last {sun_periods:g} periods)")
         ax.legend(loc="upper right", fontsize="small")

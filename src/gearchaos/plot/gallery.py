@@ -180,7 +180,7 @@ def poincare_gallery(
                 message(ex, "—")
             elif extra == "phase":
                 try:
-                    p = float(result.settings.get("periods", 20))
+                    p = float(result.solver.periods)
                     phase_portrait(result, var, planet, ax=ex, periods=min(20.0, p))
                     ex.set_xlabel(f"${info.symbol}$")
                     ex.set_ylabel(f"${info.dot_symbol}$")

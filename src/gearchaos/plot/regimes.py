@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import ParameterError, Status
 from ._common import get_ax
 
 __all__ = [
@@ -81,7 +81,7 @@ REGIME_COLOURS: Mapping[str, str] = MappingProxyType(
     }
 )
 
-_NOT_RUN_STATUS = 4
+_NOT_RUN_STATUS = int(Status.NOT_RUN)
 
 
 # --------------------------------------------------------------------------- categories

@@ -6,87 +6,25 @@
 * ``scheduler="tcp://host:port"``: an existing ``dask.distributed`` cluster;
 * ``dask_local=N``: a ``dask.distributed.LocalCluster`` with N single-threaded workers.
 
-Every executor runs :func:`run_task_arrays` on the same numbers with the same compiled kernel,
-so results are bitwise identical whatever the executor and the number of workers.
+Every executor runs :func:`~gearchaos.integrate.run_chains` on the same numbers with the same
+compiled kernel, so results are bitwise identical whatever the executor and the number of
+workers.
 """
 
 from __future__ import annotations
 
 import concurrent.futures as cf
 import contextlib
+import functools
 import multiprocessing
 from collections.abc import Iterator
 from typing import Any
 
-import numpy as np
+from .._checks import check_int
+from ..errors import ParameterError
+from ..integrate._chains import run_chains
 
-__all__ = ["executor", "run_task_arrays"]
-
-
-def run_task_arrays(a: dict[str, Any], single_thread: bool = False) -> dict[str, np.ndarray]:
-    """Run one task's chains with the compiled chain kernel; returns the raw outputs."""
-    from .._numba import call_literal
-    from ..integrate.dopri import dopri_chains
-
-    if single_thread:
-        import numba
-
-        numba.set_num_threads(1)
-    P = a["P"]
-    C, L = P.shape[0], P.shape[1]
-    ns, no, nt = a["n_samples"], a["n_obs"], a["n_track"]
-    n = a["Y0"].shape[1]  # system state, then tangent vectors when Lyapunov exponents are asked
-    out_y = np.full((C, L, ns, n), np.nan)
-    out_o = np.full((C, L, ns, no), np.nan)
-    omin = np.zeros((C, L, nt))
-    omax = np.zeros((C, L, nt))
-    yf = np.zeros((C, L, n))
-    info = np.zeros((C, L, 4))
-    status = np.zeros((C, L), dtype=np.int64)
-    k = int(a.get("n_tangent", 0))
-    lsum = np.zeros((C, L, k))
-    call_literal(
-        dopri_chains,
-        a["kind"],
-        a["Y0"],
-        P,
-        a["SW"],
-        a["t_rec"],
-        a["dt"],
-        ns,
-        a["t_end"],
-        no,
-        nt,
-        a["n_state"],
-        a["rtol"],
-        a["atol"],
-        np.inf,
-        a["max_steps"],
-        a["continuation"],
-        out_y,
-        out_o,
-        omin,
-        omax,
-        yf,
-        info,
-        status,
-        lsum,
-    )
-    return {
-        "states": out_y,
-        "observables": out_o,
-        "obs_min": omin,
-        "obs_max": omax,
-        "final_state": yf,
-        "info": info,
-        "status": status,
-        # exponents: log stretch per unit τ over the samples after the first
-        "lyapunov": lsum / ((ns - 1) * a["dt"])[:, :, None] if ns > 1 else lsum * np.nan,
-    }
-
-
-def _single_thread_task(a: dict[str, Any]) -> dict[str, np.ndarray]:
-    return run_task_arrays(a, single_thread=True)
+__all__ = ["InProcess", "executor"]
 
 
 def _init_worker() -> None:  # pragma: no cover - runs in worker processes
@@ -114,19 +52,15 @@ def executor(
     workers: int | None = None, scheduler: str | None = None, dask_local: int | None = None
 ) -> Iterator[tuple[Any, Any, str]]:
     """Yield (executor, task function, description) for the chosen execution mode."""
-    from ..errors import ParameterError
-
     chosen = [x is not None for x in (workers, scheduler, dask_local)]
     if sum(chosen) > 1:
         raise ParameterError("choose at most one of workers, scheduler and dask_local")
+    single = functools.partial(run_chains, single_thread=True)
     if workers is not None:
-        if int(workers) < 1:
-            raise ParameterError(f"workers must be >= 1: got {workers!r}")
+        n = check_int("workers", workers, lo=1, hi=4096)
         ctx = multiprocessing.get_context("spawn")
-        with cf.ProcessPoolExecutor(
-            max_workers=int(workers), mp_context=ctx, initializer=_init_worker
-        ) as ex:
-            yield ex, run_task_arrays, f"{int(workers)} local processes"
+        with cf.ProcessPoolExecutor(max_workers=n, mp_context=ctx, initializer=_init_worker) as ex:
+            yield ex, run_chains, f"{n} local processes"
         return
     if scheduler is not None or dask_local is not None:
         try:
@@ -136,20 +70,27 @@ def executor(
                 "scheduler/dask_local need dask.distributed: pip install 'gearchaos[dask]'"
             ) from exc
         if scheduler is not None:
-            with Client(scheduler) as client:
-                yield client.get_executor(), _single_thread_task, f"dask cluster {scheduler}"
+            if not isinstance(scheduler, str) or "://" not in scheduler:
+                raise ParameterError(
+                    f"scheduler must be an address such as tcp://HOST:8786: got {scheduler!r}"
+                )
+            try:
+                client = Client(scheduler, timeout=30)
+            except (OSError, TimeoutError, ValueError) as exc:
+                raise ParameterError(f"scheduler {scheduler!r} cannot be reached: {exc}") from None
+            with client:
+                yield client.get_executor(), single, f"dask cluster {scheduler}"
             return
-        if int(dask_local) < 1:  # type: ignore[arg-type]
-            raise ParameterError(f"dask_local must be >= 1: got {dask_local!r}")
+        n = check_int("dask_local", dask_local, lo=1, hi=4096)
         with (
             LocalCluster(
-                n_workers=int(dask_local),  # type: ignore[arg-type]
+                n_workers=n,
                 threads_per_worker=1,
                 processes=True,
                 dashboard_address=None,
             ) as cluster,
             Client(cluster) as client,
         ):
-            yield client.get_executor(), _single_thread_task, f"dask LocalCluster ({dask_local})"
+            yield client.get_executor(), single, f"dask LocalCluster ({n})"
         return
-    yield InProcess(), run_task_arrays, "in-process (all cores)"
+    yield InProcess(), run_chains, "in-process (all cores)"

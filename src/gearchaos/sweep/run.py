@@ -13,55 +13,20 @@ import os
 import signal
 import threading
 import time
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
 
-from ..errors import ParameterError
+from .._version import provenance
+from ..errors import ParameterError, Status
+from ..integrate._chains import ChainOutput, ChainRun
 from .execute import InProcess, executor
 from .grid import Grid, Task
-from .spec import SweepSpec
-from .store import NOT_RUN, STATUS_MEANINGS, SweepStore
+from .spec import DEFAULT_OBSERVE, SweepSpec
+from .store import SweepStore
 
 __all__ = ["bifurcation", "run_sweep"]
-
-_PER_PLANET_STATES = ("p", "p_dot")
-
-
-def _resolve(system: Any, name: str, planets: Sequence[int]) -> tuple[str, np.ndarray, bool]:
-    """Where a variable lives: ("state"|"obs", column indices, per-planet?)."""
-    sn, on = system.state_names, system.obs_names
-    if name in sn:
-        return "state", np.array([sn.index(name)]), False
-    if name in on:
-        return "obs", np.array([on.index(name)]), False
-    n_pl = getattr(system.model, "n_planets", 0)
-    if n_pl and (name in _PER_PLANET_STATES or any(_group(o) == name for o in on)):
-        for p in planets:
-            if p > n_pl:
-                raise ParameterError(f"planets must be <= {n_pl} for this gear set: got {p}")
-    try:
-        cols = system.obs_indices(name)
-        return "obs", cols[np.asarray(planets) - 1], True
-    except KeyError:
-        pass
-    if n_pl and name in _PER_PLANET_STATES:
-        suffix = "_dot" if name.endswith("_dot") else ""
-        cols = np.array([sn.index(f"p_{p}{suffix}") for p in planets])
-        return "state", cols, True
-    import difflib
-
-    valid = sorted(set(sn) | set(on) | {g.rsplit("_", 1)[0] for g in on if g[-1].isdigit()})
-    close = difflib.get_close_matches(name, valid, n=1)
-    hint = f"; did you mean {close[0]!r}?" if close else ""
-    raise ParameterError(f"unknown observed variable {name!r}{hint}")
-
-
-def _group(name: str) -> str:
-    head, _, tail = name.rpartition("_")
-    return head if tail.isdigit() else name
-
 
 def _tracked_groups(system: Any) -> list[tuple[str, np.ndarray, bool]]:
     """Tracked observables grouped: per-planet groups (delta_sp …) and scalars (x_s …)."""
@@ -88,7 +53,7 @@ class _Layout:
         self.grid = grid
         self.lead_dims = grid.dims
         self.lead_shape = grid.shape
-        self.observed = [(nm, *_resolve(ref, nm, spec.planets)) for nm in spec.observe]
+        self.observed = [ref.observable(nm, spec.planets) for nm in spec.observe]
         self.tracked = _tracked_groups(ref)
         self.n_planets = int(getattr(ref.model, "n_planets", 0))
         self.state_names = ref.state_names
@@ -99,7 +64,8 @@ class _Layout:
         ns, npl = int(spec.periods), len(spec.planets)
         var: dict[str, Any] = {}
         chunks: dict[str, tuple[int, ...]] = {}
-        for nm, _src, _cols, per_planet in self.observed:
+        for ob in self.observed:
+            nm, per_planet = ob.name, ob.per_planet
             dims = (*lead, "section", *(("planet",) if per_planet else ()))
             shape = (*shp, ns, *((npl,) if per_planet else ()))
             var[nm] = (dims, (shape, "float64"), np.nan, {"long_name": f"{nm} at the section"})
@@ -118,8 +84,8 @@ class _Layout:
         var["status"] = (
             lead,
             (shp, "int8"),
-            NOT_RUN,
-            {"flag_values": [0, 1, 2, 3, 4], "flag_meanings": STATUS_MEANINGS},
+            int(Status.NOT_RUN),
+            {"flag_values": [int(s) for s in Status], "flag_meanings": Status.meanings()},
         )
         chunks["status"] = ch
         for nm in ("steps_accepted", "steps_rejected"):
@@ -146,45 +112,43 @@ class _Layout:
         chunks["final_state"] = (*ch, n)
         return var, chunks
 
-    def extract(self, task: Task, out: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    def extract(self, task: Task, run: ChainRun, out: ChainOutput) -> dict[str, np.ndarray]:
         """Block arrays of every variable for one finished task."""
         spec = self.grid.spec
         bshape = tuple(b.stop - b.start for b in task.block)
         starts = tuple(b.start for b in task.block)
         ns, npl = int(spec.periods), len(spec.planets)
         data: dict[str, np.ndarray] = {}
-        for nm, _src, _cols, per_planet in self.observed:
-            data[nm] = np.full((*bshape, ns, *((npl,) if per_planet else ())), np.nan)
+        for ob in self.observed:
+            data[ob.name] = np.full((*bshape, ns, *((npl,) if ob.per_planet else ())), np.nan)
         for nm, cols, per_planet in self.tracked:
             for which in ("min", "max"):
                 data[f"{nm}_{which}"] = np.full(
                     (*bshape, *((cols.size,) if per_planet else ())), np.nan
                 )
-        data["status"] = np.full(bshape, NOT_RUN, dtype=np.int8)
+        data["status"] = np.full(bshape, int(Status.NOT_RUN), dtype=np.int8)
         data["steps_accepted"] = np.full(bshape, -1, dtype=np.int64)
         data["steps_rejected"] = np.full(bshape, -1, dtype=np.int64)
         n_st = len(self.state_names)
         data["final_state"] = np.full((*bshape, n_st), np.nan)
         if spec.lyapunov:
             data["lle"] = np.full(bshape, np.nan)
+            lle = out.lyapunov(run.dt)
         for c, chain in enumerate(task.chains):
             for j, idx in enumerate(chain):
                 pos = tuple(i - s for i, s in zip(idx, starts, strict=True))
-                states = out["states"][c, j]
-                obs = out["observables"][c, j]
-                for nm, src, cols, per_planet in self.observed:
-                    v = (states if src == "state" else obs)[:, cols]
-                    data[nm][pos] = v if per_planet else v[:, 0]
+                for ob in self.observed:
+                    data[ob.name][pos] = ob.take(out.states[c, j], out.observables[c, j])
                 for nm, cols, per_planet in self.tracked:
-                    lo, hi = out["obs_min"][c, j][cols], out["obs_max"][c, j][cols]
+                    lo, hi = out.obs_min[c, j][cols], out.obs_max[c, j][cols]
                     data[f"{nm}_min"][pos] = lo if per_planet else lo[0]
                     data[f"{nm}_max"][pos] = hi if per_planet else hi[0]
-                data["status"][pos] = out["status"][c, j]
-                data["steps_accepted"][pos] = int(out["info"][c, j, 0])
-                data["steps_rejected"][pos] = int(out["info"][c, j, 1])
-                data["final_state"][pos] = out["final_state"][c, j, :n_st]
+                data["status"][pos] = out.status[c, j]
+                data["steps_accepted"][pos] = int(out.info[c, j, 0])
+                data["steps_rejected"][pos] = int(out.info[c, j, 1])
+                data["final_state"][pos] = out.final_state[c, j, :n_st]
                 if spec.lyapunov:
-                    data["lle"][pos] = out["lyapunov"][c, j, 0]
+                    data["lle"][pos] = lle[c, j, 0]
         return data
 
 
@@ -196,7 +160,7 @@ def _coords(grid: Grid, layout: _Layout) -> dict[str, tuple[tuple[str, ...], np.
     for a in spec.axes:
         c[a.name] = ((a.name,), np.array(a.values, dtype=float))
     c["section"] = (("section",), np.arange(int(spec.periods)))
-    if any(per for *_, per in layout.observed):
+    if any(ob.per_planet for ob in layout.observed):
         c["planet"] = (("planet",), np.array(spec.planets, dtype=np.int64))
     if any(per for *_, per in layout.tracked):
         c["planet_all"] = (("planet_all",), np.arange(1, layout.n_planets + 1))
@@ -206,7 +170,6 @@ def _coords(grid: Grid, layout: _Layout) -> dict[str, tuple[tuple[str, ...], np.
 
 def _attrs(target: Any, grid: Grid) -> dict[str, Any]:
     from ..gearset import GearSet
-    from ..integrate.result import provenance
 
     spec, ref = grid.spec, grid.reference
     a: dict[str, Any] = {
@@ -227,7 +190,7 @@ def _attrs(target: Any, grid: Grid) -> dict[str, Any]:
     if "omega" not in [ax.name for ax in spec.axes]:
         a["omega_fixed"] = float(ref.omega)
     # clearances and scales of the base gear set with the fixed overrides (not of a grid point)
-    model = grid._build_model({k: v for k, v in grid.fixed.items() if k != "omega"})
+    model = grid.base_model()
     if hasattr(model, "scales"):
         a["omega_n_rad_s"] = float(model.scales.omega_n)
         a["characteristic_length_m"] = float(model.scales.length)
@@ -251,21 +214,6 @@ def _sigterm_as_interrupt() -> Iterator[None]:
         yield
     finally:
         signal.signal(signal.SIGTERM, old)
-
-
-def _merge(arrs: list[dict[str, Any]]) -> dict[str, Any]:
-    out = dict(arrs[0])
-    for k in ("Y0", "P", "SW", "t_rec", "dt", "t_end"):
-        out[k] = np.concatenate([a[k] for a in arrs], axis=0)
-    return out
-
-
-def _split(res: dict[str, np.ndarray], sizes: list[int]) -> list[dict[str, np.ndarray]]:
-    out, start = [], 0
-    for s in sizes:
-        out.append({k: v[start : start + s] for k, v in res.items()})
-        start += s
-    return out
 
 
 def run_sweep(
@@ -346,12 +294,12 @@ def _run_in_process(
             group.append(todo[i])
             chains += len(todo[i].chains)
             i += 1
-        arrs = [grid.task_arrays(t) for t in group]
-        res = fn(_merge(arrs) if len(arrs) > 1 else arrs[0])
-        parts = _split(res, [len(t.chains) for t in group]) if len(group) > 1 else [res]
-        for t, part in zip(group, parts, strict=True):
-            st.write(t.index, t.block, layout.extract(t, part))
-            bar.advance(t.n_points, int(np.sum(part["status"] != 0)))
+        runs = [grid.task_run(t) for t in group]
+        res = fn(ChainRun.concat(runs))
+        parts = res.split([len(t.chains) for t in group])
+        for t, run, part in zip(group, runs, parts, strict=True):
+            st.write(t.index, t.block, layout.extract(t, run, part))
+            bar.advance(t.n_points, int(np.sum(part.status != 0)))
 
 
 def _run_pool(
@@ -367,13 +315,14 @@ def _run_pool(
     import concurrent.futures as cf
 
     it = iter(todo)
-    inflight: dict[Any, Task] = {}
+    inflight: dict[Any, tuple[Task, ChainRun]] = {}
 
     def submit_next() -> bool:
         t = next(it, None)
         if t is None:
             return False
-        inflight[ex.submit(fn, grid.task_arrays(t))] = t
+        run = grid.task_run(t)
+        inflight[ex.submit(fn, run)] = (t, run)
         return True
 
     for _ in range(2 * int(width)):
@@ -383,10 +332,10 @@ def _run_pool(
         while inflight:
             finished, _ = cf.wait(list(inflight), return_when=cf.FIRST_COMPLETED)
             for fut in finished:
-                t = inflight.pop(fut)
+                t, run = inflight.pop(fut)
                 res = fut.result()
-                st.write(t.index, t.block, layout.extract(t, res))
-                bar.advance(t.n_points, int(np.sum(res["status"] != 0)))
+                st.write(t.index, t.block, layout.extract(t, run, res))
+                bar.advance(t.n_points, int(np.sum(res.status != 0)))
                 submit_next()
     finally:
         for fut in inflight:
@@ -449,10 +398,12 @@ class _Bar:
 
 
 def _default_observe(target: Any) -> tuple[str, ...]:
-    from ..gearset import GearSet
+    """X̄_sp and X̄'_sp for gear sets; a reference system's first tracked observable and its
+    derivative."""
+    from ..model.system import System
 
-    if isinstance(target, GearSet) or hasattr(getattr(target, "model", None), "n_planets"):
-        return ("delta_sp", "delta_sp_dot")
+    if not isinstance(target, System) or hasattr(target.model, "n_planets"):
+        return DEFAULT_OBSERVE
     names, nt = target.obs_names, target.n_track
     return (names[0], names[nt]) if len(names) > nt else (names[0],)
 
@@ -463,21 +414,13 @@ def bifurcation(
     *,
     family: Any = None,
     fixed: dict[str, Any] | None = None,
-    observe: Sequence[str] | None = None,
-    planets: Sequence[int] = (1,),
-    initial_conditions: str = "fresh",
-    direction: str = "up",
-    transient_periods: float = 100,
-    periods: int = 100,
-    rtol: float = 1e-8,
-    atol: float = 1e-10,
-    lyapunov: bool = False,
     store: str | os.PathLike[str] | None = None,
     overwrite: bool = False,
     workers: int | None = None,
     scheduler: str | None = None,
     dask_local: int | None = None,
     progress: bool = True,
+    **options: Any,
 ) -> Any:
     """Bifurcation diagram (or 2-D map) data: Poincaré sections over a parameter grid.
 
@@ -493,20 +436,6 @@ def bifurcation(
         One more axis drawn as separate panels (e.g. ``{"xi": [0.03, 0.05, 0.07, 0.09]}``).
     fixed
         Fixed overrides by dotted name, ``omega`` included when it is not swept.
-    observe, planets
-        Variables of :func:`gearchaos.simulate`'s dataset stored at every section point, and the
-        planets of the per-planet ones. Default: X̄_sp1 and X̄'_sp1 (``delta_sp``,
-        ``delta_sp_dot``) for gear sets; the first tracked observable and its derivative (e.g.
-        ``x``, ``x_dot``) for reference systems.
-    initial_conditions, direction
-        ``fresh`` (zero state everywhere, the seed's protocol) or ``continuation`` along the
-        first varied axis, ``up``, ``down`` or ``both`` (shows hysteresis).
-    transient_periods, periods, rtol, atol
-        Protocol and tolerances, as in :func:`gearchaos.simulate`.
-    lyapunov
-        Also store the largest Lyapunov exponent ``lle`` of every point (variational
-        equations integrated with the trajectory, under the same error control, so section
-        values agree with a sweep without it to the tolerance, not bitwise).
     store
         Path of a Zarr store. Written chunk by chunk; an interrupted sweep (Ctrl-C, SIGTERM,
         SIGKILL) resumes when called again with the same arguments; other settings are refused
@@ -517,6 +446,24 @@ def bifurcation(
         whatever the executor.
     progress
         Show a progress bar (points, points/s, ETA) on stderr.
+    **options
+        The sweep's options (:class:`~gearchaos.sweep.spec.SweepSpec`):
+
+        ``observe``, ``planets``
+            Variables of :func:`gearchaos.simulate`'s dataset stored at every section point,
+            and the planets of the per-planet ones. Default: X̄_sp1 and X̄'_sp1 (``delta_sp``,
+            ``delta_sp_dot``) for gear sets; the first tracked observable and its derivative
+            (e.g. ``x``, ``x_dot``) for reference systems.
+        ``initial_conditions``, ``direction``
+            ``fresh`` (zero state everywhere, the seed's protocol) or ``continuation`` along
+            the first varied axis, ``up``, ``down`` or ``both`` (shows hysteresis).
+        ``lyapunov``
+            Also store the largest Lyapunov exponent ``lle`` of every point (variational
+            equations integrated with the trajectory, under the same error control, so section
+            values agree with a sweep without it to the tolerance, not bitwise).
+        ``transient_periods`` (100), ``periods`` (100), ``rtol``, ``atol``, ``max_steps``
+            Protocol and tolerances (:class:`~gearchaos.integrate.settings.SolverSettings`),
+            or ``solver=SolverSettings(...)``.
 
     Returns
     -------
@@ -525,22 +472,9 @@ def bifurcation(
         point ``status``, step counts, extrema of every mesh deflection and the final state.
         Attributes carry the gear set, the sweep specification, the solver settings and versions.
     """
-    if observe is None:
-        observe = _default_observe(target)
-    spec = SweepSpec.build(
-        vary,
-        family=family,
-        fixed=fixed,
-        observe=tuple(observe),
-        planets=tuple(planets),
-        initial_conditions=initial_conditions,
-        direction=direction,
-        transient_periods=transient_periods,
-        periods=periods,
-        rtol=rtol,
-        atol=atol,
-        lyapunov=lyapunov,
-    )
+    if options.get("observe") is None:
+        options["observe"] = _default_observe(target)
+    spec = SweepSpec.build(vary, family=family, fixed=fixed, **options)
     return run_sweep(
         target,
         spec,

@@ -21,14 +21,16 @@ be checked against the command that would resume it.
 
 from __future__ import annotations
 
-import math
+import difflib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from ..errors import ParameterError
+from .._checks import check_bool, check_choice, check_int
+from ..errors import ParameterError, StoreError
+from ..integrate.settings import SolverSettings
 
 __all__ = ["Axis", "SweepSpec", "parse_axis", "parse_values"]
 
@@ -37,41 +39,70 @@ DIRECTIONS = ("up", "down", "both")
 DEFAULT_OBSERVE = ("delta_sp", "delta_sp_dot")
 
 
+#: Most values one axis may have (a 2-D map of 10⁶ × 10⁶ points is refused by memory).
+MAX_AXIS_VALUES = 10**6
+
+
+def _syntax(name: str, text: Any) -> ParameterError:
+    return ParameterError(
+        f"{name} must be start:stop:count, log:start:stop:count or a,b,c: got {text!r}"
+    )
+
+
+def _count(name: str, raw: str, text: str) -> int:
+    try:
+        n = int(raw)
+    except ValueError:
+        raise _syntax(name, text) from None
+    if not 1 <= n <= MAX_AXIS_VALUES:
+        raise ParameterError(
+            f"{name}: the count must be an integer in [1, {MAX_AXIS_VALUES}]: got {text!r}"
+        )
+    return n
+
+
 def parse_values(name: str, text: str | float | Sequence[float] | np.ndarray) -> tuple[float, ...]:
     """Values of an axis from ``start:stop:count``, ``log:start:stop:count``, ``a,b,c``, a
-    number or a sequence. Errors name the axis, the rule and the value."""
+    number or a one-dimensional sequence. Errors name the axis, the rule and the value."""
     if isinstance(text, str):
         t = text.strip()
         try:
             if t.startswith("log:"):
-                a, b, n = t[4:].split(":")
-                lo, hi, cnt = float(a), float(b), int(n)
-                if lo <= 0 or hi <= 0:
+                parts = t[4:].split(":")
+                if len(parts) != 3:
+                    raise _syntax(name, text)
+                lo, hi, cnt = float(parts[0]), float(parts[1]), _count(name, parts[2], text)
+                if not (lo > 0 and hi > 0):
                     raise ParameterError(f"{name}: log spacing needs positive bounds: got {text!r}")
                 vals = np.geomspace(lo, hi, cnt)
             elif ":" in t:
                 parts = t.split(":")
                 if len(parts) != 3:
-                    raise ParameterError(
-                        f"{name} must be start:stop:count, log:start:stop:count or a,b,c: "
-                        f"got {text!r}"
-                    )
-                a, b, n = parts
-                vals = np.linspace(float(a), float(b), int(n))
-                cnt = int(n)
+                    raise _syntax(name, text)
+                a, b = float(parts[0]), float(parts[1])
+                vals = np.linspace(a, b, _count(name, parts[2], text))
             else:
                 vals = np.array([float(v) for v in t.split(",") if v.strip()])
-                cnt = vals.size
-        except ValueError as exc:
-            raise ParameterError(
-                f"{name} must be start:stop:count, log:start:stop:count or a,b,c: got {text!r}"
-            ) from exc
-        if cnt < 1:
-            raise ParameterError(f"{name} needs at least one value: got {text!r}")
+        except ValueError:
+            raise _syntax(name, text) from None
+    elif isinstance(text, bool) or text is None:
+        raise _syntax(name, text)
     elif isinstance(text, int | float | np.floating | np.integer):
         vals = np.array([float(text)])
     else:
-        vals = np.asarray(text, dtype=float).ravel()
+        try:
+            vals = np.asarray(text, dtype=float)
+        except (TypeError, ValueError):
+            raise _syntax(name, text) from None
+        if vals.ndim != 1:
+            raise ParameterError(
+                f"{name} values must be a one-dimensional sequence: got an array of shape "
+                f"{vals.shape}"
+            )
+        if vals.size > MAX_AXIS_VALUES:
+            raise ParameterError(
+                f"{name} may have at most {MAX_AXIS_VALUES} values: got {vals.size}"
+            )
     if vals.size < 1:
         raise ParameterError(f"{name} needs at least one value: got {text!r}")
     if not np.all(np.isfinite(vals)):
@@ -122,6 +153,31 @@ def _axes(items: Any) -> tuple[Axis, ...]:
     return tuple(parse_axis(i) for i in items)
 
 
+#: Solver settings of a sweep when none are given: the seed's 100 + 100 periods.
+SWEEP_SOLVER = SolverSettings(transient_periods=100, periods=100)
+
+#: The options of :meth:`SweepSpec.build` besides the axes and the fixed values.
+SPEC_OPTIONS = ("observe", "planets", "initial_conditions", "direction", "lyapunov")
+
+
+def _names(what: str, items: Any) -> tuple[str, ...]:
+    if isinstance(items, str):
+        items = (items,)
+    try:
+        names = tuple(items)
+    except TypeError:
+        raise ParameterError(f"{what} must be a list of variable names: got {items!r}") from None
+    return names
+
+
+def _planets(items: Any) -> tuple[int, ...]:
+    if isinstance(items, str | bytes) or not hasattr(items, "__iter__"):
+        raise ParameterError(
+            f"planets must be a list of planet numbers such as [1, 2]: got {items!r}"
+        )
+    return tuple(items)
+
+
 @dataclass(frozen=True)
 class SweepSpec:
     """Everything that defines a sweep's numbers (not how it is executed).
@@ -143,6 +199,10 @@ class SweepSpec:
         point starts from the previous point's final state along the first varied axis).
     direction
         For continuation: ``up``, ``down`` or ``both`` (an extra ``direction`` dimension).
+    solver
+        Transient and recorded periods, tolerances (one sample per period: the section).
+    lyapunov
+        Also integrate the largest Lyapunov exponent of every point.
     """
 
     vary: tuple[Axis, ...]
@@ -152,10 +212,7 @@ class SweepSpec:
     planets: tuple[int, ...] = (1,)
     initial_conditions: str = "fresh"
     direction: str = "up"
-    transient_periods: float = 100
-    periods: int = 100
-    rtol: float = 1e-8
-    atol: float = 1e-10
+    solver: SolverSettings = SWEEP_SOLVER
     lyapunov: bool = False
     extra: tuple[tuple[str, Any], ...] = field(default=())
 
@@ -171,13 +228,8 @@ class SweepSpec:
         for k, _ in self.fixed:
             if k in names:
                 raise ParameterError(f"{k} is both swept and fixed (--set); choose one")
-        if self.initial_conditions not in INITIAL_CONDITIONS:
-            raise ParameterError(
-                f"initial_conditions must be one of {INITIAL_CONDITIONS}: "
-                f"got {self.initial_conditions!r}"
-            )
-        if self.direction not in DIRECTIONS:
-            raise ParameterError(f"direction must be one of {DIRECTIONS}: got {self.direction!r}")
+        check_choice("initial_conditions", self.initial_conditions, INITIAL_CONDITIONS)
+        check_choice("direction", self.direction, DIRECTIONS)
         if self.direction != "up" and self.initial_conditions == "fresh":
             raise ParameterError(
                 f"direction={self.direction!r} needs initial_conditions='continuation' "
@@ -185,12 +237,28 @@ class SweepSpec:
             )
         if not self.observe:
             raise ParameterError("observe must name at least one variable")
-        if not self.planets or any(int(p) < 1 for p in self.planets):
+        for name in self.observe:
+            if not isinstance(name, str) or not name:
+                raise ParameterError(f"observe must hold variable names: got {name!r}")
+        twice = sorted({n for n in self.observe if self.observe.count(n) > 1})
+        if twice:
+            raise ParameterError(f"observe names each variable once: {twice} repeated")
+        if not self.planets:
             raise ParameterError(f"planets must be 1-based planet numbers: got {self.planets}")
-        if not (isinstance(self.periods, int) and self.periods >= 1):
-            raise ParameterError(f"periods must be an integer >= 1: got {self.periods!r}")
-        if not (math.isfinite(self.transient_periods) and self.transient_periods >= 0):
-            raise ParameterError(f"transient_periods must be >= 0: got {self.transient_periods!r}")
+        for p in self.planets:
+            check_int("planets", p, lo=1)
+        if len(set(self.planets)) != len(self.planets):
+            raise ParameterError(f"planets must not repeat a planet: got {list(self.planets)}")
+        if not isinstance(self.solver, SolverSettings):
+            raise ParameterError(
+                f"solver must be a SolverSettings: got {type(self.solver).__name__}"
+            )
+        if self.solver.samples_per_period != 1:
+            raise ParameterError(
+                "a sweep records one sample per period (the section): "
+                f"got samples_per_period={self.solver.samples_per_period}"
+            )
+        check_bool("lyapunov", self.lyapunov)
 
     @classmethod
     def build(
@@ -199,22 +267,57 @@ class SweepSpec:
         *,
         family: Any = None,
         fixed: Mapping[str, Any] | None = None,
-        **kwargs: Any,
+        solver: SolverSettings | None = None,
+        **options: Any,
     ) -> SweepSpec:
-        """Convenience constructor from strings, mappings or sequences (see module doc)."""
+        """A spec from strings, mappings or sequences (see the module doc). ``options`` are
+        the spec's own (``observe``, ``planets``, ``initial_conditions``, ``direction``,
+        ``lyapunov``) and the solver settings by name (``transient_periods``, ``periods``,
+        ``rtol``, ``atol``, ``max_steps``), which override ``solver``."""
         fam = _axes(family)
         if len(fam) > 1:
             raise ParameterError(f"family must be a single axis: got {len(fam)}")
-        if "observe" in kwargs:
-            kwargs["observe"] = tuple(kwargs["observe"])
-        if "planets" in kwargs:
-            kwargs["planets"] = tuple(int(p) for p in kwargs["planets"])
+        if fixed is not None and not isinstance(fixed, Mapping):
+            raise ParameterError(
+                "fixed must be a mapping of dotted names to values "
+                f"(e.g. {{'omega': 1.5}}): got {fixed!r}"
+            )
+        own = {k: v for k, v in options.items() if k in SPEC_OPTIONS}
+        settings = {k: v for k, v in options.items() if k not in SPEC_OPTIONS}
+        for key in settings:
+            if key not in SolverSettings.field_names():
+                valid = [*SPEC_OPTIONS, *SolverSettings.field_names()]
+                close = difflib.get_close_matches(key, valid, n=1)
+                hint = f"; did you mean {close[0]!r}?" if close else ""
+                raise ParameterError(f"unknown sweep option {key!r}{hint}")
+        if "observe" in own:
+            own["observe"] = _names("observe", own["observe"])
+        if "planets" in own:
+            own["planets"] = _planets(own["planets"])
         return cls(
             vary=_axes(vary),
             family=fam[0] if fam else None,
             fixed=tuple(sorted((fixed or {}).items())),
-            **kwargs,
+            solver=SolverSettings.build(solver or SWEEP_SOLVER, **settings),
+            **own,
         )
+
+    # ------------------------------------------------------------------ settings
+    @property
+    def transient_periods(self) -> float:
+        return self.solver.transient_periods
+
+    @property
+    def periods(self) -> int:
+        return self.solver.periods
+
+    @property
+    def rtol(self) -> float:
+        return self.solver.rtol
+
+    @property
+    def atol(self) -> float:
+        return self.solver.atol
 
     # ------------------------------------------------------------------ grid
     @property
@@ -293,22 +396,34 @@ class SweepSpec:
 
     @classmethod
     def from_toml(cls, text: str) -> SweepSpec:
+        """The spec written by :meth:`to_toml`; unreadable text is a :class:`StoreError`."""
         import tomllib
 
-        d = tomllib.loads(text)
-        fam = d.get("family")
-        return cls(
-            vary=tuple(Axis(a["name"], tuple(float(x) for x in a["values"])) for a in d["vary"]),
-            family=Axis(fam["name"], tuple(float(x) for x in fam["values"])) if fam else None,
-            fixed=tuple(sorted(d.get("fixed", {}).items())),
-            observe=tuple(d["observe"]),
-            planets=tuple(int(p) for p in d["planets"]),
-            initial_conditions=d["initial_conditions"],
-            direction=d["direction"],
-            transient_periods=d["transient_periods"],
-            periods=int(d["periods"]),
-            rtol=d["rtol"],
-            atol=d["atol"],
-            lyapunov=bool(d.get("lyapunov", False)),
-            extra=tuple(sorted(d.get("extra", {}).items())),
-        )
+        try:
+            d = tomllib.loads(text)
+            fam = d.get("family")
+            return cls(
+                vary=tuple(
+                    Axis(a["name"], tuple(float(x) for x in a["values"])) for a in d["vary"]
+                ),
+                family=Axis(fam["name"], tuple(float(x) for x in fam["values"])) if fam else None,
+                fixed=tuple(sorted(d.get("fixed", {}).items())),
+                observe=tuple(d["observe"]),
+                planets=tuple(int(p) for p in d["planets"]),
+                initial_conditions=d["initial_conditions"],
+                direction=d["direction"],
+                solver=SolverSettings(
+                    transient_periods=d["transient_periods"],
+                    periods=int(d["periods"]),
+                    rtol=d["rtol"],
+                    atol=d["atol"],
+                ),
+                lyapunov=bool(d.get("lyapunov", False)),
+                extra=tuple(sorted(d.get("extra", {}).items())),
+            )
+        except (tomllib.TOMLDecodeError, KeyError, TypeError, ValueError, AttributeError) as exc:
+            if isinstance(exc, ParameterError):
+                raise StoreError(f"the stored sweep specification is invalid: {exc}") from None
+            raise StoreError(
+                f"the stored sweep specification is not readable ({type(exc).__name__}: {exc})"
+            ) from None

@@ -25,8 +25,6 @@ from ..errors import StoreError
 __all__ = ["SweepStore", "open_sweep"]
 
 PROGRESS = "_progress"
-STATUS_MEANINGS = "ok max_steps step_underflow non_finite not_run"
-NOT_RUN = 4
 
 
 def open_sweep(path: str | os.PathLike[str]) -> Any:

@@ -1,0 +1,247 @@
+"""The one Python caller of the compiled integrator: :func:`run_chains`.
+
+Single runs, batches and sweep tasks are all *chains*: C independent chains (run in parallel
+by ``numba.prange``) of L points each (run in order, each optionally starting from its
+predecessor's final state). :class:`ChainRun` holds the numbers of such a job — packed
+parameters, switch widths, sample times, tolerances — and nothing else, so it can be shipped
+to another process or a Dask worker; :class:`ChainOutput` holds the kernel's raw outputs.
+The kernel's argument list is written here and nowhere else.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, fields, replace
+from typing import Any
+
+import numpy as np
+
+from .._numba import call_literal
+from ..errors import ParameterError, Status
+from ..model.system import System
+from .settings import SolverSettings
+
+__all__ = ["ChainOutput", "ChainRun", "run_chains"]
+
+
+@dataclass(frozen=True, eq=False)
+class ChainRun:
+    """The numbers of C chains of L points of one system kind.
+
+    Arrays: ``Y0`` (C, n_full) initial states (system state, then ``n_tangent`` tangent
+    vectors); ``P`` (C, L, n_par) packed parameters; ``SW`` (C, L, n_track) dead-zone half
+    widths; ``t0``, ``t_rec``, ``dt``, ``t_end`` (C, L) start, first sample, sample interval
+    and end times.
+    """
+
+    kind: int
+    Y0: np.ndarray
+    P: np.ndarray
+    SW: np.ndarray
+    t0: np.ndarray
+    t_rec: np.ndarray
+    dt: np.ndarray
+    t_end: np.ndarray
+    n_samples: int
+    n_obs: int
+    n_track: int
+    n_state: int
+    n_tangent: int
+    rtol: float
+    atol: float
+    max_steps: int
+    continuation: bool = False
+    h_init: float = -1.0
+    max_step: float = np.inf
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """(chains C, points per chain L)."""
+        return int(self.P.shape[0]), int(self.P.shape[1])
+
+    @classmethod
+    def from_systems(
+        cls,
+        chains: Sequence[Sequence[System]],
+        settings: SolverSettings,
+        *,
+        y0: np.ndarray | None = None,
+        t0: float = 0.0,
+        n_tangent: int = 0,
+        continuation: bool = False,
+        first_step: float | None = None,
+        max_step: float = np.inf,
+    ) -> ChainRun:
+        """Pack chains of systems (one kind and parameter layout) with their sample times.
+
+        ``y0`` is None (zero start), one state (every chain) or one state per chain.
+        """
+        ref = chains[0][0]
+        C, L = len(chains), max(len(c) for c in chains)
+        n_par = ref.params.size
+        P = np.zeros((C, L, n_par))
+        SW = np.full((C, L, ref.n_track), np.inf)
+        T = np.ones((C, L))
+        for c, chain in enumerate(chains):
+            for j, s in enumerate(chain):
+                if s.params.size != n_par or s.kind != ref.kind:
+                    raise ParameterError(
+                        "all systems of a run must share kind and parameter layout (model "
+                        f"kind and number of planets): system {s.name} ({s.params.size} "
+                        f"parameters) differs from {ref.name} ({n_par} parameters)"
+                    )
+                P[c, j] = s.params
+                SW[c, j] = s.switch_widths
+                T[c, j] = s.period
+        n = ref.n_state
+        k = int(n_tangent)
+        Y0 = np.zeros((C, n * (1 + k)))
+        if y0 is not None:
+            Y0[:, :n] = y0
+        times = settings.sample_times(T, t0=np.full((C, L), float(t0)))
+        return cls(
+            kind=ref.kind,
+            Y0=Y0,
+            P=P,
+            SW=SW,
+            t0=np.full((C, L), float(t0)),
+            t_rec=times.t_rec,
+            dt=times.dt,
+            t_end=times.t_end,
+            n_samples=times.n_samples,
+            n_obs=ref.n_obs,
+            n_track=ref.n_track,
+            n_state=n,
+            n_tangent=k,
+            rtol=float(settings.rtol),
+            atol=float(settings.atol),
+            max_steps=times.max_steps,
+            continuation=bool(continuation),
+            h_init=-1.0 if first_step is None else float(first_step),
+            max_step=float(max_step),
+        )
+
+    @classmethod
+    def concat(cls, runs: Sequence[ChainRun]) -> ChainRun:
+        """One job of all chains of ``runs`` (same kind, lengths and settings)."""
+        if len(runs) == 1:
+            return runs[0]
+        stacked: dict[str, Any] = {
+            name: np.concatenate([getattr(r, name) for r in runs], axis=0)
+            for name in ("Y0", "P", "SW", "t0", "t_rec", "dt", "t_end")
+        }
+        return replace(runs[0], **stacked)
+
+    @property
+    def output_bytes(self) -> float:
+        """Memory the outputs of this job take."""
+        C, L = self.shape
+        n_full = self.Y0.shape[1]
+        return 8.0 * C * L * self.n_samples * (1 + n_full + self.n_obs)
+
+
+@dataclass(frozen=True, eq=False)
+class ChainOutput:
+    """Raw outputs of :func:`run_chains`, chain and point first.
+
+    ``tau`` (C, L, s) sample times (NaN where not reached); ``states`` (C, L, s, n_full);
+    ``observables`` (C, L, s, n_obs); ``obs_min``/``obs_max`` (C, L, n_track) extrema of the
+    tracked observables over the recorded window; ``final_state`` (C, L, n_full) with the
+    tangent vectors; ``info`` (C, L, 4): accepted steps, rejected steps, time reached, next
+    step size; ``status`` (C, L) :class:`~gearchaos.errors.Status` codes; ``log_sums``
+    (C, L, k) accumulated log stretch factors of the tangent vectors.
+    """
+
+    tau: np.ndarray
+    states: np.ndarray
+    observables: np.ndarray
+    obs_min: np.ndarray
+    obs_max: np.ndarray
+    final_state: np.ndarray
+    info: np.ndarray
+    status: np.ndarray
+    log_sums: np.ndarray
+
+    def statuses(self) -> list[Status]:
+        """The status of every point, chain by chain."""
+        return [Status(int(code)) for code in self.status.ravel()]
+
+    def split(self, sizes: Sequence[int]) -> list[ChainOutput]:
+        """The outputs of consecutive groups of ``sizes`` chains (inverse of
+        :meth:`ChainRun.concat`)."""
+        out, start = [], 0
+        for size in sizes:
+            out.append(
+                ChainOutput(
+                    **{f.name: getattr(self, f.name)[start : start + size] for f in fields(self)}
+                )
+            )
+            start += size
+        return out
+
+    def lyapunov(self, dt: np.ndarray) -> np.ndarray:
+        """Exponents per unit τ, (C, L, k): log stretch over the samples after the first."""
+        ns = self.tau.shape[2]
+        if ns < 2:
+            return self.log_sums * np.nan
+        return self.log_sums / ((ns - 1) * dt)[:, :, None]
+
+
+def run_chains(run: ChainRun, *, single_thread: bool = False) -> ChainOutput:
+    """Run the chains of ``run`` with the compiled Dormand–Prince kernel.
+
+    ``single_thread`` pins numba to one thread (for worker processes that share a machine).
+    Never raises on solver failure: each point carries its own status.
+    """
+    from .dopri import dopri_chains
+
+    if single_thread:
+        import numba
+
+        numba.set_num_threads(1)
+    C, L = run.shape
+    ns, n_full = run.n_samples, run.Y0.shape[1]
+    k = run.n_tangent
+    # unreached samples stay NaN, never zeros that look like data
+    out = ChainOutput(
+        tau=np.full((C, L, ns), np.nan),
+        states=np.full((C, L, ns, n_full), np.nan),
+        observables=np.full((C, L, ns, run.n_obs), np.nan),
+        obs_min=np.zeros((C, L, run.n_track)),
+        obs_max=np.zeros((C, L, run.n_track)),
+        final_state=np.zeros((C, L, n_full)),
+        info=np.zeros((C, L, 4)),
+        status=np.zeros((C, L), dtype=np.int64),
+        log_sums=np.zeros((C, L, k)),
+    )
+    call_literal(
+        dopri_chains,
+        run.kind,
+        np.ascontiguousarray(run.Y0, dtype=np.float64),
+        np.ascontiguousarray(run.P, dtype=np.float64),
+        np.ascontiguousarray(run.SW, dtype=np.float64),
+        np.ascontiguousarray(run.t0, dtype=np.float64),
+        np.ascontiguousarray(run.t_rec, dtype=np.float64),
+        np.ascontiguousarray(run.dt, dtype=np.float64),
+        int(ns),
+        np.ascontiguousarray(run.t_end, dtype=np.float64),
+        int(run.n_obs),
+        int(run.n_track),
+        int(run.n_state),
+        float(run.rtol),
+        float(run.atol),
+        float(run.h_init),
+        float(run.max_step),
+        int(run.max_steps),
+        bool(run.continuation),
+        out.tau,
+        out.states,
+        out.observables,
+        out.obs_min,
+        out.obs_max,
+        out.final_state,
+        out.info,
+        out.status,
+        out.log_sums,
+    )
+    return out

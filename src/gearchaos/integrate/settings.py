@@ -1,0 +1,185 @@
+"""Solver settings: one frozen, validated object from every front door down to the kernel.
+
+:class:`SolverSettings` holds the seed's protocol (transient periods discarded, periods
+recorded, samples per period, section phase) and the integrator's tolerances and step budget.
+``simulate``, sweeps, Lyapunov exponents, galleries and the CLI all build one, so a setting is
+validated once, with one message, whatever the entry point; :meth:`SolverSettings.sample_times`
+is the one place where sample times and step budgets are computed.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import difflib
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .._checks import check_int, check_memory, check_real
+from ..errors import ParameterError
+
+__all__ = ["SampleTimes", "SolverSettings"]
+
+#: Bounds of the settings (see :meth:`SolverSettings.check`).
+RTOL_RANGE = (1e-14, 1.0)
+ATOL_MAX = 1.0
+MAX_PERIODS = 10**9
+MAX_SAMPLES_PER_PERIOD = 10**6
+MAX_STEP_BUDGET = 2**62
+
+
+@dataclass(frozen=True)
+class SampleTimes:
+    """Where the kernel samples: τ_j = ``t_rec`` + j ``dt`` for j < ``n_samples``, then on to
+    ``t_end``; at most ``max_steps`` step attempts. ``t_rec``, ``dt`` and ``t_end`` are floats
+    or arrays (one value per point of a sweep)."""
+
+    t_rec: Any
+    dt: Any
+    n_samples: int
+    t_end: Any
+    max_steps: int
+
+
+@dataclass(frozen=True)
+class SolverSettings:
+    """The simulation protocol and the Dormand–Prince 5(4) controller settings.
+
+    Parameters
+    ----------
+    transient_periods
+        Forcing periods T = 2π/Ω discarded before recording (the seed: 100). Need not be an
+        integer.
+    periods
+        Forcing periods recorded: one Poincaré section point each.
+    samples_per_period
+        Samples per recorded period (1: the section points only; more for time histories,
+        phase portraits and spectra).
+    section_phase
+        Phase φ of the section: samples at τ_k = (2πk + φ)/Ω after the transient.
+    rtol, atol
+        Relative and absolute error tolerances of the step-size controller.
+    max_steps
+        Step attempts allowed before the integration gives up (``Status.MAX_STEPS``); ``None``
+        allows 100 000 + 50 000 per simulated period.
+
+    Every value is checked on construction (:meth:`check`); an invalid one raises
+    :class:`~gearchaos.errors.ParameterError` naming the setting, the rule and the value.
+    """
+
+    transient_periods: float = 100
+    periods: int = 200
+    samples_per_period: int = 1
+    section_phase: float = 0.0
+    rtol: float = 1e-8
+    atol: float = 1e-10
+    max_steps: int | None = None
+
+    def __post_init__(self) -> None:
+        self.check()
+
+    # ------------------------------------------------------------------ validation
+    def check(self) -> None:
+        """Raise :class:`~gearchaos.errors.ParameterError` at the first invalid setting.
+
+        Rules: ``transient_periods`` a number in [0, 1e9]; ``periods`` an integer in
+        [1, 1e9]; ``samples_per_period`` an integer in [1, 1e6]; ``section_phase`` a finite
+        number; ``rtol`` a number in [1e-14, 0.1] (below 1e-14 the floating-point resolution
+        of the time variable is reached); ``atol`` a number in (0, 1] (states are of order one:
+        lengths in units of b_c); ``max_steps`` None or an integer >= 1. Booleans and strings
+        are not numbers.
+        """
+        check_real("transient_periods", self.transient_periods, lo=0.0, hi=float(MAX_PERIODS))
+        check_int("periods", self.periods, lo=1, hi=MAX_PERIODS)
+        check_int("samples_per_period", self.samples_per_period, lo=1, hi=MAX_SAMPLES_PER_PERIOD)
+        check_real("section_phase", self.section_phase)
+        check_real("rtol", self.rtol, lo=RTOL_RANGE[0], hi=RTOL_RANGE[1])
+        check_real("atol", self.atol, lo=0.0, hi=ATOL_MAX, lo_open=True)
+        if self.max_steps is not None:
+            check_int("max_steps", self.max_steps, lo=1, hi=MAX_STEP_BUDGET)
+
+    # ------------------------------------------------------------------ construction
+    @classmethod
+    def field_names(cls) -> tuple[str, ...]:
+        return tuple(f.name for f in dataclasses.fields(cls))
+
+    @classmethod
+    def build(cls, base: SolverSettings | None = None, /, **changes: Any) -> SolverSettings:
+        """``base`` (default: the defaults) with ``changes`` applied; ``None`` values keep the
+        base value. Unknown names are refused with the closest valid name."""
+        names = cls.field_names()
+        for key in changes:
+            if key not in names:
+                close = difflib.get_close_matches(key, names, n=1)
+                hint = f"; did you mean {close[0]!r}?" if close else ""
+                raise ParameterError(
+                    f"unknown solver setting {key!r}{hint} (settings: {', '.join(names)})"
+                )
+        kept = {k: v for k, v in changes.items() if v is not None or k == "max_steps"}
+        if base is None:
+            return cls(**kept)
+        return dataclasses.replace(base, **kept)
+
+    def replace(self, **changes: Any) -> SolverSettings:
+        """A validated copy with some settings changed."""
+        return SolverSettings.build(self, **changes)
+
+    # ------------------------------------------------------------------ derived
+    @property
+    def n_samples(self) -> int:
+        """Samples recorded: ``periods × samples_per_period``."""
+        return int(self.periods) * int(self.samples_per_period)
+
+    @property
+    def step_budget(self) -> int:
+        """``max_steps``, or 100 000 + 50 000 per simulated period (at least one)."""
+        if self.max_steps is not None:
+            return int(self.max_steps)
+        total = float(self.transient_periods) + int(self.periods)
+        return int(100_000 + 50_000 * max(total, 1.0))
+
+    def sample_times(self, period: Any, t0: Any = 0.0) -> SampleTimes:
+        """Sample times of a run with forcing period T (a float, or an array of one T per
+        point) starting at τ = ``t0``: the first sample after the transient,
+        τ_rec = t0 + transient_periods·T + φT/2π, then every T/samples_per_period."""
+        T = period
+        phase = float(self.section_phase)
+        t_rec = t0 + self.transient_periods * T
+        if phase != 0.0:
+            t_rec = t_rec + phase * T / (2.0 * math.pi)
+        return SampleTimes(
+            t_rec=t_rec,
+            dt=T / self.samples_per_period,
+            n_samples=self.n_samples,
+            t_end=t_rec + self.periods * T,
+            max_steps=self.step_budget,
+        )
+
+    def check_memory(self, values_per_sample: int, points: int = 1, what: str = "") -> None:
+        """Refuse, before allocating, outputs of ``points`` runs that record
+        ``values_per_sample`` float64 values per sample."""
+        nbytes = 8.0 * float(values_per_sample) * self.n_samples * float(points)
+        check_memory(
+            what
+            or f"recording {self.periods} periods × {self.samples_per_period} samples per period",
+            nbytes,
+        )
+
+    def attrs(self) -> dict[str, Any]:
+        """The settings as result attributes (``max_steps`` only when it was given)."""
+        out = {
+            "rtol": self.rtol,
+            "atol": self.atol,
+            "transient_periods": self.transient_periods,
+            "periods": self.periods,
+            "samples_per_period": self.samples_per_period,
+            "section_phase": self.section_phase,
+        }
+        return out
+
+
+def sample_index(n_samples: int, samples_per_period: int) -> np.ndarray:
+    """Indices of the Poincaré section samples among ``n_samples`` samples."""
+    return np.arange(0, n_samples, samples_per_period)

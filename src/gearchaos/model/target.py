@@ -1,0 +1,131 @@
+"""From a target and parameter values by dotted name to a :class:`System`: :func:`resolve`.
+
+A *target* is what a user simulates, sweeps or continues: a
+:class:`~gearchaos.gearset.GearSet` (parameters: the dotted gear-set names of
+:mod:`gearchaos.gearset.schema`, the alias ``xi``) or a :class:`System` (a reference system or a
+model built by hand; parameters: the fields of its model, ``zeta``, ``f_alt`` …). Both take
+``omega``, the dimensionless forcing frequency Ω. This module is the one place that applies
+such names: it splits Ω from the rest, applies the rest to the target, and refuses unknown
+names with the closest valid one.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import difflib
+from collections.abc import Mapping
+from typing import Any
+
+from .._checks import check_real
+from ..errors import ParameterError
+from ..gearset import GearSet
+from ..gearset.schema import ALIASES, FIELDS
+from .planetary import PlanetaryModel
+from .system import System
+
+__all__ = [
+    "DEFAULT_OMEGA",
+    "OMEGA",
+    "check_names",
+    "model_for",
+    "parameter_names",
+    "resolve",
+    "split_omega",
+]
+
+#: The name of the dimensionless forcing frequency Ω = ω/ω_n among the parameters.
+OMEGA = "omega"
+#: Ω of the command line when it is neither swept nor set (the README's quick-start point).
+DEFAULT_OMEGA = 1.5
+
+#: Fields of a model dataclass that are its layout, not parameters.
+_LAYOUT_FIELDS = frozenset({"kind", "name", "n_state", "n_track", "state_names", "obs_names"})
+
+
+def _check_target(target: Any) -> None:
+    if not isinstance(target, GearSet | System):
+        raise ParameterError(f"target must be a GearSet or a System: got {type(target).__name__}")
+
+
+def parameter_names(target: Any) -> list[str]:
+    """The names :func:`resolve` accepts for ``target`` (Ω included)."""
+    _check_target(target)
+    if isinstance(target, GearSet):
+        return [*FIELDS, *ALIASES, OMEGA]
+    model = target.model
+    if not dataclasses.is_dataclass(model):
+        return [OMEGA]
+    return [
+        *(f.name for f in dataclasses.fields(model) if f.name not in _LAYOUT_FIELDS),
+        OMEGA,
+    ]
+
+
+def check_names(target: Any, names: Any) -> None:
+    """Refuse names ``target`` does not have, suggesting the closest valid one."""
+    valid = parameter_names(target)
+    for name in names:
+        if not isinstance(name, str):
+            raise ParameterError(f"parameter names must be strings: got {name!r}")
+        if name not in valid:
+            close = difflib.get_close_matches(name, sorted(valid), n=1)
+            hint = f"; did you mean {close[0]!r}?" if close else ""
+            raise ParameterError(f"unknown parameter {name!r}{hint}")
+
+
+def split_omega(values: Mapping[str, Any]) -> tuple[float | None, dict[str, Any]]:
+    """(Ω or None, the other values); Ω is checked to be a finite number > 0."""
+    rest = dict(values)
+    if OMEGA not in rest:
+        return None, rest
+    omega = check_real(OMEGA, rest.pop(OMEGA), lo=0.0, lo_open=True)
+    return omega, rest
+
+
+def model_for(target: Any, changes: Mapping[str, Any]) -> Any:
+    """The model of ``target`` with ``changes`` (no Ω) applied.
+
+    A gear set is evolved by dotted name and non-dimensionalised; a system's model gets the
+    changed fields. Unknown names are refused with a suggestion.
+    """
+    _check_target(target)
+    if isinstance(target, GearSet):
+        gs = target.evolve(dict(changes)) if changes else target
+        return PlanetaryModel.from_gearset(gs)
+    if not changes:
+        return target.model
+    check_names(target, changes)
+    return dataclasses.replace(target.model, **changes)
+
+
+def resolve(
+    target: Any, values: Mapping[str, Any] | None = None, *, default_omega: float | None = None
+) -> System:
+    """The :class:`System` of ``target`` with parameter ``values`` by dotted name.
+
+    Parameters
+    ----------
+    target
+        A :class:`~gearchaos.gearset.GearSet` or a :class:`System`.
+    values
+        Parameters by name: ``omega`` (Ω), gear-set names (``backlash.sun_planet``, ``xi``) or
+        model fields of a system (``zeta``).
+    default_omega
+        Ω when ``values`` has none: a gear set needs one (else :class:`ParameterError`); a
+        system keeps its own Ω when neither is given.
+    """
+    omega, changes = split_omega(values or {})
+    if omega is None:
+        if default_omega is not None:
+            omega = check_real(OMEGA, default_omega, lo=0.0, lo_open=True)
+        elif isinstance(target, System):
+            omega = target.omega
+        else:
+            _check_target(target)
+            raise ParameterError(
+                "omega is required for a gear set: sweep it, or fix it "
+                "(omega=1.5 in Python, --set omega=1.5 on the command line)"
+            )
+    if isinstance(target, System) and not changes:
+        return target if omega == target.omega else target.at(omega)
+    return System(model_for(target, changes), omega)
