@@ -1167,7 +1167,7 @@ def classify(
         _open_store(store)
         from .sweep import classify_store
 
-        table = classify_store(store, rtol=rtol, max_period=max_period)
+        table = classify_store(store, period_rtol=rtol, max_period=max_period)
     if json_out:
         _print_json(table)
         return

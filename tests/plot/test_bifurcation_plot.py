@@ -17,8 +17,14 @@ from matplotlib.figure import Figure
 import gearchaos as gc
 from gearchaos.analysis.derived import gearset_info
 from gearchaos.errors import ParameterError
-from gearchaos.plot import bifurcation, bifurcation_figure, distinct_map, sweep_figure
-from gearchaos.plot.bifurcation import axis_label, distinct_counts
+from gearchaos.plot import (
+    axis_label,
+    bifurcation,
+    bifurcation_figure,
+    distinct_counts,
+    distinct_map,
+    sweep_figure,
+)
 from gearchaos.sweep import SweepSpec
 
 SECTIONS = 24  # divisible by 1, 2, 3, 4, 6, 8: every period below repeats whole
@@ -107,7 +113,10 @@ def test_axis_labels_use_the_paper_symbols() -> None:
     assert axis_label("backlash.planet_ring") == r"$\bar b_{rp}$"
     assert axis_label("clearance.sun_bearing") == r"$\bar b_s$"
     assert axis_label("torque.input") == r"$T_D$ [N m]"
-    assert axis_label("mass.sun") == "mass.sun"  # fallback: the dotted name
+    # every gear-set field has a symbol and unit in the registry (gearset/schema.py) ...
+    assert axis_label("mass.sun") == r"$m_s$ [kg]"
+    # ... and a name outside it labels itself
+    assert axis_label("not.a_parameter") == "not.a_parameter"
 
 
 # --------------------------------------------------------------------------- bifurcation

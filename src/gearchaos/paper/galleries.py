@@ -185,7 +185,7 @@ def run_gallery(
     from ..analysis.lyapunov import lyapunov_spectrum
     from ..analysis.summary import summarize
     from ..integrate import simulate
-    from ..plot.bifurcation import axis_symbol
+    from ..plot import axis_symbol
     from ..plot.gallery import parse_extras, poincare_gallery
 
     fixed = dict(fixed or {})
