@@ -23,7 +23,7 @@ from .result import SimulationResult
 from .settings import SolverSettings
 from .trajectory import Trajectory
 
-__all__ = ["Trajectory", "integrate", "simulate"]
+__all__ = ["Trajectory", "integrate", "run_simulation", "simulate"]
 
 _DEFAULT = SolverSettings()
 
@@ -179,14 +179,17 @@ def simulate(
     )
     raise_on_failure = check_bool("check", check)
     system = resolve(system_or_gearset, {} if omega is None else {"omega": omega})
-    gs = getattr(system.model, "gearset", None)
-    if gs is not None and gs.has_eccentricity:
-        from ..gearset.validation import warn_if_eccentric
+    return run_simulation(system, settings, y0=y0, check=raise_on_failure)
 
-        warn_if_eccentric(gs, "Poincaré section")
+
+def run_simulation(
+    system: System, settings: SolverSettings, *, y0: Any = None, check: bool = True
+) -> SimulationResult:
+    """:func:`simulate` of a resolved system with given settings (the library's own door)."""
+    system.warn_for("Poincaré section")
     traj = integrate(system, settings, y0=y0)
     result = SimulationResult.from_trajectory(traj)
-    if raise_on_failure and not traj.ok:
+    if check and not traj.ok:
         err = IntegrationError(
             f"simulation at omega={system.omega:g} stopped at tau={traj.tau_reached:.6g} "
             f"after {traj.steps_accepted + traj.steps_rejected} step attempts: "
@@ -195,5 +198,5 @@ def simulate(
         err.result = result  # type: ignore[attr-defined]
         raise err
     if not traj.ok:
-        warnings.warn(f"{traj.status.name}: {traj.status.message}", RuntimeWarning, stacklevel=2)
+        warnings.warn(f"{traj.status.name}: {traj.status.message}", RuntimeWarning, stacklevel=3)
     return result

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from ..gearset import GearSet
+from ..gearset.validation import warn_if_eccentric
 from . import layout as L
 from .system import System
 
@@ -313,6 +314,12 @@ class PlanetaryModel:
 
     def pack(self, omega: float) -> np.ndarray:
         return pack_planetary(self.parameters, omega)
+
+    def warn_for(self, analysis: str) -> None:
+        """Warn when a Poincaré-section analysis meets eccentricities (see
+        :func:`~gearchaos.gearset.validation.warn_if_eccentric`)."""
+        if self.gearset is not None and self.gearset.has_eccentricity:
+            warn_if_eccentric(self.gearset, analysis)
 
     def with_parameters(self, **changes: Any) -> PlanetaryModel:
         """A copy with some dimensionless parameters changed (the gear set is dropped)."""

@@ -202,6 +202,13 @@ class System:
         """Forcing period T = 2π/Ω in units of τ."""
         return 2.0 * math.pi / self.omega
 
+    def warn_for(self, analysis: str) -> None:
+        """Let the model warn when ``analysis`` is questionable for it (a planetary model with
+        eccentricities has no 1T-periodic section, MODEL.md §3)."""
+        hook = getattr(self.model, "warn_for", None)
+        if hook is not None:
+            hook(analysis)
+
     def at(self, omega: float) -> System:
         """The same model at another forcing frequency."""
         return System(self.model, omega)

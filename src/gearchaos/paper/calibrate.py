@@ -55,7 +55,9 @@ from typing import Any, TypeVar
 
 import numpy as np
 
+from .._checks import check_bool, check_int
 from ..errors import ParameterError
+from ..integrate.settings import SolverSettings
 
 __all__ = [
     "BASE_PRESET",
@@ -516,7 +518,8 @@ class Evaluation:
 
 @dataclass(frozen=True)
 class SweepSettings:
-    """Coarseness of the calibration sweeps."""
+    """Coarseness of the calibration sweeps: points per landmark range and the solver settings
+    (checked on construction, with the same messages as every other entry point)."""
 
     points: int = 48
     transient_periods: int = 60
@@ -524,6 +527,21 @@ class SweepSettings:
     rtol: float = 1e-7
     atol: float = 1e-9
     lyapunov: bool = True
+
+    def __post_init__(self) -> None:
+        check_int("points", self.points, lo=1, hi=10**6)
+        check_bool("lyapunov", self.lyapunov)
+        _ = self.solver
+
+    @property
+    def solver(self) -> SolverSettings:
+        """The solver settings of every calibration sweep."""
+        return SolverSettings(
+            transient_periods=self.transient_periods,
+            periods=self.periods,
+            rtol=self.rtol,
+            atol=self.atol,
+        )
 
     @classmethod
     def quick(cls) -> SweepSettings:
@@ -615,10 +633,7 @@ def sweep_plan(
             "observe": rec.observe,
             "planets": (1,),
             "initial_conditions": "fresh",
-            "transient_periods": settings.transient_periods,
-            "periods": settings.periods,
-            "rtol": settings.rtol,
-            "atol": settings.atol,
+            "solver": settings.solver,
             "lyapunov": settings.lyapunov,
         }
     return plan

@@ -354,12 +354,12 @@ def conclusion_1(stores: Stores) -> Verdict:
 
 def conclusion_2(stores: Stores) -> Verdict:
     """Every model ingredient is present in the gear set and excited in the runs."""
-    from ..gearset import GearSet
+    from ..sweep.result import SweepResult
 
     ds = next((d for d in stores.values() if d.attrs.get("gearset_toml")), None)
     if ds is None:
         return _missing(2, ["any figure with its gear set"])
-    gs = GearSet.from_toml_string(ds.attrs["gearset_toml"])
+    gs = SweepResult.of(ds).base_gearset
     st, te, bl = gs.stiffness, gs.transmission_error, gs.backlash
     parts = {
         "time-varying mesh stiffness": st.sun_planet_alternating > 0

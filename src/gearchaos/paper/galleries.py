@@ -28,7 +28,6 @@ given value can differ from the seed's.
 from __future__ import annotations
 
 import csv
-import dataclasses
 import json
 import math
 import os
@@ -81,32 +80,6 @@ _SYMBOLS: dict[str, tuple[str, str]] = {
 
 
 # --------------------------------------------------------------------------- runner
-def _point(target: Any, vals: Mapping[str, Any]) -> tuple[Any, float | None]:
-    """(what :func:`gearchaos.simulate` takes, Ω) of one point: a gear set with the changes
-    applied, or a reference system with its model fields replaced."""
-    from ..gearset import GearSet
-    from ..model.system import System
-
-    changes = dict(vals)
-    omega = changes.pop("omega", None)
-    if isinstance(target, GearSet):
-        if omega is None:
-            raise ParameterError(
-                "omega must be varied or fixed (e.g. fixed={'omega': 1.5} or --set omega=1.5)"
-            )
-        return (target.evolve(changes) if changes else target), float(omega)
-    if isinstance(target, System):
-        model = target.model
-        if changes:
-            try:
-                model = dataclasses.replace(model, **changes)
-            except TypeError:
-                names = ", ".join(sorted(changes))
-                raise ParameterError(f"unknown parameter of {target.name}: got {names}") from None
-        return System(model, float(omega) if omega is not None else target.omega), None
-    raise ParameterError(f"target must be a GearSet or a System: got {type(target).__name__}")
-
-
 def _finite(v: Any) -> float | None:
     if v is None:
         return None
@@ -182,9 +155,9 @@ def run_gallery(
         An unknown or invalid parameter name or value (checked for every value before anything
         runs), ``param`` also in ``fixed``, no Ω, or invalid ``with_``.
     """
-    from ..analysis.lyapunov import lyapunov_spectrum
-    from ..analysis.summary import summarize
-    from ..integrate import simulate
+    from ..analysis.point import analyse_point
+    from ..integrate.settings import SolverSettings
+    from ..model.target import resolve
     from ..plot import axis_symbol
     from ..plot.gallery import parse_extras, poincare_gallery
 
@@ -195,42 +168,26 @@ def run_gallery(
     if not vals:
         raise ParameterError(f"{param} needs at least one value: got none")
     extras = parse_extras(with_)
-    # build every point first: a bad name or value fails before anything runs
-    points = [_point(gs, {**fixed, param: v}) for v in vals]
-    spp = 64 if extras else 1
+    settings = SolverSettings(
+        transient_periods=transient,
+        periods=periods,
+        samples_per_period=64 if extras else 1,
+        rtol=rtol,
+        atol=atol,
+    )
+    # resolve every point first: a bad name or value fails before anything runs
+    systems = [resolve(gs, {**fixed, param: v}) for v in vals]
     results: list[Any] = []
     summaries: list[dict[str, Any]] = []
     rows: list[dict[str, Any]] = []
     sym = _SYMBOLS.get(param, (param, param))[0]
     with _progress(progress, len(vals)) as bar:
         task = bar.add_task("Poincaré gallery", total=len(vals))
-        for v, (target, omega) in zip(vals, points, strict=True):
+        for v, system in zip(vals, systems, strict=True):
             bar.update(task, description=f"{sym} = {v:g}")
-            res = simulate(
-                target,
-                omega=omega,
-                transient_periods=transient,
-                periods=periods,
-                samples_per_period=spp,
-                rtol=rtol,
-                atol=atol,
-                check=False,
-            )
-            lle = None
-            if res.status.ok:
-                lr = lyapunov_spectrum(
-                    res.system,
-                    n_exponents=1,
-                    transient_periods=transient,
-                    periods=periods,
-                    rtol=rtol,
-                    atol=atol,
-                )
-                lle = _finite(lr.largest) if lr.status.ok else None
-            summary = summarize(res, lle=lle)
-            if not res.status.ok:
-                summary["motion"] = "failed"
-            results.append(res)
+            point = analyse_point(system, None, settings)
+            summary = point.summary
+            results.append(point.result)
             summaries.append(summary)
             rows.append(
                 {
@@ -449,7 +406,7 @@ def reproduce_gallery(
     dict
         ``{"figure", "json", "table" (the CSV), "points", "failed", "seconds", "rows"}``.
     """
-    from .. import __version__
+    from .._version import __version__
     from ..gearset import preset
     from ..plot import savefig
 

@@ -49,6 +49,7 @@ from typing import Any, Literal
 import numpy as np
 
 from ..errors import ParameterError
+from ..sweep.result import SweepResult
 
 __all__ = [
     "AXES",
@@ -415,14 +416,11 @@ def _panel(mark: Landmark, ds: Any, planet: int) -> tuple[np.ndarray, np.ndarray
 
 
 def _stored_fixed(ds: Any) -> dict[str, Any]:
-    text = getattr(ds, "attrs", {}).get("sweep_toml")
-    if not isinstance(text, str):
+    """The sweep's numeric fixed values by dotted name (none for a dataset without a spec)."""
+    if not getattr(ds, "attrs", {}).get("sweep_toml"):
         return {}
-    try:
-        fixed = tomllib.loads(text).get("fixed", {})
-    except tomllib.TOMLDecodeError:
-        return {}
-    return {k: v for k, v in _flatten(fixed).items() if isinstance(v, int | float)}
+    fixed = SweepResult.of(ds).fixed
+    return {k: v for k, v in fixed.items() if isinstance(v, int | float)}
 
 
 def _counts(labels: np.ndarray) -> str:

@@ -336,10 +336,10 @@ def reproduce(
         ``name`` is not a recipe.
     """
     recipe = get_recipe(name)
-    from .. import bifurcation  # the sweep layer sits below paper/
     from ..gearset import preset
     from ..plot import savefig
     from ..plot.bifurcation import bifurcation_figure
+    from ..sweep import bifurcation
 
     t0 = time.perf_counter()
     out = Path(os.fspath(outdir))

@@ -32,6 +32,8 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from ..sweep.result import SweepResult
+
 __all__ = ["FIGURES", "HONESTY", "build_report", "render_html"]
 
 #: Every figure of the seed, in the paper's order.
@@ -174,10 +176,9 @@ def _landmark_rows(stores: Mapping[str, Any]) -> tuple[list[dict[str, Any]], str
 
 
 def _regime_table(ds: Any) -> str:
-    raw = ds.attrs.get("regime_table")
-    if not raw:
+    table = SweepResult.of(ds).regime_table()
+    if not table:
         return "<p>No regime table stored.</p>"
-    table = json.loads(raw) if isinstance(raw, str) else dict(raw)
     kinds: list[str] = []
     for fr in table.values():
         for k in fr:
@@ -239,7 +240,7 @@ def render_html(
     gearset_label: str | None = None,
 ) -> str:
     """The report page (see the module docstring)."""
-    from .. import __version__
+    from .._version import __version__
     from .galleries import GALLERIES
     from .recipes import PRESET, RECIPES
 

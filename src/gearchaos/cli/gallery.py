@@ -1,0 +1,165 @@
+"""``gearchaos poincare``: a gallery of Poincaré maps along a parameter path."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+from ..errors import ParameterError
+from ..model.target import DEFAULT_OMEGA
+from ._common import (
+    AtolOpt,
+    GearsetOpt,
+    JsonOpt,
+    PeriodsOpt,
+    PresetOpt,
+    QuietOpt,
+    RtolOpt,
+    SetOpt,
+    TransientOpt,
+    app,
+    default_omega_note,
+    load_gearset,
+    parse_sets,
+    print_json,
+    reported_errors,
+    solver_settings,
+    stdout,
+    wrote,
+)
+from ._render import gallery_rows_table
+
+
+@app.command()
+def poincare(
+    vary: Annotated[
+        str | None,
+        typer.Option(
+            "--vary",
+            "-v",
+            help=(
+                "NAME=VALUES: one panel per value, VALUES a,b,c or start:stop:count; NAME is "
+                "omega, xi or a dotted gear-set parameter, e.g. "
+                "omega=1.2,1.35,1.5,1.7,1.875,1.926,2.02,2.3 or backlash.sun_planet=1:6:12."
+            ),
+            show_default=False,
+        ),
+    ] = None,
+    output: Annotated[
+        Path | None,
+        typer.Option("--output", "-o", help="Figure file: .png, .pdf or .svg.", show_default=False),
+    ] = None,
+    preset: PresetOpt = None,
+    gearset: GearsetOpt = None,
+    set_: SetOpt = None,
+    transient: TransientOpt = 100.0,
+    periods: PeriodsOpt = 300,
+    with_: Annotated[
+        str | None,
+        typer.Option(
+            "--with",
+            help="Extra rows under each map: phase, spectrum or phase,spectrum.",
+            show_default=False,
+        ),
+    ] = None,
+    planet: Annotated[int, typer.Option("--planet", help="Planet of X̄_sp.")] = 1,
+    rtol: RtolOpt = 1e-8,
+    atol: AtolOpt = 1e-10,
+    quiet: QuietOpt = False,
+    json_out: JsonOpt = False,
+) -> None:
+    """A gallery of Poincaré maps (X̄_sp1 against X̄'_sp1) along a parameter path, each panel
+    titled with the value, its motion label and its largest Lyapunov exponent λ₁.
+
+    Every value is one simulation with the seed's protocol (TRANSIENT mesh periods discarded,
+    PERIODS recorded) plus a Lyapunov run at the same settings; the label (1T … nT, QP, chaos,
+    unresolved) uses that λ₁. Prints a table of the values (value, motion, λ₁, K of the 0–1
+    test, distinct points); **--json** prints them as rows.
+
+    Example: **gearchaos poincare --vary omega=1.2,1.35,1.5,1.7,1.875,1.926,2.02,2.3
+    --with phase -o gallery.png**
+    """
+    from ..plot.figure import SAVE_FORMATS
+
+    with reported_errors():
+        if not vary:
+            raise ParameterError(
+                "--vary is required: give NAME=VALUES, e.g. --vary omega=1.2,1.5,1.875"
+            )
+        if output is None:
+            raise ParameterError("--output is required: the figure file, e.g. -o gallery.png")
+        if output.suffix.lower() not in SAVE_FORMATS:
+            raise ParameterError(
+                f"--output must end in one of {', '.join(SAVE_FORMATS)}: got {str(output)!r}"
+            )
+        from ..plot.gallery import parse_extras
+        from ..sweep.spec import parse_axis
+
+        try:
+            extras = parse_extras(with_)
+        except ParameterError:
+            raise ParameterError(
+                f"--with must be phase, spectrum or phase,spectrum: got {with_!r}"
+            ) from None
+        axis = parse_axis(vary)
+        omega, changes = parse_sets(set_ or [])
+        fixed: dict[str, Any] = dict(changes)
+        if axis.name in fixed or (axis.name == "omega" and omega is not None):
+            raise ParameterError(f"{axis.name} is both varied and set with --set; choose one")
+        if axis.name != "omega":
+            if omega is None:
+                omega = DEFAULT_OMEGA
+                default_omega_note(quiet or json_out, "varied")
+            fixed["omega"] = omega
+        solver_settings(transient=transient, periods=periods, rtol=rtol, atol=atol)
+        gs = load_gearset(preset, gearset)
+
+        import matplotlib
+
+        matplotlib.use("Agg")
+        from ..paper.galleries import run_gallery
+        from ..plot import savefig
+
+        t0 = time.perf_counter()
+        fig, rows = run_gallery(
+            gs,
+            axis.name,
+            axis.values,
+            fixed=fixed,
+            transient=transient,
+            periods=periods,
+            with_=extras,
+            progress=not (quiet or json_out),
+            rtol=rtol,
+            atol=atol,
+            planet=planet,
+        )
+        if output.parent != Path(""):
+            output.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            savefig(fig, output)
+        finally:
+            import matplotlib.pyplot as plt
+
+            plt.close(fig)
+        seconds = time.perf_counter() - t0
+    if json_out:
+        print_json(
+            {
+                "figure": str(output),
+                "param": axis.name,
+                "fixed": fixed,
+                "transient_periods": transient,
+                "periods": periods,
+                "seconds": seconds,
+                "rows": rows,
+            }
+        )
+        return
+    if quiet:
+        return
+    stdout().print(gallery_rows_table(rows, axis.name, title=f"Poincaré gallery of {gs.name}"))
+    wrote(output)
