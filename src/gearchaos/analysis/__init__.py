@@ -20,11 +20,14 @@ from .contact import contact_fractions, contact_regime, contact_regimes, separat
 from .lyapunov import LyapunovResult, lyapunov_spectrum, max_lyapunov
 from .periodicity import detect_period, period_label
 from .poincare import count_distinct, section_points
+from .point import PointAnalysis, analyse_point
 from .summary import format_summary, summarize
 
 __all__ = [
     "LyapunovResult",
     "MotionClass",
+    "PointAnalysis",
+    "analyse_point",
     "chaos01",
     "classify_motion",
     "classify_sections",

@@ -32,17 +32,6 @@ if TYPE_CHECKING:
     from ..gearset import GearSet
     from ..integrate.settings import SolverSettings
 
-__all__ = [
-    "DEFAULT_OMEGA",
-    "DEFAULT_PRESET",
-    "EXIT_FAILURE",
-    "EXIT_INTERRUPTED",
-    "EXIT_INVALID",
-    "INTERRUPTED_MESSAGE",
-    "app",
-    "parse_sets",
-]
-
 #: Gear set used when neither ``--preset`` nor ``--gearset`` is given.
 DEFAULT_PRESET = "sheng2016"
 

@@ -21,7 +21,7 @@ from ..errors import ParameterError, Status
 from ..model.system import System
 from .settings import SolverSettings
 
-__all__ = ["ChainOutput", "ChainRun", "run_chains"]
+__all__ = ["ChainOutput", "ChainRun", "SampleArrays", "run_chains"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -141,16 +141,11 @@ class ChainRun:
 
 
 @dataclass(frozen=True, eq=False)
-class ChainOutput:
-    """Raw outputs of :func:`run_chains`, chain and point first.
-
-    ``tau`` (C, L, s) sample times (NaN where not reached); ``states`` (C, L, s, n_full);
-    ``observables`` (C, L, s, n_obs); ``obs_min``/``obs_max`` (C, L, n_track) extrema of the
-    tracked observables over the recorded window; ``final_state`` (C, L, n_full) with the
-    tangent vectors; ``info`` (C, L, 4): accepted steps, rejected steps, time reached, next
-    step size; ``status`` (C, L) :class:`~gearchaos.errors.Status` codes; ``log_sums``
-    (C, L, k) accumulated log stretch factors of the tangent vectors.
-    """
+class SampleArrays:
+    """What an integration records, for one run or many: sample times ``tau`` (NaN where not
+    reached), ``states`` and ``observables`` at them, the extrema ``obs_min``/``obs_max`` of the
+    tracked observables over the recorded window, and the ``final_state``. Leading axes: none
+    (a :class:`~gearchaos.integrate.Trajectory`), points (a batch) or chains × points."""
 
     tau: np.ndarray
     states: np.ndarray
@@ -158,6 +153,20 @@ class ChainOutput:
     obs_min: np.ndarray
     obs_max: np.ndarray
     final_state: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class ChainOutput(SampleArrays):
+    """Raw outputs of :func:`run_chains`, chain and point first.
+
+    The :class:`SampleArrays` with shapes ``tau`` (C, L, s), ``states`` (C, L, s, n_full),
+    ``observables`` (C, L, s, n_obs), ``obs_min``/``obs_max`` (C, L, n_track), ``final_state``
+    (C, L, n_full) with the tangent vectors; then ``info`` (C, L, 4): accepted steps, rejected
+    steps, time reached, next step size; ``status`` (C, L)
+    :class:`~gearchaos.errors.Status` codes; ``log_sums`` (C, L, k) accumulated log stretch
+    factors of the tangent vectors.
+    """
+
     info: np.ndarray
     status: np.ndarray
     log_sums: np.ndarray

@@ -213,26 +213,24 @@ class System:
         """The same model at another forcing frequency."""
         return System(self.model, omega)
 
-    def observe(self, tau: np.ndarray, states: np.ndarray) -> np.ndarray:
-        """Observables (``obs_names``) at the given times and states, shape (m, n_obs)."""
+    def evaluate(self, tau: Any, states: Any) -> tuple[np.ndarray, np.ndarray]:
+        """(observables (m, n_obs), derivatives f(τ, y) (m, n_state)) at m times and states,
+        with the compiled right-hand side."""
         from .._numba import call_literal
         from .kernels import observe_many
 
         tau = np.ascontiguousarray(tau, dtype=np.float64).reshape(-1)
         states = np.ascontiguousarray(states, dtype=np.float64).reshape(tau.size, self.n_state)
-        obs, _ = call_literal(observe_many, self.kind, tau, states, self.params, self.n_obs)
-        return np.asarray(obs)
+        obs, d = call_literal(observe_many, self.kind, tau, states, self.params, self.n_obs)
+        return np.asarray(obs), np.asarray(d)
+
+    def observe(self, tau: np.ndarray, states: np.ndarray) -> np.ndarray:
+        """Observables (``obs_names``) at the given times and states, shape (m, n_obs)."""
+        return self.evaluate(tau, states)[0]
 
     def derivative(self, tau: float, state: np.ndarray) -> np.ndarray:
         """The right-hand side f(τ, y) evaluated once (for tests and users)."""
-        from .._numba import call_literal
-        from .kernels import observe_many
-
-        y = np.ascontiguousarray(state, dtype=np.float64).reshape(1, self.n_state)
-        _, d = call_literal(
-            observe_many, self.kind, np.array([float(tau)]), y, self.params, self.n_obs
-        )
-        return np.asarray(d[0])
+        return self.evaluate([float(tau)], state)[1][0]
 
     def __repr__(self) -> str:
         return f"System({self.name}, omega={self.omega:g}, n_state={self.n_state})"

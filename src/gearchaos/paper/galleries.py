@@ -39,6 +39,7 @@ from types import MappingProxyType
 from typing import Any
 
 from ..errors import ParameterError
+from .recipes import lookup_figure
 
 __all__ = [
     "GALLERIES",
@@ -359,15 +360,7 @@ GALLERIES: dict[str, Gallery] = _galleries()
 
 def get_gallery(name: str) -> Gallery:
     """The gallery called ``name`` (``fig5``, ``Fig5`` and ``5`` alike)."""
-    key = str(name).strip().lower()
-    if key.isdigit():
-        key = "fig" + key
-    try:
-        return GALLERIES[key]
-    except KeyError:
-        raise ParameterError(
-            f"gallery must be one of {', '.join(GALLERIES)}: got {name!r}"
-        ) from None
+    return lookup_figure(GALLERIES, name, "gallery")
 
 
 def _write_json(path: Path, obj: Any) -> None:

@@ -38,7 +38,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -275,15 +275,23 @@ def _recipes() -> dict[str, Recipe]:
 RECIPES: dict[str, Recipe] = _recipes()
 
 
-def get_recipe(name: str) -> Recipe:
-    """The recipe called ``name`` (``fig4``, ``Fig4`` and ``4`` alike)."""
+T = TypeVar("T")
+
+
+def lookup_figure(table: Mapping[str, T], name: Any, what: str) -> T:
+    """The entry of ``table`` for a figure name (``fig4``, ``Fig4`` and ``4`` alike)."""
     key = str(name).strip().lower()
     if key.isdigit():
         key = "fig" + key
     try:
-        return RECIPES[key]
+        return table[key]
     except KeyError:
-        raise ParameterError(f"figure must be one of {', '.join(RECIPES)}: got {name!r}") from None
+        raise ParameterError(f"{what} must be one of {', '.join(table)}: got {name!r}") from None
+
+
+def get_recipe(name: str) -> Recipe:
+    """The recipe called ``name`` (``fig4``, ``Fig4`` and ``4`` alike)."""
+    return lookup_figure(RECIPES, name, "figure")
 
 
 def reproduce(

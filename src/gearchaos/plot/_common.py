@@ -307,6 +307,20 @@ def clearance_lines(ax: Any, info: VarInfo, *, vertical: bool = False) -> None:
         )
 
 
+def corner_note(ax: Any, text: str) -> Any:
+    """A small grey note in the lower right corner of ``ax`` (points left out, and why)."""
+    return ax.text(
+        0.99,
+        0.01,
+        text,
+        ha="right",
+        va="bottom",
+        fontsize="x-small",
+        color="0.3",
+        transform=ax.transAxes,
+    )
+
+
 def message(ax: Any, text: str) -> Any:
     """Show ``text`` in the middle of an otherwise empty Axes."""
     ax.text(0.5, 0.5, text, ha="center", va="center", transform=ax.transAxes, wrap=True)

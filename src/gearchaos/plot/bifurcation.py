@@ -31,13 +31,14 @@ from ._common import (
     CLEARANCE_GID,
     axis_label,
     axis_symbol,
+    corner_note,
     fmt,
     get_ax,
     no_offset,
     resonance_lines,
     var_symbol,
 )
-from .regimes import regime_band, regime_categories, regime_handles
+from .regimes import regime_band, regime_categories, regime_legend_below
 
 __all__ = ["bifurcation", "bifurcation_figure", "resolve_var", "suptitle"]
 
@@ -232,16 +233,7 @@ def bifurcation(
     if n_missing:
         notes.append(f"{n_missing} of {n_points} points not run yet (incomplete store)")
     if notes:
-        ax.text(
-            0.99,
-            0.01,
-            "\n".join(notes),
-            ha="right",
-            va="bottom",
-            fontsize="x-small",
-            color="0.3",
-            transform=ax.transAxes,
-        )
+        corner_note(ax, "\n".join(notes))
     if x.size > 1:
         lo, hi = float(np.min(x)), float(np.max(x))
         pad = 0.01 * (hi - lo)
@@ -412,16 +404,7 @@ def bifurcation_figure(
         ax.set_visible(False)
     if regimes:
         cats = np.asarray(regime_categories(res).values, dtype=object).ravel()
-        handles = regime_handles(cats)
-        fig.legend(
-            handles=handles,
-            loc="outside lower center",
-            ncols=min(len(handles), 8),
-            fontsize="small",
-            frameon=False,
-            title="motion",
-            title_fontsize="small",
-        )
+        regime_legend_below(fig, cats)
     fig.suptitle(
         suptitle(res, "bifurcation diagram" + ("s" if len(values) > 1 else "")),
         fontsize="medium",

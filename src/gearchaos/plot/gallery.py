@@ -21,7 +21,7 @@ import numpy as np
 from ..errors import ParameterError
 from ._common import axis_symbol, is_planetary, message, variable
 from .phase import phase_portrait, poincare_map
-from .regimes import regime_colour, regime_handles
+from .regimes import regime_colour, regime_legend_below
 from .timeseries import spectrum
 
 __all__ = ["GALLERY_EXTRAS", "gallery_title", "parse_extras", "poincare_gallery"]
@@ -203,14 +203,5 @@ def poincare_gallery(
             f"at different {axis_symbol(param)}"
         )
     fig.suptitle(title, fontsize="medium")
-    handles = regime_handles(labels)
-    fig.legend(
-        handles=handles,
-        loc="outside lower center",
-        ncols=min(len(handles), 8),
-        fontsize="small",
-        frameon=False,
-        title="motion (panel frame colour)",
-        title_fontsize="small",
-    )
+    regime_legend_below(fig, labels, title="motion (panel frame colour)")
     return fig

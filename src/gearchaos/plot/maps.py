@@ -21,6 +21,7 @@ from ..sweep.result import SweepResult
 from ._common import (
     axis_label,
     axis_symbol,
+    corner_note,
     edges,
     fmt,
     get_ax,
@@ -166,16 +167,7 @@ def distinct_map(
         resonance_lines(ax, res.gearset, float(np.min(x)), float(np.max(x)))
     n_missing = int(np.ma.count_masked(c))
     if n_missing:
-        ax.text(
-            0.99,
-            0.01,
-            f"{n_missing} of {c.size} points not run yet (blank)",
-            ha="right",
-            va="bottom",
-            fontsize="x-small",
-            color="0.3",
-            transform=ax.transAxes,
-        )
+        corner_note(ax, f"{n_missing} of {c.size} points not run yet (blank)")
     if colorbar:
         fig = ax.figure
         cb = fig.colorbar(mesh, ax=ax, ticks=np.arange(0, max_count + 2))

@@ -38,6 +38,7 @@ __all__ = [
     "regime_colour",
     "regime_handles",
     "regime_legend",
+    "regime_legend_below",
     "regime_map",
 ]
 
@@ -133,6 +134,20 @@ def regime_legend(target: Any, labels: Iterable[Any], **kwargs: Any) -> Any:
     opts: dict[str, Any] = {"title": "motion", "fontsize": "small", "title_fontsize": "small"}
     opts.update(kwargs)
     return target.legend(handles=handles, **opts)
+
+
+def regime_legend_below(fig: Any, labels: Iterable[Any], *, title: str = "motion") -> Any:
+    """One legend under all panels of ``fig`` naming exactly the regimes of ``labels``."""
+    handles = regime_handles(labels)
+    return fig.legend(
+        handles=handles,
+        loc="outside lower center",
+        ncols=max(1, min(len(handles), 8)),
+        fontsize="small",
+        frameon=False,
+        title=title,
+        title_fontsize="small",
+    )
 
 
 def regime_categories(ds: Any, *, select: Mapping[str, Any] | None = None) -> Any:

@@ -21,7 +21,7 @@ import numpy as np
 from .._version import provenance
 from ..errors import ParameterError, Status
 from ..integrate._chains import ChainOutput, ChainRun
-from .execute import InProcess, executor
+from .execute import EXECUTION_OPTIONS, Execution, InProcess, executor
 from .grid import Grid, Task
 from .spec import DEFAULT_OBSERVE, SweepSpec
 from .store import SweepStore
@@ -223,14 +223,13 @@ def run_sweep(
     *,
     store: str | os.PathLike[str] | None = None,
     overwrite: bool = False,
-    workers: int | None = None,
-    scheduler: str | None = None,
-    dask_local: int | None = None,
+    execution: Execution | None = None,
     progress: bool = True,
     chunk_points: int | None = None,
     classify: bool = True,
 ) -> Any:
-    """Run (or resume) a sweep described by ``spec``; return its :class:`xarray.Dataset`."""
+    """Run (or resume) a sweep described by ``spec`` on ``execution`` (default: in-process on
+    all cores) into ``store``; return its :class:`xarray.Dataset`."""
     grid = Grid(target, spec, chunk_points=chunk_points)
     layout = _Layout(grid)
     st = SweepStore(store)
@@ -262,13 +261,14 @@ def run_sweep(
     with (
         _sigterm_as_interrupt(),
         bar,
-        executor(workers, scheduler, dask_local) as (ex, fn, desc),
+        executor(execution) as (ex, fn, desc),
     ):
         bar.describe(desc)
         if isinstance(ex, InProcess):
             _run_in_process(todo, grid, layout, st, fn, bar)
         else:
-            _run_pool(todo, grid, layout, st, ex, fn, bar, workers or dask_local or 8)
+            ex_ = execution or Execution()
+            _run_pool(todo, grid, layout, st, ex, fn, bar, ex_.workers or ex_.dask_local or 8)
     # every task is written: drop the markers before classification consolidates the metadata
     st.clear_progress()
     if classify:
@@ -417,9 +417,6 @@ def bifurcation(
     fixed: dict[str, Any] | None = None,
     store: str | os.PathLike[str] | None = None,
     overwrite: bool = False,
-    workers: int | None = None,
-    scheduler: str | None = None,
-    dask_local: int | None = None,
     progress: bool = True,
     **options: Any,
 ) -> Any:
@@ -441,10 +438,6 @@ def bifurcation(
         Path of a Zarr store. Written chunk by chunk; an interrupted sweep (Ctrl-C, SIGTERM,
         SIGKILL) resumes when called again with the same arguments; other settings are refused
         unless ``overwrite``. ``None`` keeps the result in memory.
-    workers, scheduler, dask_local
-        Executor: N local processes, a ``dask.distributed`` scheduler address, or a local Dask
-        cluster of N workers. Default: in-process on all cores. Results are bitwise identical
-        whatever the executor.
     progress
         Show a progress bar (points, points/s, ETA) on stderr.
     **options
@@ -466,6 +459,11 @@ def bifurcation(
             Protocol and tolerances (:class:`~gearchaos.integrate.settings.SolverSettings`),
             or ``solver=SolverSettings(...)``.
 
+        and where it runs (:class:`~gearchaos.sweep.execute.Execution`): ``workers`` (N local
+        processes), ``scheduler`` (the address of a ``dask.distributed`` cluster) or
+        ``dask_local`` (a local Dask cluster of N workers); default in-process on all cores.
+        Results are bitwise identical whatever the executor.
+
     Returns
     -------
     xarray.Dataset
@@ -473,16 +471,10 @@ def bifurcation(
         point ``status``, step counts, extrema of every mesh deflection and the final state.
         Attributes carry the gear set, the sweep specification, the solver settings and versions.
     """
+    where = Execution(**{k: options.pop(k) for k in EXECUTION_OPTIONS if k in options})
     if options.get("observe") is None:
         options["observe"] = _default_observe(target)
     spec = SweepSpec.build(vary, family=family, fixed=fixed, **options)
     return run_sweep(
-        target,
-        spec,
-        store=store,
-        overwrite=overwrite,
-        workers=workers,
-        scheduler=scheduler,
-        dask_local=dask_local,
-        progress=progress,
+        target, spec, store=store, overwrite=overwrite, execution=where, progress=progress
     )
