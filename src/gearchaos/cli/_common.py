@@ -289,13 +289,28 @@ def solver_settings(
     invalid values exit 2 naming the setting."""
     from ..integrate.settings import SolverSettings
 
-    return SolverSettings(
-        transient_periods=transient,
-        periods=periods,
-        samples_per_period=samples_per_period,
-        rtol=rtol,
-        atol=atol,
-    )
+    try:
+        return SolverSettings(
+            transient_periods=transient,
+            periods=periods,
+            samples_per_period=samples_per_period,
+            rtol=rtol,
+            atol=atol,
+        )
+    except ParameterError as exc:
+        setting = str(exc).split(" ", 1)[0]
+        option = _OPTIONS.get(setting)
+        raise ParameterError(f"{option}: {exc}" if option else str(exc)) from None
+
+
+#: The command-line option of each solver setting.
+_OPTIONS = {
+    "transient_periods": "--transient",
+    "periods": "--periods",
+    "samples_per_period": "--samples-per-period",
+    "rtol": "--rtol",
+    "atol": "--atol",
+}
 
 
 # --------------------------------------------------------------------------- shared options

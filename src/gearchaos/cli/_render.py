@@ -13,7 +13,7 @@ from rich.markup import escape
 from rich.table import Table
 from rich.text import Text
 
-from ..gearset.schema import CLEARANCES, FIELDS, describe
+from ..gearset.schema import display_symbol as symbol
 
 __all__ = [
     "add_motion_rows",
@@ -23,17 +23,7 @@ __all__ = [
     "info_renderables",
     "pairs_table",
     "regime_table",
-    "symbol",
 ]
-
-
-def symbol(name: str) -> str:
-    """Plain symbol of a parameter for tables: ``Ω``, ``ξ``, ``b̄_sp`` (clearances are shown
-    dimensionless, as the seed quotes them); the name itself when it has none."""
-    if name in FIELDS and any(name == p for p, _, _ in CLEARANCES.values()):
-        return "b̄_" + FIELDS[name].symbol.split("_", 1)[1]
-    field = describe(name)
-    return field.symbol if field is not None and field.symbol else name
 
 
 # Labels of the gearset_info() entries (symbols of MODEL.md); unknown keys get a label

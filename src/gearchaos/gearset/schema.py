@@ -29,6 +29,7 @@ __all__ = [
     "Field",
     "Rule",
     "describe",
+    "display_symbol",
     "symbol",
     "tex",
 ]
@@ -558,3 +559,11 @@ def tex(name: str) -> str | None:
     """Mathtext symbol (without ``$``) of a parameter, or ``None`` for unknown names."""
     f = describe(name)
     return None if f is None else f.tex
+
+
+def display_symbol(name: str) -> str:
+    """Plain symbol for tables and captions: ``Ω``, ``ξ``, ``b̄_sp`` (the clearances are shown
+    dimensionless, as the seed quotes them), ``T_D``; the name itself when it has none."""
+    if any(name == parameter for parameter, _, _ in CLEARANCES.values()):
+        return "b̄_" + FIELDS[name].symbol.split("_", 1)[1]
+    return symbol(name)

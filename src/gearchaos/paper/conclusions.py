@@ -36,6 +36,7 @@ from typing import Any
 
 import numpy as np
 
+from ..gearset.schema import display_symbol
 from .evidence import (
     MIN_RESOLVED,
     _dims,
@@ -136,12 +137,13 @@ def _missing(cid: int, names: Sequence[str]) -> Verdict:
 
 
 # --------------------------------------------------------------------------- conclusions
-_BIFURCATION_PARAMS = {
-    "omega": "Ω",
-    "backlash.sun_planet": "b̄_sp",
-    "backlash.planet_ring": "b̄_rp",
-    "clearance.sun_bearing": "b̄_s",
-}
+#: The seed's four bifurcation parameters.
+_BIFURCATION_PARAMS = (
+    "omega",
+    "backlash.sun_planet",
+    "backlash.planet_ring",
+    "clearance.sun_bearing",
+)
 
 
 def conclusion_1(stores: Stores) -> Verdict:
@@ -152,7 +154,7 @@ def conclusion_1(stores: Stores) -> Verdict:
     for name, ds in stores.items():
         _, vary = _dims(ds)
         if vary in _BIFURCATION_PARAMS:
-            swept.setdefault(_BIFURCATION_PARAMS[vary], []).append(name)
+            swept.setdefault(display_symbol(vary), []).append(name)
         lab = _labels(ds)
         total += lab.size
         failed += int(np.count_nonzero(lab == "failed"))

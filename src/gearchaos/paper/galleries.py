@@ -39,7 +39,8 @@ from types import MappingProxyType
 from typing import Any
 
 from ..errors import ParameterError
-from .recipes import lookup_figure
+from ..gearset.schema import display_symbol, tex
+from .recipes import load_figures, lookup_figure
 
 __all__ = [
     "GALLERIES",
@@ -70,14 +71,6 @@ ROW_KEYS = (
     "motion_note",
 )
 
-# dotted name -> (unicode symbol, mathtext symbol) for captions
-_SYMBOLS: dict[str, tuple[str, str]] = {
-    "omega": ("Ω", r"\Omega"),
-    "xi": ("ξ", r"\xi"),
-    "backlash.sun_planet": ("b̄_sp", r"\bar{b}_{sp}"),
-    "backlash.planet_ring": ("b̄_rp", r"\bar{b}_{rp}"),
-    "clearance.sun_bearing": ("b̄_s", r"\bar{b}_{s}"),
-}
 
 
 # --------------------------------------------------------------------------- runner
@@ -181,7 +174,7 @@ def run_gallery(
     results: list[Any] = []
     summaries: list[dict[str, Any]] = []
     rows: list[dict[str, Any]] = []
-    sym = _SYMBOLS.get(param, (param, param))[0]
+    sym = display_symbol(param)
     with _progress(progress, len(vals)) as bar:
         task = bar.add_task("Poincaré gallery", total=len(vals))
         for v, system in zip(vals, systems, strict=True):
@@ -264,92 +257,28 @@ class Gallery:
     def title(self, quick: bool = False) -> str:
         """Figure title in mathtext, built from the recipe's own numbers."""
         number = self.name.removeprefix("fig")
-        given = ", ".join(f"${_SYMBOLS[k][1]} = {_fmt(v)}$" for k, v in self.fixed.items())
+        given = ", ".join(f"${tex(k)} = {_fmt(v)}$" for k, v in self.fixed.items())
         tr, rec = QUICK_PERIODS if quick else (self.transient_periods, self.periods)
         text = (
             f"Fig. {number}: Poincaré maps of $\\bar{{X}}_{{sp1}}$ versus "
-            f"$\\bar{{X}}'_{{sp1}}$ at {given} and different ${_SYMBOLS[self.param][1]}$\n"
+            f"$\\bar{{X}}'_{{sp1}}$ at {given} and different ${tex(self.param)}$\n"
             f"{tr} transient + {rec} recorded mesh periods, zero initial state"
         )
         return text + (" (quick)" if quick else "")
 
 
-_FIG10_VALUES = (1.0, 1.9, 3.7, 4.41, 4.79, 4.84, 4.91, 5.39, 5.47, 5.55, 5.93, 6.0, 7.5, 9.0)
-
-
 def _galleries() -> dict[str, Gallery]:
-    stand_in = (
-        "The default gear set stands in for the seed's lost Table 1, so the motion at a value "
-        "can differ from the seed's panels."
-    )
     items = [
         Gallery(
-            name="fig5",
-            caption=(
-                "Poincaré maps of X̄_sp1 versus X̄'_sp1 at given ξ = 0.03, b̄_sp = 3, b̄_rp = 3.5, "
-                "b̄_s = 2 and different Ω values"
-            ),
-            param="omega",
-            values=(1.2, 1.35, 1.5, 1.69, 1.696, 1.875, 1.926, 2.02, 2.45, 2.62, 3.03, 3.58),
-            named=(1.35, 1.69, 1.696, 1.875, 1.926, 2.02, 2.45, 2.62, 3.03, 3.58),
-            fixed={
-                "xi": 0.03,
-                "backlash.sun_planet": 3.0,
-                "backlash.planet_ring": 3.5,
-                "clearance.sun_bearing": 2.0,
-            },
-            notes=(
-                "Named in the text of Sec. 3.1: 1.35 (end of 1T), 1.69 and 1.696 (QP → 1T), "
-                "1.875 (2T), 1.926 (Hopf), 2.02 (1T, entry to chaos), 2.45 and 2.62 (chaotic "
-                "window), 3.03 (2T), 3.58 (back to 1T). Added: 1.2 (inside the 1T range "
-                "0 ≤ Ω ≤ 1.35) and 1.5 (inside 1.36 ≤ Ω ≤ 2.45, the Ω of the other figures). "
-                + stand_in
-            ),
-        ),
-        Gallery(
-            name="fig7",
-            caption=(
-                "Poincaré maps of X̄_sp1 versus X̄'_sp1 at given Ω = 1.5, ξ = 0.05, b̄_rp = 3.5, "
-                "b̄_s = 2 and different b̄_sp values"
-            ),
-            param="backlash.sun_planet",
-            values=(1.0, 1.5, 2.0, 2.4, 2.81, 2.85, 3.3, 3.8, 4.3, 4.83, 5.4, 6.0),
-            named=(1.0, 2.81, 2.85, 4.83, 6.0),
-            fixed={
-                "omega": 1.5,
-                "xi": 0.05,
-                "backlash.planet_ring": 3.5,
-                "clearance.sun_bearing": 2.0,
-            },
-            notes=(
-                "Named in the text of Sec. 3.2: the range 1 ≤ b̄_sp ≤ 6, 2.81 (Hopf) and the "
-                "period-doubling range 2.85 ≤ b̄_sp ≤ 4.83. The other values fill the range "
-                "(1T → QP → 3T → 1T below 2.81, 2T/4T/8T/16T inside the doubling range, chaos "
-                "above it, in the seed). " + stand_in
-            ),
-        ),
-        Gallery(
-            name="fig10",
-            caption=(
-                "Poincaré maps of X̄_sp1 versus X̄'_sp1 at given ξ = 0.05, Ω = 1.5, b̄_sp = 3, "
-                "b̄_s = 2 and different b̄_rp values"
-            ),
-            param="backlash.planet_ring",
-            values=_FIG10_VALUES,
-            named=(1.0, 1.9, 3.7, 4.41, 4.79, 4.84, 4.91, 5.39, 5.47, 5.55, 5.93, 6.0, 9.0),
-            fixed={
-                "omega": 1.5,
-                "xi": 0.05,
-                "backlash.sun_planet": 3.0,
-                "clearance.sun_bearing": 2.0,
-            },
-            notes=(
-                "Named in the text of Sec. 3.3: the range 1 ≤ b̄_rp ≤ 9, 1.9 (end of 1T), 3.7 "
-                "and 4.41 (chaos), 4.79 (6T), 4.84 (3T), 4.91 (QP), 5.39 (chaos), 5.47 (8T), "
-                "5.55 (4T), 5.93 and 6 (chaos/Hopf switching). Added: 7.5 (the final "
-                "period-doubling route, panels (u)–(x)). " + stand_in
-            ),
-        ),
+            name=d["name"],
+            caption=d["caption"],
+            param=d["param"],
+            values=tuple(d["values"]),
+            named=tuple(d["named"]),
+            fixed=d["fixed"],
+            notes=d["notes"],
+        )
+        for d in load_figures()["gallery"]
     ]
     return {g.name: g for g in items}
 

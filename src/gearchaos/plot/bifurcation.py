@@ -156,19 +156,7 @@ def bifurcation(
     sub = res.ds
     var = resolve_var(sub, var)
     lay = res.layout(var)
-    rest = ([lay.family] if lay.family else []) + list(lay.vary)
-    if len(rest) != 1:
-        if not rest:
-            raise ParameterError(
-                "nothing left to plot against: select fixed every swept dimension "
-                f"({', '.join(map(str, (select or {}).keys()))})"
-            )
-        raise ParameterError(
-            f"a bifurcation diagram needs one swept dimension: the dataset has "
-            f"{', '.join(rest)}; fix the others with select, e.g. "
-            f"select={{{rest[0]!r}: {fmt(sub[rest[0]].values[0])}}}"
-        )
-    x_name = rest[0]
+    x_name = res.line_axis("a bifurcation diagram", var)
     ax = get_ax(ax)
     x = np.asarray(sub[x_name].values, dtype=np.float64)
 

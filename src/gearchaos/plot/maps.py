@@ -139,19 +139,7 @@ def distinct_map(
     res = SweepResult.of(ds).select(select)
     sub = res.ds
     var = resolve_var(sub, var)
-    lay = res.layout(var)
-    left = [*(["direction"] if lay.directions else []), *([lay.family] if lay.family else [])]
-    if left:
-        raise ParameterError(
-            f"distinct_map draws one 2-D grid: fix {', '.join(left)} with select, e.g. "
-            f"select={{{left[0]!r}: {fmt(sub[left[0]].values[0])!r}}}"
-        )
-    if len(lay.vary) != 2:
-        raise ParameterError(
-            f"distinct_map needs a 2-D sweep: the dataset varies {', '.join(lay.vary) or 'nothing'}"
-            "; use bifurcation for 1-D sweeps"
-        )
-    xname, yname = lay.vary
+    xname, yname = res.grid_axes("distinct_map", var)
     counts = distinct_counts(res, var=var, planet=planet, max_count=max_count)
     c = np.ma.masked_less(np.asarray(counts.transpose(yname, xname).values), 0)
     x = np.asarray(sub[xname].values, dtype=np.float64)

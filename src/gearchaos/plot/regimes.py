@@ -25,7 +25,7 @@ import numpy as np
 
 from ..errors import ParameterError, Status
 from ..sweep.result import SweepResult
-from ._common import axis_label, edges, fmt, get_ax, no_offset, resonance_lines
+from ._common import axis_label, edges, get_ax, no_offset, resonance_lines
 
 __all__ = [
     "NOT_RUN",
@@ -226,17 +226,8 @@ def regime_band(
     res = SweepResult.of(ds).select(select)
     sub = res.ds
     cats_da = regime_categories(res)
-    lay = res.layout("motion")
-    directions, family, vary = lay.directions, lay.family, lay.vary
-    rest = ([family] if family else []) + list(vary)
-    if len(rest) != 1:
-        if not rest:
-            raise ParameterError("nothing left to draw along: select fixed every swept dimension")
-        raise ParameterError(
-            f"a regime band needs one swept dimension: the dataset has {', '.join(rest)}; fix "
-            f"the others with select, e.g. select={{{rest[0]!r}: {fmt(sub[rest[0]].values[0])}}}"
-        )
-    x_name = rest[0]
+    directions = res.layout("motion").directions
+    x_name = res.line_axis("a regime band", "motion")
     x = np.asarray(sub[x_name].values, dtype=np.float64)
     order = np.argsort(x, kind="stable")
     cell = edges(x[order])
@@ -308,20 +299,7 @@ def regime_map(
     res = SweepResult.of(ds).select(select)
     sub = res.ds
     cats_da = regime_categories(res)
-    lay = res.layout("motion")
-    directions, family, vary = lay.directions, lay.family, lay.vary
-    left = [*(["direction"] if directions else []), *([family] if family else [])]
-    if left:
-        raise ParameterError(
-            f"regime_map draws one 2-D grid: fix {', '.join(left)} with select, e.g. "
-            f"select={{{left[0]!r}: {fmt(sub[left[0]].values[0])!r}}}"
-        )
-    if len(vary) != 2:
-        raise ParameterError(
-            f"regime_map needs a 2-D sweep: the dataset varies {', '.join(vary) or 'nothing'}"
-            "; use regime_band under a bifurcation diagram for 1-D sweeps"
-        )
-    xname, yname = vary
+    xname, yname = res.grid_axes("regime_map", "motion")
     cats = np.asarray(cats_da.transpose(yname, xname).values, dtype=object)
     present = _ordered(str(c) for c in cats.ravel())
     index = {c: k for k, c in enumerate(present)}

@@ -56,7 +56,8 @@ def classify_dataset(ds: Any, *, period_rtol: float = 1e-3, max_period: int = 64
     kw: dict[str, Any] = {"details": True, "rtol": period_rtol, "max_period": max_period}
     if "lle" in ds.data_vars:
         kw["lle"] = np.asarray(ds["lle"].values, dtype=float)
-        kw["run_periods"] = int(res.spec.periods if res.spec is not None else ds.attrs["periods"])
+        spec = res.spec
+        kw["run_periods"] = int(spec.solver.periods if spec is not None else ds.attrs["periods"])
         kw["forcing_period"] = res.forcing_period()
     details = classify_sections(pts, **kw)
     status = res.status()

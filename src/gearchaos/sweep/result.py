@@ -180,6 +180,42 @@ class SweepResult:
                 vary = dims  # without a readable spec: every leading dimension is varied
         return SweepLayout(directions, family, vary)
 
+    def line_axis(self, what: str, var: str | None = None) -> str:
+        """The one swept dimension left (after a selection) for ``what`` (e.g. "a bifurcation
+        diagram") to draw along; a clear error naming what to fix otherwise. A ``direction``
+        dimension may remain (drawn as two branches)."""
+        rest = list(self.layout(var).swept)
+        if len(rest) == 1:
+            return rest[0]
+        if not rest:
+            raise ParameterError(
+                f"nothing left for {what} to draw along: select fixed every swept dimension"
+            )
+        raise ParameterError(
+            f"{what} needs one swept dimension: the dataset has {', '.join(rest)}; fix the "
+            f"others with select, e.g. select={{{rest[0]!r}: "
+            f"{float(self.ds[rest[0]].values[0]):g}}}"
+        )
+
+    def grid_axes(self, what: str, var: str | None = None) -> tuple[str, str]:
+        """(x, y) of a 2-D sweep for ``what`` (e.g. "regime_map") to draw as one map; a clear
+        error when a direction or family dimension is left or the sweep is not 2-D."""
+        lay = self.layout(var)
+        left = [*(["direction"] if lay.directions else []), *([lay.family] if lay.family else [])]
+        if left:
+            first = self.ds[left[0]].values[0]
+            value = first if isinstance(first, str) else f"{float(first):g}"
+            raise ParameterError(
+                f"{what} draws one 2-D grid: fix {', '.join(left)} with select, e.g. "
+                f"select={{{left[0]!r}: {value!r}}}"
+            )
+        if len(lay.vary) != 2:
+            raise ParameterError(
+                f"{what} needs a 2-D sweep: the dataset varies "
+                f"{', '.join(lay.vary) or 'nothing'}; draw 1-D sweeps as bifurcation diagrams"
+            )
+        return lay.vary[0], lay.vary[1]
+
     def select(self, select: Mapping[str, Any] | None) -> SweepResult:
         """The dataset with the dimensions in ``select`` fixed (numeric axes: one of the swept
         values, matched to 1e-9 relative; ``direction``: ``up`` or ``down``)."""

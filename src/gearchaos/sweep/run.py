@@ -62,7 +62,7 @@ class _Layout:
     def variables(self) -> tuple[dict[str, Any], dict[str, tuple[int, ...]]]:
         spec = self.grid.spec
         lead, shp, ch = self.lead_dims, self.lead_shape, self.grid.chunks
-        ns, npl = int(spec.periods), len(spec.planets)
+        ns, npl = int(spec.solver.periods), len(spec.planets)
         var: dict[str, Any] = {}
         chunks: dict[str, tuple[int, ...]] = {}
         for ob in self.observed:
@@ -118,7 +118,7 @@ class _Layout:
         spec = self.grid.spec
         bshape = tuple(b.stop - b.start for b in task.block)
         starts = tuple(b.start for b in task.block)
-        ns, npl = int(spec.periods), len(spec.planets)
+        ns, npl = int(spec.solver.periods), len(spec.planets)
         data: dict[str, np.ndarray] = {}
         for ob in self.observed:
             data[ob.name] = np.full((*bshape, ns, *((npl,) if ob.per_planet else ())), np.nan)
@@ -160,7 +160,7 @@ def _coords(grid: Grid, layout: _Layout) -> dict[str, tuple[tuple[str, ...], np.
         c["direction"] = (("direction",), np.array(spec.directions, dtype="U4"))
     for a in spec.axes:
         c[a.name] = ((a.name,), np.array(a.values, dtype=float))
-    c["section"] = (("section",), np.arange(int(spec.periods)))
+    c["section"] = (("section",), np.arange(int(spec.solver.periods)))
     if any(ob.per_planet for ob in layout.observed):
         c["planet"] = (("planet",), np.array(spec.planets, dtype=np.int64))
     if any(per for *_, per in layout.tracked):
@@ -179,10 +179,10 @@ def _attrs(target: Any, grid: Grid) -> dict[str, Any]:
         "gearset_toml": target.to_toml() if isinstance(target, GearSet) else "",
         "model_parameters": "" if isinstance(target, GearSet) else repr(target.model),
         "sweep_toml": spec.to_toml(),
-        "rtol": float(spec.rtol),
-        "atol": float(spec.atol),
-        "transient_periods": float(spec.transient_periods),
-        "periods": int(spec.periods),
+        "rtol": float(spec.solver.rtol),
+        "atol": float(spec.solver.atol),
+        "transient_periods": float(spec.solver.transient_periods),
+        "periods": int(spec.solver.periods),
         "initial_conditions": spec.initial_conditions,
         "direction": spec.direction,
         "dims": list(grid.dims),
