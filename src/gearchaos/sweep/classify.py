@@ -23,6 +23,7 @@ import numpy as np
 from .._checks import check_int, check_real
 from ..errors import StoreError
 from .result import SweepResult
+from .store import SweepStore, consolidate, foreign_files_ignored, open_sweep
 
 __all__ = ["classify_dataset", "classify_store"]
 
@@ -127,7 +128,10 @@ def classify_store(
     check_real("period_rtol", period_rtol, lo=0.0, hi=1.0, lo_open=True, hi_open=True)
     check_int("max_period", max_period, lo=1, hi=10_000)
     zstore = os.fspath(store) if isinstance(store, str | os.PathLike) else store
-    ds = xr.open_zarr(zstore, chunks=None, consolidated=False)
+    if isinstance(zstore, str):
+        open_sweep(zstore)  # a damaged or foreign store is reported, never relabelled
+    with foreign_files_ignored():
+        ds = xr.open_zarr(zstore, chunks=None, consolidated=False)
     res = classify_dataset(ds, period_rtol=period_rtol, max_period=max_period)
     g = zarr.open_group(zstore, mode="a", use_consolidated=False)
     dims = list(res["dims"])
@@ -163,12 +167,16 @@ def classify_store(
             shape=values.shape,
             chunks=values.shape if values.size else "auto",
             dtype=values.dtype,
-            fill_value=fill,
+            # only floats carry a fill value (NaN): xarray would mask a bool False or a
+            # period 0 equal to the fill value as missing (the array is written whole)
+            fill_value=fill if values.dtype.kind == "f" else None,
             attributes={"long_name": doc, "_ARRAY_DIMENSIONS": dims},
             overwrite=True,
         )
         arr[...] = values
     g.attrs["regime_table"] = json.dumps(res["regime_table"])
     g.attrs["classification_rtol"] = float(period_rtol)
-    zarr.consolidate_metadata(zstore)
+    consolidate(zstore)
+    if isinstance(zstore, str):
+        SweepStore(zstore).refresh_manifest()
     return dict(res["regime_table"])

@@ -23,6 +23,7 @@ from ..errors import ParameterError, Status
 from ..integrate._chains import ChainOutput, ChainRun
 from .execute import EXECUTION_OPTIONS, Execution, InProcess, executor
 from .grid import Grid, Task
+from .integrity import StoreLock
 from .spec import DEFAULT_OBSERVE, SweepSpec
 from .store import SweepStore
 
@@ -232,21 +233,54 @@ def run_sweep(
     all cores) into ``store``; return its :class:`xarray.Dataset`."""
     grid = Grid(target, spec, chunk_points=chunk_points)
     layout = _Layout(grid)
-    st = SweepStore(store)
+    path = _store_path(store)
+    st = SweepStore(path)
     attrs = _attrs(target, grid)
+    lock = StoreLock(path) if path is not None else contextlib.nullcontext()
+    with lock:
+        return _run_locked(grid, layout, st, attrs, overwrite, execution, progress, classify)
+
+
+def _store_path(store: Any) -> str | None:
+    """The store's path (``None``: in memory); an empty or non-path value is refused."""
+    if store is None:
+        return None
+    if not isinstance(store, str | os.PathLike):
+        raise ParameterError(f"store must be a path such as 'run.zarr' or None: got {store!r}")
+    path = os.fspath(store)
+    if not path.strip():
+        raise ParameterError("store must be a path such as 'run.zarr': got an empty string")
+    if os.path.basename(os.path.normpath(path)) in ("", ".", ".."):
+        raise ParameterError(
+            f"store must name a directory to create, such as 'run.zarr': got {path!r}"
+        )
+    return path
+
+
+def _run_locked(
+    grid: Grid,
+    layout: _Layout,
+    st: SweepStore,
+    attrs: dict[str, Any],
+    overwrite: bool,
+    execution: Execution | None,
+    progress: bool,
+    classify: bool,
+) -> Any:
     identity = {k: attrs[k] for k in ("model", "gearset_toml", "model_parameters", "sweep_toml")}
     if st.exists() and overwrite:
         st.remove()
     if st.exists():
         st.check_same(identity)
         if st.attrs().get("complete"):
+            st.clear_stale_progress()
             return st.open()
-    elif store is not None and os.path.exists(os.fspath(store)):
+    elif st.path is not None and os.path.exists(st.path):
         if overwrite:
             st.remove()
         else:
             raise ParameterError(
-                f"{os.fspath(store)} exists and is not a gearchaos sweep store; "
+                f"{st.path} exists and is not a gearchaos sweep store; "
                 "choose another path or pass overwrite=True (--overwrite)"
             )
     if not st.exists():
@@ -269,8 +303,7 @@ def run_sweep(
         else:
             ex_ = execution or Execution()
             _run_pool(todo, grid, layout, st, ex, fn, bar, ex_.workers or ex_.dask_local or 8)
-    # every task is written: drop the markers before classification consolidates the metadata
-    st.clear_progress()
+    # every task is written (its marker says so): label the points, then finish the store
     if classify:
         from .classify import classify_store
 
