@@ -41,11 +41,12 @@ class MissingFileError(StoreError, FileNotFoundError):
 
 
 def _size(n: int) -> str:
+    """``100 bytes``, ``1048576 bytes (1 MiB)``."""
     if n < 1024:
         return f"{n} bytes"
     if n < 1024**2:
-        return f"{n / 1024:.4g} KiB"
-    return f"{n / 1024**2:.4g} MiB"
+        return f"{n} bytes ({n / 1024:.4g} KiB)"
+    return f"{n} bytes ({n / 1024**2:.4g} MiB)"
 
 
 def _kind(mode: int) -> str:
@@ -123,7 +124,7 @@ def read_text_file(path: object, *, what: str, max_bytes: int) -> str:
         size = os.fstat(fd).st_size
         if size > max_bytes:
             raise StoreError(
-                f"{what} '{shown}' is {_size(size)}, more than the {_size(max_bytes)} allowed"
+                f"{what} '{shown}' is {size} bytes, more than the {_size(max_bytes)} allowed"
             )
         chunks: list[bytes] = []
         total = 0

@@ -52,13 +52,19 @@ def parse(text: object) -> dict[str, Any]:
     Raises
     ------
     ParameterError
-        ``invalid TOML: ...`` for text that is not a ``str``, not TOML, nested too deeply for
-        the parser (arrays or inline tables hundreds of levels deep) or holding an integer of
-        more than 4300 digits.
+        ``invalid TOML: ...`` for text that is not a ``str``, longer than
+        :data:`MAX_FILE_BYTES` characters (refused before parsing), not TOML, nested too deeply
+        for the parser (arrays or inline tables hundreds of levels deep) or holding an integer
+        of more than 4300 digits.
     """
     if not isinstance(text, str):
         raise ParameterError(
             f"invalid TOML: the text must be a str: got {show(text)} ({type(text).__name__})"
+        )
+    if len(text) > MAX_FILE_BYTES:
+        raise ParameterError(
+            f"invalid TOML: the text is {len(text)} characters, more than the {MAX_FILE_BYTES} "
+            "a gear set may take"
         )
     try:
         return tomllib.loads(text)
