@@ -11,7 +11,6 @@ every finished chunk). Errors are reported on stderr as one line, never as a tra
 from __future__ import annotations
 
 import contextlib
-import difflib
 import json
 import math
 import warnings
@@ -26,6 +25,7 @@ from rich.text import Text
 
 from .._version import __version__
 from ..errors import IntegrationError, ParameterError, StoreError
+from ..gearset.parsing import parse_text
 from ..model.target import DEFAULT_OMEGA, OMEGA
 
 if TYPE_CHECKING:
@@ -140,71 +140,6 @@ def print_json(obj: Any) -> None:
 
 
 # --------------------------------------------------------------------------- --set parsing
-def _parse_float(name: str, raw: str) -> float:
-    try:
-        return float(raw)
-    except ValueError:
-        raise ParameterError(f"{name} must be a number: got {raw!r}") from None
-
-
-def parse_int(name: str, raw: str) -> int:
-    """An integer option value (``3`` or ``3.0``)."""
-    try:
-        return int(raw)
-    except ValueError:
-        pass
-    try:
-        value = float(raw)
-    except ValueError:
-        value = math.nan
-    if value.is_integer():
-        return int(value)
-    raise ParameterError(f"{name} must be an integer: got {raw!r}")
-
-
-def _parse_floats(name: str, raw: str) -> tuple[float, ...]:
-    text = raw.strip()
-    if text.startswith("[") and text.endswith("]"):
-        text = text[1:-1]
-    items = [item.strip() for item in text.split(",") if item.strip()]
-    return tuple(_parse_float(f"{name}[{i}]", item) for i, item in enumerate(items))
-
-
-def _unquote(raw: str) -> str:
-    if len(raw) >= 2 and raw[0] == raw[-1] and raw[0] in "'\"":
-        return raw[1:-1]
-    return raw
-
-
-def _parse_value(key: str, raw: str) -> object:
-    """Convert the text of ``--set key=raw`` to the Python type of the field ``key``."""
-    from ..gearset.schema import ALIASES, FIELDS, META, TABLES
-
-    field = FIELDS.get(key)
-    kind = field.kind if field is not None else None
-    if key in ALIASES:
-        kind = "float"
-    elif key in META:
-        kind = "str"
-    if kind == "int":
-        return parse_int(key, raw)
-    if kind == "float":
-        return _parse_float(key, raw)
-    if kind == "floats":
-        return _parse_floats(key, raw)
-    if kind == "str":
-        return _unquote(raw)
-    if key in TABLES:
-        names = [n for n in FIELDS if n.startswith(key + ".")]
-        raise ParameterError(
-            f"{key} is a table, not a parameter; set one of its fields: {', '.join(names)}"
-        )
-    close = difflib.get_close_matches(key.lower(), [*FIELDS, *ALIASES, OMEGA], n=1)
-    if close == [OMEGA]:
-        raise ParameterError(f"unknown parameter {key!r}; did you mean 'omega'?")
-    return raw  # GearSet.evolve reports the unknown name with its own suggestion
-
-
 def parse_sets(items: Sequence[str]) -> tuple[float | None, dict[str, object]]:
     """Split ``--set NAME=VALUE`` options into Ω and gear-set changes.
 
@@ -239,11 +174,11 @@ def parse_sets(items: Sequence[str]) -> tuple[float | None, dict[str, object]]:
         if not sep or not key:
             raise ParameterError(f"--set expects NAME=VALUE (e.g. omega=1.5): got {item!r}")
         if key == OMEGA:
-            omega = _parse_float(OMEGA, raw)
+            omega = float(parse_text(OMEGA, raw))  # type: ignore[arg-type]
             if not (math.isfinite(omega) and omega > 0):
                 raise ParameterError(f"omega must be a finite number > 0: got {raw!r}")
         else:
-            changes[key] = _parse_value(key, raw)
+            changes[key] = parse_text(key, raw)
     return omega, changes
 
 

@@ -12,6 +12,7 @@ from rich.markup import escape
 from rich.text import Text
 
 from ..errors import ParameterError
+from ..gearset.parsing import parse_int
 from ._common import (
     AtolOpt,
     GearsetOpt,
@@ -27,7 +28,6 @@ from ._common import (
     default_omega_note,
     interruptible,
     load_gearset,
-    parse_int,
     parse_sets,
     print_json,
     reported_errors,

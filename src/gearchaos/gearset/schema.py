@@ -491,6 +491,7 @@ EXTRA: Final = MappingProxyType(
             r"\Omega",
             "dimensionless mesh frequency Ω = ω/ω_n",
             POSITIVE,
+            limits=_OMEGA,
         ),
         XI: Field(
             XI,
