@@ -213,12 +213,7 @@ def default_omega_note(quiet: bool, what: str = "swept") -> None:
 
 
 def solver_settings(
-    *,
-    transient: float,
-    periods: int,
-    rtol: float,
-    atol: float,
-    samples_per_period: int = 1,
+    transient: float, periods: int, rtol: float, atol: float, samples_per_period: int = 1
 ) -> SolverSettings:
     """The :class:`~gearchaos.integrate.settings.SolverSettings` of the solver options;
     invalid values exit 2 naming the setting."""
@@ -313,23 +308,33 @@ OverwriteOpt = Annotated[
 ]
 
 
-def _version_callback(value: bool) -> None:
-    if value:
-        typer.echo(f"gearchaos {__version__}")
-        raise typer.Exit()
-
-
-@app.callback()
+@app.callback(invoke_without_command=True)
 def main(
+    ctx: typer.Context,
     version: Annotated[
-        bool,
-        typer.Option(
-            "--version",
-            "-V",
-            callback=_version_callback,
-            is_eager=True,
-            help="Print the version and exit.",
-        ),
+        bool, typer.Option("--version", "-V", help="Print the version and exit.")
     ] = False,
 ) -> None:
     """gearchaos: nonlinear dynamics of planetary gear trains with clearances."""
+    if version:
+        if ctx.invoked_subcommand is not None:
+            fail(
+                f"--version takes no command: got {ctx.invoked_subcommand!r}; run "
+                f"'gearchaos --version' or 'gearchaos {ctx.invoked_subcommand} ...'",
+                EXIT_INVALID,
+            )
+        typer.echo(f"gearchaos {__version__}")
+        raise typer.Exit()
+    if ctx.invoked_subcommand is None:
+        typer.echo(ctx.get_help())
+        raise typer.Exit(EXIT_INVALID)
+
+
+def output_path(raw: str | None, option: str = "--output") -> Path | None:
+    """The path of an output option; an empty one is refused (it would mean the current
+    directory by accident)."""
+    if raw is None:
+        return None
+    if not raw.strip():
+        raise ParameterError(f"{option} must be a path: got an empty string")
+    return Path(raw)

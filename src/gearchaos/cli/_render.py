@@ -4,7 +4,7 @@ tables and gallery rows. Symbols come from the parameter registry
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -13,6 +13,7 @@ from rich.markup import escape
 from rich.table import Table
 from rich.text import Text
 
+from ..gearset.mapping import flatten
 from ..gearset.schema import display_symbol as symbol
 
 __all__ = [
@@ -138,15 +139,6 @@ def fmt(value: Any) -> str:
     return str(value)
 
 
-def _flatten(prefix: str, value: Mapping[str, Any]) -> Iterator[tuple[str, Any]]:
-    for k, v in value.items():
-        path = f"{prefix}.{k}" if prefix else str(k)
-        if isinstance(v, Mapping):
-            yield from _flatten(path, v)
-        else:
-            yield path, v
-
-
 def pairs_table(title: str | None) -> Table:
     table = Table(title=escape(title) if title else None, title_justify="left", show_header=False)
     table.add_column("quantity", style="cyan")
@@ -165,7 +157,7 @@ def info_renderables(data: Mapping[str, Any]) -> list[Any]:
             continue
         if isinstance(value, Mapping):
             target = overview if key in _OVERVIEW_GROUPS else pairs_table(_TITLES.get(key, key))
-            for path, v in _flatten(key, value):
+            for path, v in flatten(value, f"{key}.").items():
                 target.add_row(escape(label(path)), escape(fmt(v)))
             if target is not overview:
                 groups.append(target)

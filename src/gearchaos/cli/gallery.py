@@ -114,7 +114,7 @@ def poincare(
                 omega = DEFAULT_OMEGA
                 default_omega_note(quiet or json_out, "varied")
             fixed["omega"] = omega
-        solver_settings(transient=transient, periods=periods, rtol=rtol, atol=atol)
+        settings = solver_settings(transient, periods, rtol, atol)
         gs = load_gearset(preset, gearset)
 
         import matplotlib
@@ -129,13 +129,10 @@ def poincare(
             axis.name,
             axis.values,
             fixed=fixed,
-            transient=transient,
-            periods=periods,
             with_=extras,
             progress=not (quiet or json_out),
-            rtol=rtol,
-            atol=atol,
             planet=planet,
+            settings=settings,
         )
         if output.parent != Path(""):
             output.parent.mkdir(parents=True, exist_ok=True)

@@ -264,12 +264,13 @@ def calibrate(
             )
 
     with reported_errors():
-        if landmarks is not None and not landmarks.exists():
-            raise FileNotFoundError(f"landmarks file not found: '{landmarks}'")
+        from ..paper.landmarks import load_landmarks
+
+        marks = load_landmarks(landmarks)  # a bad file is refused before anything runs
         if out.parent and not out.parent.exists():
             out.parent.mkdir(parents=True, exist_ok=True)
         result = run_calibration(
-            landmarks,
+            marks,
             out,
             budget_minutes=budget_minutes,
             max_candidates=max_candidates,

@@ -9,6 +9,7 @@ from typing import Annotated, Any
 import typer
 from rich.text import Text
 
+from ..errors import ParameterError
 from ._common import (
     DEFAULT_OMEGA,
     AtolOpt,
@@ -21,6 +22,7 @@ from ._common import (
     TransientOpt,
     app,
     load_gearset,
+    output_path,
     parse_sets,
     print_json,
     reported_errors,
@@ -50,8 +52,8 @@ def simulate(
     ] = 64,
     rtol: RtolOpt = 1e-8,
     atol: AtolOpt = 1e-10,
-    output: Annotated[
-        Path | None,
+    output_dir: Annotated[
+        str | None,
         typer.Option(
             "--output",
             "-o",
@@ -60,7 +62,6 @@ def simulate(
                 "simulation.png (summary figure); created if missing. "
                 "Without -o nothing is written."
             ),
-            file_okay=False,
             show_default=False,
         ),
     ] = None,
@@ -91,16 +92,13 @@ def simulate(
     Example: **gearchaos simulate --preset sheng2016 --set omega=1.5 --set xi=0.05 -o out/**
     """
     with reported_errors():
+        output = output_path(output_dir)
+        if output is not None and output.exists() and not output.is_dir():
+            raise ParameterError(f"--output must be a directory: {str(output)!r} is a file")
         omega, changes = parse_sets(set_ or [])
         gs = load_gearset(preset, gearset, changes)
         omega = DEFAULT_OMEGA if omega is None else omega
-        settings = solver_settings(
-            transient=transient,
-            periods=periods,
-            rtol=rtol,
-            atol=atol,
-            samples_per_period=samples_per_period,
-        )
+        settings = solver_settings(transient, periods, rtol, atol, samples_per_period)
         if output is not None:
             output.mkdir(parents=True, exist_ok=True)
         from ..analysis.point import analyse_point

@@ -220,7 +220,7 @@ def bifurcation(
                 f"--direction {direction} needs --ic continuation "
                 "(fresh starts do not depend on the sweep direction)"
             )
-        settings = solver_settings(transient=transient, periods=periods, rtol=rtol, atol=atol)
+        settings = solver_settings(transient, periods, rtol, atol)
         omega, changes = parse_sets(set_ or [])
         gs = load_gearset(preset, gearset)
         swept = {_axis_name(v) for v in vary} | ({_axis_name(family)} if family else set())

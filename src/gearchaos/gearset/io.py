@@ -1,21 +1,8 @@
 """TOML input and output of gear sets, dotted-name access and ``evolve``: the public functions.
 
-A gear-set file has two top-level keys, ``name`` and ``description``, and one table per record
-of :class:`~gearchaos.gearset.records.GearSet`, named as the GearSet field::
-
-    name = "sheng2016"
-    description = "..."
-
-    [teeth]
-    sun = 34          # [1]
-    ...
-
-    [backlash]
-    units = "dimensionless"
-    sun_planet = 3.0  # [b_c or m (backlash.units)]
-
-Every parameter has a stable dotted name (``teeth.sun``, ``backlash.sun_planet``; see
-:func:`field_names`) used alike by :func:`evolve`, :func:`get_value`, the CLI and sweep stores.
+The file layout is described in :mod:`gearchaos.gearset.tomltext`. Every parameter has a
+stable dotted name (``teeth.sun``, ``backlash.sun_planet``; see :func:`field_names`) used
+alike by :func:`evolve`, :func:`get_value`, the CLI and sweep stores.
 
 Reading (:func:`from_toml`, :func:`from_toml_string`, :func:`from_dict`) is strict: unknown
 tables or keys raise :class:`~gearchaos.errors.ParameterError` suggesting the closest valid
@@ -95,14 +82,7 @@ def evolve(gs: GearSet, changes: Mapping[str, object]) -> GearSet:
 
 
 def to_dict(gs: GearSet) -> dict[str, object]:
-    """The gear set as a nested plain dictionary in TOML layout.
-
-    Returns
-    -------
-    dict
-        ``{"name": ..., "description": ..., "teeth": {"sun": 34, ...}, ...}`` with one
-        sub-dictionary per record, named as the GearSet field; tuples become lists.
-    """
+    """The gear set as a nested plain dictionary in TOML layout (see :meth:`GearSet.to_dict`)."""
     return _check_gearset(gs, "to_dict").to_dict()
 
 
@@ -131,23 +111,10 @@ def from_dict(data: Mapping[str, object]) -> GearSet:
 
 
 def from_toml_string(text: str) -> GearSet:
-    """Parse a gear set from TOML text.
-
-    Parameters
-    ----------
-    text : str
-        TOML in the layout of :func:`to_toml` (see :func:`template_toml`).
-
-    Returns
-    -------
-    GearSet
-
-    Raises
-    ------
-    ParameterError
-        For text that is not a ``str`` or not TOML (also nested too deeply to parse), and for
-        everything :func:`from_dict` rejects.
-    """
+    """Parse a gear set from TOML text in the layout of :func:`to_toml` (see
+    :func:`template_toml`); :class:`~gearchaos.errors.ParameterError` for text that is not a
+    ``str`` or not TOML (also nested too deeply to parse), and for everything
+    :func:`from_dict` rejects."""
     return GearSet.from_toml_string(text)
 
 
@@ -182,19 +149,8 @@ def from_toml(path: str | os.PathLike[str]) -> GearSet:
 
 
 def to_toml(gs: GearSet) -> str:
-    """The gear set as TOML text with the units of every value in a trailing comment.
-
-    Parameters
-    ----------
-    gs : GearSet
-
-    Returns
-    -------
-    str
-        TOML in the layout of :func:`to_dict`. Integers are written as integers, floats in the
-        shortest form that parses back to the same double, strings as escaped basic strings,
-        harmonics as arrays of floats; ``from_toml_string(to_toml(gs)) == gs`` exactly.
-    """
+    """The gear set as TOML text with the units of every value in a trailing comment; reads
+    back to an equal gear set (see :meth:`GearSet.to_toml`)."""
     return _check_gearset(gs, "to_toml").to_toml()
 
 

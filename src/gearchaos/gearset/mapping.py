@@ -27,6 +27,7 @@ __all__ = [
     "check_changes",
     "coerce",
     "field_names",
+    "flatten",
     "get_value",
     "optional_tables",
     "record_values",
@@ -321,3 +322,19 @@ def records_from_data(data: object) -> tuple[dict[str, object], dict[str, object
                 raise ParameterError(f"missing required parameter '{table}.{f.name}'")
         records[table] = cls(**values)
     return records, meta
+
+
+def flatten(data: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
+    """Nested mappings as one level with dotted keys: ``{"a": {"b": 1}}`` → ``{"a.b": 1}``;
+    a list of mappings (a TOML array of tables) becomes ``a[0].b``, ``a[1].b`` …"""
+    out: dict[str, Any] = {}
+    for k, v in data.items():
+        key = f"{prefix}{k}"
+        if isinstance(v, Mapping):
+            out.update(flatten(v, key + "."))
+        elif isinstance(v, list) and v and all(isinstance(x, Mapping) for x in v):
+            for i, item in enumerate(v):
+                out.update(flatten(item, f"{key}[{i}]."))
+        else:
+            out[key] = v
+    return out

@@ -49,23 +49,7 @@ from .tables import (
 from .tomltext import MAX_FILE_BYTES, parse, to_toml
 from .validation import validate
 
-__all__ = [
-    "MAX_FILE_BYTES",
-    "UNITS",
-    "Backlash",
-    "Clearance",
-    "Damping",
-    "Eccentricity",
-    "GearSet",
-    "Geometry",
-    "Inertia",
-    "Mass",
-    "MeshPhasing",
-    "Stiffness",
-    "Teeth",
-    "Torque",
-    "TransmissionError",
-]
+__all__ = ["MAX_FILE_BYTES", "UNITS", "GearSet"]
 
 
 _NO_CHANGES: Final[Mapping[str, object]] = MappingProxyType({})

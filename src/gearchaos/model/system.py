@@ -113,33 +113,20 @@ class System:
         object.__setattr__(self, "params", p)
 
     # -- delegated layout -------------------------------------------------------------
-    @property
-    def kind(self) -> int:
-        return int(self.model.kind)
-
-    @property
-    def name(self) -> str:
-        return str(self.model.name)
-
-    @property
-    def n_state(self) -> int:
-        return int(self.model.n_state)
-
-    @property
-    def state_names(self) -> tuple[str, ...]:
-        return tuple(self.model.state_names)
-
-    @property
-    def obs_names(self) -> tuple[str, ...]:
-        return tuple(self.model.obs_names)
-
-    @property
-    def n_obs(self) -> int:
-        return len(self.model.obs_names)
-
-    @property
-    def n_track(self) -> int:
-        return int(self.model.n_track)
+    kind = property(lambda self: int(self.model.kind), doc="Kind of the compiled model.")
+    name = property(lambda self: str(self.model.name), doc="Name of the model.")
+    n_state = property(lambda self: int(self.model.n_state), doc="Length of the state.")
+    state_names = property(
+        lambda self: tuple(self.model.state_names), doc="Names of the state components."
+    )
+    obs_names = property(
+        lambda self: tuple(self.model.obs_names), doc="Names of the observables, in order."
+    )
+    n_obs = property(lambda self: len(self.model.obs_names), doc="Number of observables.")
+    n_track = property(
+        lambda self: int(self.model.n_track),
+        doc="Number of leading observables whose extrema are tracked (the dead-zone arguments).",
+    )
 
     def observable(self, name: str, planets: Sequence[int] | None = None) -> Observable:
         """Where a variable lives in the kernel's outputs, by name.

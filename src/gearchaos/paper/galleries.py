@@ -40,6 +40,7 @@ from typing import Any
 
 from ..errors import ParameterError
 from ..gearset.schema import display_symbol, tex
+from ..integrate.settings import SolverSettings
 from .recipes import load_figures, lookup_figure
 
 __all__ = [
@@ -57,6 +58,8 @@ __all__ = [
 PRESET = "sheng2016"
 #: (transient, recorded) mesh periods of the full galleries (the seed discards 100).
 FULL_PERIODS = (100, 500)
+#: Solver settings of :func:`run_gallery` when none are given: 100 transient, 300 recorded.
+GALLERY_SETTINGS = SolverSettings(transient_periods=100, periods=300)
 #: (transient, recorded) mesh periods of ``quick`` galleries (the 0–1 test needs ≥ 100 points).
 QUICK_PERIODS = (50, 100)
 #: Keys of every row of :func:`run_gallery` (and columns of the recipes' CSV), in order.
@@ -102,14 +105,12 @@ def run_gallery(
     values: Sequence[float],
     *,
     fixed: Mapping[str, Any] | None = None,
-    transient: float = 100,
-    periods: int = 300,
     with_: Iterable[str] | str | None = (),
     progress: bool = True,
-    rtol: float = 1e-8,
-    atol: float = 1e-10,
     planet: int = 1,
     title: str | None = None,
+    settings: Any = None,
+    **solver: Any,
 ) -> tuple[Any, list[dict[str, Any]]]:
     """Simulate, measure and label every value of a parameter path and draw the gallery.
 
@@ -124,16 +125,17 @@ def run_gallery(
     fixed
         Other parameters by dotted name, ``omega`` included when it is not varied (required for
         a gear set).
-    transient, periods
-        Mesh periods discarded, then recorded (one Poincaré point each) — for the simulation
-        and for the Lyapunov exponent alike.
     with_
         ``"phase"`` and/or ``"spectrum"`` rows under each map; the simulations then record 64
         samples per period (else one, the section points only).
     progress
         A progress bar on stderr.
-    rtol, atol, planet, title
-        Tolerances; planet of X̄_sp; figure title (default: the gallery's own).
+    planet, title
+        Planet of X̄_sp; figure title (default: the gallery's own).
+    settings, **solver
+        :class:`~gearchaos.integrate.settings.SolverSettings` (default: 100 transient and 300
+        recorded periods) and/or its fields by name (``transient_periods``, ``periods``,
+        ``rtol``, ``atol``) — for the simulation and the Lyapunov exponent alike.
 
     Returns
     -------
@@ -146,29 +148,23 @@ def run_gallery(
     Raises
     ------
     ParameterError
-        An unknown or invalid parameter name or value (checked for every value before anything
-        runs), ``param`` also in ``fixed``, no Ω, or invalid ``with_``.
+        An unknown or invalid parameter name, value or setting (checked for every value before
+        anything runs), ``param`` also in ``fixed``, no Ω, or invalid ``with_``.
     """
     from ..analysis.point import analyse_point
-    from ..integrate.settings import SolverSettings
     from ..model.target import resolve
     from ..plot import axis_symbol
     from ..plot.gallery import parse_extras, poincare_gallery
 
+    extras = parse_extras(with_)
+    base = SolverSettings.build(settings or GALLERY_SETTINGS, **solver)
+    settings = base.replace(samples_per_period=64 if extras else 1)
     fixed = dict(fixed or {})
     if param in fixed:
         raise ParameterError(f"{param} is both varied and fixed; choose one")
     vals = [float(v) for v in values]
     if not vals:
         raise ParameterError(f"{param} needs at least one value: got none")
-    extras = parse_extras(with_)
-    settings = SolverSettings(
-        transient_periods=transient,
-        periods=periods,
-        samples_per_period=64 if extras else 1,
-        rtol=rtol,
-        atol=atol,
-    )
     # resolve every point first: a bad name or value fails before anything runs
     systems = [resolve(gs, {**fixed, param: v}) for v in vals]
     results: list[Any] = []
@@ -202,7 +198,10 @@ def run_gallery(
         title += f" at different {axis_symbol(param)}"
         if given:
             title += "\nat " + ", ".join(given)
-        title += f"\n{transient:g} transient + {periods} recorded periods, zero initial state"
+        title += (
+            f"\n{settings.transient_periods:g} transient + {settings.periods} recorded periods, "
+            "zero initial state"
+        )
     fig = poincare_gallery(
         results, summaries, param=param, values=vals, with_=extras, planet=planet, title=title
     )
@@ -344,7 +343,7 @@ def reproduce_gallery(
         g.param,
         g.values,
         fixed=dict(g.fixed),
-        transient=tr,
+        transient_periods=tr,
         periods=rec,
         progress=progress,
         title=g.title(quick),

@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import StoreError
+from ..gearset.mapping import flatten
 from .integrity import (
     MANIFEST,
     all_chunks,
@@ -297,21 +298,8 @@ def _short(v: Any, limit: int = 80) -> str:
 def _toml_diff(old: str, new: str, what: str) -> str:
     import tomllib
 
-    def flat(d: dict[str, Any], prefix: str = "") -> dict[str, Any]:
-        out: dict[str, Any] = {}
-        for k, v in d.items():
-            key = f"{prefix}{k}"
-            if isinstance(v, dict):
-                out.update(flat(v, key + "."))
-            elif isinstance(v, list) and v and isinstance(v[0], dict):
-                for i, item in enumerate(v):
-                    out.update(flat(item, f"{key}[{i}]."))
-            else:
-                out[key] = v
-        return out
-
     try:
-        a, b = flat(tomllib.loads(old)), flat(tomllib.loads(new))
+        a, b = flatten(tomllib.loads(old)), flatten(tomllib.loads(new))
     except Exception:
         return f"{what} differs (the stored text is not readable TOML)"
     keys = sorted(k for k in set(a) | set(b) if a.get(k) != b.get(k))
