@@ -285,6 +285,7 @@ def _run_locked(
             )
     if not st.exists():
         variables, chunks = layout.variables()
+        _check_sizes(grid, variables, st.path)
         st.create(_coords(grid, layout), variables, chunks, attrs)
 
     done = st.done_tasks()
@@ -310,6 +311,35 @@ def _run_locked(
         classify_store(st.zarr_store)
     st.finish()
     return st.open()
+
+
+def _check_sizes(grid: Grid, variables: dict[str, Any], path: str | None) -> None:
+    """Refuse, before anything is written, a sweep whose task outputs do not fit in memory or
+    whose store (uncompressed, the worst case) does not fit on the disk."""
+    import shutil
+
+    from .._checks import check_memory
+
+    ref = grid.reference
+    per_point = grid.spec.solver.n_samples * (
+        ref.n_state * (1 + int(grid.spec.lyapunov)) + ref.n_obs + 1
+    )
+    largest = int(np.prod(grid.chunks))  # points of the largest task
+    check_memory(f"one task of the sweep ({largest} points)", 8.0 * per_point * largest)
+    total = sum(
+        float(np.prod(shape)) * np.dtype(dtype).itemsize
+        for _, (shape, dtype), _, _ in variables.values()
+    )
+    if path is None:
+        check_memory("the sweep held in memory (store=None)", total)
+        return
+    parent = os.path.dirname(os.path.abspath(path))
+    free = shutil.disk_usage(parent if os.path.isdir(parent) else os.getcwd()).free
+    if total > free:
+        raise ParameterError(
+            f"the sweep store {path} may need up to {total / 2**30:.3g} GiB but the disk has "
+            f"{free / 2**30:.3g} GiB free; record fewer periods or points, or write elsewhere"
+        )
 
 
 def _run_in_process(
