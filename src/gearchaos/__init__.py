@@ -25,6 +25,7 @@ from .model import (
     planetary_system,
 )
 from .sweep import bifurcation, open_sweep
+from .sweep.export import export
 
 __all__ = [
     "GearSet",
@@ -38,6 +39,7 @@ __all__ = [
     "backlash_oscillator",
     "bifurcation",
     "duffing",
+    "export",
     "linear_oscillator",
     "linear_system",
     "lorenz",
