@@ -44,7 +44,8 @@ def _rewrite(obj: griffe.Object, text: str) -> str:
         tilde, name = match.groups()
         shown = name.strip().split(".")[-1] if tilde else name.strip().lstrip(".")
         target = html.escape(_target(obj, name), quote=True)
-        return f'<autoref identifier="{target}" optional><code>{html.escape(shown)}</code></autoref>'
+        code = f"<code>{html.escape(shown)}</code>"
+        return f'<autoref identifier="{target}" optional>{code}</autoref>'
 
     return _ROLE.sub(replace, text)
 
