@@ -1,11 +1,12 @@
-"""Griffe extension: turn the Sphinx roles of gearchaos' docstrings into cross-references.
+"""Griffe extension: Sphinx roles become cross-references, ``#:`` comments docstrings.
 
 The docstrings are numpydoc with Sphinx roles (``:func:`detect_period```,
 ``:class:`~gearchaos.model.System```), which mkdocstrings would print verbatim. This extension
 rewrites each role, before the docstring is parsed, into an *optional* mkdocs-autorefs
 reference: a link when the target is documented on the site, plain code otherwise (never a
 build warning). Relative names are resolved in the docstring's own scope; ``~`` keeps only
-the last component as the link text, as in Sphinx.
+the last component as the link text, as in Sphinx. Module constants are documented the
+Sphinx way, by ``#:`` comment lines above the assignment; they become the constants' docstrings.
 """
 
 from __future__ import annotations
@@ -50,9 +51,30 @@ def _rewrite(obj: griffe.Object, text: str) -> str:
     return _ROLE.sub(replace, text)
 
 
+def _doc_comment(attr: griffe.Attribute) -> str | None:
+    """The ``#:`` comment lines right above an attribute's assignment, as text."""
+    if not attr.lineno or attr.parent is None:
+        return None
+    try:
+        lines = attr.module.lines  # the whole file: line numbers are absolute
+    except Exception:  # no source (compiled or inspected module)
+        return None
+    found: list[str] = []
+    i = attr.lineno - 2  # 0-based index of the line above the assignment
+    while 0 <= i < len(lines) and lines[i].lstrip().startswith("#:"):
+        found.insert(0, lines[i].lstrip()[2:].strip())
+        i -= 1
+    return "\n".join(found) or None
+
+
 class SphinxRoles(griffe.Extension):
-    """Rewrite Sphinx roles in every docstring griffe loads."""
+    """Rewrite Sphinx roles in every docstring griffe loads, and read the Sphinx doc-comments
+    (``#: text`` above an assignment) of module constants as their docstrings."""
 
     def on_instance(self, *, obj: griffe.Object, **_: Any) -> None:
         if obj.docstring is not None and ":" in obj.docstring.value:
             obj.docstring.value = _rewrite(obj, obj.docstring.value)
+
+    def on_attribute_instance(self, *, attr: griffe.Attribute, **_: Any) -> None:
+        if attr.docstring is None and (text := _doc_comment(attr)):
+            attr.docstring = griffe.Docstring(_rewrite(attr, text), lineno=attr.lineno, parent=attr)
