@@ -25,7 +25,7 @@ from .model import (
     planetary_system,
 )
 from .sweep import bifurcation, open_sweep
-from .sweep.export import export
+from .sweep.exports import export
 
 __all__ = [
     "GearSet",

@@ -38,7 +38,7 @@ def export(
 
     Example: **gearchaos export fig4.zarr --to csv -o fig4.csv**
     """
-    from ..sweep.export import export as run_export
+    from ..sweep.exports import export as run_export
 
     with c.reported_errors():
         path = c.output_path(output)

@@ -4,16 +4,39 @@ The records of the tables (:class:`Teeth` … :class:`MeshPhasing`) are those of
 :mod:`.tables`; :class:`GearSet` holds one of each (:mod:`.records`).
 """
 
-from . import tables
 from .io import from_toml, from_toml_string, template_toml, to_toml
 from .presets import list_presets, preset
 from .records import UNITS, GearSet
-from .tables import *  # noqa: F403 - the record classes, listed in tables.__all__
+from .tables import (
+    Backlash,
+    Clearance,
+    Damping,
+    Eccentricity,
+    Geometry,
+    Inertia,
+    Mass,
+    MeshPhasing,
+    Stiffness,
+    Teeth,
+    Torque,
+    TransmissionError,
+)
 
 __all__ = [
-    *(name for name in tables.__all__ if name != "RECORD_CLASSES"),
     "UNITS",
+    "Backlash",
+    "Clearance",
+    "Damping",
+    "Eccentricity",
     "GearSet",
+    "Geometry",
+    "Inertia",
+    "Mass",
+    "MeshPhasing",
+    "Stiffness",
+    "Teeth",
+    "Torque",
+    "TransmissionError",
     "from_toml",
     "from_toml_string",
     "list_presets",

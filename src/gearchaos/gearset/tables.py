@@ -12,22 +12,6 @@ from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Final
 
-__all__ = [
-    "RECORD_CLASSES",
-    "Backlash",
-    "Clearance",
-    "Damping",
-    "Eccentricity",
-    "Geometry",
-    "Inertia",
-    "Mass",
-    "MeshPhasing",
-    "Stiffness",
-    "Teeth",
-    "Torque",
-    "TransmissionError",
-]
-
 
 @dataclass(frozen=True)
 class Teeth:
