@@ -12,8 +12,9 @@ coordinates
 per point
     ``orbit_state`` (point, state): y* at the section; ``multiplier_re``, ``multiplier_im``,
     ``multiplier_abs`` (point, multiplier); ``max_multiplier``, ``unstable`` (number of
-    |μ| > 1), ``stable`` (int8), ``residual``, ``iterations`` (map evaluations of the corrector,
-    with tangents), ``dparameter_ds`` (dλ/ds of the unit tangent: changes sign at folds);
+    |μ| > 1), ``stable`` (int8), ``residual``, ``iterations`` (map evaluations of the
+    corrector), ``jacobians`` (of them, with tangents), ``dparameter_ds`` (dλ/ds of the unit
+    tangent: changes sign at folds), ``on_grid`` (int8: landed on a value of ``grid``);
     the observed variables at the n section points (``delta_sp`` (point, section, planet),
     ``delta_sp_dot`` …, as sweeps store them); extrema over the orbit of the tracked
     observables (``delta_sp_min`` (point, planet_all) …); ``contact_regime`` (point, contact).
@@ -115,6 +116,7 @@ def branch_dataset(
         "start": _start_text(start),
         "n_points": int(P),
         "map_evaluations": int(br.evals),
+        "jacobian_evaluations": int(br.jacobians),
         "tol": float(br.tol),
         "step": st.initial,
         "min_step": st.minimum,
@@ -137,8 +139,12 @@ def branch_dataset(
     ds["stable"] = ("point", (np.abs(mu).max(axis=1) < 1.0).astype(np.int8))
     ds["residual"] = ("point", np.array([p.residual for p in pts]))
     ds["iterations"] = ("point", np.array([p.evals for p in pts], dtype=np.int64))
-    ds["iterations"].attrs["long_name"] = "map evaluations (with tangents) of the corrector"
+    ds["iterations"].attrs["long_name"] = "map evaluations of the corrector"
+    ds["jacobians"] = ("point", np.array([p.jacobians for p in pts], dtype=np.int64))
+    ds["jacobians"].attrs["long_name"] = "map evaluations with tangents (monodromy matrices)"
     ds["dparameter_ds"] = ("point", np.array([float(p.tangent[-1]) for p in pts]))
+    ds["on_grid"] = ("point", np.array([p.landed for p in pts], dtype=np.int8))
+    ds["on_grid"].attrs["long_name"] = "1 where the point was landed on a value of grid"
     for ob in observed:
         vals = np.array([ob.take(p.shot.sections[0], p.shot.section_obs[0]) for p in pts])
         dims = ("point", "section", "planet") if ob.per_planet else ("point", "section")

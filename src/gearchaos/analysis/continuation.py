@@ -45,7 +45,15 @@ from ..integrate.settings import SolverSettings
 from ..model.system import System
 from ..model.target import OMEGA, resolve
 from . import events as ev
-from .orbits import PeriodicOrbit, _guess, contact_levels, default_tol, solve_orbit, split_values
+from .orbits import (
+    ORBIT_SETTINGS,
+    PeriodicOrbit,
+    _guess,
+    contact_levels,
+    default_tol,
+    solve_orbit,
+    split_values,
+)
 from .shooting import Problem, Solution, correct, newton_step
 
 __all__ = ["continuation", "parse_vary"]
@@ -125,6 +133,8 @@ class _Branch:
         self.levels: list[tuple[str, int, float, str]] = []
         self.found: list[ev.Event] = []
         self._systems: dict[float, System] = {}
+        self.grid = np.empty(0)
+        self._slopes: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         self.prob = Problem(
             self.system, n, cfg, tol, steps.max_corrector, 1e-6 * max(1.0, abs(lo), abs(hi))
         )
@@ -153,18 +163,24 @@ class _Branch:
 
     # -- corrector ------------------------------------------------------------------
     def correct(
-        self, z: np.ndarray, normal: np.ndarray, offset: float, near: Solution | None = None
+        self,
+        z: np.ndarray,
+        normal: np.ndarray,
+        offset: float,
+        near: Solution | None = None,
+        sigma: float = 0.0,
     ) -> tuple[Solution | None, str]:
-        """The branch point on the hyperplane ⟨normal, z⟩ = offset, by a chord iteration
-        from ``near``'s Jacobian (G_λ by a forward difference when there is none)."""
-        sol, why = correct(
-            self.prob,
-            z,
-            normal,
-            offset,
-            monodromy=None if near is None else near.monodromy,
-            g_lam=None if near is None else near.g_lam,
-        )
+        """The branch point on the hyperplane ⟨normal, z⟩ = offset, by a quasi-Newton
+        iteration from ``near``'s Jacobian, extrapolated along the branch by σ with the slope
+        from the point before it (a Jacobian evaluation when there is no ``near``)."""
+        mono = g_lam = None
+        if near is not None:
+            mono, g_lam = near.monodromy, near.g_lam
+            slope = self._slopes.get(id(near))
+            if slope is not None:
+                mono = mono + sigma * slope[0]
+                g_lam = g_lam + sigma * slope[1]
+        sol, why = correct(self.prob, z, normal, offset, monodromy=mono, g_lam=g_lam)
         if sol is not None:
             self.evals += sol.evals
             self.jacobians += sol.jacobians
@@ -190,7 +206,7 @@ class _Branch:
         assert p.tangent is not None
         zp = p.z + sigma * p.tangent
         normal = self.weight(p.tangent)
-        q, _ = self.correct(zp, normal, float(normal @ zp), near=p)
+        q, _ = self.correct(zp, normal, float(normal @ zp), near=p, sigma=sigma)
         return q
 
     # -- the continuation loop --------------------------------------------------------
@@ -208,7 +224,7 @@ class _Branch:
             assert p.tangent is not None
             zp = p.z + ds * p.tangent
             normal = self.weight(p.tangent)
-            q, why = self.correct(zp, normal, float(normal @ zp), near=p)
+            q, why = self.correct(zp, normal, float(normal @ zp), near=p, sigma=ds)
             if q is not None and switched and len(pts) == 1 and self._is_subharmonic_lost(q):
                 q, why = None, "the corrector fell back onto the period-n/2 branch"
             if q is not None:
@@ -224,22 +240,45 @@ class _Branch:
                         f"even with the minimum step {st.minimum:.3g}"
                     )
                 continue
-            q.s = p.s + ds
             if not self.lo <= q.lam <= self.hi:
                 bound = self.hi if q.lam > self.hi else self.lo
                 end = self._land(p, bound)
                 if end is None:
                     return pts, f"could not land on the range end {self.name}={bound:.8g}"
-                pts.append(end)
-                self.detect(p, end, len(pts) - 2)
+                self._extend(pts, end)
                 where = "stop" if bound == self.stop else "start"
                 return pts, f"reached the range {where} {self.name}={bound:.8g}"
-            pts.append(q)
-            self.detect(p, q, len(pts) - 2)
+            self._extend(pts, q)
             if q.corrections <= 2:
                 ds = min(ds * 1.5, st.maximum)
             elif q.corrections >= 5:
                 ds = max(ds * 0.6, st.minimum)
+
+    def _extend(self, pts: list[Solution], q: Solution) -> None:
+        """Append q to the branch, after the points landed on grid values between the last
+        point and q, detecting the events between consecutive points."""
+        p = pts[-1]
+        lo, hi = sorted((p.lam, q.lam))
+        inside = self.grid[(self.grid > lo) & (self.grid < hi)]
+        ordered = inside if q.lam > p.lam else inside[::-1]
+        for value in ordered:
+            g = self._land(p, float(value))
+            if g is None:  # a grid value the corrector cannot land on: leave it out
+                continue
+            g.landed = True
+            self._append(pts, g)
+            p = g
+        self._append(pts, q)
+
+    def _append(self, pts: list[Solution], q: Solution) -> None:
+        p = pts[-1]
+        assert p.tangent is not None
+        q.s = p.s + float(self.weight(p.tangent) @ (q.z - p.z))
+        if q.s > p.s:  # the change of M and G_λ per unit arclength, to extrapolate from q
+            h = q.s - p.s
+            self._slopes[id(q)] = ((q.monodromy - p.monodromy) / h, (q.g_lam - p.g_lam) / h)
+        pts.append(q)
+        self.detect(p, q, len(pts) - 2)
 
     def _land(self, p: Solution, bound: float) -> Solution | None:
         """The branch point at λ = bound (natural-parameter corrector from p's tangent)."""
@@ -248,12 +287,10 @@ class _Branch:
         sigma = (bound - p.lam) / tl if tl != 0 else 0.0
         normal = np.zeros(p.y.size + 1)
         normal[-1] = 1.0
-        q, _ = self.correct(p.z + sigma * p.tangent, normal, bound, near=p)
+        q, _ = self.correct(p.z + sigma * p.tangent, normal, bound, near=p, sigma=sigma)
         if q is None:
             return None
         q.tangent = self.tangent(q, p.tangent)
-        d = q.z - p.z
-        q.s = p.s + self.wnorm(d)
         return q
 
     def _is_subharmonic_lost(self, q: Solution) -> bool:
@@ -269,7 +306,7 @@ class _Branch:
     def detect(self, p: Solution, q: Solution, index: int) -> None:
         """Find, locate and record the events between consecutive points p and q."""
         assert p.tangent is not None and q.tangent is not None
-        span = q.s - p.s
+        span = q.s - p.s  # q's coordinate along p's tangent
         found = []
         ta = ev.contact_tests(self.levels, p.shot.obs_min[0], p.shot.obs_max[0])
         tb = ev.contact_tests(self.levels, q.shot.obs_min[0], q.shot.obs_max[0])
@@ -367,6 +404,7 @@ def continuation(
     max_corrector: int = 12,
     tol: float | None = None,
     event_tol: float | None = None,
+    grid: Any = None,
     observe: Any = None,
     store: str | os.PathLike[str] | None = None,
     overwrite: bool = False,
@@ -404,6 +442,10 @@ def continuation(
         Residual tolerance of every point (default 100·rtol, at least 1e-10).
     event_tol
         Arclength tolerance of the event location (default range·1e-6).
+    grid
+        Parameter values to land on: every time the branch passes one, a branch point is
+        computed exactly there (flagged ``on_grid``), e.g. a sweep's grid, to compare
+        orbits with brute-force section points.
     observe
         Variables stored at the section points (default ``delta_sp`` and ``delta_sp_dot``
         for gear sets, the first tracked observable and its derivative otherwise).
@@ -422,7 +464,7 @@ def continuation(
     from .branch import branch_dataset, save_branch
 
     name, a, b = parse_vary(vary)
-    values, cfg = split_values(values_and_settings, settings, params, SolverSettings())
+    values, cfg = split_values(values_and_settings, settings, params, ORBIT_SETTINGS)
     if name in values:
         raise ParameterError(f"{name} is varied and cannot also be fixed")
     lo, hi = min(a, b), max(a, b)
@@ -442,6 +484,14 @@ def continuation(
         raise ParameterError(f"the start {name}={lam0:g} lies outside the range [{lo:g}, {hi:g}]")
     br = _Branch(target, name, values, cfg, n, eps, steps, lo, hi)
     br.stop = b
+    if grid is not None:
+        try:
+            values_grid = np.asarray(grid, dtype=float).reshape(-1)
+        except (TypeError, ValueError):
+            raise ParameterError(f"grid must be numbers: got {grid!r}") from None
+        if not np.all(np.isfinite(values_grid)):
+            raise ParameterError(f"grid must be finite numbers: got {grid!r}")
+        br.grid = np.unique(values_grid)
     system0 = br.system(lam0)
     br.levels = contact_levels(system0)
     if guess is None or (isinstance(guess, PeriodicOrbit) and guess.period != n):
@@ -467,6 +517,7 @@ def continuation(
         br.prob = replace(br.prob, tol=eps)
     if p0 is None:
         raise IntegrationError(f"the start point at {name}={lam0:g} failed: {why}")
+    p0.landed = bool(np.any(br.grid == lam0))
     if switch is None:
         t0 = br.tangent(p0, e_lam * (1.0 if b > lam0 else -1.0))
     else:

@@ -51,6 +51,9 @@ __all__ = [
     "split_values",
 ]
 
+#: Orbit defaults: the guess simulation from rest runs 50 forcing periods (Newton does the rest).
+ORBIT_SETTINGS = SolverSettings(transient_periods=50)
+
 #: Bearing regimes: never touching, touching one side, touching both sides of the clearance.
 BEARING_REGIMES = ("free", "single_sided", "double_sided")
 
@@ -406,8 +409,9 @@ def periodic_orbit(
         Parameter values by name (``omega=1.2``, ``xi=0.05``; names that are not Python
         identifiers go in ``params={"backlash.sun_planet": 2.4}``) and solver settings
         (a :class:`~gearchaos.integrate.settings.SolverSettings` and/or ``rtol``, ``atol``,
-        ``transient_periods`` (of the guess), ``section_phase``, ``max_steps`` by name).
-        The section is the one :func:`gearchaos.simulate` samples with the same settings.
+        ``transient_periods`` (of the guess; default 50), ``section_phase``, ``max_steps``
+        by name). The section is the one :func:`gearchaos.simulate` samples with the same
+        settings.
     tol
         Tolerance of the residual ‖G(y)‖_∞ / max(1, ‖y‖_∞) and of the last Newton correction
         (relative to max(1, ‖y‖_∞)); default rtol/10, at least 1e-12.
@@ -427,7 +431,7 @@ def periodic_orbit(
     eccentricity errors are not T-periodic (a warning says so).
     """
     n = check_int("period", period, lo=1, hi=10_000)
-    values, cfg = split_values(values_and_settings, settings, params, SolverSettings())
+    values, cfg = split_values(values_and_settings, settings, params, ORBIT_SETTINGS)
     system = resolve(target, values)
     gs = getattr(system.model, "gearset", None)
     if gs is not None and gs.has_eccentricity:

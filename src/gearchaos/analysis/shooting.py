@@ -13,9 +13,10 @@ sample per point), so the final tangents of point k hold the one-period fundamen
 
     G(y, λ) = Pⁿ_λ(y) − y = 0,    ⟨a, z⟩ = c,    z = (y, λ),
 
-by a chord–Newton iteration with the Jacobian [[M − I, G_λ], [aᵀ]]: M from the variational
-equations (evaluated where a Jacobian is needed, at the start or when the convergence slows),
-the other map evaluations without tangents (about 20 times cheaper for the planetary model),
+by a quasi-Newton iteration with the Jacobian [[M − I, G_λ], [aᵀ]]: M from the variational
+equations (evaluated where a Jacobian is needed, at the start or when the convergence slows)
+and updated by Broyden's rank-one formula after each step, the other map evaluations without
+tangents (about 20 times cheaper for the planetary model),
 with a backtracking step when the residual does not fall. A fixed-parameter Newton solve is
 the case a = e_λ, c = λ. The last evaluation is always one with tangents at the solution, so
 the returned multipliers belong to the returned state; convergence is judged on the map
@@ -221,7 +222,7 @@ class Solution:
     (with the monodromy) at (y, λ), G_λ, the residual, the work done (map evaluations, of
     which ``jacobians`` with tangents), the sorted multipliers and the number of Newton
     ``corrections``; a continuation adds the
-    unit ``tangent`` and the arclength ``s``."""
+    unit ``tangent``, the arclength ``s`` and whether the point was ``landed`` on a grid value."""
 
     y: np.ndarray
     lam: float
@@ -234,6 +235,7 @@ class Solution:
     corrections: int = 0
     tangent: np.ndarray | None = None
     s: float = 0.0
+    landed: bool = False
 
     @property
     def monodromy(self) -> np.ndarray:
@@ -356,8 +358,9 @@ def correct(
         lam_s = max(1.0, abs(float(z[-1])))
         return bool(np.max(np.abs(dz[:-1])) <= tol * ys and abs(dz[-1]) <= tol * lam_s)
 
+    jac = _bordered(mono, cor.g_l, normal)
     while True:
-        dz = newton_step(_bordered(mono, cor.g_l, normal), -np.append(g, normal @ z - offset))
+        dz = newton_step(jac, -np.append(g, normal @ z - offset))
         if r <= tol and small(dz):
             break
         if cor.evals >= prob.max_evals:
@@ -375,6 +378,9 @@ def correct(
             break  # within tolerance, and the correction no longer helps: the noise floor
         if ts is not None and (rt < (1.0 - 1e-4) * r or rt <= tol):
             slow = rt > 0.1 * r and not fresh
+            # Broyden's (good) rank-one update of the chord Jacobian along the step taken
+            change = np.append(gt - g, normal @ dz) - jac @ dz
+            jac += np.outer(change, dz) / float(dz @ dz)
             z, g, r, shot, fresh = trial, gt, rt, ts, False
             if not slow:
                 continue
@@ -393,6 +399,7 @@ def correct(
             return None, cor.why
         assert new.monodromy is not None
         shot, mono, fresh = new, new.monodromy[0], True
+        jac = _bordered(mono, cor.g_l, normal)
         g = shot.end[0] - z[:-1]
         r = residual_of(g, z[:-1])
 
