@@ -45,7 +45,14 @@ from .._version import provenance
 from ..errors import ParameterError, StoreError
 from .orbits import PeriodicOrbit, model_attrs, orbit_contacts, tracked_groups
 
-__all__ = ["branch_dataset", "branch_multipliers", "fixed_json", "open_branch", "save_branch"]
+__all__ = [
+    "branch_dataset",
+    "branch_multipliers",
+    "check_store",
+    "fixed_json",
+    "open_branch",
+    "save_branch",
+]
 
 
 def _default_observe(system: Any) -> tuple[str, ...]:
@@ -194,12 +201,9 @@ def branch_multipliers(ds: Any) -> np.ndarray:
     return np.asarray(ds["multiplier_re"].values) + 1j * np.asarray(ds["multiplier_im"].values)
 
 
-def save_branch(ds: Any, path: str | os.PathLike[str], *, overwrite: bool = False) -> str:
-    """Write a branch to ``path``: ``*.nc`` as netCDF-4 (h5netcdf), ``*.zarr`` as a Zarr store.
-
-    An existing path is refused unless ``overwrite``; the file appears under its name only
-    when complete.
-    """
+def check_store(path: str | os.PathLike[str], overwrite: bool = False) -> str:
+    """The kind of a branch file (``zarr`` or ``netcdf``) from its suffix; refuses other
+    suffixes and, unless ``overwrite``, existing paths (before any computation)."""
     path = os.fspath(path)
     if path.endswith(".zarr"):
         kind = "zarr"
@@ -207,9 +211,19 @@ def save_branch(ds: Any, path: str | os.PathLike[str], *, overwrite: bool = Fals
         kind = "netcdf"
     else:
         raise ParameterError(f"store must end in .nc or .zarr: got {path!r}")
-    if os.path.exists(path):
-        if not overwrite:
-            raise StoreError(f"{path} exists; choose another path or pass overwrite=True")
+    if os.path.exists(path) and not overwrite:
+        raise StoreError(f"{path} exists; choose another path or pass overwrite=True")
+    return kind
+
+
+def save_branch(ds: Any, path: str | os.PathLike[str], *, overwrite: bool = False) -> str:
+    """Write a branch to ``path``: ``*.nc`` as netCDF-4 (h5netcdf), ``*.zarr`` as a Zarr store.
+
+    An existing path is refused unless ``overwrite``; the file appears under its name only
+    when complete.
+    """
+    kind = check_store(path, overwrite)
+    path = os.fspath(path)
     tmp = path + ".partial"
     if os.path.isdir(tmp):
         shutil.rmtree(tmp)

@@ -16,7 +16,7 @@ equations and G_λ by a forward difference (an extra chain of the same compiled 
 next tangent solves [[M − I, G_λ], [W t_kᵀ]] t = (0, 1). The weighted inner product
 ⟨a, b⟩_W = κ² a_y·b_y + a_λ b_λ, κ = (λ range)/(Y √n_state), Y = max(1, ‖y_0‖_∞), measures
 arclength in units of the parameter: a state change of the size of the state counts as the
-whole range. The step grows after corrector solves of ≤ 2 Newton steps, shrinks after ≥ 4,
+whole range. The step grows after corrector solves of ≤ 3 Newton steps, shrinks after ≥ 6,
 and halves after a failure, down to ``min_step`` where the continuation stops with the reason.
 
 Between consecutive points the test functions of :mod:`gearchaos.analysis.events` detect
@@ -134,6 +134,7 @@ class _Branch:
         self.found: list[ev.Event] = []
         self._systems: dict[float, System] = {}
         self.grid = np.empty(0)
+        self.switched = False
         self._slopes: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         self.prob = Problem(
             self.system, n, cfg, tol, steps.max_corrector, 1e-6 * max(1.0, abs(lo), abs(hi))
@@ -214,6 +215,7 @@ class _Branch:
         """Continue from p0 with tangent t0 until the range ends, a step fails at the minimum
         step or ``max_points`` is reached; returns the points and the stop reason."""
         p0.tangent = t0
+        self.switched = switched
         pts = [p0]
         st = self.steps
         ds = st.initial
@@ -249,9 +251,9 @@ class _Branch:
                 where = "stop" if bound == self.stop else "start"
                 return pts, f"reached the range {where} {self.name}={bound:.8g}"
             self._extend(pts, q)
-            if q.corrections <= 2:
+            if q.corrections <= 3:
                 ds = min(ds * 1.5, st.maximum)
-            elif q.corrections >= 5:
+            elif q.corrections >= 6:
                 ds = max(ds * 0.6, st.minimum)
 
     def _extend(self, pts: list[Solution], q: Solution) -> None:
@@ -324,6 +326,10 @@ class _Branch:
             detail = f"{names}: {self._regime(p, key)} → {self._regime(q, key)}"
             found.append(self._locate("grazing", fn, p, span, ta[key], tb[key], detail))
         changes = ev.multiplier_changes(p.mu, q.mu, float(p.tangent[-1]), float(q.tangent[-1]))
+        if self.switched and index == 0:
+            # a branch switched at a bifurcation starts where a multiplier is +1 (μ² of the
+            # period-n orbit's −1, or the branch point's +1): that is where it came from
+            changes = [c for c in changes if c[1] != "fold"]
         for kind, test in changes:
 
             def mfn(pt: Solution | None, test: str = test) -> float | None:
@@ -461,9 +467,11 @@ def continuation(
         events; attributes with the stop reason and provenance
         (see :func:`gearchaos.analysis.branch.branch_dataset`).
     """
-    from .branch import branch_dataset, save_branch
+    from .branch import branch_dataset, check_store, save_branch
 
     name, a, b = parse_vary(vary)
+    if store is not None:
+        check_store(store, overwrite)
     values, cfg = split_values(values_and_settings, settings, params, ORBIT_SETTINGS)
     if name in values:
         raise ParameterError(f"{name} is varied and cannot also be fixed")

@@ -261,6 +261,10 @@ class Problem:
     fd_step: float = 0.0
 
 
+#: The largest Newton step, relative to max(1, ‖y‖_∞).
+TRUST_RADIUS = 10.0
+
+
 def _bordered(mono: np.ndarray, g_lam: np.ndarray, normal: np.ndarray) -> np.ndarray:
     m = mono.shape[0]
     jac = np.zeros((m + 1, m + 1))
@@ -331,25 +335,34 @@ def correct(
 ) -> tuple[Solution | None, str]:
     """Solve G(y, λ) = 0, ⟨normal, z⟩ = offset from z0 (see the module docstring).
 
-    ``monodromy`` and ``g_lam`` of a nearby solution start a chord iteration without a
-    Jacobian evaluation. The iteration stops when the residual is below ``prob.tol`` and the
-    Newton correction is too (relative to max(1, ‖y‖_∞) and max(1, |λ|)) or no longer lowers
-    the residual (the noise floor of the map, which an ill-conditioned Jacobian amplifies into
-    the correction). At the solution M comes from an evaluation with tangents and, when
-    ``prob.fd_step`` is not 0, G_λ from a forward difference (two chains without tangents in
-    one call). Returns (None, reason) on failure.
+    ``monodromy`` and ``g_lam`` of a nearby solution start the iteration without a Jacobian
+    evaluation. G is always evaluated without tangents (the map that simulations and sweeps
+    integrate: with the tangents in the error control the steps differ, and so does Pⁿ, by
+    about rtol); evaluations with tangents only supply M. The iteration stops when the
+    residual is below ``prob.tol`` and the Newton correction is too (relative to
+    max(1, ‖y‖_∞) and max(1, |λ|)), or the correction no longer lowers ‖G‖ (the noise floor
+    of the map, which an ill-conditioned Jacobian amplifies into the correction). At the
+    solution M comes from an evaluation with tangents there and, when ``prob.fd_step`` is not
+    0, G_λ from a forward difference (two chains in one call). Returns (None, reason) on
+    failure.
     """
-    m = z0.size - 1
-    cor = _Corrector(prob, g_lam, m)
+    cor = _Corrector(prob, g_lam, z0.size - 1)
     tol = prob.tol
     z = np.array(z0, dtype=np.float64)
     corrections = 0
-    fresh = monodromy is None
-    shot = cor.evaluate(z, tangents=fresh, fd=fresh and g_lam is None)
+    mono_at: np.ndarray | None = None  # the z where the monodromy was evaluated
+    tshot: Shot | None = None
+    if monodromy is None:
+        tshot = cor.evaluate(z, tangents=True)
+        if tshot is None:
+            return None, cor.why
+        assert tshot.monodromy is not None
+        monodromy, mono_at = tshot.monodromy[0], z.copy()
+    fd_at: np.ndarray | None = z.copy() if g_lam is None else None
+    shot = cor.evaluate(z, tangents=False, fd=g_lam is None)
     if shot is None:
         return None, cor.why
-    mono = shot.monodromy[0] if shot.monodromy is not None else monodromy
-    assert mono is not None
+    mono = monodromy
     g = shot.end[0] - z[:-1]
     r = residual_of(g, z[:-1])
 
@@ -360,6 +373,7 @@ def correct(
 
     jac = _bordered(mono, cor.g_l, normal)
     while True:
+        fresh = mono_at is not None and np.array_equal(mono_at, z)
         dz = newton_step(jac, -np.append(g, normal @ z - offset))
         if r <= tol and small(dz):
             break
@@ -367,54 +381,70 @@ def correct(
             if r <= tol:
                 break
             return None, f"no convergence in {prob.max_evals} map evaluations (residual {r:.3g})"
+        # trust region: a nearly singular Jacobian must not throw the state far away
+        reach = float(np.max(np.abs(dz[:-1])))
+        cap = TRUST_RADIUS * max(1.0, float(np.max(np.abs(z[:-1]))))
+        if reach > cap:
+            dz = dz * (cap / reach)
         trial = z + dz
         corrections += 1
         ts = cor.evaluate(trial, tangents=False)
         rt = math.inf
+        # decrease is judged on ‖G‖ itself (the relative residual would also fall if y ran off)
+        a, at = float(np.max(np.abs(g))), math.inf
         if ts is not None:
             gt = ts.end[0] - trial[:-1]
             rt = residual_of(gt, trial[:-1])
-        if r <= tol and not rt < 0.5 * r:
+            at = float(np.max(np.abs(gt)))
+        if r <= tol and not at < 0.5 * a:
             break  # within tolerance, and the correction no longer helps: the noise floor
-        if ts is not None and (rt < (1.0 - 1e-4) * r or rt <= tol):
-            slow = rt > 0.1 * r and not fresh
-            # Broyden's (good) rank-one update of the chord Jacobian along the step taken
+        if ts is not None and (at < (1.0 - 1e-4) * a or rt <= tol):
+            slow = at > 0.1 * a and not fresh
+            # Broyden's (good) rank-one update of the Jacobian along the step taken
             change = np.append(gt - g, normal @ dz) - jac @ dz
             jac += np.outer(change, dz) / float(dz @ dz)
-            z, g, r, shot, fresh = trial, gt, rt, ts, False
+            z, g, r, shot = trial, gt, rt, ts
             if not slow:
                 continue
         elif fresh:
             # a fresh Jacobian and still no decrease: shorter steps, together in one call
-            step = _backtrack(prob, z, dz, r)
+            step = _backtrack(prob, z, dz, g)
             cor.evals += 1
             if step is None:
                 return None, f"the damped Newton step no longer lowers the residual ({r:.3g})"
             z, g, r, shot = step
-            fresh = False
             continue
-        # the chord Jacobian is stale (slow or no decrease): M and G_λ at z
-        new = cor.evaluate(z, tangents=True, fd=True)
-        if new is None:
+        # the Jacobian is stale (slow or no decrease): M, G_λ (and G) at z
+        tshot = cor.evaluate(z, tangents=True)
+        new = tshot and cor.evaluate(z, tangents=False, fd=True)
+        if tshot is None or not new:
             return None, cor.why
-        assert new.monodromy is not None
-        shot, mono, fresh = new, new.monodromy[0], True
+        assert tshot.monodromy is not None
+        mono, mono_at, fd_at, shot = tshot.monodromy[0], z.copy(), z.copy(), new
         jac = _bordered(mono, cor.g_l, normal)
         g = shot.end[0] - z[:-1]
         r = residual_of(g, z[:-1])
 
-    # the multipliers of the solution; the residual stays that of the map without tangents
-    # where there is one (simulations and sweeps integrate it: with the tangents in the error
-    # control the steps differ, and so does Pⁿ, by about rtol/30)
-    if shot.monodromy is None:
-        new = cor.evaluate(z, tangents=True)
-        if new is None:
-            return None, cor.why
-        shot = new
-    assert shot.monodromy is not None
-    if prob.fd_step != 0.0 and not cor.evaluate(z, tangents=False, fd=True):
+    # the multipliers of the solution (and G_λ there)
+    if mono_at is None or not np.array_equal(mono_at, z):
+        tshot = cor.evaluate(z, tangents=True)
+    if tshot is None or tshot.monodromy is None:
         return None, cor.why
-    mu = multipliers_of(shot.monodromy[0])
+    if prob.fd_step != 0.0 and (fd_at is None or not np.array_equal(fd_at, z)):
+        if not cor.evaluate(z, tangents=False, fd=True):
+            return None, cor.why
+    mu = multipliers_of(tshot.monodromy[0])
+    # sections and extrema of the map without tangents, the monodromy from the tangents
+    shot = Shot(
+        end=shot.end,
+        monodromy=tshot.monodromy,
+        sections=shot.sections,
+        section_obs=shot.section_obs,
+        obs_min=shot.obs_min,
+        obs_max=shot.obs_max,
+        status=shot.status,
+        steps=shot.steps,
+    )
     sol = Solution(
         z[:-1].copy(), float(z[-1]), shot, cor.g_l, r, cor.evals, cor.jacs, mu, corrections
     )
@@ -431,19 +461,19 @@ def _plain(prob: Problem, zs: np.ndarray) -> Shot | None:
 
 
 def _backtrack(
-    prob: Problem, z: np.ndarray, dz: np.ndarray, r: float
+    prob: Problem, z: np.ndarray, dz: np.ndarray, g0: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, float, Shot] | None:
-    """The longest of the steps λ dz, λ = ½ … 1/16, that lowers the residual (Armijo)."""
+    """The longest of the steps λ dz, λ = ½ … 1/16, that lowers ‖G‖ (Armijo)."""
     lams = (0.5, 0.25, 0.125, 0.0625)
     zs = np.array([z + lam * dz for lam in lams])
     shots = _plain(prob, zs)
+    a = float(np.max(np.abs(g0)))
     if shots is None:
         return None
     for c, lam in enumerate(lams):
         if not shots.ok(c):
             continue
         g = shots.end[c] - zs[c, :-1]
-        rt = residual_of(g, zs[c, :-1])
-        if rt < (1.0 - 1e-4 * lam) * r:
-            return zs[c], g, rt, shots.chain(c)
+        if float(np.max(np.abs(g))) < (1.0 - 1e-4 * lam) * a:
+            return zs[c], g, residual_of(g, zs[c, :-1]), shots.chain(c)
     return None
