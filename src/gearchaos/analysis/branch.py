@@ -13,8 +13,9 @@ per point
     ``orbit_state`` (point, state): y* at the section; ``multiplier_re``, ``multiplier_im``,
     ``multiplier_abs`` (point, multiplier); ``max_multiplier``, ``unstable`` (number of
     |μ| > 1), ``stable`` (int8), ``residual``, ``iterations`` (map evaluations of the
-    corrector), ``jacobians`` (of them, with tangents), ``dparameter_ds`` (dλ/ds of the unit
-    tangent: changes sign at folds), ``on_grid`` (int8: landed on a value of ``grid``);
+    corrector), ``jacobians`` (of them, with tangents), ``newton_steps`` (corrections),
+    ``dparameter_ds`` (dλ/ds of the unit tangent: changes sign at folds), ``on_grid`` (int8:
+    landed on a value of ``grid``);
     the observed variables at the n section points (``delta_sp`` (point, section, planet),
     ``delta_sp_dot`` …, as sweeps store them); extrema over the orbit of the tracked
     observables (``delta_sp_min`` (point, planet_all) …); ``contact_regime`` (point, contact).
@@ -147,6 +148,8 @@ def branch_dataset(
     ds["residual"] = ("point", np.array([p.residual for p in pts]))
     ds["iterations"] = ("point", np.array([p.evals for p in pts], dtype=np.int64))
     ds["iterations"].attrs["long_name"] = "map evaluations of the corrector"
+    ds["newton_steps"] = ("point", np.array([p.corrections for p in pts], dtype=np.int64))
+    ds["newton_steps"].attrs["long_name"] = "Newton corrections of the corrector"
     ds["jacobians"] = ("point", np.array([p.jacobians for p in pts], dtype=np.int64))
     ds["jacobians"].attrs["long_name"] = "map evaluations with tangents (monodromy matrices)"
     ds["dparameter_ds"] = ("point", np.array([float(p.tangent[-1]) for p in pts]))

@@ -11,9 +11,11 @@ tangent t_k the predictor is z_k + Δs t_k and the corrector solves, by Newton's
     G(y, λ) = 0,    ⟨t_k, z − z_k − Δs t_k⟩_W = 0
 
 (Keller's pseudo-arclength; the second equation fixes the position along the branch, so folds
-are passed). The bordered Jacobian is [[M − I, G_λ], [W t_kᵀ]], M = DPⁿ from the variational
-equations and G_λ by a forward difference (an extra chain of the same compiled call). The
-next tangent solves [[M − I, G_λ], [W t_kᵀ]] t = (0, 1). The weighted inner product
+are passed), by the quasi-Newton corrector of :mod:`gearchaos.analysis.shooting` with the
+bordered Jacobian [[M − I, G_λ], [W t_kᵀ]]: M = DPⁿ from the variational equations, G_λ by a
+forward difference (two chains of one compiled call), both started from the previous point's,
+extrapolated along the branch. The next tangent solves [[M − I, G_λ], [W t_kᵀ]] t = (0, 1)
+with M and G_λ at the new point. The weighted inner product
 ⟨a, b⟩_W = κ² a_y·b_y + a_λ b_λ, κ = (λ range)/(Y √n_state), Y = max(1, ‖y_0‖_∞), measures
 arclength in units of the parameter: a state change of the size of the state counts as the
 whole range. The step grows after corrector solves of ≤ 3 Newton steps, shrinks after ≥ 6,
@@ -48,9 +50,10 @@ from . import events as ev
 from .orbits import (
     ORBIT_SETTINGS,
     PeriodicOrbit,
-    _guess,
     contact_levels,
     default_tol,
+    initial_guess,
+    orbit_contacts,
     solve_orbit,
     split_values,
 )
@@ -211,11 +214,12 @@ class _Branch:
         return q
 
     # -- the continuation loop --------------------------------------------------------
-    def run(self, p0: Solution, t0: np.ndarray, switched: bool) -> tuple[list[Solution], str]:
+    def run(self, p0: Solution, t0: np.ndarray, switched: str) -> tuple[list[Solution], str]:
         """Continue from p0 with tangent t0 until the range ends, a step fails at the minimum
-        step or ``max_points`` is reached; returns the points and the stop reason."""
+        step or ``max_points`` is reached; returns the points and the stop reason.
+        ``switched`` names the event kind a switched branch starts from ("" otherwise)."""
         p0.tangent = t0
-        self.switched = switched
+        self.switched = bool(switched)
         pts = [p0]
         st = self.steps
         ds = st.initial
@@ -227,7 +231,8 @@ class _Branch:
             zp = p.z + ds * p.tangent
             normal = self.weight(p.tangent)
             q, why = self.correct(zp, normal, float(normal @ zp), near=p, sigma=ds)
-            if q is not None and switched and len(pts) == 1 and self._is_subharmonic_lost(q):
+            doubled = switched == "period_doubling" and len(pts) == 1
+            if q is not None and doubled and self._is_subharmonic_lost(q):
                 q, why = None, "the corrector fell back onto the period-n/2 branch"
             if q is not None:
                 q.tangent = self.tangent(q, p.tangent)
@@ -345,12 +350,8 @@ class _Branch:
             self.found.append(ev.Event(**{**e, "point": index}))
 
     def _regime(self, p: Solution, key: tuple[str, str]) -> str:
-        from .orbits import orbit_contacts
-
-        return orbit_contacts(self._system_cache(p), p.shot.obs_min[0], p.shot.obs_max[0])[key[0]]
-
-    def _system_cache(self, p: Solution) -> System:
-        return self.system(p.lam)
+        regimes = orbit_contacts(self.system(p.lam), p.shot.obs_min[0], p.shot.obs_max[0])
+        return regimes[key[0]]
 
     def _locate(
         self, kind: str, fn: Any, p: Solution, span: float, fa: float, fb: float, detail: str
@@ -501,11 +502,16 @@ def continuation(
             raise ParameterError(f"grid must be finite numbers: got {grid!r}")
         br.grid = np.unique(values_grid)
     system0 = br.system(lam0)
+    gs = getattr(system0.model, "gearset", None)
+    if gs is not None and gs.has_eccentricity:
+        from ..gearset.validation import warn_if_eccentric
+
+        warn_if_eccentric(gs, "Poincaré section")
     br.levels = contact_levels(system0)
     if guess is None or (isinstance(guess, PeriodicOrbit) and guess.period != n):
-        y0 = _guess(system0, None, n, cfg)
+        y0 = initial_guess(system0, None, n, cfg)
     else:
-        y0 = _guess(system0, guess, n, cfg)
+        y0 = initial_guess(system0, guess, n, cfg)
     if switch is None:
         orbit = solve_orbit(system0, y0, n, cfg, eps, 40)
         if not orbit.converged:
@@ -531,7 +537,7 @@ def continuation(
     else:
         t0 = np.append(switch, 0.0)
         t0 /= br.wnorm(t0)
-    pts, reason = br.run(p0, t0, switch is not None)
+    pts, reason = br.run(p0, t0, "" if switch is None else start.kind)
     ds = branch_dataset(
         br, pts, sorted(br.found, key=lambda e: e.arclength), reason, (a, b), observe, start
     )

@@ -36,11 +36,11 @@ import numpy as np
 
 from .._checks import check_int, check_real
 from .._version import provenance
-from ..errors import ParameterError, Status
+from ..errors import IntegrationError, ParameterError, Status
 from ..integrate.settings import SolverSettings
 from ..model.system import System
 from ..model.target import resolve
-from .contact import REGIMES, contact_regime
+from .contact import contact_regime
 from .shooting import Problem, Solution, correct, section_time
 
 __all__ = [
@@ -143,7 +143,7 @@ class PeriodicOrbit:
     settings: SolverSettings
     status: Status = Status.OK
     message: str = ""
-    tol: float = 1e-7
+    tol: float = 1e-9
     values: Mapping[str, float] = field(default_factory=dict)
 
     # -- derived ----------------------------------------------------------------
@@ -335,7 +335,7 @@ def default_tol(settings: SolverSettings) -> float:
     return max(1e-12, 0.1 * float(settings.rtol))
 
 
-def _guess(system: System, guess: Any, n: int, cfg: SolverSettings) -> np.ndarray:
+def initial_guess(system: System, guess: Any, n: int, cfg: SolverSettings) -> np.ndarray:
     """The Newton start: a state, an orbit's state, or the section point of a simulation
     (``guess=None``: ``transient_periods`` from rest) that best repeats after n periods."""
     if isinstance(guess, PeriodicOrbit):
@@ -345,7 +345,7 @@ def _guess(system: System, guess: Any, n: int, cfg: SolverSettings) -> np.ndarra
 
         traj = integrate(system, cfg.replace(periods=2 * n, samples_per_period=1))
         if not traj.ok:
-            raise ParameterError(
+            raise IntegrationError(
                 f"the guess simulation at omega={system.omega:g} failed: {traj.status.message}"
             )
         secs = traj.states[traj.section_index]
@@ -440,7 +440,7 @@ def periodic_orbit(
         warn_if_eccentric(gs, "Poincaré section")
     eps = default_tol(cfg) if tol is None else check_real("tol", tol, lo=0.0, lo_open=True)
     iters = check_int("max_iterations", max_iterations, lo=1)
-    y = _guess(system, guess, n, cfg)
+    y = initial_guess(system, guess, n, cfg)
     return solve_orbit(system, y, n, cfg, eps, iters, values=values)
 
 
@@ -494,7 +494,3 @@ def orbit_from(system: System, sol: Solution, **kw: Any) -> PeriodicOrbit:
         status=Status(int(shot.status[0])),
         **kw,
     )
-
-
-#: Contact regimes of meshes and bearings (for validation of stored values).
-ALL_REGIMES = (*REGIMES, *BEARING_REGIMES, "unknown")

@@ -13,15 +13,17 @@ sample per point), so the final tangents of point k hold the one-period fundamen
 
     G(y, λ) = Pⁿ_λ(y) − y = 0,    ⟨a, z⟩ = c,    z = (y, λ),
 
-by a quasi-Newton iteration with the Jacobian [[M − I, G_λ], [aᵀ]]: M from the variational
-equations (evaluated where a Jacobian is needed, at the start or when the convergence slows)
-and updated by Broyden's rank-one formula after each step, the other map evaluations without
-tangents (about 20 times cheaper for the planetary model),
-with a backtracking step when the residual does not fall. A fixed-parameter Newton solve is
-the case a = e_λ, c = λ. The last evaluation is always one with tangents at the solution, so
-the returned multipliers belong to the returned state; convergence is judged on the map
-without tangents where there is one (the map that simulations and sweeps integrate: with the
-tangents in the error control the steps, and so Pⁿ, differ by about rtol/30).
+by a quasi-Newton iteration with the Jacobian [[M − I, G_λ], [aᵀ]]. M comes from the
+variational equations where a Jacobian is needed (at the start, or when the convergence slows
+below a tenfold reduction per step) and is updated by Broyden's rank-one formula after every
+step; a continuation passes in the M of the previous point extrapolated along the branch.
+G itself is always evaluated without tangents, about 20 times cheaper for the planetary model
+and the map that simulations and sweeps integrate (with the tangents in the error control the
+steps differ, and so does Pⁿ, by about rtol). A step that does not lower ‖G‖_∞ is refused: a
+stale Jacobian is refreshed, a fresh one backtracks (½ … 1/16 of the step, evaluated together);
+a step never moves the state by more than ten times its size (trust region). A fixed-parameter
+Newton solve is the case a = e_λ, c = λ. The last evaluation with tangents is always at the
+solution, so the returned multipliers belong to the returned state.
 """
 
 from __future__ import annotations
