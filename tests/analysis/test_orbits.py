@@ -274,3 +274,40 @@ def test_dotted_parameters_by_params(sheng: gc.GearSet) -> None:
     c = gc.periodic_orbit(sheng, omega=0.5)
     shift = a.section("delta_sp")[0, 0] - c.section("delta_sp")[0, 0]
     assert shift == pytest.approx(-0.5, abs=1e-6)
+
+
+# ----------------------------------------------------------------------------------- batches
+def test_batched_orbits_confirm_the_points_of_a_sweep(sheng: gc.GearSet) -> None:
+    """The sweep's final states (at a section time) are the guesses; the batched Newton finds
+    the orbits the sweep converged to, and each is what periodic_orbit finds alone."""
+    from gearchaos.analysis.orbit_batch import periodic_orbits
+    from gearchaos.analysis.periodicity import periods_of
+
+    sweep = gc.bifurcation(
+        sheng, "omega=2.9:3.1:5", progress=False, transient_periods=600, periods=16
+    )
+    settings = gc.integrate.SolverSettings(transient_periods=600, periods=16)
+    labels = periods_of(
+        np.stack([sweep.delta_sp.values[..., 0], sweep.delta_sp_dot.values[..., 0]], axis=-1)
+    )
+    one = np.flatnonzero(labels == 1)  # the points the sweep labels 1T
+    assert one.size >= 3
+    points = [{"omega": float(sweep.omega.values[k])} for k in one]
+    guesses = sweep.final_state.values[one]
+    orbits = periodic_orbits(sheng, points, guesses=guesses, settings=settings)
+    for k, orbit in zip(one, orbits, strict=True):
+        assert orbit.converged, orbit.message
+        assert orbit.minimal_period == 1
+        assert orbit.stable
+        # the sweep's section points lie on the orbit (to the sweep's convergence)
+        assert orbit.section("delta_sp")[0, 0] == pytest.approx(
+            float(sweep.delta_sp.values[k, -1, 0]), abs=1e-4
+        )
+        alone = gc.periodic_orbit(
+            sheng, guess=sweep.final_state.values[k], settings=settings, omega=orbit.omega
+        )
+        assert np.max(np.abs(alone.state - orbit.state)) < 1e-7
+        assert max_mismatch(alone.multipliers, orbit.multipliers) < 1e-6
+    with pytest.raises(gc.ParameterError, match="guesses"):
+        periodic_orbits(sheng, points, guesses=np.zeros((2, 16)))
+    assert periodic_orbits(sheng, []) == []

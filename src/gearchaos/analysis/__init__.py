@@ -4,7 +4,8 @@
 :mod:`.lyapunov` (exponents from the variational equations), :mod:`.chaos01` (0–1 test),
 :mod:`.classify` (motion labels), :mod:`.contact` (contact regimes per mesh), :mod:`.summary`
 (a JSON-serialisable summary of one simulation), :mod:`.orbits` (periodic orbits by shooting,
-Floquet multipliers; :mod:`.shooting` holds the map evaluations and the Newton corrector),
+Floquet multipliers; :mod:`.shooting` holds the map evaluations and the Newton corrector,
+:mod:`.orbit_batch` many orbits in one Newton iteration),
 :mod:`.continuation` (pseudo-arclength continuation of branches, :mod:`.events` their folds,
 period doublings, Neimark–Sacker and grazing events, :mod:`.branch` their datasets and files)
 and, for gear sets, :mod:`.modal` (linear natural frequencies).
@@ -24,6 +25,7 @@ from .contact import contact_fractions, contact_regime, contact_regimes, separat
 from .continuation import continuation
 from .events import Event, events
 from .lyapunov import LyapunovResult, lyapunov_spectrum, max_lyapunov
+from .orbit_batch import periodic_orbits
 from .orbits import PeriodicOrbit, periodic_orbit
 from .periodicity import detect_period, period_label
 from .poincare import count_distinct, section_points
@@ -51,6 +53,7 @@ __all__ = [
     "open_branch",
     "period_label",
     "periodic_orbit",
+    "periodic_orbits",
     "regime_table",
     "save_branch",
     "section_points",
