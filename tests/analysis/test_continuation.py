@@ -261,3 +261,41 @@ def test_invalid_arguments_are_named() -> None:
         gc.continuation(system, "omega=0.6:0.7", max_step=-1.0)
     with pytest.raises(gc.ParameterError, match=r"\.nc or \.zarr"):
         gc.continuation(system, "omega=0.6:0.61", store="branch.txt")
+
+
+def test_sun_bearing_grazing_where_the_free_orbit_reaches_the_clearance() -> None:
+    """With sequential (Parker) mesh phasing the sun centre moves. While |x̄_s|, |ȳ_s| ≤ b̄_s
+    the bearing exerts no stiffness force (its damping acts everywhere), so the orbit does not
+    depend on b̄_s; shrinking b̄_s, the bearing first touches where b̄_s equals the largest
+    excursion of the free orbit, on the positive sides of ȳ_s and x̄_s."""
+    gs = gc.preset("sheng2016").evolve({"mesh_phasing.model": "parker"})
+    ds = gc.continuation(gs, "clearance.sun_bearing=0.0025:0.0015", omega=0.5, max_step=1e-4)
+    free = gc.periodic_orbit(gs, omega=0.5, **TIGHT)  # b̄_s = 2: never touches
+    res = gc.simulate(
+        free.system, y0=free.state, transient_periods=0, periods=1, samples_per_period=4000,
+        **TIGHT,
+    )  # fmt: skip
+    reach_x, reach_y = float(np.max(res.series("x_s"))), float(np.max(res.series("y_s")))
+    assert 0.0015 < min(reach_x, reach_y) and max(reach_x, reach_y) < 0.0025
+    found = events(ds)
+    assert all(e.kind == "grazing" for e in found)
+    first = sorted(found, key=lambda e: -e.value)[:2]
+    expected = sorted(
+        [(reach_x, "sun_bearing_x: free → single_sided"),
+         (reach_y, "sun_bearing_y: free → single_sided")],
+        reverse=True,
+    )  # fmt: skip
+    tols = (1e-8, 1e-7)
+    for e, (value, detail), tol in zip(first, expected, tols, strict=True):
+        # the second contact happens on an orbit the first one has (slightly) changed
+        assert e.detail == detail
+        assert e.value == pytest.approx(value, abs=tol)
+    # before the first contact the orbit is the same at every b̄_s
+    before = ds.where(ds["clearance.sun_bearing"] > max(reach_x, reach_y), drop=True)
+    assert before.sizes["point"] >= 3
+    assert np.ptp(before.orbit_state.values, axis=0).max() < 1e-9
+    assert np.max(np.abs(before.orbit_state.values[0] - free.state)) < 1e-8
+    last = ds.contact_regime.isel(point=-1)
+    assert list(last.sel(contact=["sun_bearing_x", "sun_bearing_y"]).values) == [
+        "double_sided", "double_sided",
+    ]  # fmt: skip

@@ -168,8 +168,10 @@ def branch_dataset(
                 ds[f"{nm}_{which}"] = ("point", arr[:, 0])
             ds[f"{nm}_{which}"].attrs["long_name"] = f"{which} of {nm} over the orbit"
     if levels:
+        # against the clearances of each point (the continued parameter may be one)
         reg = [
-            list(orbit_contacts(ref, p.shot.obs_min[0], p.shot.obs_max[0]).values()) for p in pts
+            list(orbit_contacts(br.system(p.lam), p.shot.obs_min[0], p.shot.obs_max[0]).values())
+            for p in pts
         ]
         ds["contact_regime"] = (("point", "contact"), np.array(reg, dtype="U16"))
     _put_events(ds, events, m)

@@ -315,8 +315,8 @@ class _Branch:
         assert p.tangent is not None and q.tangent is not None
         span = q.s - p.s  # q's coordinate along p's tangent
         found = []
-        ta = ev.contact_tests(self.levels, p.shot.obs_min[0], p.shot.obs_max[0])
-        tb = ev.contact_tests(self.levels, q.shot.obs_min[0], q.shot.obs_max[0])
+        ta = self.contact_tests(p)
+        tb = self.contact_tests(q)
         grazing = ev.contact_changes(ta, tb)
         for group in grazing:
             key = group[0]
@@ -324,8 +324,7 @@ class _Branch:
             def fn(pt: Solution | None, key: tuple[str, str] = key) -> float | None:
                 if pt is None:
                     return None
-                tv = ev.contact_tests(self.levels, pt.shot.obs_min[0], pt.shot.obs_max[0])
-                return tv[key]
+                return self.contact_tests(pt)[key]
 
             names = ",".join(k[0] for k in group)
             detail = f"{names}: {self._regime(p, key)} → {self._regime(q, key)}"
@@ -348,6 +347,12 @@ class _Branch:
             found.append(self._locate(kind, mfn, p, span, fa, fb, note))
         for e in found:
             self.found.append(ev.Event(**{**e, "point": index}))
+
+    def contact_tests(self, p: Solution) -> dict[tuple[str, str], float]:
+        """Grazing test functions at p, against the clearances at p's parameter value (the
+        continued parameter may be a clearance)."""
+        levels = contact_levels(self.system(p.lam))
+        return ev.contact_tests(levels, p.shot.obs_min[0], p.shot.obs_max[0])
 
     def _regime(self, p: Solution, key: tuple[str, str]) -> str:
         regimes = orbit_contacts(self.system(p.lam), p.shot.obs_min[0], p.shot.obs_max[0])
