@@ -299,3 +299,21 @@ def test_sun_bearing_grazing_where_the_free_orbit_reaches_the_clearance() -> Non
     assert list(last.sel(contact=["sun_bearing_x", "sun_bearing_y"]).values) == [
         "double_sided", "double_sided",
     ]  # fmt: skip
+
+
+def test_neimark_sacker_of_the_duffing_oscillator_where_the_damping_vanishes() -> None:
+    """x'' + δx' + x + x³ = γ cos Ωτ: the divergence of the vector field is −δ, so
+    det M = exp(−δT) (Liouville) and a complex pair of multipliers has |μ|² = exp(−δT).
+    Continuing in δ through 0, the pair leaves the unit circle exactly at δ = 0."""
+    omega = 1.2
+    system = gc.duffing(omega, delta=0.1, gamma=0.1)
+    ds = gc.continuation(system, "delta=0.1:-0.1", max_step=0.01, **TIGHT)
+    (ns,) = events(ds)
+    assert ns.kind == "neimark_sacker"
+    assert ns.value == pytest.approx(0.0, abs=1e-6)
+    assert abs(ns.multiplier) == pytest.approx(1.0, abs=1e-6)
+    assert ns.multiplier.imag > 0.1
+    period = 2 * math.pi / omega
+    expected = np.exp(-ds.delta.values * period / 2)
+    assert np.max(np.abs(ds.multiplier_abs.values - expected[:, None])) < 1e-9
+    assert np.array_equal(ds.stable.values == 1, ds.delta.values > 0)
