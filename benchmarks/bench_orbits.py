@@ -109,6 +109,7 @@ def bench_branch(gs: gc.GearSet, points: int) -> dict[str, float]:
         "sweep_cpu": sc,
         "evals_per_point": float(branch.iterations.mean()),
         "jacobians_per_point": float(branch.jacobians.mean()),
+        "newton_per_point": float(branch.newton_steps.mean()),
         "all_evals_per_point": branch.attrs["map_evaluations"] / n_b,
         "events": int(branch.sizes["event"]),
         "stop_reason": branch.attrs["stop_reason"],
@@ -170,6 +171,7 @@ def main() -> None:
         f"{b['sweep_cpu'] / b['branch_cpu']:.2f} | "
         f"{(b['sweep_wall'] / b['sweep_points']) / (b['branch_wall'] / b['branch_points']):.2f} |"
     )
+    print(f"Newton steps per branch point: {b['newton_per_point']:.2f}")
     print(
         f"map evaluations per branch point: {b['evals_per_point']:.2f} in the corrector "
         f"({b['jacobians_per_point']:.2f} with tangents), {b['all_evals_per_point']:.2f} with "

@@ -117,6 +117,8 @@ def test_period_doubling_cascade_matches_the_brute_force_sweep() -> None:
         assert ds.attrs["period"] == n
         # every orbit of the branch but the first (the bifurcation point) has n distinct points
         assert np.all(np.ptp(ds.x.values[1:], axis=1) > 1e-6)
+        assert ds.minimal_period.values[0] == n // 2
+        assert np.all(ds.minimal_period.values[1:] == n)
         on = ds.where(ds.on_grid == 1, drop=True)
         compared = 0
         for i, w in enumerate(on.omega.values):

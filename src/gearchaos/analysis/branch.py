@@ -14,8 +14,9 @@ per point
     ``multiplier_abs`` (point, multiplier); ``max_multiplier``, ``unstable`` (number of
     |μ| > 1), ``stable`` (int8), ``residual``, ``iterations`` (map evaluations of the
     corrector), ``jacobians`` (of them, with tangents), ``newton_steps`` (corrections),
-    ``dparameter_ds`` (dλ/ds of the unit tangent: changes sign at folds), ``on_grid`` (int8:
-    landed on a value of ``grid``);
+    ``dparameter_ds`` (dλ/ds of the unit tangent: changes sign at folds), ``minimal_period``
+    (the smallest d | n after which the section points repeat), ``on_grid`` (int8: landed on
+    a value of ``grid``);
     the observed variables at the n section points (``delta_sp`` (point, section, planet),
     ``delta_sp_dot`` …, as sweeps store them); extrema over the orbit of the tracked
     observables (``delta_sp_min`` (point, planet_all) …); ``contact_regime`` (point, contact).
@@ -44,7 +45,13 @@ import numpy as np
 
 from .._version import provenance
 from ..errors import ParameterError, StoreError
-from .orbits import PeriodicOrbit, model_attrs, orbit_contacts, tracked_groups
+from .orbits import (
+    PeriodicOrbit,
+    minimal_period,
+    model_attrs,
+    orbit_contacts,
+    tracked_groups,
+)
 
 __all__ = [
     "branch_dataset",
@@ -153,6 +160,13 @@ def branch_dataset(
     ds["jacobians"] = ("point", np.array([p.jacobians for p in pts], dtype=np.int64))
     ds["jacobians"].attrs["long_name"] = "map evaluations with tangents (monodromy matrices)"
     ds["dparameter_ds"] = ("point", np.array([float(p.tangent[-1]) for p in pts]))
+    ds["minimal_period"] = (
+        "point",
+        np.array([minimal_period(p.shot.sections[0], br.tol) for p in pts], dtype=np.int64),
+    )
+    ds["minimal_period"].attrs["long_name"] = (
+        "smallest d | n after which the section points repeat (d < n: a period-d orbit)"
+    )
     ds["on_grid"] = ("point", np.array([p.landed for p in pts], dtype=np.int8))
     ds["on_grid"].attrs["long_name"] = "1 where the point was landed on a value of grid"
     for ob in observed:

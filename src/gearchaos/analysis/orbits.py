@@ -170,15 +170,7 @@ class PeriodicOrbit:
     def minimal_period(self) -> int:
         """The smallest d dividing n with the section points repeating after d periods (to
         max(1e-6, 100 tol) relative): 1 for a period-1 orbit found as a fixed point of P²."""
-        scale = max(1.0, float(np.max(np.abs(self.sections))))
-        thr = max(1e-6, 100.0 * self.tol) * scale
-        for d in range(1, self.period + 1):
-            if self.period % d:
-                continue
-            shifted = np.roll(self.sections, -d, axis=0)
-            if np.max(np.abs(shifted - self.sections)) <= thr:
-                return d
-        return self.period
+        return minimal_period(self.sections, self.tol)
 
     @property
     def contact(self) -> dict[str, str]:
@@ -272,6 +264,18 @@ class PeriodicOrbit:
             ds.coords["contact"] = ("contact", np.array(list(contacts), dtype="U16"))
             ds["contact_regime"] = ("contact", np.array(list(contacts.values()), dtype="U16"))
         return ds
+
+
+def minimal_period(sections: np.ndarray, tol: float) -> int:
+    """The smallest d dividing n = len(sections) with the n section points of an orbit
+    repeating after d periods, to max(1e-6, 100 tol) relative to max(1, max |y|)."""
+    n = int(sections.shape[0])
+    scale = max(1.0, float(np.max(np.abs(sections))))
+    thr = max(1e-6, 100.0 * tol) * scale
+    for d in range(1, n + 1):
+        if n % d == 0 and np.max(np.abs(np.roll(sections, -d, axis=0) - sections)) <= thr:
+            return d
+    return n
 
 
 def tracked_groups(system: System) -> list[tuple[str, np.ndarray, bool]]:

@@ -28,6 +28,7 @@ from .store import SweepStore
 
 __all__ = ["bifurcation", "run_sweep"]
 
+
 def _tracked_groups(system: Any) -> list[tuple[str, np.ndarray, bool]]:
     """Tracked observables grouped: per-planet groups (delta_sp …) and scalars (x_s …)."""
     names = system.obs_names[: system.n_track]
