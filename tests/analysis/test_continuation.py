@@ -19,6 +19,7 @@ brute-force sweeps (:func:`gearchaos.bifurcation`) of the same systems.
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -319,3 +320,20 @@ def test_neimark_sacker_of_the_duffing_oscillator_where_the_damping_vanishes() -
     expected = np.exp(-ds.delta.values * period / 2)
     assert np.max(np.abs(ds.multiplier_abs.values - expected[:, None])) < 1e-9
     assert np.array_equal(ds.stable.values == 1, ds.delta.values > 0)
+
+
+def test_branch_summary_is_json_and_segments_cover_the_branch(planetary_branch) -> None:
+    import json
+
+    from gearchaos.analysis.branch import branch_summary
+
+    summary = branch_summary(planetary_branch)
+    json.dumps(summary)
+    assert summary["parameter"] == "omega" and summary["period"] == 1
+    assert sum(seg["points"] for seg in summary["segments"]) == summary["points"]
+    # stability alternates from one segment to the next, and changes only at events
+    flags = [seg["stable"] for seg in summary["segments"]]
+    assert all(a != b for a, b in itertools.pairwise(flags))
+    kinds = {e["kind"] for e in summary["events"]}
+    assert len(summary["segments"]) - 1 <= len(summary["events"])
+    assert "period_doubling" in kinds

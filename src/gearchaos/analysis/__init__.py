@@ -11,7 +11,7 @@ period doublings, Neimark–Sacker and grazing events, :mod:`.branch` their data
 and, for gear sets, :mod:`.modal` (linear natural frequencies).
 """
 
-from .branch import branch_multipliers, open_branch, save_branch
+from .branch import branch_multipliers, branch_summary, open_branch, save_branch
 from .chaos01 import chaos01
 from .classify import (
     MotionClass,
@@ -37,6 +37,7 @@ __all__ = [
     "MotionClass",
     "PeriodicOrbit",
     "branch_multipliers",
+    "branch_summary",
     "chaos01",
     "classify_motion",
     "classify_sections",

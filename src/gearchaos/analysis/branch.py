@@ -56,6 +56,7 @@ from .orbits import (
 __all__ = [
     "branch_dataset",
     "branch_multipliers",
+    "branch_summary",
     "check_store",
     "fixed_json",
     "open_branch",
@@ -213,6 +214,55 @@ def fixed_json(values: Mapping[str, Any]) -> str:
     """The fixed parameter values as JSON (numbers and strings; anything else by repr)."""
     out = {k: v if isinstance(v, int | float | str) else repr(v) for k, v in values.items()}
     return json.dumps(out, sort_keys=True)
+
+
+def branch_summary(ds: Any) -> dict[str, Any]:
+    """A JSON-serialisable summary of a branch: ``parameter``, ``period``, ``range``,
+    ``points``, ``stop_reason``, ``segments`` (maximal runs of consecutive points of equal
+    stability: ``from``/``to`` parameter values, ``stable``, ``points``) and ``events``
+    (``kind``, ``value``, ``point``, ``multiplier`` {re, im, abs} or None for grazing,
+    ``detail``, ``located``), in arclength order."""
+    name = str(ds.attrs["parameter"])
+    lam = np.asarray(ds[name].values, dtype=float)
+    stable = np.asarray(ds["stable"].values, dtype=bool)
+    segments = []
+    start = 0
+    for k in range(1, lam.size + 1):
+        if k == lam.size or stable[k] != stable[start]:
+            segments.append(
+                {
+                    "from": float(lam[start]),
+                    "to": float(lam[k - 1]),
+                    "stable": bool(stable[start]),
+                    "points": int(k - start),
+                }
+            )
+            start = k
+    events = []
+    for k in range(ds.sizes.get("event", 0)):
+        re, im = float(ds.event_multiplier_re[k]), float(ds.event_multiplier_im[k])
+        kind = str(ds.event_kind.values[k])
+        events.append(
+            {
+                "kind": kind,
+                "value": float(ds.event_value[k]),
+                "point": int(ds.event_point[k]),
+                "multiplier": None
+                if kind == "grazing"
+                else {"re": re, "im": im, "abs": float(np.hypot(re, im))},
+                "detail": str(ds.event_detail.values[k]),
+                "located": bool(int(ds.event_located[k])),
+            }
+        )
+    return {
+        "parameter": name,
+        "period": int(ds.attrs["period"]),
+        "range": [float(ds.attrs["range_start"]), float(ds.attrs["range_stop"])],
+        "points": int(lam.size),
+        "stop_reason": str(ds.attrs["stop_reason"]),
+        "segments": segments,
+        "events": events,
+    }
 
 
 def branch_multipliers(ds: Any) -> np.ndarray:

@@ -440,7 +440,8 @@ def continuation(
         START), a :class:`~gearchaos.analysis.orbits.PeriodicOrbit` (its state, at its Ω or
         its value of the parameter), or an :class:`~gearchaos.analysis.events.Event` of
         kind ``period_doubling`` (start the period-2n branch there) or ``branch_point``
-        (the other branch, same n).
+        (the other branch, same n), with the target, fixed values and settings of the
+        branch it was found on.
     settings, params, **values_and_settings
         Fixed parameter values by name (``omega=1.5`` when another parameter is varied,
         ``params={"backlash.planet_ring": 3}``) and solver settings by name or as a

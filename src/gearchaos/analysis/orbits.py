@@ -44,10 +44,13 @@ from .contact import contact_regime
 from .shooting import Problem, Solution, correct, section_time
 
 __all__ = [
+    "ORBIT_SETTINGS",
     "PeriodicOrbit",
     "contact_levels",
+    "minimal_period",
     "orbit_contacts",
     "periodic_orbit",
+    "solve_orbit",
     "split_values",
 ]
 
@@ -117,7 +120,8 @@ class PeriodicOrbit:
     multipliers : complex (n_state,) eigenvalues of the monodromy matrix, by modulus, descending.
     residual : ‖Pⁿ(y*) − y*‖_∞ / max(1, ‖y*‖_∞) at the returned state.
     converged : whether the residual fell below ``tol``.
-    iterations : Newton iterations taken (map evaluations with tangents, trial steps included).
+    iterations : map evaluations of the Newton iteration (with and without tangents, trial
+        steps included).
     monodromy : (n_state, n_state) M = DPⁿ(y*).
     sections : (n, n_state) the states at τ_s + kT, k = 0 … n−1.
     section_obs : (n, n_obs) the observables there.
@@ -126,6 +130,7 @@ class PeriodicOrbit:
     status : the integration status of the last map evaluation.
     message : why the iteration stopped.
     tol : the residual tolerance.
+    values : the parameter values by name it was computed at.
     """
 
     system: System
@@ -144,7 +149,7 @@ class PeriodicOrbit:
     status: Status = Status.OK
     message: str = ""
     tol: float = 1e-9
-    values: Mapping[str, float] = field(default_factory=dict)
+    values: Mapping[str, Any] = field(default_factory=dict)
 
     # -- derived ----------------------------------------------------------------
     @property
@@ -218,13 +223,16 @@ class PeriodicOrbit:
             "status": self.status.name.lower(),
             "message": self.message,
             "section_tau": self.section_tau,
-            **{f"parameter:{k}": float(v) for k, v in self.values.items()},
+            **{
+                f"parameter:{k}": v if isinstance(v, int | float | str) else repr(v)
+                for k, v in self.values.items()
+            },
             **self.settings.attrs(),
             **provenance(),
         }
 
     def to_dataset(self) -> Any:
-        """The orbit as an :class:`xarray.Dataset`: ``state`` (state), ``multiplier_re``,
+        """The orbit as an :class:`xarray.Dataset`: ``orbit_state`` (state), ``multiplier_re``,
         ``multiplier_im``, ``multiplier_abs`` (multiplier), ``monodromy`` (state, state_in),
         ``section_state`` (section, state), the tracked observables at the sections
         (``delta_sp`` (section, planet) …), their extrema (``delta_sp_min`` …), ``contact``
@@ -394,10 +402,11 @@ def periodic_orbit(
 
     Solves G(y) = Pⁿ(y) − y = 0 for the stroboscopic map P over one forcing period T = 2π/Ω
     by Newton's method, y ← y + λ d with (M − I) d = −G(y) and M = DPⁿ(y) from the
-    variational equations: a chord iteration (M kept while the residual falls at least
-    fourfold per step, refreshed otherwise), λ = 1 or the longest of ½ … 1/16 that lowers
-    ‖G‖ (evaluated together in one compiled call). The multipliers are always those of the
-    returned state (a last evaluation with tangents there).
+    variational equations: a quasi-Newton iteration (M updated by Broyden's formula while
+    ‖G‖ falls at least tenfold per step, evaluated afresh otherwise), λ = 1 or the longest of
+    ½ … 1/16 that lowers ‖G‖ (evaluated together in one compiled call), every step at most
+    ten times the size of the state. The multipliers are always those of the returned state
+    (a last evaluation with tangents there).
 
     Parameters
     ----------
