@@ -50,7 +50,6 @@ from .orbits import (
     minimal_period,
     model_attrs,
     orbit_contacts,
-    tracked_groups,
 )
 
 __all__ = [
@@ -99,7 +98,7 @@ def branch_dataset(
     P = len(pts)
     obs_names = (observe,) if isinstance(observe, str) else tuple(observe or ())
     observed = [ref.observable(nm) for nm in (obs_names or _default_observe(ref))]
-    tracked = tracked_groups(ref)
+    tracked = ref.tracked_groups()
     levels = br.levels
     n_planets = int(getattr(ref.model, "n_planets", 0))
     coords: dict[str, Any] = {

@@ -12,6 +12,7 @@ noise floor of the map).
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -160,16 +161,7 @@ def periodic_orbits(
             assert t.monodromy is not None
             kept = (t, t.monodromy[0])
         chain, mono = kept
-        shot = Shot(
-            end=chain.end,
-            monodromy=mono[None],
-            sections=chain.sections,
-            section_obs=chain.section_obs,
-            obs_min=chain.obs_min,
-            obs_max=chain.obs_max,
-            status=chain.status,
-            steps=chain.steps,
-        )
+        shot = dataclasses.replace(chain, monodromy=mono[None])
         state = best_y[k] if best[k] is not None else y[k]
         sol = Solution(
             state.copy(),

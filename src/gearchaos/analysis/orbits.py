@@ -256,7 +256,7 @@ class PeriodicOrbit:
         ds["multiplier_abs"] = ("multiplier", np.abs(self.multipliers))
         ds["monodromy"] = (("state", "state_in"), self.monodromy, {"long_name": "M = DPⁿ(y*)"})
         ds["section_state"] = (("section", "state"), self.sections)
-        for nm, cols, per_planet in tracked_groups(sys):
+        for nm, cols, per_planet in sys.tracked_groups():
             vals = self.section_obs[:, cols]
             if per_planet:
                 ds.coords["planet"] = ("planet", np.arange(1, cols.size + 1))
@@ -284,24 +284,6 @@ def minimal_period(sections: np.ndarray, tol: float) -> int:
         if n % d == 0 and np.max(np.abs(np.roll(sections, -d, axis=0) - sections)) <= thr:
             return d
     return n
-
-
-def tracked_groups(system: System) -> list[tuple[str, np.ndarray, bool]]:
-    """Tracked observables grouped as sweeps store them: per-planet groups (``delta_sp`` …)
-    and scalars (``x_s`` …)."""
-    names = system.obs_names[: system.n_track]
-    out: list[tuple[str, np.ndarray, bool]] = []
-    seen: set[str] = set()
-    for k, nm in enumerate(names):
-        head, _, tail = nm.rpartition("_")
-        if tail.isdigit():
-            if head not in seen:
-                seen.add(head)
-                idx = [j for j, m in enumerate(names) if m.rpartition("_")[0] == head]
-                out.append((head, np.array(idx), True))
-        else:
-            out.append((nm, np.array([k]), False))
-    return out
 
 
 def model_attrs(system: System) -> dict[str, Any]:
@@ -370,18 +352,7 @@ def initial_guess(system: System, guess: Any, n: int, cfg: SolverSettings) -> np
             )
         secs = secs[-2 * n :] if secs.shape[0] >= 2 * n else secs
     else:
-        try:
-            y = np.array(guess, dtype=np.float64).reshape(-1)
-        except (TypeError, ValueError):
-            raise ParameterError(
-                f"guess must be None, a state, a PeriodicOrbit or a simulation: got {guess!r}"
-            ) from None
-        if y.size != system.n_state or not np.all(np.isfinite(y)):
-            raise ParameterError(
-                f"guess must be {system.n_state} finite numbers "
-                f"({', '.join(system.state_names)}): got {y!r}"
-            )
-        return y
+        return system.check_state(guess, "guess")
     m = secs.shape[0] - n
     gaps = [np.max(np.abs(secs[j + n] - secs[j])) for j in range(m)]
     return np.array(secs[int(np.argmin(gaps)) + n], dtype=np.float64)

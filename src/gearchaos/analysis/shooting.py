@@ -28,6 +28,7 @@ solution, so the returned multipliers belong to the returned state.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 from collections.abc import Callable, Sequence
@@ -37,7 +38,7 @@ import numpy as np
 
 from ..errors import ParameterError, Status
 from ..integrate._chains import ChainRun, run_chains
-from ..integrate.settings import SolverSettings
+from ..integrate.settings import SampleTimes, SolverSettings
 from ..model.system import System
 
 __all__ = [
@@ -121,33 +122,30 @@ def shoot(
     n = ref.n_state
     y = np.asarray(states, dtype=np.float64).reshape(C, n)
     k = n if tangents else 0
-    Y0 = np.zeros((C, n * (1 + k)))
-    Y0[:, :n] = y
     for s in systems:
         if s.kind != ref.kind or s.params.size != ref.params.size:
             raise ParameterError("all systems of a shooting must share kind and layout")
     T = np.array([s.period for s in systems])
     ts = section_fraction(settings) * T
     t0 = ts[:, None] + np.arange(period)[None, :] * T[:, None]
-    # the numbers of ChainRun.from_systems, laid out directly: one sample at the start of each
-    # period, no transient (this is the hot path of Newton iterations)
-    run = ChainRun(
-        kind=ref.kind,
-        Y0=Y0,
-        P=np.repeat(np.array([s.params for s in systems])[:, None, :], period, axis=1),
-        SW=np.repeat(np.array([s.switch_widths for s in systems])[:, None, :], period, axis=1),
-        t0=t0,
+    # the layout of ChainRun.from_systems without packing point by point (the hot path of
+    # Newton iterations): one sample at the start of each period, no transient
+    times = SampleTimes(
         t_rec=t0.copy(),
         dt=np.repeat(T[:, None], period, axis=1),
-        t_end=t0 + T[:, None],
         n_samples=1,
-        n_obs=ref.n_obs,
-        n_track=ref.n_track,
-        n_state=n,
-        n_tangent=k,
-        rtol=float(settings.rtol),
-        atol=float(settings.atol),
+        t_end=t0 + T[:, None],
         max_steps=_step_budget(settings),
+    )
+    run = ChainRun.from_arrays(
+        ref,
+        np.repeat(np.array([s.params for s in systems])[:, None, :], period, axis=1),
+        np.repeat(np.array([s.switch_widths for s in systems])[:, None, :], period, axis=1),
+        t0,
+        times,
+        settings,
+        y0=y,
+        n_tangent=k,
         continuation=True,
     )
     threads = numba.get_num_threads()
@@ -437,16 +435,7 @@ def correct(
             return None, cor.why
     mu = multipliers_of(tshot.monodromy[0])
     # sections and extrema of the map without tangents, the monodromy from the tangents
-    shot = Shot(
-        end=shot.end,
-        monodromy=tshot.monodromy,
-        sections=shot.sections,
-        section_obs=shot.section_obs,
-        obs_min=shot.obs_min,
-        obs_max=shot.obs_max,
-        status=shot.status,
-        steps=shot.steps,
-    )
+    shot = dataclasses.replace(shot, monodromy=tshot.monodromy)
     sol = Solution(
         z[:-1].copy(), float(z[-1]), shot, cor.g_l, r, cor.evals, cor.jacs, mu, corrections
     )

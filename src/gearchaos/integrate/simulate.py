@@ -29,21 +29,7 @@ _DEFAULT = SolverSettings()
 
 
 def _initial_state(system: System, y0: Any) -> np.ndarray | None:
-    if y0 is None:
-        return None
-    try:
-        y = np.array(y0, dtype=np.float64).reshape(-1)
-    except (TypeError, ValueError):
-        raise ParameterError(
-            f"y0 must be {system.n_state} numbers ({', '.join(system.state_names)}): got {y0!r}"
-        ) from None
-    if y.size != system.n_state:
-        raise ParameterError(
-            f"y0 must have {system.n_state} entries ({', '.join(system.state_names)}): got {y.size}"
-        )
-    if not np.all(np.isfinite(y)):
-        raise ParameterError(f"y0 must be finite: got {y!r}")
-    return y
+    return None if y0 is None else system.check_state(y0, "y0")
 
 
 def integrate(

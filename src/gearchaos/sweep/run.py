@@ -30,23 +30,6 @@ from .store import SweepStore
 __all__ = ["bifurcation", "run_sweep"]
 
 
-def _tracked_groups(system: Any) -> list[tuple[str, np.ndarray, bool]]:
-    """Tracked observables grouped: per-planet groups (delta_sp …) and scalars (x_s …)."""
-    names = system.obs_names[: system.n_track]
-    out: list[tuple[str, np.ndarray, bool]] = []
-    seen: set[str] = set()
-    for k, nm in enumerate(names):
-        head, _, tail = nm.rpartition("_")
-        if tail.isdigit():
-            if head not in seen:
-                seen.add(head)
-                idx = [j for j, m in enumerate(names) if m.rpartition("_")[0] == head]
-                out.append((head, np.array(idx), True))
-        else:
-            out.append((nm, np.array([k]), False))
-    return out
-
-
 class _Layout:
     """Store variables of a sweep and how to fill them from kernel outputs."""
 
@@ -56,7 +39,7 @@ class _Layout:
         self.lead_dims = grid.dims
         self.lead_shape = grid.shape
         self.observed = [ref.observable(nm, spec.planets) for nm in spec.observe]
-        self.tracked = _tracked_groups(ref)
+        self.tracked = ref.tracked_groups()
         self.n_planets = int(getattr(ref.model, "n_planets", 0))
         self.state_names = ref.state_names
 
