@@ -297,6 +297,15 @@ def plot(
             "(Ω sweeps).",
         ),
     ] = False,
+    branch: Annotated[
+        list[Path] | None,
+        typer.Option(
+            "--branch",
+            help="Branch file of `gearchaos continue`, repeatable: drawn over the diagrams of its "
+            "parameter (stable solid, unstable dashed, events marked and named).",
+            show_default=False,
+        ),
+    ] = None,
 ) -> None:
     """Draw a sweep store: bifurcation diagrams (one panel per family value, with a band of
     motion labels under each) for a 1-D sweep, maps coloured by motion label (1T, 2T, …, QP,
@@ -315,10 +324,17 @@ def plot(
         import matplotlib
 
         matplotlib.use("Agg")
+        from ..analysis.branch import open_branch
         from ..plot import savefig, sweep_figure
 
+        branches = [open_branch(b) for b in branch or []]
         fig = sweep_figure(
-            res, var=var, planet=planet, clearance_lines=clearance, resonances=resonances
+            res,
+            var=var,
+            planet=planet,
+            clearance_lines=clearance,
+            resonances=resonances,
+            branches=branches,
         )
         if output.parent != Path(""):
             output.parent.mkdir(parents=True, exist_ok=True)

@@ -13,10 +13,18 @@ from ._common import (
     get_ax,
     is_planetary,
     period_axis_label,
-    readable_limits,
     sample_window,
     to_periods,
     variable,
+)
+from .units import (
+    PhysicalScales,
+    clearance_notes,
+    fit_to_data,
+    linear_axis,
+    secondary_axis,
+    section_style,
+    var_quantity,
 )
 
 __all__ = ["amplitude_spectrum", "spectrum", "time_history"]
@@ -28,6 +36,8 @@ def time_history(
     planet: int = 1,
     ax: Any = None,
     periods: float | None = None,
+    *,
+    physical: bool = True,
 ) -> Any:
     """Plot a variable against time in mesh (forcing) periods, t/T_m = τΩ/2π.
 
@@ -45,11 +55,15 @@ def time_history(
     periods
         Show only the last ``periods`` recorded periods (default: all).
 
+    physical
+        Physical axes opposite the dimensionless ones (time in ms; µm, mm/s or N), for gear
+        sets.
+
     Returns
     -------
     matplotlib.axes.Axes
-        With dashed lines at ±b̄ for variables with a clearance and dots at the Poincaré
-        section times.
+        Limits follow the data; dashed lines at ±b̄ for variables with a clearance where they
+        fall inside (an edge note where not), dots at the Poincaré section times.
     """
     info = variable(result, var, planet)
     ax = get_ax(ax)
@@ -61,11 +75,13 @@ def time_history(
         ax.plot(t[sl], y[sl], lw=0.8, color="C0", label=f"${info.symbol}$")
     idx = np.arange(result.tau.size)[sl]
     sec = idx[idx % s == 0]
+    style = section_style(sec.size)
     ax.plot(
         t[sec],
         y[sec],
         ".",
-        ms=4 if s > 1 else 3,
+        ms=max(1.0, float(np.sqrt(style["s"]))),
+        alpha=style["alpha"],
         color="C3",
         label="section points",
         zorder=3,
@@ -73,7 +89,15 @@ def time_history(
     clearance_lines(ax, info)
     ax.set_xlabel(period_axis_label(result))
     ax.set_ylabel(info.label)
-    readable_limits(ax)
+    fit_to_data(ax, None, y[sl])
+    if info.clearance is not None:
+        clearance_notes(ax, "y", (-info.clearance, info.clearance), info.clearance_symbol or "b")
+    if physical:
+        scales = PhysicalScales.of_result(result)
+        secondary_axis(ax, "y", var_quantity(info.name), scales)
+        ms = scales.period_ms(result.system.omega)
+        if ms is not None:
+            linear_axis(ax, "x", ms, "t [ms]")
     return ax
 
 
