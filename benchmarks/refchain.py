@@ -112,20 +112,14 @@ def integrate(p, y0, t_end, rtol, atol):  # pragma: no cover - compiled
             yt[i] = y[i] + h * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
         _rhs(t + C5 * h, yt, p, k5)
         for i in range(n):
-            yt[i] = y[i] + h * (
-                A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i]
-            )
+            yt[i] = y[i] + h * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i])
         _rhs(t + h, yt, p, k6)
         for i in range(n):
-            yt[i] = y[i] + h * (
-                A71 * k1[i] + A73 * k3[i] + A74 * k4[i] + A75 * k5[i] + A76 * k6[i]
-            )
+            yt[i] = y[i] + h * (A71 * k1[i] + A73 * k3[i] + A74 * k4[i] + A75 * k5[i] + A76 * k6[i])
         _rhs(t + h, yt, p, k7)
         s = 0.0
         for i in range(n):
-            e = h * (
-                E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i]
-            )
+            e = h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i])
             sc = atol + rtol * max(abs(y[i]), abs(yt[i]))
             s += (e / sc) ** 2
         err = math.sqrt(s / n)
