@@ -175,20 +175,28 @@ def _landmark_rows(stores: Mapping[str, Any]) -> tuple[list[dict[str, Any]], str
     return rows, ""
 
 
+def _regime_rank(label: str) -> tuple[int, int, str]:
+    """Columns in one fixed order: 1T, 2T, …, QP, chaos, unresolved, failed (then others)."""
+    from ..plot.regimes import REGIME_ORDER
+
+    if label in REGIME_ORDER:
+        return (REGIME_ORDER.index(label), 0, label)
+    head = label[:-1]
+    if label.endswith("T") and head.isdigit():  # a period beyond the named ones: after them
+        return (REGIME_ORDER.index("QP") - 1, int(head), label)
+    return (len(REGIME_ORDER), 0, label)
+
+
 def _regime_table(ds: Any) -> str:
     table = SweepResult.of(ds).regime_table()
     if not table:
         return "<p>No regime table stored.</p>"
-    kinds: list[str] = []
-    for fr in table.values():
-        for k in fr:
-            if k not in kinds:
-                kinds.append(k)
+    kinds = sorted({k for fr in table.values() for k in fr}, key=_regime_rank)
     head = "".join(f"<th>{_e(k)}</th>" for k in kinds)
     body = []
     for panel, fr in table.items():
         cells = "".join(
-            f"<td>{100 * float(fr[k]):.0f} %</td>" if k in fr else "<td>—</td>" for k in kinds
+            f"<td>{100 * float(fr.get(k, 0.0)):.0f} %</td>" for k in kinds
         )
         body.append(f"<tr><th>{_e(panel)}</th>{cells}</tr>")
     return (
