@@ -29,6 +29,7 @@ def test_reproduce_all_quick_writes_every_figure_and_the_report(tmp_path: Path) 
     for fig in FIGS:
         assert (out / f"{fig}-quick.png").is_file(), fig
         assert f"src='{fig}-quick.png'" in page  # relative path: the page is self-contained
+        assert f"<a href='{fig}-quick.png'" in page  # a click opens it at full resolution
         assert f"id='{fig}'" in page
     assert "id='conclusions'" in page
     for cid in range(1, 9):
