@@ -27,6 +27,9 @@ from .units import (
     var_quantity,
 )
 
+#: ``gid`` of the mesh-harmonic labels and sideband lines of a spectrum.
+HARMONIC_GID = "mesh-harmonic"
+
 __all__ = ["amplitude_spectrum", "spectrum", "time_history"]
 
 
@@ -183,10 +186,36 @@ def spectrum(
         shown = amp[ratio <= hi]
         lo = max(float(np.min(shown[shown > 0])) if np.any(shown > 0) else floor, top * 1e-9)
         ax.set_ylim(lo / 2.0, top * 3.0)
+    scales = PhysicalScales.of_result(result) if is_planetary(result) else PhysicalScales()
+    f_m = float(result.omega) * scales.omega_n / (2.0 * math.pi) if scales.omega_n else None
     for h in range(1, math.floor(hi) + 1):
         ax.axvline(h, color="0.8", lw=0.6, zorder=0)
+        label = f"{h}$f_m$" if f_m is None else f"{h}$f_m$ = {h * f_m:.0f} Hz"
+        ax.text(
+            h,
+            0.98,
+            label,
+            transform=ax.get_xaxis_transform(),
+            rotation=90,
+            ha="right",
+            va="top",
+            fontsize="x-small",
+            color="0.35",
+            gid=HARMONIC_GID,
+        )
+    gs = getattr(getattr(result.system, "model", None), "gearset", None)
+    if gs is not None and gs.has_eccentricity:
+        # eccentricities modulate the meshes at the sun's speed relative to the carrier,
+        # f_s = f_m / z_s: sidebands h f_m ± f_s
+        side = 1.0 / float(gs.teeth.sun)
+        for h in range(1, math.floor(hi) + 1):
+            for r in (h - side, h + side):
+                if 0.0 < r <= hi:
+                    ax.axvline(r, color="0.85", lw=0.5, ls=":", zorder=0, gid=HARMONIC_GID)
     if is_planetary(result):
-        ax.set_xlabel(r"$\omega/\omega_m$ (multiples of the mesh frequency)")
+        ax.set_xlabel(r"$\omega/\omega_m$ (multiples of the mesh frequency $f_m$)")
+        if f_m is not None:
+            linear_axis(ax, "x", f_m, "frequency [Hz]")
     else:
         ax.set_xlabel(r"$\omega/\Omega$ (multiples of the forcing frequency)")
     ax.set_ylabel(f"amplitude of ${info.symbol}$")
