@@ -20,6 +20,14 @@ PeriodOpt = Annotated[
     int, typer.Option("--period", "-n", help="Period n of the orbit, in mesh periods.")
 ]
 
+GuessOpt = Annotated[
+    float,
+    typer.Option(
+        "--transient",
+        help="Mesh periods simulated from rest for the first guess of the (starting) orbit.",
+    ),
+]
+
 
 def _spinner(text: str, quiet: bool) -> contextlib.AbstractContextManager[Any]:
     err = c.stderr()
@@ -32,13 +40,7 @@ def orbit(
     gearset: c.GearsetOpt = None,
     set_: c.SetOpt = None,
     period: PeriodOpt = 1,
-    transient: Annotated[
-        float,
-        typer.Option(
-            "--transient",
-            help="Mesh periods simulated from rest for the first guess of the orbit.",
-        ),
-    ] = 50.0,
+    transient: GuessOpt = 50.0,
     rtol: c.RtolOpt = 1e-8,
     atol: c.AtolOpt = 1e-10,
     json_out: c.JsonOpt = False,
@@ -120,12 +122,7 @@ def continue_(
     gearset: c.GearsetOpt = None,
     set_: c.SetOpt = None,
     period: PeriodOpt = 1,
-    transient: Annotated[
-        float,
-        typer.Option(
-            "--transient", help="Mesh periods simulated from rest for the starting orbit."
-        ),
-    ] = 50.0,
+    transient: GuessOpt = 50.0,
     rtol: c.RtolOpt = 1e-8,
     atol: c.AtolOpt = 1e-10,
     max_points: Annotated[

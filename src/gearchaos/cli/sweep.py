@@ -52,6 +52,11 @@ def open_store(path: Path) -> Any:
     return res
 
 
+StoreArg = Annotated[
+    Path,
+    typer.Argument(help="Sweep store written by `gearchaos bifurcation`.", show_default=False),
+]
+
 @c.app.command()
 def bifurcation(
     output: Annotated[
@@ -270,10 +275,7 @@ def bifurcation(
 
 @c.app.command()
 def plot(
-    store: Annotated[
-        Path,
-        typer.Argument(help="Sweep store written by `gearchaos bifurcation`.", show_default=False),
-    ],
+    store: StoreArg,
     output: Annotated[
         Path,
         typer.Option("--output", "-o", help="Figure file: .png, .pdf or .svg.", show_default=False),
@@ -344,10 +346,7 @@ def plot(
 
 @c.app.command()
 def classify(
-    store: Annotated[
-        Path,
-        typer.Argument(help="Sweep store written by `gearchaos bifurcation`.", show_default=False),
-    ],
+    store: StoreArg,
     period_rtol: Annotated[
         float | None,
         typer.Option(

@@ -23,6 +23,7 @@ import numpy as np
 from .._version import provenance
 from ..errors import ParameterError, Status
 from ..integrate._chains import ChainOutput, ChainRun
+from ..model.target import scale_attrs
 from .execute import EXECUTION_OPTIONS, Execution, InProcess, executor
 from .grid import Grid, Task
 from .integrity import StoreLock
@@ -178,11 +179,7 @@ def _attrs(target: Any, grid: Grid) -> dict[str, Any]:
         a["omega_fixed"] = float(ref.omega)
     # clearances and scales of the base gear set with the fixed overrides (not of a grid point)
     model = grid.base_model()
-    if hasattr(model, "scales"):
-        a["omega_n_rad_s"] = float(model.scales.omega_n)
-        a["characteristic_length_m"] = float(model.scales.length)
-    for k, v in getattr(model, "clearances", {}).items():
-        a[f"clearance_{k}"] = float(v)
+    a.update(scale_attrs(model))
     return a
 
 
