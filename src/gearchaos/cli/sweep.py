@@ -160,6 +160,17 @@ def bifurcation(
             ),
         ),
     ] = False,
+    orbits: Annotated[
+        bool,
+        typer.Option(
+            "--orbits",
+            help=(
+                "Confirm every label nT (n ≤ 8) by shooting a period-n orbit from the point's "
+                "final state; store orbit_residual, orbit_max_multiplier (largest |μ|) and "
+                "orbit_status (confirmed, unstable, shorter_period, not_converged, ...)."
+            ),
+        ),
+    ] = False,
     quiet: c.QuietOpt = False,
     json_out: c.JsonOpt = False,
 ) -> None:
@@ -226,6 +237,7 @@ def bifurcation(
             initial_conditions=ic,
             direction=direction,
             lyapunov=lyapunov,
+            orbits=orbits,
             solver=settings,
             store=output,
             overwrite=overwrite,
@@ -258,7 +270,8 @@ def bifurcation(
         Text(
             f"{transient:g} transient + {periods} recorded mesh periods, {ic} initial "
             f"conditions, rtol {rtol:g}, atol {atol:g}"
-            + (", largest Lyapunov exponents" if lyapunov else ""),
+            + (", largest Lyapunov exponents" if lyapunov else "")
+            + (", nT labels checked by periodic orbits" if orbits else ""),
             style="dim",
         )
     )

@@ -26,6 +26,7 @@ from ..integrate._chains import ChainOutput, ChainRun
 from .execute import EXECUTION_OPTIONS, Execution, InProcess, executor
 from .grid import Grid, Task
 from .integrity import StoreLock
+from .orbits import ORBIT_VARIABLES, status_attrs, task_orbits
 from .spec import DEFAULT_OBSERVE, SweepSpec
 from .store import SweepStore
 
@@ -89,6 +90,11 @@ class _Layout:
                 },
             )
             chunks["lle"] = ch
+        if spec.orbits:
+            for nm, (doc, dtype, fill) in ORBIT_VARIABLES.items():
+                extra = status_attrs() if nm == "orbit_status" else {}
+                var[nm] = (lead, (shp, dtype), fill, {"long_name": doc, **extra})
+                chunks[nm] = ch
         n = len(self.state_names)
         var["final_state"] = (
             (*lead, "state"),
@@ -136,6 +142,8 @@ class _Layout:
                 data["final_state"][pos] = out.final_state[c, j, :n_st]
                 if spec.lyapunov:
                     data["lle"][pos] = lle[c, j, 0]
+        if spec.orbits:
+            data.update(task_orbits(self.grid, self.observed, task, run, data))
         return data
 
 
