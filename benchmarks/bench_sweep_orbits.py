@@ -1,9 +1,11 @@
 """Benchmark: the extra cost of ``orbits=True`` (``--orbits``) on a sweep.
 
-Run as ``python benchmarks/bench_sweep_orbits.py [--points 100] [--preset sheng2016]``.
+Run as ``python benchmarks/bench_sweep_orbits.py [--points 100] [--preset sheng2016]
+[--range 0.2:4]``.
 
-The same sweep — Ω ∈ [0.2, 4] with ``--points`` points, fresh zero start, 100 transient + 100
-recorded periods, in-process on all cores, no store — runs without and with ``orbits=True``
+The same sweep — Ω ∈ [0.2, 4] (``--range``) with ``--points`` points, fresh zero start,
+100 transient + 100 recorded periods, in-process on all cores, no store — runs without and
+with ``orbits=True``
 (every point labelled nT, n ≤ 8, confirmed by shooting a period-n orbit from its final state).
 Reported: wall and process CPU time of both, their ratio, the points shot and how their
 orbits ended. The issue's rule: when the extra cost exceeds 30 %, the check is opt-in.
@@ -36,9 +38,10 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--points", type=int, default=100)
     ap.add_argument("--preset", default="sheng2016")
+    ap.add_argument("--range", default="0.2:4", help="START:STOP of Ω")
     args = ap.parse_args()
     gs = gc.preset(args.preset)
-    vary = f"omega=0.2:4:{args.points}"
+    vary = f"omega={args.range}:{args.points}"
     # warm-up: every kernel compiled or loaded
     gc.bifurcation(gs, "omega=1:3:2", transient_periods=2, periods=4, orbits=True, progress=False)
     plain, w0, c0 = timed(gc.bifurcation, gs, vary, progress=False)
