@@ -59,7 +59,7 @@ __all__ = [
 
 if TYPE_CHECKING:
     from .analysis.arclength import continuation
-    from .analysis.attractors import attractors
+    from .analysis.coexistence import attractors
     from .analysis.orbits import PeriodicOrbit, periodic_orbit
 
 _LAZY_SUBPACKAGES = ("analysis", "plot", "paper")
@@ -68,7 +68,7 @@ _LAZY_ATTRIBUTES = {
     "PeriodicOrbit": "analysis.orbits",
     "periodic_orbit": "analysis.orbits",
     "continuation": "analysis.arclength",
-    "attractors": "analysis.attractors",
+    "attractors": "analysis.coexistence",
 }
 
 

@@ -6,14 +6,14 @@
 (a JSON-serialisable summary of one simulation), :mod:`.orbits` (periodic orbits by shooting,
 Floquet multipliers; :mod:`.shooting` holds the map evaluations and the Newton corrector,
 :mod:`.orbit_batch` many orbits in one Newton iteration),
-:mod:`.attractors` (coexisting attractors at one point, from several starts),
+:mod:`.coexistence` (coexisting attractors at one point, from several starts),
 :mod:`.arclength` (pseudo-arclength continuation of branches, :mod:`.branch_events` their folds,
 period doublings, Neimark–Sacker and grazing events, :mod:`.branch` their datasets and files)
 and, for gear sets, :mod:`.modal` (linear natural frequencies).
 """
 
 from .arclength import continuation
-from .attractors import Attractor, attractors
+from .coexistence import Attractor, attractors
 from .branch import branch_multipliers, branch_summary, open_branch, save_branch
 from .branch_events import Event, events
 from .chaos01 import chaos01
