@@ -13,7 +13,6 @@ and, for gear sets, :mod:`.modal` (linear natural frequencies).
 """
 
 from .arclength import continuation
-from .coexistence import Attractor, attractors
 from .branch import branch_multipliers, branch_summary, open_branch, save_branch
 from .branch_events import Event, events
 from .chaos01 import chaos01
@@ -25,6 +24,7 @@ from .classify import (
     sort_labels,
     spectral_broadband,
 )
+from .coexistence import Attractor, attractors
 from .contact import contact_fractions, contact_regime, contact_regimes, separation_fraction
 from .lyapunov import LyapunovResult, lyapunov_spectrum, max_lyapunov
 from .orbit_batch import periodic_orbits

@@ -179,13 +179,16 @@ def follow_branches(
     *,
     max_period: int = 4,
     max_points: int = 400,
+    max_branches: int = 24,
     steps: int = 100,
     settings: Any = None,
     cache: str | os.PathLike[str] | None = None,
 ) -> list[Any]:
     """Continue the branches of one panel: from the middle of every 1T (and 3T) stretch of the
     sweep's labels, in both directions to the ends of the swept range, switching at every
-    period doubling up to period ``max_period``. ``steps`` sets the largest step (range/steps);
+    period doubling of a branch that is stable on one side of it (the attractor doubles) up to
+    period ``max_period``, at most ``max_branches`` branches in all (breadth first), each of
+    at most ``max_points`` points. ``steps`` sets the largest step (range/steps);
     ``cache`` is a directory where each branch is saved and, when present, read back (so a
     report run twice continues nothing twice). Branches that fail to start are skipped.
 
@@ -226,24 +229,31 @@ def follow_branches(
 
     starts = [(s, 1) for s in _stretch_starts(xs, labels, "1T")]
     starts += [(s, 3) for s in _stretch_starts(xs, labels, "3T")]
+    queue: list[tuple[Any, float]] = []
     for s, n in starts:
         for end in (lo, hi):
-            if math.isclose(s, end):
-                continue
-            ds = run((name, s, end), period=n)
-            queue = [ds] if ds is not None else []
-            while queue:
-                br = queue.pop()
+            if not math.isclose(s, end) and len(out) + len(queue) < max_branches:
+                ds = run((name, s, end), period=n)
+                if ds is not None:
+                    queue.append((ds, end))
+            while queue and len(out) < max_branches:
+                br, stop = queue.pop(0)
                 out.append(br)
-                per = int(br.attrs.get("period", 1))
-                if 2 * per > max_period:
+                if 2 * int(br.attrs.get("period", 1)) > max_period:
                     continue
-                for ev in events(br):
-                    if ev.kind == "period_doubling":
-                        # the whole range: the new branch leaves the event either way
-                        child = run((name, hi + lo - end, end), start=ev)
-                        if child is not None:
-                            queue.append(child)
+                rows = event_rows(br)
+                for ev, row in zip(events(br), rows, strict=True):
+                    # switch where the attractor doubles: a PD of a branch stable on one side
+                    if ev.kind != "period_doubling" or not (
+                        row["stable_below"] or row["stable_above"]
+                    ):
+                        continue
+                    if len(out) + len(queue) >= max_branches:
+                        break
+                    # the whole range: the new branch leaves the event either way
+                    child = run((name, hi + lo - stop, stop), start=ev)
+                    if child is not None:
+                        queue.append((child, stop))
     return out
 
 
@@ -377,9 +387,9 @@ def landmarks_from_events(results: Sequence[Any], branches: Mapping[str, Any]) -
 ROUTE_FIGURES = ("fig4", "fig6", "fig8", "fig9", "fig11")
 #: Panels continued in a quick report: one per figure, those its landmarks name.
 QUICK_PANELS = {"fig4": 0.03, "fig6": 0.05, "fig9": 0.05}
-#: (largest step as a fraction of the range, most points per branch, highest period): full and
-#: quick reports.
-BRANCH_STEPS = {False: (200, 800, 8), True: (25, 120, 4)}
+#: (range / largest step, most points per branch, highest period, most branches per panel):
+#: full and quick reports.
+BRANCH_STEPS = {False: (200, 800, 8, 24), True: (20, 40, 4, 4)}
 
 
 def report_branches(
@@ -401,7 +411,7 @@ def report_branches(
     from .recipes import PRESET, RECIPES
 
     target = preset(PRESET) if gearset is None else gearset
-    steps, max_points, max_period = BRANCH_STEPS[bool(quick)]
+    steps, max_points, max_period, max_branches = BRANCH_STEPS[bool(quick)]
     rows: dict[str, list[dict[str, Any]]] = {}
     done: dict[str, Any] = {}
     for fig in ROUTE_FIGURES:
@@ -426,6 +436,7 @@ def report_branches(
                 brs = follow_branches(
                     target, recipe.vary.name, x, lab, fixed,
                     max_period=max_period, max_points=max_points, steps=steps, cache=cache,
+                    max_branches=max_branches,
                 )  # fmt: skip
                 n_panels += 1
                 n_branches += len(brs)
