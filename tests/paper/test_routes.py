@@ -20,6 +20,7 @@ from gearchaos.paper.conclusions import conclusion_4, conclusion_5, conclusion_6
 from gearchaos.paper.evidence import chaos_onsets
 from gearchaos.paper.landmarks import Landmark, LandmarkResult
 from gearchaos.paper.routes import (
+    BRANCH_ROW,
     event_rows,
     follow_branches,
     landmarks_from_events,
@@ -117,6 +118,23 @@ FIG4 = {
 }
 
 
+def test_a_panel_without_followed_branches_keeps_the_label_routes() -> None:
+    """Rows of another panel only: the labels' route stands; a marker row of a followed branch
+    on this panel (no event near the onset) makes the onset a crisis."""
+    cascade = ["1T"] * 8 + ["2T"] * 2 + ["4T"] * 2 + ["chaos"] * 9  # labels: period doubling
+    fam = xr.concat([sweep(cascade), sweep(cascade)], dim="xi").assign_coords(xi=[0.03, 0.05])
+    fam["motion"] = fam["motion"].transpose("xi", "omega")
+    other = [{**row("neimark_sacker", 2.15, period=4), "panel": 0.05}]
+    v = conclusion_4({"fig4": fam}, branches={"fig4": other})
+    routes = {o["panel"]: o["route"] for o in v.measured["onsets"]}
+    assert routes[0.05] == "Hopf"
+    assert routes[0.03] == "period doubling"  # from the labels
+    marker = {**row(BRANCH_ROW, float("nan")), "panel": 0.03}
+    v = conclusion_4({"fig4": fam}, branches={"fig4": [*other, marker]})
+    assert {o["panel"]: o["route"] for o in v.measured["onsets"]}[0.03] == "crisis"
+    assert "routes from 1 event(s)" in v.evidence
+
+
 def landmark(event: str, at: float, tol: float = 0.05) -> Landmark:
     return Landmark(
         id="x", figure="fig4", panel={"xi": 0.03}, quote="q", axis="omega", kind="transition",
@@ -137,6 +155,9 @@ def test_landmarks_that_name_a_bifurcation_read_the_events() -> None:
     assert after[2] is before[2]  # names no bifurcation: unchanged
     far = landmarks_from_events(before[:1], {"fig4": [{**rows[0], "value": 2.05}]})
     assert far[0].verdict == "partly"  # 0.124 from 1.926: within three tolerances
+    # no branch followed on the landmark's panel: the label verdict stands
+    elsewhere = [{**r, "panel": 0.05} for r in rows]
+    assert landmarks_from_events(before[:1], {"fig4": elsewhere})[0] is before[0]
 
 
 def test_backlash_cascade_routes_chaos_by_period_doubling() -> None:

@@ -337,10 +337,10 @@ def _gather_routes(
                 "branches)" + (f" — {onset_text(o, fam)}" if o else "")
             )
             continue
-        label_side = [{**x, "route": x["label_route"], "event": None} for x in o]
+        label_side = [{**x, "route": x.get("label_route", x["route"]), "event": None} for x in o]
         texts.append(
-            f"{f}: {len(o)} onset(s) of chaos, routes from {len(rows)} event(s) of the "
-            "continued branches"
+            f"{f}: {len(o)} onset(s) of chaos, routes from "
+            f"{sum(1 for r in rows if r['kind'] != 'branch')} event(s) of the continued branches"
             + (f" — {onset_text(o, fam)}" if o else "")
             + (f"; brute-force labels say: {onset_text(label_side, fam)}" if o else "")
         )

@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 
 __all__ = [
+    "BRANCH_ROW",
     "ROUTE_OF_EVENT",
     "event_rows",
     "follow_branches",
@@ -54,16 +55,37 @@ ROUTE_OF_EVENT = (
 )
 
 
-def event_rows(branch: Any, panel: float | None = None) -> list[dict[str, Any]]:
+#: ``kind`` of the row that marks a followed branch (no event): a panel with such rows had
+#: branches, so an onset there with no event nearby is a crisis.
+BRANCH_ROW = "branch"
+
+
+def event_rows(
+    branch: Any, panel: float | None = None, *, marker: bool = False
+) -> list[dict[str, Any]]:
     """The events of one branch dataset as plain rows: ``kind``, ``value``, ``period`` (of
-    the branch), ``stable_before`` / ``stable_after`` (the branch on either side of the event,
-    in the order of the branch points), ``panel`` (the family value) and ``multiplier``."""
+    the branch), ``stable_below`` / ``stable_above`` (the branch on the side of smaller and of
+    larger parameter values), ``panel`` (the family value) and ``multiplier``; with ``marker``
+    first a row of kind :data:`BRANCH_ROW` (value NaN) that says the branch was followed."""
+    head: list[dict[str, Any]] = []
+    if marker:
+        head.append(
+            {
+                "kind": BRANCH_ROW,
+                "value": math.nan,
+                "period": int(branch.attrs.get("period", 1)),
+                "stable_below": False,
+                "stable_above": False,
+                "panel": panel,
+                "multiplier": complex(math.nan, 0.0),
+            }
+        )
     if "event" not in branch.dims:
-        return []
+        return head
     name = str(branch.attrs["parameter"])
     stable = np.asarray(branch["stable"].values, dtype=bool)
     lam = np.asarray(branch[name].values, dtype=float)
-    rows = []
+    rows = head
     for k in range(branch.sizes["event"]):
         i = int(branch["event_point"].values[k])
         j = min(i + 1, stable.size - 1)
@@ -86,6 +108,8 @@ def event_rows(branch: Any, panel: float | None = None) -> list[dict[str, Any]]:
 
 
 def _event_key(row: Mapping[str, Any]) -> str:
+    if row["kind"] == BRANCH_ROW:
+        return BRANCH_ROW
     if int(row.get("period", 1)) in (3, 6):
         return "three"
     return str(row["kind"])
@@ -274,6 +298,9 @@ def panel_routes(ds: Any, rows: Sequence[Mapping[str, Any]] | None = None) -> li
             if (fv is None and r.get("panel") is None)
             or (fv is not None and r.get("panel") is not None and math.isclose(r["panel"], fv))
         ]  # fmt: skip
+        if not mine:  # no branch was followed on this panel: the labels' routes stand
+            out.extend(found)
+            continue
         for o, routed in zip(found, routes_from_events(found, x, lab, mine), strict=True):
             out.append({**o, **routed})
     return out
@@ -307,6 +334,8 @@ def _panel_value(mark: Any) -> float | None:
 
 
 def _wanted(row: Mapping[str, Any], event: str) -> bool:
+    if row["kind"] == BRANCH_ROW:
+        return False
     if event == "period_3":
         return int(row.get("period", 1)) in (3, 6)
     return str(row["kind"]) == event
@@ -336,11 +365,14 @@ def landmarks_from_events(results: Sequence[Any], branches: Mapping[str, Any]) -
             out.append(r)
             continue
         pv = _panel_value(mark)
-        mine = [
+        panel_rows = [
             row for row in rows
-            if _wanted(row, mark.event)
-            and (pv is None or row.get("panel") is None or math.isclose(row["panel"], pv))
+            if pv is None or row.get("panel") is None or math.isclose(row["panel"], pv)
         ]  # fmt: skip
+        if not panel_rows:  # no branch was followed on this panel
+            out.append(r)
+            continue
+        mine = [row for row in panel_rows if _wanted(row, mark.event)]
         lo, hi = mark.span
         what = _EVENT_NAME[mark.event]
         label_side = f"brute-force labels say: {r.evidence} ({r.verdict})"
@@ -441,12 +473,13 @@ def report_branches(
                 n_panels += 1
                 n_branches += len(brs)
                 for b in brs:
-                    mine.extend(event_rows(b, fv))
-            rows[fig] = mine
+                    mine.extend(event_rows(b, fv, marker=True))
+            if n_branches:
+                rows[fig] = mine
             done[fig] = {
                 "panels": n_panels,
                 "branches": n_branches,
-                "events": len(mine),
+                "events": sum(1 for r in mine if r["kind"] != BRANCH_ROW),
                 "seconds": time.perf_counter() - t0,
             }
         except Exception as exc:  # one failing figure never hides the others
