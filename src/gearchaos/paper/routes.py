@@ -421,7 +421,7 @@ ROUTE_FIGURES = ("fig4", "fig6", "fig8", "fig9", "fig11")
 QUICK_PANELS = {"fig4": 0.03, "fig6": 0.05, "fig9": 0.05}
 #: (range / largest step, most points per branch, highest period, most branches per panel):
 #: full and quick reports.
-BRANCH_STEPS = {False: (200, 800, 8, 24), True: (20, 40, 4, 4)}
+BRANCH_STEPS = {False: (100, 300, 8, 8), True: (20, 40, 4, 4)}
 
 
 def report_branches(

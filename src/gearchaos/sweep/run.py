@@ -543,6 +543,10 @@ def bifurcation(
             Also store the largest Lyapunov exponent ``lle`` of every point (variational
             equations integrated with the trajectory, under the same error control, so section
             values agree with a sweep without it to the tolerance, not bitwise).
+        ``orbits``
+            Confirm every label nT (n ≤ 8) by shooting a period-n orbit from the point's final
+            state and store ``orbit_residual``, ``orbit_max_multiplier`` (max |μ|),
+            ``orbit_period`` and ``orbit_status`` (:mod:`gearchaos.sweep.orbits`).
         ``transient_periods`` (100), ``periods`` (100), ``rtol``, ``atol``, ``max_steps``
             Protocol and tolerances (:class:`~gearchaos.integrate.settings.SolverSettings`),
             or ``solver=SolverSettings(...)``.
