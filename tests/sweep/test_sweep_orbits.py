@@ -142,3 +142,28 @@ def test_orbits_option_is_validated_and_spelled_in_the_spec() -> None:
     spec = SweepSpec.build("omega=1:2:3", orbits=True)
     assert SweepSpec.from_toml(spec.to_toml()) == spec
     assert "orbits" not in SweepSpec.build("omega=1:2:3").to_toml()
+
+
+def test_cli_bifurcation_orbits_counts_the_outcomes(tmp_path) -> None:
+    import json
+
+    from typer.testing import CliRunner
+
+    from gearchaos.cli import app
+
+    out = tmp_path / "run.zarr"
+    args = ["bifurcation", "--preset", "hindawi2021", "--vary", "omega=0.5,0.6"]
+    args += ["--set", "xi=0.1", "--transient", "200", "--periods", "16", "--orbits"]
+    args += ["-o", str(out)]
+    result = CliRunner().invoke(app, [*args, "--json", "--quiet"])
+    assert result.exit_code == 0, result.output
+    counts = json.loads(result.stdout)["orbits"]
+    ds = gc.open_sweep(out)
+    assert sum(counts.values()) == 2
+    names = {v: k for k, v in ORBIT_STATUS.items()}
+    for code in ds.orbit_status.values:
+        assert names[int(code)] in counts
+    # a 1T point of a well-damped train at low Ω: confirmed by a stable orbit
+    assert list(ds.motion.values) == ["1T", "1T"]
+    assert counts == {"confirmed": 2}
+    assert np.all(ds.orbit_max_multiplier.values < 1.0)

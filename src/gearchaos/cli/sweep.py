@@ -250,7 +250,21 @@ def bifurcation(
         res = sweep.SweepResult.of(ds)
         points, failed = int(res.status().size), res.n_failed
 
-    result = {"store": str(output), "points": points, "failed": failed, "seconds": seconds}
+    result: dict[str, Any] = {
+        "store": str(output),
+        "points": points,
+        "failed": failed,
+        "seconds": seconds,
+    }
+    if orbits:
+        import numpy as np
+
+        from ..sweep.orbits import ORBIT_STATUS
+
+        codes = np.asarray(res.ds["orbit_status"].values).ravel()
+        result["orbits"] = {
+            k: int(np.sum(codes == v)) for k, v in ORBIT_STATUS.items() if np.any(codes == v)
+        }
     if json_out:
         c.print_json(result)
         return
@@ -275,6 +289,9 @@ def bifurcation(
             style="dim",
         )
     )
+    if orbits:
+        table2 = ", ".join(f"{k.replace('_', ' ')} {n}" for k, n in result["orbits"].items())
+        out.print(Text(f"periodic orbits behind the nT labels: {table2}", style="dim"))
     regimes = res.regime_table()
     if regimes:
         out.print(regime_table(regimes, title="motion regimes (fraction of the swept points)"))
