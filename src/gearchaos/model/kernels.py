@@ -285,18 +285,14 @@ def planetary_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
             if dsp > bsp or dsp < -bsp:
                 sk = s1 * p[P_HEADER + B_CK_SP * N + i] + c1 * p[P_HEADER + B_SK_SP * N + i]
                 obs[2 * N + 2 + i] = fsp
-                obs[nt + 2 * N + 2 + i] = (
-                    -om * sk * dksp * fzsp + ksp * dsp_d - csp * esp_dd
-                )
+                obs[nt + 2 * N + 2 + i] = -om * sk * dksp * fzsp + ksp * dsp_d - csp * esp_dd
             else:
                 obs[2 * N + 2 + i] = 0.0
                 obs[nt + 2 * N + 2 + i] = 0.0
             if drp > brp or drp < -brp:
                 sk = s1 * p[P_HEADER + B_CK_RP * N + i] + c1 * p[P_HEADER + B_SK_RP * N + i]
                 obs[3 * N + 2 + i] = frp
-                obs[nt + 3 * N + 2 + i] = (
-                    -om * sk * dkrp * fzrp + krp * drp_d - crp * erp_dd
-                )
+                obs[nt + 3 * N + 2 + i] = -om * sk * dkrp * fzrp + krp * drp_d - crp * erp_dd
             else:
                 obs[3 * N + 2 + i] = 0.0
                 obs[nt + 3 * N + 2 + i] = 0.0

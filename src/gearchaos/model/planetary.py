@@ -314,9 +314,7 @@ class PlanetaryModel:
         """Half clearances b of the dead zones f(·; b) of the tracked observables (``inf``
         for the contact forces)."""
         par, N = self.parameters, self.n_planets
-        return np.array(
-            [par.b_sp] * N + [par.b_rp] * N + [par.b_s, par.b_s] + [np.inf] * (2 * N)
-        )
+        return np.array([par.b_sp] * N + [par.b_rp] * N + [par.b_s, par.b_s] + [np.inf] * (2 * N))
 
     @property
     def clearances(self) -> dict[str, float]:
