@@ -2,6 +2,7 @@
 
 from .classify import classify_dataset, classify_store
 from .execute import Execution
+from .response import response
 from .result import SweepLayout, SweepResult
 from .run import bifurcation, run_sweep
 from .spec import Axis, SweepSpec, parse_axis, parse_values
@@ -20,5 +21,6 @@ __all__ = [
     "open_sweep",
     "parse_axis",
     "parse_values",
+    "response",
     "run_sweep",
 ]

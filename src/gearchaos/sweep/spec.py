@@ -156,8 +156,12 @@ def _axes(items: Any) -> tuple[Axis, ...]:
 #: Solver settings of a sweep when none are given: the seed's 100 + 100 periods.
 SWEEP_SOLVER = SolverSettings(transient_periods=100, periods=100)
 
+#: Solver settings of a frequency-response sweep when none are given: 100 transient and 50
+#: recorded periods, 32 samples per period for the RMS values.
+RESPONSE_SOLVER = SolverSettings(transient_periods=100, periods=50, samples_per_period=32)
+
 #: The options of :meth:`SweepSpec.build` besides the axes and the fixed values.
-SPEC_OPTIONS = ("observe", "planets", "initial_conditions", "direction", "lyapunov")
+SPEC_OPTIONS = ("observe", "planets", "initial_conditions", "direction", "lyapunov", "response")
 
 
 def _names(what: str, items: Any) -> tuple[str, ...]:
@@ -203,6 +207,12 @@ class SweepSpec:
         Transient and recorded periods, tolerances (one sample per period: the section).
     lyapunov
         Also integrate the largest Lyapunov exponent of every point.
+    response
+        Also store the frequency-response quantities of every point
+        (:mod:`gearchaos.model.response`): RMS and peak contact force of every mesh, dynamic
+        load factor and RMS dynamic transmission error. Only a response sweep may record more
+        than one sample per period (the RMS values come from the samples; the sections are
+        every ``samples_per_period``-th sample).
     """
 
     vary: tuple[Axis, ...]
@@ -215,6 +225,7 @@ class SweepSpec:
     solver: SolverSettings = SWEEP_SOLVER
     lyapunov: bool = False
     extra: tuple[tuple[str, Any], ...] = field(default=())
+    response: bool = False
 
     def __post_init__(self) -> None:
         if not 1 <= len(self.vary) <= 2:
@@ -253,9 +264,10 @@ class SweepSpec:
             raise ParameterError(
                 f"solver must be a SolverSettings: got {type(self.solver).__name__}"
             )
-        if self.solver.samples_per_period != 1:
+        check_bool("response", self.response)
+        if self.solver.samples_per_period != 1 and not self.response:
             raise ParameterError(
-                "a sweep records one sample per period (the section): "
+                "a sweep records one sample per period (the section), a response sweep more: "
                 f"got samples_per_period={self.solver.samples_per_period}"
             )
         check_bool("lyapunov", self.lyapunov)
@@ -298,7 +310,9 @@ class SweepSpec:
             vary=_axes(vary),
             family=fam[0] if fam else None,
             fixed=tuple(sorted((fixed or {}).items())),
-            solver=SolverSettings.build(solver or SWEEP_SOLVER, **settings),
+            solver=SolverSettings.build(
+                solver or (RESPONSE_SOLVER if own.get("response") else SWEEP_SOLVER), **settings
+            ),
             **own,
         )
 
@@ -356,6 +370,14 @@ class SweepSpec:
             f"lyapunov = {val(self.lyapunov)}",
             f"observe = {val(list(self.observe))}",
             f"planets = {val(list(self.planets))}",
+            *(
+                [
+                    f"response = {val(True)}",
+                    f"samples_per_period = {self.solver.samples_per_period}",
+                ]
+                if self.response
+                else []
+            ),
             "",
         ]
         for a in self.vary:
@@ -400,8 +422,10 @@ class SweepSpec:
                     periods=int(d["periods"]),
                     rtol=d["rtol"],
                     atol=d["atol"],
+                    samples_per_period=int(d.get("samples_per_period", 1)),
                 ),
                 lyapunov=bool(d.get("lyapunov", False)),
+                response=bool(d.get("response", False)),
                 extra=tuple(sorted(d.get("extra", {}).items())),
             )
         except (tomllib.TOMLDecodeError, KeyError, TypeError, ValueError, AttributeError) as exc:
