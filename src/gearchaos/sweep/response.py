@@ -18,9 +18,12 @@ from __future__ import annotations
 import os
 from typing import Any
 
+import numpy as np
+
+from .._checks import check_real
 from .run import bifurcation
 
-__all__ = ["response"]
+__all__ = ["find_jumps", "response"]
 
 
 def response(
@@ -74,3 +77,36 @@ def response(
         response=True,
         **options,
     )
+
+
+def find_jumps(x: Any, y: Any, *, rel: float = 0.25) -> list[float]:
+    """Where a response curve jumps: the midpoints (x_k + x_{k+1})/2 of the neighbouring
+    points whose values differ by more than ``rel`` times the curve's range max y − min y.
+
+    Parameters
+    ----------
+    x, y
+        The swept values (in sweep order) and the response along one branch (``direction``
+        ``up`` or ``down``); NaN points (failed) are skipped.
+    rel
+        Threshold as a fraction of the range (default 0.25).
+
+    Returns
+    -------
+    list of float
+        The jump positions in increasing x.
+    """
+    check_real("rel", rel, lo=0.0, lo_open=True)
+    xa = np.asarray(x, dtype=float)
+    ya = np.asarray(y, dtype=float)
+    ok = np.isfinite(ya)
+    xa, ya = xa[ok], ya[ok]
+    if ya.size < 2:
+        return []
+    order = np.argsort(xa)
+    xa, ya = xa[order], ya[order]
+    span = float(ya.max() - ya.min())
+    if span <= 0.0:
+        return []
+    k = np.nonzero(np.abs(np.diff(ya)) > rel * span)[0]
+    return [float(0.5 * (xa[i] + xa[i + 1])) for i in k]
