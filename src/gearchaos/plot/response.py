@@ -146,7 +146,7 @@ def response_figure(
         hz = scales.factor("mesh_hz")
         if hz is not None:
             sec = axes[-1].secondary_xaxis(
-                -0.45, functions=(lambda v: np.asarray(v) * hz[0], lambda v: np.asarray(v) / hz[0])
+                -0.32, functions=(lambda v: np.asarray(v) * hz[0], lambda v: np.asarray(v) / hz[0])
             )
             sec.set_xlabel(f"mesh frequency $f_m$ {hz[1]}", fontsize="small")
             sec.tick_params(labelsize="small")
