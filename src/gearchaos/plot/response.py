@@ -2,7 +2,7 @@
 
 Four panels over the swept parameter (usually Ω): peak and RMS contact force of each mesh type,
 dynamic load factor and RMS dynamic transmission error. The up branch is drawn solid, the down
-branch dashed; jumps (:func:`~gearchaos.sweep.response.find_jumps`) are marked with arrows in the
+branch dashed; jumps (:func:`~gearchaos.sweep.frequency.find_jumps`) are marked with arrows in the
 direction of the sweep, and where the branches differ the band between them is shaded. Over Ω
 the top axis shows the sun speed in rpm and the mesh frequency in Hz, and the force and DTE
 panels a physical axis (N, µm) on the right, where the gear set defines them.
@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from ..sweep import SweepResult
-from ..sweep.response import find_jumps
+from ..sweep.frequency import find_jumps
 from .units import PhysicalScales, fit_to_data, linear_axis
 
 __all__ = ["response_figure"]
@@ -24,7 +24,7 @@ __all__ = ["response_figure"]
 PANELS = (
     ("force_peak", r"peak contact force $\max|\bar F^c|$", "force"),
     ("force_rms", r"RMS contact force $\sqrt{\langle \bar F^{c\,2}\rangle}$", "force"),
-    ("load_factor", r"dynamic load factor $\max|F^c|/F_{static}$", None),
+    ("load_factor", r"load factor $\max|F^c|/F_{static}$", None),
     (
         "dte_rms",
         r"RMS DTE $\sqrt{\langle(\bar\delta-\langle\bar\delta\rangle)^2\rangle}$",

@@ -2,7 +2,7 @@
 
 from .classify import classify_dataset, classify_store
 from .execute import Execution
-from .response import find_jumps, response
+from .frequency import find_jumps, response
 from .result import SweepLayout, SweepResult
 from .run import bifurcation, run_sweep
 from .spec import Axis, SweepSpec, parse_axis, parse_values

@@ -1,5 +1,5 @@
 """Store variables of a frequency-response sweep and how to fill them (see
-:mod:`gearchaos.sweep.response`)."""
+:mod:`gearchaos.sweep.frequency`)."""
 
 from __future__ import annotations
 
