@@ -182,7 +182,11 @@ def mesh_force_history(
         ax.axhline(static, ls=":", lw=0.8, color="0.3", label="static mesh force")
     ax.axhline(0.0, lw=0.5, color="0.5")
     ax.set_xlabel(period_axis_label(result))
-    ax.set_ylabel(r"contact force $\bar F^c = F^c/(k_{m,sp}\,b_c)$")
+    ax.set_ylabel(
+        r"contact force $\bar F^c = F^c/(k_{m,sp}\,b_c)$"
+        if is_planetary(result)
+        else r"contact force $F^c$"
+    )
     fit_to_data(ax, t, np.concatenate(ys))
     if physical:
         scales = PhysicalScales.of_result(result)
