@@ -194,36 +194,24 @@ def planetary_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
         ksp = 1.0 + eps_sp * ck
         dksp = eps_sp  # dκ/d(cos θ); times dcos θ/dτ below (tracked level only)
         if nh_sp > 0:
-            tm2 = 1.0
-            tm1 = ck
-            dm2 = 0.0
-            dm1 = 1.0
+            tm2, tm1, dm2, dm1 = 1.0, ck, 0.0, 1.0  # T_0, T_1 and their derivatives
             for h in range(nh_sp):
                 tt = 2.0 * ck * tm1 - tm2
                 dt_ = 2.0 * tm1 + 2.0 * ck * dm1 - dm2  # Chebyshev T_h' recurrence
                 ksp += p[h0 + h] * tt
                 dksp += p[h0 + h] * dt_
-                tm2 = tm1
-                tm1 = tt
-                dm2 = dm1
-                dm1 = dt_
+                tm2, tm1, dm2, dm1 = tm1, tt, dm1, dt_
         ckr = c1 * p[P_HEADER + B_CK_RP * N + i] - s1 * p[P_HEADER + B_SK_RP * N + i]
         krp = krm + kra * ckr
         dkrp = kra
         if nh_rp > 0:
-            tm2 = 1.0
-            tm1 = ckr
-            dm2 = 0.0
-            dm1 = 1.0
+            tm2, tm1, dm2, dm1 = 1.0, ckr, 0.0, 1.0  # T_0, T_1 and their derivatives
             for h in range(nh_rp):
                 tt = 2.0 * ckr * tm1 - tm2
                 dt_ = 2.0 * tm1 + 2.0 * ckr * dm1 - dm2
                 krp += p[h0 + nh_sp + h] * tt
                 dkrp += p[h0 + nh_sp + h] * dt_
-                tm2 = tm1
-                tm1 = tt
-                dm2 = dm1
-                dm1 = dt_
+                tm2, tm1, dm2, dm1 = tm1, tt, dm1, dt_
 
         # --- transmission errors and their τ-derivatives
         cte = p[P_HEADER + B_CE_SP * N + i]
@@ -282,20 +270,16 @@ def planetary_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
             obs[nt + N + i] = drp_d
             # contact forces: zero while the teeth are apart; their derivatives without the
             # c̄ δ̄'' term, which needs the accelerations (added after the loop)
-            if dsp > bsp or dsp < -bsp:
-                sk = s1 * p[P_HEADER + B_CK_SP * N + i] + c1 * p[P_HEADER + B_SK_SP * N + i]
-                obs[2 * N + 2 + i] = fsp
-                obs[nt + 2 * N + 2 + i] = -om * sk * dksp * fzsp + ksp * dsp_d - csp * esp_dd
-            else:
-                obs[2 * N + 2 + i] = 0.0
-                obs[nt + 2 * N + 2 + i] = 0.0
-            if drp > brp or drp < -brp:
-                sk = s1 * p[P_HEADER + B_CK_RP * N + i] + c1 * p[P_HEADER + B_SK_RP * N + i]
-                obs[3 * N + 2 + i] = frp
-                obs[nt + 3 * N + 2 + i] = -om * sk * dkrp * fzrp + krp * drp_d - crp * erp_dd
-            else:
-                obs[3 * N + 2 + i] = 0.0
-                obs[nt + 3 * N + 2 + i] = 0.0
+            on = dsp > bsp or dsp < -bsp
+            sk = s1 * p[P_HEADER + B_CK_SP * N + i] + c1 * p[P_HEADER + B_SK_SP * N + i]
+            obs[2 * N + 2 + i] = fsp if on else 0.0
+            dfc = -om * sk * dksp * fzsp + ksp * dsp_d - csp * esp_dd
+            obs[nt + 2 * N + 2 + i] = dfc if on else 0.0
+            on = drp > brp or drp < -brp
+            sk = s1 * p[P_HEADER + B_CK_RP * N + i] + c1 * p[P_HEADER + B_SK_RP * N + i]
+            obs[3 * N + 2 + i] = frp if on else 0.0
+            dfc = -om * sk * dkrp * fzrp + krp * drp_d - crp * erp_dd
+            obs[nt + 3 * N + 2 + i] = dfc if on else 0.0
             if level >= OBS_ALL:
                 obs[2 * nt + i] = fsp
                 obs[2 * nt + N + i] = frp
@@ -332,17 +316,14 @@ def planetary_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
         obs[nt + 2 * N + 1] = yd
         # the c̄ δ̄'' terms of the contact-force derivatives: δ̄_sp'' = p̄_i'' + s_i'' − e_sp'',
         # δ̄_rp'' = σ̄'' − p̄_i'' − e_rp'' (the e'' parts were added in the loop)
-        xdd = dydt[n]
-        ydd = dydt[n + 1]
-        sdd = dydt[n + N + 2]
         for i in range(N):
             pdd = dydt[n + 2 + i]
             if obs[i] > bsp or obs[i] < -bsp:
                 si = p[P_HEADER + B_S * N + i]
                 ci = p[P_HEADER + B_C * N + i]
-                obs[nt + 2 * N + 2 + i] += csp * (pdd - xdd * si + ydd * ci)
+                obs[nt + 2 * N + 2 + i] += csp * (pdd - dydt[n] * si + dydt[n + 1] * ci)
             if obs[N + i] > brp or obs[N + i] < -brp:
-                obs[nt + 3 * N + 2 + i] += crp * (sdd - pdd)
+                obs[nt + 3 * N + 2 + i] += crp * (dydt[n + N + 2] - pdd)
 
 
 @numba.njit(cache=True)
