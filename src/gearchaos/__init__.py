@@ -26,7 +26,7 @@ from .model import (
     nondimensionalise,
     planetary_system,
 )
-from .sweep import bifurcation, open_sweep
+from .sweep import bifurcation, open_sweep, response
 from .sweep.exports import export
 
 __all__ = [
@@ -54,6 +54,7 @@ __all__ = [
     "periodic_orbit",
     "planetary_system",
     "preset",
+    "response",
     "simulate",
 ]
 

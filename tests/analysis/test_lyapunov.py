@@ -246,7 +246,8 @@ def _fd_log_stretches(system: gc.System, y0: np.ndarray, h: float) -> np.ndarray
     """log|R_jj| of the QR factorisation of the one-period flow-map Jacobian, by central
     differences of :func:`gearchaos.simulate` runs from y0 ± h e_j."""
     n = system.n_state
-    kw = {"transient_periods": 0, "periods": 2, "rtol": 1e-12, "atol": 1e-14}
+    kw = {"transient_periods": 0, "periods": 2, "samples_per_period": 1}
+    kw |= {"rtol": 1e-12, "atol": 1e-14}
     jac = np.empty((n, n))
     for j in range(n):
         e = np.zeros(n)

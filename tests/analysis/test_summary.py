@@ -67,6 +67,7 @@ def test_reference_system_summary() -> None:
         gc.backlash_oscillator(1.0, zeta=0.1, b=1.0, f_mean=2.0, f_alt=0.3, omega_power=0),
         transient_periods=20,
         periods=10,
+        samples_per_period=1,
     )
     s = summarize(r)
     assert REQUIRED <= set(s)

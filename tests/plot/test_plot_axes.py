@@ -149,7 +149,9 @@ def test_spectrum_amplitude_of_a_linear_oscillator() -> None:
 
 
 def test_spectrum_needs_samples() -> None:
-    r = gc.simulate(gc.preset("hindawi2021"), omega=0.5, transient_periods=5, periods=5)
+    r = gc.simulate(
+        gc.preset("hindawi2021"), omega=0.5, transient_periods=5, periods=5, samples_per_period=1
+    )
     with pytest.raises(ParameterError, match="samples_per_period"):
         spectrum(r)
     # the other plots still work with one sample per period

@@ -12,7 +12,7 @@ from gearchaos.plot import savefig, summary_figure
 
 def test_summary_figure_png(planetary: gc.SimulationResult, tmp_path) -> None:
     fig = summary_figure(planetary)
-    assert len(fig.axes) == 6
+    assert len(fig.axes) == 7  # 2×3 panels and the contact-force panel (issue 12)
     assert "hindawi2021" in fig.get_suptitle()
     text = " ".join(t.get_text() for t in fig.axes[5].texts)
     assert "1T" in text and "sun–planet" in text and "status: ok" in text
@@ -41,7 +41,13 @@ def test_savefig_rejects_unknown_suffix(planetary: gc.SimulationResult, tmp_path
 
 
 def test_summary_figure_with_one_sample_per_period(tmp_path) -> None:
-    r = gc.simulate(gc.preset("hindawi2021"), omega=0.5, transient_periods=20, periods=20)
+    r = gc.simulate(
+        gc.preset("hindawi2021"),
+        omega=0.5,
+        transient_periods=20,
+        periods=20,
+        samples_per_period=1,
+    )
     fig = summary_figure(r)
     assert any("samples_per_period" in t.get_text() for t in fig.axes[3].texts)
     savefig(fig, tmp_path / "one.png")

@@ -10,11 +10,16 @@ impacting one — a hysteresis loop with jumps at both ends.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import pytest
 from sweep_helpers import assert_bitwise_equal
 
 import gearchaos as gc
+
+#: sweeps record one sample per period: compare with simulations that do too
+_simulate = functools.partial(gc.simulate, samples_per_period=1)
 
 ZETA, B, F_MEAN, F_ALT = 0.05, 1.0, 0.1, 0.02
 OMEGA = "0.6:1.2:13"
@@ -118,7 +123,7 @@ def test_both_attractors_persist_in_independent_simulations(both):
     amps = {}
     for branch in (up, down):
         y0 = branch.final_state.values[j] + kicked
-        res = gc.simulate(oscillator(om), y0=y0, transient_periods=300, periods=16)
+        res = _simulate(oscillator(om), y0=y0, transient_periods=300, periods=16)
         amp = res.obs_max[0] - res.obs_min[0]
         assert amp == pytest.approx(float(amplitude(branch)[j]), abs=1e-6)
         np.testing.assert_allclose(res.states[:, 0], branch.x.values[j], rtol=0, atol=1e-6)
@@ -128,7 +133,7 @@ def test_both_attractors_persist_in_independent_simulations(both):
     j = int(loop[-1]) + 2
     om = float(both.omega[j])
     ends = [
-        gc.simulate(
+        _simulate(
             oscillator(om), y0=b.final_state.values[j] + kicked, transient_periods=300, periods=16
         ).states[:, 0]
         for b in (up, down)
@@ -144,7 +149,7 @@ def test_each_point_starts_from_its_predecessor(both, direction):
     y0 = None
     for j in order:
         om = float(branch.omega[j])
-        res = gc.simulate(oscillator(om), y0=y0, **PROTOCOL)
+        res = _simulate(oscillator(om), y0=y0, **PROTOCOL)
         np.testing.assert_array_equal(branch.x.values[j], res.states[:, 0])
         np.testing.assert_array_equal(branch.final_state.values[j], res.final_state)
         assert int(branch.steps_accepted[j]) == res.steps_accepted

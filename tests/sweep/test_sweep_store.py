@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import warnings
 
 import numba
@@ -11,6 +12,9 @@ import xarray as xr
 
 import gearchaos as gc
 from gearchaos.sweep import SweepSpec
+
+#: sweeps record one sample per period: compare with simulations that do too
+_simulate = functools.partial(gc.simulate, samples_per_period=1)
 
 #: 2 × 3 × 4 grid (family, Ω, b̄_sp): unequal sizes, so a swapped axis cannot go unnoticed.
 FAMILY = {"xi": [0.03, 0.09]}
@@ -90,7 +94,7 @@ def test_points_carry_their_own_parameters(store, target, index):
     gs = target.evolve(
         {"xi": float(pt.xi), "backlash.sun_planet": float(pt["backlash.sun_planet"]), **FIXED}
     )
-    res = gc.simulate(
+    res = _simulate(
         gs,
         omega=float(pt.omega),
         transient_periods=SETTINGS["transient_periods"],
@@ -124,7 +128,7 @@ def test_reference_system_store_uses_state_names(tmp_path):
     assert np.all(ds.x_min.values <= ds.x.min("section").values)
     assert np.all(ds.x_max.values >= ds.x.max("section").values)
     pt = ds.sel(zeta=0.05, omega=1.25)
-    res = gc.simulate(
+    res = _simulate(
         gc.backlash_oscillator(1.25, zeta=0.05, b=1.0, f_mean=0.1, f_alt=0.3, omega_power=0),
         transient_periods=10,
         periods=8,
@@ -161,7 +165,7 @@ def single(gamma: float) -> gc.SimulationResult:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         system = gc.duffing(1.0, gamma=gamma, **WELL)
-        return gc.simulate(system, transient_periods=10, periods=8, check=False)
+        return _simulate(system, transient_periods=10, periods=8, check=False)
 
 
 def test_failed_points_are_stored_with_their_status_and_the_sweep_goes_on(tmp_path):

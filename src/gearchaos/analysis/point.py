@@ -16,7 +16,7 @@ from typing import Any
 from .._checks import check_bool
 from ..errors import Status
 from ..integrate.result import SimulationResult
-from ..integrate.settings import SolverSettings
+from ..integrate.settings import SIMULATION, SolverSettings
 from ..integrate.simulate import run_simulation
 from ..model.target import resolve
 from .lyapunov import lyapunov_spectrum
@@ -71,7 +71,8 @@ def analyse_point(
     values
         Parameter values by dotted name (:func:`~gearchaos.model.target.resolve`).
     settings
-        Protocol and tolerances (default: :class:`~gearchaos.integrate.settings.SolverSettings`).
+        Protocol and tolerances (default: :data:`~gearchaos.integrate.settings.SIMULATION`,
+        as :func:`gearchaos.simulate` and ``gearchaos simulate``).
     lyapunov
         Also compute the largest Lyapunov exponent (it decides quasi-periodic vs chaotic).
     default_omega
@@ -80,7 +81,7 @@ def analyse_point(
         Raise :class:`~gearchaos.errors.IntegrationError` when the simulation fails, instead of
         returning a result labelled ``failed``.
     """
-    cfg = settings if settings is not None else SolverSettings()
+    cfg = settings if settings is not None else SIMULATION
     system = resolve(target, values, default_omega=default_omega)
     result = run_simulation(system, cfg, check=check_bool("check", check))
     lle: float | None = None

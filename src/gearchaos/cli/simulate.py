@@ -10,6 +10,7 @@ import typer
 from rich.text import Text
 
 from ..errors import ParameterError
+from ..integrate.settings import SIMULATION
 from . import _common as c
 from ._render import add_motion_rows
 
@@ -19,17 +20,17 @@ def simulate(
     preset: c.PresetOpt = None,
     gearset: c.GearsetOpt = None,
     set_: c.SetOpt = None,
-    transient: c.TransientOpt = 100.0,
-    periods: c.PeriodsOpt = 200,
+    transient: c.TransientOpt = SIMULATION.transient_periods,
+    periods: c.PeriodsOpt = SIMULATION.periods,
     samples_per_period: Annotated[
         int,
         typer.Option(
             "--samples-per-period",
-            help="Samples per mesh period of the time history (figure, spectra).",
+            help="Samples per mesh period of the time history (figure, spectra, RMS values).",
         ),
-    ] = 64,
-    rtol: c.RtolOpt = 1e-8,
-    atol: c.AtolOpt = 1e-10,
+    ] = SIMULATION.samples_per_period,
+    rtol: c.RtolOpt = SIMULATION.rtol,
+    atol: c.AtolOpt = SIMULATION.atol,
     output_dir: Annotated[
         str | None,
         typer.Option(

@@ -338,10 +338,20 @@ def plot(
             show_default=False,
         ),
     ] = None,
+    sections: Annotated[
+        bool,
+        typer.Option(
+            "--sections",
+            help="For a store of `gearchaos response`: draw its bifurcation diagram instead of "
+            "the response curves.",
+        ),
+    ] = False,
 ) -> None:
     """Draw a sweep store: bifurcation diagrams (one panel per family value, with a band of
     motion labels under each) for a 1-D sweep, maps coloured by motion label (1T, 2T, …, QP,
-    chaos) for a 2-D sweep.
+    chaos) for a 2-D sweep, frequency-response curves (peak and RMS contact force, load
+    factor, RMS DTE; up and down branches, jumps marked; Ω with sun rpm and mesh Hz) for a
+    store of `gearchaos response`.
 
     Example: **gearchaos plot fig4.zarr -o fig4.png --clearance-lines**
     """
@@ -360,6 +370,15 @@ def plot(
         from ..plot import savefig, sweep_figure
 
         branches = [open_branch(b) for b in branch or []]
+        if res.ds.attrs.get("kind") == "response" and not sections:
+            from ..plot import response_figure
+
+            fig = response_figure(res)
+            if output.parent != Path(""):
+                output.parent.mkdir(parents=True, exist_ok=True)
+            savefig(fig, output)
+            c.wrote(output)
+            return
         fig = sweep_figure(
             res,
             var=var,

@@ -20,7 +20,7 @@ import numpy as np
 from .._checks import check_int, check_memory, check_real
 from ..errors import ParameterError
 
-__all__ = ["SampleTimes", "SolverSettings"]
+__all__ = ["SIMULATION", "SampleTimes", "SolverSettings"]
 
 #: Bounds of the settings (see :meth:`SolverSettings.check`).
 RTOL_RANGE = (1e-14, 1.0)
@@ -180,6 +180,12 @@ class SolverSettings:
             "section_phase": self.section_phase,
         }
         return out
+
+
+#: The defaults of one simulation, the same from Python (:func:`gearchaos.simulate`,
+#: :func:`~gearchaos.analysis.point.analyse_point`) and from ``gearchaos simulate``: the
+#: seed's protocol with 64 samples per mesh period (time histories, spectra, RMS values).
+SIMULATION = SolverSettings(samples_per_period=64)
 
 
 def sample_index(n_samples: int, samples_per_period: int) -> np.ndarray:

@@ -20,12 +20,12 @@ from ..model.system import System
 from ..model.target import resolve
 from ._chains import ChainRun, run_chains
 from .result import SimulationResult
-from .settings import SolverSettings
+from .settings import SIMULATION, SolverSettings
 from .trajectory import Trajectory
 
 __all__ = ["Trajectory", "integrate", "run_simulation", "simulate"]
 
-_DEFAULT = SolverSettings()
+_DEFAULT = SIMULATION
 
 
 def _initial_state(system: System, y0: Any) -> np.ndarray | None:

@@ -118,12 +118,18 @@ def planetary_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
     """Minimal relative-coordinate equations of MODEL.md §7.
 
     State y = (x̄_s, ȳ_s, p̄_1..p̄_N, σ̄, then their τ-derivatives).
-    obs = (δ̄_sp1..N, δ̄_rp1..N, x̄_s, ȳ_s, then their τ-derivatives, then F̄_sp1..N, F̄_rp1..N,
-    then the mesh stiffnesses κ_sp1..N, κ_rp1..N): the first 2N + 2 entries are the arguments of
-    the dead zones (tracked and event-located); the stiffnesses feed the tangent equations.
+    obs = (δ̄_sp1..N, δ̄_rp1..N, x̄_s, ȳ_s, F̄ᶜ_sp1..N, F̄ᶜ_rp1..N, then the τ-derivatives of
+    these T = 4N + 2 tracked observables, then F̄_sp1..N, F̄_rp1..N, then the mesh stiffnesses
+    κ_sp1..N, κ_rp1..N). The first 2N + 2 are the arguments of the dead zones (event-located);
+    F̄ᶜ is the *contact* force of a mesh, κ f(δ̄; b̄) + c̄ δ̄' while the teeth touch
+    (|δ̄| > b̄) and exactly 0 while they are apart; F̄ is the force of the equations of motion,
+    κ f(δ̄; b̄) + c̄ δ̄' at all times (damping acts inside the clearance, MODEL.md §4). Their
+    derivatives F̄ᶜ' = κ' f + κ δ̄' + c̄ δ̄'' (engaged) let the integrator refine the contact
+    forces' extrema inside a step; the stiffnesses feed the tangent equations.
     """
     N = int(p[P_N])
     n = N + 3
+    nt = 4 * N + 2  # tracked observables (their derivatives follow them)
     om = p[P_OMEGA]
     th = om * t
     c1 = math.cos(th)
@@ -186,52 +192,64 @@ def planetary_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
         # --- time-varying stiffness, angle addition from one sin/cos pair of Ωτ
         ck = c1 * p[P_HEADER + B_CK_SP * N + i] - s1 * p[P_HEADER + B_SK_SP * N + i]
         ksp = 1.0 + eps_sp * ck
+        dksp = eps_sp  # dκ/d(cos θ); times dcos θ/dτ below (tracked level only)
         if nh_sp > 0:
-            tm2 = 1.0
-            tm1 = ck
+            tm2, tm1, dm2, dm1 = 1.0, ck, 0.0, 1.0  # T_0, T_1 and their derivatives
             for h in range(nh_sp):
                 tt = 2.0 * ck * tm1 - tm2
+                dt_ = 2.0 * tm1 + 2.0 * ck * dm1 - dm2  # Chebyshev T_h' recurrence
                 ksp += p[h0 + h] * tt
-                tm2 = tm1
-                tm1 = tt
+                dksp += p[h0 + h] * dt_
+                tm2, tm1, dm2, dm1 = tm1, tt, dm1, dt_
         ckr = c1 * p[P_HEADER + B_CK_RP * N + i] - s1 * p[P_HEADER + B_SK_RP * N + i]
         krp = krm + kra * ckr
+        dkrp = kra
         if nh_rp > 0:
-            tm2 = 1.0
-            tm1 = ckr
+            tm2, tm1, dm2, dm1 = 1.0, ckr, 0.0, 1.0  # T_0, T_1 and their derivatives
             for h in range(nh_rp):
                 tt = 2.0 * ckr * tm1 - tm2
+                dt_ = 2.0 * tm1 + 2.0 * ckr * dm1 - dm2
                 krp += p[h0 + nh_sp + h] * tt
-                tm2 = tm1
-                tm1 = tt
+                dkrp += p[h0 + nh_sp + h] * dt_
+                tm2, tm1, dm2, dm1 = tm1, tt, dm1, dt_
 
         # --- transmission errors and their τ-derivatives
         cte = p[P_HEADER + B_CE_SP * N + i]
         ste = p[P_HEADER + B_SE_SP * N + i]
         esp = asp * (s1 * cte + c1 * ste)
         esp_d = asp * om * (c1 * cte - s1 * ste)
+        esp_dd = -om * om * esp  # e'' of every sinusoid is −(its frequency)² times it
         cte = p[P_HEADER + B_CE_RP * N + i]
         ste = p[P_HEADER + B_SE_RP * N + i]
         erp = arp * (s1 * cte + c1 * ste)
         erp_d = arp * om * (c1 * cte - s1 * ste)
+        erp_dd = -om * om * erp
         if ecc:
             ca = p[P_HEADER + B_C_ES * N + i]
             sa = p[P_HEADER + B_S_ES * N + i]
-            esp += es * (ss_ * ca + cs_ * sa)
+            e1 = es * (ss_ * ca + cs_ * sa)
+            esp += e1
             esp_d += es * om_s * (cs_ * ca - ss_ * sa)
+            esp_dd -= om_s * om_s * e1
             ca = p[P_HEADER + B_C_EPS * N + i]
             sa = p[P_HEADER + B_S_EPS * N + i]
-            esp += ep * (sp_ * ca + cp_ * sa)
+            e1 = ep * (sp_ * ca + cp_ * sa)
+            esp += e1
             esp_d += ep * om_p * (cp_ * ca - sp_ * sa)
+            esp_dd -= om_p * om_p * e1
             ca = p[P_HEADER + B_C_EPR * N + i]
             sa = p[P_HEADER + B_S_EPR * N + i]
-            erp += ep * (sp_ * ca + cp_ * sa)
+            e1 = ep * (sp_ * ca + cp_ * sa)
+            erp += e1
             erp_d += ep * om_p * (cp_ * ca - sp_ * sa)
+            erp_dd -= om_p * om_p * e1
             # sin(−Ω_H τ + θ) = sin θ cos(Ω_H τ) − cos θ sin(Ω_H τ)
             ca = p[P_HEADER + B_C_ER * N + i]
             sa = p[P_HEADER + B_S_ER * N + i]
-            erp += er * (sa * cr_ - ca * sr_)
+            e1 = er * (sa * cr_ - ca * sr_)
+            erp += e1
             erp_d += er * om_r * (-sa * sr_ - ca * cr_)
+            erp_dd -= om_r * om_r * e1
 
         pi_ = y[2 + i]
         pid = y[n + 2 + i]
@@ -239,20 +257,34 @@ def planetary_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
         dsp_d = pid + sd_i - esp_d
         drp = sig - pi_ - erp
         drp_d = sigd - pid - erp_d
-        fsp = ksp * dead_zone(dsp, bsp) + csp * dsp_d
-        frp = krp * dead_zone(drp, brp) + crp * drp_d
+        fzsp = dead_zone(dsp, bsp)
+        fzrp = dead_zone(drp, brp)
+        fsp = ksp * fzsp + csp * dsp_d
+        frp = krp * fzrp + crp * drp_d
         dydt[n + 2 + i] = (frp - fsp) * inv_mup  # completed below
 
         if level >= OBS_TRACK:
             obs[i] = dsp
             obs[N + i] = drp
-            obs[2 * N + 2 + i] = dsp_d
-            obs[3 * N + 2 + i] = drp_d
+            obs[nt + i] = dsp_d
+            obs[nt + N + i] = drp_d
+            # contact forces: zero while the teeth are apart; their derivatives without the
+            # c̄ δ̄'' term, which needs the accelerations (added after the loop)
+            on = dsp > bsp or dsp < -bsp
+            sk = s1 * p[P_HEADER + B_CK_SP * N + i] + c1 * p[P_HEADER + B_SK_SP * N + i]
+            obs[2 * N + 2 + i] = fsp if on else 0.0
+            dfc = -om * sk * dksp * fzsp + ksp * dsp_d - csp * esp_dd
+            obs[nt + 2 * N + 2 + i] = dfc if on else 0.0
+            on = drp > brp or drp < -brp
+            sk = s1 * p[P_HEADER + B_CK_RP * N + i] + c1 * p[P_HEADER + B_SK_RP * N + i]
+            obs[3 * N + 2 + i] = frp if on else 0.0
+            dfc = -om * sk * dkrp * fzrp + krp * drp_d - crp * erp_dd
+            obs[nt + 3 * N + 2 + i] = dfc if on else 0.0
             if level >= OBS_ALL:
-                obs[4 * N + 4 + i] = fsp
-                obs[5 * N + 4 + i] = frp
-                obs[6 * N + 4 + i] = ksp
-                obs[7 * N + 4 + i] = krp
+                obs[2 * nt + i] = fsp
+                obs[2 * nt + N + i] = frp
+                obs[2 * nt + 2 * N + i] = ksp
+                obs[2 * nt + 3 * N + i] = krp
         sum_fsp += fsp
         sum_frp += frp
         sum_fx += fsp * si
@@ -274,30 +306,51 @@ def planetary_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
     dydt[n] = (sum_fx - cb * xd - kb * dead_zone(x, bs)) * inv_ms
     dydt[n + 1] = (sum_fy - cb * yd - kb * dead_zone(yy, bs)) * inv_ms
     qcp = cas * qc
-    if level >= OBS_TRACK:
-        obs[2 * N] = x
-        obs[2 * N + 1] = yy
-        obs[4 * N + 2] = xd
-        obs[4 * N + 3] = yd
     for i in range(N):
         dydt[n + 2 + i] = qs + dydt[n + 2 + i] - qcp
     dydt[n + N + 2] = qs - (cas + car) * qc
+    if level >= OBS_TRACK:
+        obs[2 * N] = x
+        obs[2 * N + 1] = yy
+        obs[nt + 2 * N] = xd
+        obs[nt + 2 * N + 1] = yd
+        # the c̄ δ̄'' terms of the contact-force derivatives: δ̄_sp'' = p̄_i'' + s_i'' − e_sp'',
+        # δ̄_rp'' = σ̄'' − p̄_i'' − e_rp'' (the e'' parts were added in the loop)
+        for i in range(N):
+            pdd = dydt[n + 2 + i]
+            if obs[i] > bsp or obs[i] < -bsp:
+                si = p[P_HEADER + B_S * N + i]
+                ci = p[P_HEADER + B_C * N + i]
+                obs[nt + 2 * N + 2 + i] += csp * (pdd - dydt[n] * si + dydt[n + 1] * ci)
+            if obs[N + i] > brp or obs[N + i] < -brp:
+                obs[nt + 3 * N + 2 + i] += crp * (dydt[n + N + 2] - pdd)
 
 
 @numba.njit(cache=True)
 def backlash_oscillator_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
     """x'' + 2ζx' + (1 + ε cos Ωτ) f(x; b) = F_m + F_a Ω^q cos Ωτ;
-    obs = (x, x', contact force, stiffness 1 + ε cos Ωτ)."""
-    c = math.cos(p[BO_OMEGA] * t)
+    obs = (x, Fᶜ, x', Fᶜ', stiffness 1 + ε cos Ωτ) with the contact force
+    Fᶜ = (1 + ε cos Ωτ) f(x; b) + 2ζx' while |x| > b and 0 while |x| ≤ b (teeth apart)."""
+    om = p[BO_OMEGA]
+    c = math.cos(om * t)
     x = y[0]
     v = y[1]
-    fc = (1.0 + p[BO_EPS] * c) * dead_zone(x, p[BO_B])
+    b = p[BO_B]
+    k = 1.0 + p[BO_EPS] * c
+    fz = dead_zone(x, b)
+    damp = 2.0 * p[BO_ZETA] * v
     dydt[0] = v
-    dydt[1] = p[BO_FM] + p[BO_FA] * c - 2.0 * p[BO_ZETA] * v - fc
+    dydt[1] = p[BO_FM] + p[BO_FA] * c - damp - k * fz
     obs[0] = x
-    obs[1] = v
-    obs[2] = fc
-    obs[3] = 1.0 + p[BO_EPS] * c
+    obs[2] = v
+    if x > b or x < -b:
+        obs[1] = k * fz + damp
+        dk = -p[BO_EPS] * om * math.sin(om * t)
+        obs[3] = dk * fz + k * v + 2.0 * p[BO_ZETA] * dydt[1]
+    else:
+        obs[1] = 0.0
+        obs[3] = 0.0
+    obs[4] = k
 
 
 @numba.njit(cache=True)
@@ -398,8 +451,8 @@ def planetary_tangent(t, y, p, obs, dydt, n, k):  # pragma: no cover - compiled
             dsp_d = pdv - xdv * si + ydv * ci
             drp = sv - pv
             drp_d = sdv - pdv
-            fsp = obs[6 * N + 4 + i] * _engaged(obs[i], bsp) * dsp + csp * dsp_d
-            frp = obs[7 * N + 4 + i] * _engaged(obs[N + i], brp) * drp + crp * drp_d
+            fsp = obs[10 * N + 4 + i] * _engaged(obs[i], bsp) * dsp + csp * dsp_d
+            frp = obs[11 * N + 4 + i] * _engaged(obs[N + i], brp) * drp + crp * drp_d
             dydt[o + nd + 2 + i] = (frp - fsp) * inv_mup  # completed below
             sum_fsp += fsp
             sum_frp += frp
@@ -418,7 +471,7 @@ def planetary_tangent(t, y, p, obs, dydt, n, k):  # pragma: no cover - compiled
 
 @numba.njit(cache=True)
 def backlash_oscillator_tangent(t, y, p, obs, dydt, n, k):  # pragma: no cover - compiled
-    kx = obs[3] * _engaged(obs[0], p[BO_B])
+    kx = obs[4] * _engaged(obs[0], p[BO_B])
     for r in range(k):
         o = n + r * n
         dydt[o] = y[o + 1]

@@ -14,7 +14,7 @@ They let users and tests check the integrator and every analysis on textbook pro
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -56,12 +56,18 @@ class BacklashOscillator:
     f_mean: float = 0.1
     f_alt: float = 0.1
     omega_power: int = 2
-    kind: int = L.KIND_BACKLASH_OSCILLATOR
-    name: str = "backlash_oscillator"
-    n_state: int = 2
-    n_track: int = 1
-    state_names: tuple[str, ...] = ("x", "x_dot")
-    obs_names: tuple[str, ...] = ("x", "x_dot", "contact_force", "stiffness")
+    # the layout (not parameters: left out of the repr, which store attributes record)
+    kind: int = field(default=L.KIND_BACKLASH_OSCILLATOR, repr=False)
+    name: str = field(default="backlash_oscillator", repr=False)
+    n_state: int = field(default=2, repr=False)
+    #: x (the dead zone's argument) and the contact force Fᶜ have their extrema tracked
+    n_track: int = field(default=2, repr=False)
+    #: the last tracked observable is the contact force (no switch of its own)
+    n_contact_forces: int = field(default=1, repr=False)
+    state_names: tuple[str, ...] = field(default=("x", "x_dot"), repr=False)
+    obs_names: tuple[str, ...] = field(
+        default=("x", "contact_force", "x_dot", "contact_force_dot", "stiffness"), repr=False
+    )
 
     def __post_init__(self) -> None:
         _check("zeta", self.zeta, ">=0")
@@ -81,7 +87,8 @@ class BacklashOscillator:
 
     @property
     def switch_widths(self) -> np.ndarray:
-        return np.array([self.b])
+        """b for x; none (``inf``) for the contact force, whose extrema are only tracked."""
+        return np.array([self.b, np.inf])
 
     def pack(self, omega: float) -> np.ndarray:
         p = np.zeros(L.BO_SIZE)

@@ -296,10 +296,14 @@ class PlanetaryModel:
             *(f"delta_rp_{i}" for i in N),
             "x_s",
             "y_s",
+            *(f"contact_force_sp_{i}" for i in N),
+            *(f"contact_force_rp_{i}" for i in N),
             *(f"delta_sp_dot_{i}" for i in N),
             *(f"delta_rp_dot_{i}" for i in N),
             "x_s_dot",
             "y_s_dot",
+            *(f"contact_force_sp_dot_{i}" for i in N),
+            *(f"contact_force_rp_dot_{i}" for i in N),
             *(f"force_sp_{i}" for i in N),
             *(f"force_rp_{i}" for i in N),
             *(f"stiffness_sp_{i}" for i in N),
@@ -308,15 +312,21 @@ class PlanetaryModel:
 
     @property
     def n_track(self) -> int:
-        """Extrema are tracked, and dead-zone switches located, for the 2N mesh deflections
-        and the two sun-bearing displacements."""
-        return 2 * self.n_planets + 2
+        """Extrema are tracked for the 2N mesh deflections, the two sun-bearing displacements
+        (dead-zone switches located) and the 2N mesh contact forces (no switch of their own)."""
+        return 4 * self.n_planets + 2
+
+    @property
+    def n_contact_forces(self) -> int:
+        """The last 2N tracked observables are the mesh contact forces F̄ᶜ_sp, F̄ᶜ_rp."""
+        return 2 * self.n_planets
 
     @property
     def switch_widths(self) -> np.ndarray:
-        """Half clearances b of the dead zones f(·; b) of the tracked observables."""
+        """Half clearances b of the dead zones f(·; b) of the tracked observables (``inf``
+        for the contact forces)."""
         par, N = self.parameters, self.n_planets
-        return np.array([par.b_sp] * N + [par.b_rp] * N + [par.b_s, par.b_s])
+        return np.array([par.b_sp] * N + [par.b_rp] * N + [par.b_s, par.b_s] + [np.inf] * (2 * N))
 
     @property
     def clearances(self) -> dict[str, float]:

@@ -172,13 +172,25 @@ class System:
             cols = [cols[int(p) - 1] for p in planets]
         return Observable(name, source, np.array(cols), True)
 
-    def tracked_groups(self) -> list[tuple[str, np.ndarray, bool]]:
+    n_contact_forces = property(
+        lambda self: int(getattr(self.model, "n_contact_forces", 0)),
+        doc="How many of the tracked observables, at their end, are mesh contact forces.",
+    )
+
+    def tracked_groups(self, contact_forces: bool = False) -> list[tuple[str, np.ndarray, bool]]:
         """The tracked observables grouped as sweeps and orbits store them: per-planet groups
-        (``delta_sp`` → its columns, True) and scalars (``x_s`` → one column, False)."""
-        names = self.obs_names[: self.n_track]
+        (``delta_sp`` → its columns, True) and scalars (``x_s`` → one column, False).
+
+        Without ``contact_forces`` these are the tracked observables that are not contact
+        forces (the dead-zone arguments); with it, only the contact forces
+        (``contact_force_sp`` …), whose extrema give peak dynamic mesh forces."""
+        n_dz = self.n_track - self.n_contact_forces
+        first = n_dz if contact_forces else 0
+        names = self.obs_names[: self.n_track if contact_forces else n_dz]
         out: list[tuple[str, np.ndarray, bool]] = []
         seen: set[str] = set()
-        for k, nm in enumerate(names):
+        for k in range(first, len(names)):
+            nm = names[k]
             head, _, tail = nm.rpartition("_")
             if tail.isdigit():
                 if head not in seen:

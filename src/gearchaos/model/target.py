@@ -40,7 +40,9 @@ OMEGA = "omega"
 DEFAULT_OMEGA = 1.5
 
 #: Fields of a model dataclass that are its layout, not parameters.
-_LAYOUT_FIELDS = frozenset({"kind", "name", "n_state", "n_track", "state_names", "obs_names"})
+_LAYOUT_FIELDS = frozenset(
+    {"kind", "name", "n_state", "n_track", "n_contact_forces", "state_names", "obs_names"}
+)
 
 
 def _check_target(target: Any) -> None:

@@ -24,6 +24,7 @@ from .regimes import (
     regime_legend,
     regime_map,
 )
+from .response import response_figure
 from .timeseries import amplitude_spectrum, spectrum, time_history
 
 __all__ = [
@@ -42,6 +43,7 @@ __all__ = [
     "regime_colour",
     "regime_legend",
     "regime_map",
+    "response_figure",
     "savefig",
     "spectrum",
     "summary_figure",

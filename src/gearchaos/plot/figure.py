@@ -6,10 +6,12 @@ import os
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from ..errors import ParameterError
 from ._common import is_planetary, message
 from .phase import phase_portrait, poincare_map, sun_orbit
-from .timeseries import spectrum, time_history
+from .timeseries import mesh_force_history, spectrum, time_history
 
 __all__ = ["SAVE_FORMATS", "savefig", "summary_figure"]
 
@@ -85,13 +87,15 @@ def summary_figure(
     *,
     planet: int = 1,
     history_periods: float = 10,
-    figsize: tuple[float, float] = (16.0, 9.5),
+    figsize: tuple[float, float] = (16.0, 13.0),
 ) -> Any:
-    """A one-page 2×3 figure of one simulation.
+    """A one-page figure of one simulation: 2×3 panels over a full-width force panel.
 
     Panels: time history of X̄_sp (last ``history_periods`` periods), phase portrait,
     Poincaré map, amplitude spectrum (a message when ``samples_per_period < 4``), sun-centre
-    orbit, and a text panel with Ω, ω_n, sun speed, distinct section points, contact regimes,
+    orbit, a text panel, and under them the mesh contact forces of ``planet`` over the same
+    periods with the separations shaded (:func:`~gearchaos.plot.timeseries.mesh_force_history`);
+    the text panel lists Ω, ω_n, sun speed, distinct section points, contact regimes,
     status and the gear set name. Works for reference systems too (their first state is
     shown; the sun-orbit panel then says why it is empty).
 
@@ -116,7 +120,11 @@ def summary_figure(
     if summary is None:
         summary = summarize(result)
     fig = Figure(figsize=figsize, layout="constrained")
-    axs = fig.subplots(2, 3)
+    mosaic = fig.subplot_mosaic(
+        [["00", "01", "02"], ["10", "11", "12"], ["force", "force", "force"]],
+        height_ratios=[1.0, 1.0, 0.8],
+    )
+    axs = np.array([[mosaic[f"{r}{c}"] for c in range(3)] for r in range(2)])
     planetary = is_planetary(result)
     var = "delta_sp" if planetary else None
     periods = min(float(history_periods), float(result.solver.periods))
@@ -160,6 +168,13 @@ def summary_figure(
         ax.legend(loc="upper right", fontsize="small")
     else:
         message(axs[1, 1], f"no sun orbit: {result.system.name} is not a planetary model")
+
+    try:
+        ax = mesh_force_history(result, planet, ax=mosaic["force"], periods=periods)
+        ax.set_title(f"mesh contact forces (last {periods:g} periods; shaded: teeth apart)")
+        ax.legend(loc="center left", bbox_to_anchor=(1.06, 0.5), fontsize="small")
+    except ParameterError as e:
+        message(mosaic["force"], str(e))
 
     tx = axs[1, 2]
     tx.set_axis_off()

@@ -30,7 +30,7 @@ from .units import (
 #: ``gid`` of the mesh-harmonic labels and sideband lines of a spectrum.
 HARMONIC_GID = "mesh-harmonic"
 
-__all__ = ["amplitude_spectrum", "spectrum", "time_history"]
+__all__ = ["amplitude_spectrum", "mesh_force_history", "spectrum", "time_history"]
 
 
 def time_history(
@@ -98,6 +98,99 @@ def time_history(
     if physical:
         scales = PhysicalScales.of_result(result)
         secondary_axis(ax, "y", var_quantity(info.name), scales)
+        ms = scales.period_ms(result.system.omega)
+        if ms is not None:
+            linear_axis(ax, "x", ms, "t [ms]")
+    return ax
+
+
+def _spans(mask: np.ndarray) -> list[tuple[int, int]]:
+    """(first, last) indices of the runs of True in ``mask``."""
+    m = np.concatenate([[False], np.asarray(mask, bool), [False]])
+    d = np.diff(m.astype(np.int8))
+    return list(zip(np.nonzero(d == 1)[0], np.nonzero(d == -1)[0] - 1, strict=True))
+
+
+def mesh_force_history(
+    result: Any,
+    planet: int = 1,
+    ax: Any = None,
+    periods: float | None = None,
+    *,
+    physical: bool = True,
+) -> Any:
+    """Plot the mesh contact forces of one planet against time in mesh periods, with the
+    separations shaded.
+
+    The contact force is F̄ᶜ = κ(τ) f(δ̄; b̄) + c̄ δ̄' while the teeth touch (|δ̄| > b̄) and
+    exactly 0 while they are apart (MODEL.md §4; the damping term alone is not a contact
+    force). For planetary results both meshes of ``planet`` are drawn (sun–planet F̄ᶜ_spi and
+    planet–ring F̄ᶜ_rpi) with the static mesh force T̄_D/N dotted; for the backlash oscillator
+    its single mesh (static force F_m). Intervals where a mesh is separated are shaded in its
+    colour.
+
+    Parameters
+    ----------
+    result
+        A :class:`~gearchaos.SimulationResult` with ``samples_per_period`` ≫ 1.
+    planet
+        The planet (1-based) of a planetary result.
+    ax, periods, physical
+        As for :func:`time_history` (the physical axis is the force in N, the time in ms).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    from ..model.response import mesh_groups, static_mesh_force
+
+    groups = mesh_groups(result.system)
+    if not groups:
+        raise ParameterError(
+            f"mesh_force_history needs a model with gear meshes: got {result.system.name}"
+        )
+    ax = get_ax(ax)
+    sl = sample_window(result, periods)
+    t = to_periods(result, result.tau)[sl]
+    colours = {"sp": "C0", "rp": "C3", "mesh": "C0"}
+    names = {"sp": "sun–planet", "rp": "planet–ring", "mesh": "mesh"}
+    ys = []
+    for g in groups:
+        obs = result.system.observable(g.force.name, [planet] if g.force.per_planet else None)
+        y = np.asarray(obs.take(result.states, result.observables))
+        y = (y[:, 0] if y.ndim > 1 else y)[sl]
+        ys.append(y)
+        sub = f"{g.mesh}{planet}" if g.force.per_planet else ""
+        label = rf"$\bar F^c_{{{sub}}}$ {names[g.mesh]}" if sub else r"$\bar F^c$"
+        ax.plot(t, y, lw=0.9, color=colours[g.mesh], label=label)
+        first = True
+        for a, b in _spans(y == 0.0):
+            lo = t[max(a - 1, 0)] if a > 0 else t[a]
+            hi = t[min(b + 1, t.size - 1)]
+            ax.axvspan(
+                lo,
+                hi,
+                color=colours[g.mesh],
+                alpha=0.12,
+                lw=0,
+                gid="separation",
+                label=f"{names[g.mesh]} teeth apart" if first else None,
+            )
+            first = False
+    static = static_mesh_force(result.system)
+    if math.isfinite(static):
+        ax.axhline(static, ls=":", lw=0.8, color="0.3", label="static mesh force")
+    ax.axhline(0.0, lw=0.5, color="0.5")
+    ax.set_xlabel(period_axis_label(result))
+    ax.set_ylabel(
+        r"contact force $\bar F^c = F^c/(k_{m,sp}\,b_c)$"
+        if is_planetary(result)
+        else r"contact force $F^c$"
+    )
+    fit_to_data(ax, t, np.concatenate(ys))
+    if physical:
+        scales = PhysicalScales.of_result(result)
+        secondary_axis(ax, "y", "force", scales, symbol="$F^c$")
         ms = scales.period_ms(result.system.omega)
         if ms is not None:
             linear_axis(ax, "x", ms, "t [ms]")

@@ -2,6 +2,7 @@
 
 from .classify import classify_dataset, classify_store
 from .execute import Execution
+from .frequency import find_jumps, response
 from .result import SweepLayout, SweepResult
 from .run import bifurcation, run_sweep
 from .spec import Axis, SweepSpec, parse_axis, parse_values
@@ -17,8 +18,10 @@ __all__ = [
     "bifurcation",
     "classify_dataset",
     "classify_store",
+    "find_jumps",
     "open_sweep",
     "parse_axis",
     "parse_values",
+    "response",
     "run_sweep",
 ]

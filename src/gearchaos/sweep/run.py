@@ -24,6 +24,7 @@ from .._version import provenance
 from ..errors import ParameterError, Status
 from ..integrate._chains import ChainOutput, ChainRun
 from ..model.target import scale_attrs
+from ._response_store import response_extract, response_variables
 from .execute import EXECUTION_OPTIONS, Execution, InProcess, executor
 from .grid import Grid, Task
 from .integrity import StoreLock
@@ -104,6 +105,10 @@ class _Layout:
             {"long_name": "state at the end of the recorded window"},
         )
         chunks["final_state"] = (*ch, n)
+        if spec.response:
+            rv, rc = response_variables(self.grid.reference, lead, shp, ch)
+            var.update(rv)
+            chunks.update(rc)
         return var, chunks
 
     def extract(self, task: Task, run: ChainRun, out: ChainOutput) -> dict[str, np.ndarray]:
@@ -128,11 +133,24 @@ class _Layout:
         if spec.lyapunov:
             data["lle"] = np.full(bshape, np.nan)
             lle = out.lyapunov(run.dt)
+        spp = int(spec.solver.samples_per_period)  # > 1 only in response sweeps
         for c, chain in enumerate(task.chains):
             for j, idx in enumerate(chain):
                 pos = tuple(i - s for i, s in zip(idx, starts, strict=True))
                 for ob in self.observed:
-                    data[ob.name][pos] = ob.take(out.states[c, j], out.observables[c, j])
+                    data[ob.name][pos] = ob.take(
+                        out.states[c, j][::spp], out.observables[c, j][::spp]
+                    )
+                if spec.response:
+                    response_extract(
+                        data,
+                        pos,
+                        self.grid.system(idx),
+                        out.obs_min[c, j],
+                        out.obs_max[c, j],
+                        out.observables[c, j],
+                        ok=out.status[c, j] == int(Status.OK),
+                    )
                 for nm, cols, per_planet in self.tracked:
                     lo, hi = out.obs_min[c, j][cols], out.obs_max[c, j][cols]
                     data[f"{nm}_min"][pos] = lo if per_planet else lo[0]
@@ -180,6 +198,7 @@ def _attrs(target: Any, grid: Grid) -> dict[str, Any]:
         "periods": int(spec.solver.periods),
         "initial_conditions": spec.initial_conditions,
         "direction": spec.direction,
+        **({"kind": "response"} if spec.response else {}),
         "dims": list(grid.dims),
         **provenance(),
     }

@@ -156,8 +156,20 @@ def _axes(items: Any) -> tuple[Axis, ...]:
 #: Solver settings of a sweep when none are given: the seed's 100 + 100 periods.
 SWEEP_SOLVER = SolverSettings(transient_periods=100, periods=100)
 
+#: Solver settings of a frequency-response sweep when none are given: 100 transient and 50
+#: recorded periods, 32 samples per period for the RMS values.
+RESPONSE_SOLVER = SolverSettings(transient_periods=100, periods=50, samples_per_period=32)
+
 #: The options of :meth:`SweepSpec.build` besides the axes and the fixed values.
-SPEC_OPTIONS = ("observe", "planets", "initial_conditions", "direction", "lyapunov", "orbits")
+SPEC_OPTIONS = (
+    "observe",
+    "planets",
+    "initial_conditions",
+    "direction",
+    "lyapunov",
+    "orbits",
+    "response",
+)
 
 
 def _names(what: str, items: Any) -> tuple[str, ...]:
@@ -207,6 +219,12 @@ class SweepSpec:
         Confirm every label nT (n ≤ 8) by a converged period-n orbit shot from the point's
         final state, and store its residual, largest multiplier modulus and a status flag
         (:mod:`gearchaos.sweep.orbits`).
+    response
+        Also store the frequency-response quantities of every point
+        (:mod:`gearchaos.model.response`): RMS and peak contact force of every mesh, dynamic
+        load factor and RMS dynamic transmission error. Only a response sweep may record more
+        than one sample per period (the RMS values come from the samples; the sections are
+        every ``samples_per_period``-th sample).
     """
 
     vary: tuple[Axis, ...]
@@ -220,6 +238,7 @@ class SweepSpec:
     lyapunov: bool = False
     orbits: bool = False
     extra: tuple[tuple[str, Any], ...] = field(default=())
+    response: bool = False
 
     def __post_init__(self) -> None:
         if not 1 <= len(self.vary) <= 2:
@@ -258,9 +277,10 @@ class SweepSpec:
             raise ParameterError(
                 f"solver must be a SolverSettings: got {type(self.solver).__name__}"
             )
-        if self.solver.samples_per_period != 1:
+        check_bool("response", self.response)
+        if self.solver.samples_per_period != 1 and not self.response:
             raise ParameterError(
-                "a sweep records one sample per period (the section): "
+                "a sweep records one sample per period (the section), a response sweep more: "
                 f"got samples_per_period={self.solver.samples_per_period}"
             )
         check_bool("lyapunov", self.lyapunov)
@@ -304,7 +324,9 @@ class SweepSpec:
             vary=_axes(vary),
             family=fam[0] if fam else None,
             fixed=tuple(sorted((fixed or {}).items())),
-            solver=SolverSettings.build(solver or SWEEP_SOLVER, **settings),
+            solver=SolverSettings.build(
+                solver or (RESPONSE_SOLVER if own.get("response") else SWEEP_SOLVER), **settings
+            ),
             **own,
         )
 
@@ -363,6 +385,14 @@ class SweepSpec:
             f"observe = {val(list(self.observe))}",
             f"planets = {val(list(self.planets))}",
             *([f"orbits = {val(self.orbits)}"] if self.orbits else []),
+            *(
+                [
+                    f"response = {val(True)}",
+                    f"samples_per_period = {self.solver.samples_per_period}",
+                ]
+                if self.response
+                else []
+            ),
             "",
         ]
         for a in self.vary:
@@ -407,9 +437,11 @@ class SweepSpec:
                     periods=int(d["periods"]),
                     rtol=d["rtol"],
                     atol=d["atol"],
+                    samples_per_period=int(d.get("samples_per_period", 1)),
                 ),
                 lyapunov=bool(d.get("lyapunov", False)),
                 orbits=bool(d.get("orbits", False)),
+                response=bool(d.get("response", False)),
                 extra=tuple(sorted(d.get("extra", {}).items())),
             )
         except (tomllib.TOMLDecodeError, KeyError, TypeError, ValueError, AttributeError) as exc:

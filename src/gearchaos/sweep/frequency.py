@@ -1,0 +1,112 @@
+"""Frequency response: a continuation sweep that stores the dynamic mesh forces of every point.
+
+:func:`response` is :func:`~gearchaos.sweep.run.bifurcation` with ``response=True``,
+continuation along the swept axis (both directions by default, so jumps between coexisting
+branches show) and :data:`~gearchaos.sweep.spec.RESPONSE_SOLVER` (32 samples per period). Per
+point and mesh type ``m`` (``sp``, ``rp``; ``mesh`` for the backlash oscillator) the store gets,
+besides the sections and extrema of every sweep (:mod:`gearchaos.model.response`):
+
+* ``force_rms_m``, ``force_peak_m`` (per planet): √⟨F̄ᶜ²⟩ and max |F̄ᶜ| of the contact force
+  F̄ᶜ = κ f(δ̄; b̄) + c̄ δ̄' (0 while the teeth are apart), in k_m,sp b_c;
+* ``load_factor_m``: max over the planets of max |F̄ᶜ| / (T̄_D/N), the dynamic load factor;
+* ``dte_rms_m`` (per planet): √⟨(δ̄ − ⟨δ̄⟩)²⟩, the RMS dynamic transmission error, in b_c;
+* ``contact_force_m_min``/``_max`` (per planet): the tracked extrema of F̄ᶜ.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any
+
+import numpy as np
+
+from .._checks import check_real
+from .run import bifurcation
+
+__all__ = ["find_jumps", "response"]
+
+
+def response(
+    target: Any,
+    vary: Any,
+    *,
+    direction: str = "both",
+    fixed: dict[str, Any] | None = None,
+    store: str | os.PathLike[str] | None = None,
+    overwrite: bool = False,
+    progress: bool = True,
+    **options: Any,
+) -> Any:
+    """Frequency-response curves: dynamic mesh forces, load factors and transmission errors
+    along a parameter (usually Ω), swept up and down by continuation.
+
+    Parameters
+    ----------
+    target
+        A :class:`~gearchaos.gearset.GearSet` or a :class:`~gearchaos.model.System`.
+    vary
+        One axis, e.g. ``"omega=0.5:2.5:201"`` (syntax of
+        :func:`~gearchaos.sweep.run.bifurcation`).
+    direction
+        ``up``, ``down`` or ``both`` (default): each point starts from the final state of its
+        neighbour in that direction, so coexisting branches and the jumps between them show.
+    fixed, store, overwrite, progress
+        As for :func:`~gearchaos.sweep.run.bifurcation`.
+    **options
+        Further sweep options (``observe``, ``planets``, ``lyapunov``, ``family``) and solver
+        settings (default :data:`~gearchaos.sweep.spec.RESPONSE_SOLVER`: 100 transient and 50
+        recorded periods, 32 samples per period).
+
+    Returns
+    -------
+    xarray.Dataset
+        A sweep dataset (dimensions ``direction`` when both, then the axis) with, per point and
+        mesh type m, ``force_rms_m`` = √⟨F̄ᶜ²⟩, ``force_peak_m`` = max |F̄ᶜ|,
+        ``load_factor_m`` = max_i max |F̄ᶜ_i| / (T̄_D/N) and ``dte_rms_m`` = √⟨(δ̄ − ⟨δ̄⟩)²⟩
+        (module docstring); the attribute ``kind`` is ``"response"``.
+    """
+    return bifurcation(
+        target,
+        vary,
+        fixed=fixed,
+        store=store,
+        overwrite=overwrite,
+        progress=progress,
+        initial_conditions="continuation",
+        direction=direction,
+        response=True,
+        **options,
+    )
+
+
+def find_jumps(x: Any, y: Any, *, rel: float = 0.25) -> list[float]:
+    """Where a response curve jumps: the midpoints (x_k + x_{k+1})/2 of the neighbouring
+    points whose values differ by more than ``rel`` times the curve's range max y − min y.
+
+    Parameters
+    ----------
+    x, y
+        The swept values (in sweep order) and the response along one branch (``direction``
+        ``up`` or ``down``); NaN points (failed) are skipped.
+    rel
+        Threshold as a fraction of the range (default 0.25).
+
+    Returns
+    -------
+    list of float
+        The jump positions in increasing x.
+    """
+    check_real("rel", rel, lo=0.0, lo_open=True)
+    xa = np.asarray(x, dtype=float)
+    ya = np.asarray(y, dtype=float)
+    ok = np.isfinite(ya)
+    xa, ya = xa[ok], ya[ok]
+    if ya.size < 2:
+        return []
+    order = np.argsort(xa)
+    xa, ya = xa[order], ya[order]
+    span = float(ya.max() - ya.min())
+    if span <= 0.0:
+        return []
+    k = np.nonzero(np.abs(np.diff(ya)) > rel * span)[0]
+    return [float(0.5 * (xa[i] + xa[i + 1])) for i in k]

@@ -1,0 +1,150 @@
+"""Frequency-response sweeps (issue 12): store round trip, agreement with single simulations,
+jumps where an independent solver puts them, and the figure's physical axes."""
+
+from __future__ import annotations
+
+import math
+
+import matplotlib
+import numpy as np
+import pytest
+
+import gearchaos as gc
+from gearchaos.model.response import response_quantities
+from gearchaos.sweep import SweepSpec, find_jumps
+
+matplotlib.use("Agg")
+
+Z, B, FM, FA = 0.05, 1.0, 0.1, 0.2
+
+
+def _oscillator(omega: float = 1.0) -> gc.System:
+    return gc.backlash_oscillator(omega, zeta=Z, b=B, f_mean=FM, f_alt=FA)
+
+
+def test_response_store_round_trip_and_first_point_equals_a_simulation(tmp_path) -> None:
+    path = tmp_path / "resp.zarr"
+    kw = {"transient_periods": 30, "periods": 6, "samples_per_period": 16}
+    ds = gc.response(_oscillator(), "omega=0.7:1.3:4", store=path, progress=False, **kw)
+    back = gc.open_sweep(path)
+    assert back.attrs["kind"] == "response"
+    for name in ("force_rms_mesh", "force_peak_mesh", "load_factor_mesh", "dte_rms_mesh"):
+        assert back[name].dims == ("direction", "omega")
+        np.testing.assert_array_equal(back[name].values, ds[name].values)
+        assert np.all(np.isfinite(back[name].values))
+    spec = SweepSpec.from_toml(back.attrs["sweep_toml"])
+    assert spec.response and spec.solver.samples_per_period == 16
+    assert spec.direction == "both" and spec.initial_conditions == "continuation"
+    # sections are every 16th sample: as many as recorded periods
+    assert back.sizes["section"] == 6
+    # the first point of the up branch starts from rest like a single simulation
+    res = gc.simulate(_oscillator(0.7), **kw)
+    rq = response_quantities(res.system, res.obs_min, res.obs_max, res.observables)
+    up = back.sel(direction="up", omega=0.7)
+    for k, v in rq.items():
+        assert float(up[k]) == pytest.approx(float(v), rel=1e-12), k
+    np.testing.assert_allclose(up["x"].values, res.section("x"), rtol=1e-12)
+    # a second call with the same arguments reopens the finished store
+    again = gc.response(_oscillator(), "omega=0.7:1.3:4", store=path, progress=False, **kw)
+    np.testing.assert_array_equal(again.force_peak_mesh.values, ds.force_peak_mesh.values)
+
+
+def test_bifurcation_sweeps_refuse_several_samples_per_period() -> None:
+    with pytest.raises(gc.ParameterError, match="samples_per_period"):
+        SweepSpec.build("omega=1:2:3", samples_per_period=8)
+
+
+def test_find_jumps() -> None:
+    x = np.linspace(0, 1, 11)
+    y = np.where(x < 0.45, 1.0, 3.0) + 0.01 * x
+    assert find_jumps(x, y) == [pytest.approx(0.45)]
+    assert find_jumps(x, np.ones(11)) == []
+    with pytest.raises(gc.ParameterError, match="rel"):
+        find_jumps(x, y, rel=0.0)
+
+
+def _scipy_peaks(grid: np.ndarray, order: np.ndarray, transient: int, periods: int) -> np.ndarray:
+    """Peak contact force along a continuation with scipy's DOP853 (independent solver)."""
+    from scipy.integrate import solve_ivp
+
+    def f(t, y, om):
+        x, v = y
+        return [v, FM + FA * om**2 * np.cos(om * t) - 2 * Z * v - (x - np.clip(x, -B, B))]
+
+    y0 = [0.0, 0.0]
+    peaks = {}
+    for om in order:
+        T = 2 * math.pi / om
+        kw = {"args": (om,), "method": "DOP853", "rtol": 1e-8, "atol": 1e-10}
+        s = solve_ivp(f, (0, transient * T), y0, **kw)
+        t_rec = np.linspace(transient * T, (transient + periods) * T, periods * 128 + 1)
+        s = solve_ivp(f, (t_rec[0], t_rec[-1]), s.y[:, -1], t_eval=t_rec, **kw)
+        x, v = s.y
+        fc = np.where(np.abs(x) > B, x - np.sign(x) * B + 2 * Z * v, 0.0)
+        peaks[float(om)] = np.abs(fc).max()
+        y0 = s.y[:, -1]
+    return np.array([peaks[float(o)] for o in grid])
+
+
+def _largest_jump(x: np.ndarray, y: np.ndarray) -> float:
+    k = int(np.argmax(np.abs(np.diff(y))))
+    return float(0.5 * (x[k] + x[k + 1]))
+
+
+def test_up_and_down_jumps_are_where_scipy_continuation_puts_them() -> None:
+    """The backlash oscillator softens when its teeth separate: sweeping up it stays on the
+    low branch until the jump up near Ω ≈ 1.0, sweeping down on the high branch until the
+    jump down near Ω ≈ 0.8 (hysteresis)."""
+    grid = np.round(np.linspace(0.7, 1.1, 9), 12)
+    step = grid[1] - grid[0]
+    ds = gc.response(
+        _oscillator(), {"omega": grid}, transient_periods=40, periods=6, progress=False
+    )
+    jumps = {}
+    for d, order in (("up", grid), ("down", grid[::-1])):
+        ours = ds.force_peak_mesh.sel(direction=d).values
+        ref = _scipy_peaks(grid, order, 40, 6)
+        jumps[d] = _largest_jump(grid, ours)
+        assert abs(jumps[d] - _largest_jump(grid, ref)) <= step + 1e-12, d
+        assert jumps[d] in [pytest.approx(j) for j in find_jumps(grid, ours)]
+    assert jumps["down"] < jumps["up"]  # a hysteresis loop
+
+
+def test_response_figure_axes_follow_the_gear_set(tmp_path) -> None:
+    from gearchaos.plot import response_figure
+
+    gs = gc.preset("sheng2016")
+    ds = gc.response(
+        gs, "omega=0.6:1.0:3", transient_periods=10, periods=4, samples_per_period=8,
+        progress=False,
+    )  # fmt: skip
+    fig = response_figure(ds)
+    fig.canvas.draw()
+    # ω_n from the gear set's own masses and stiffness (MODEL.md §1, §7)
+    z, geo = gs.teeth, gs.geometry
+    cos_a = math.cos(math.radians(geo.pressure_angle_sun))
+    ms = gs.inertia.sun / (geo.module * z.sun / 2 * cos_a) ** 2
+    mp = gs.inertia.planet / (geo.module * z.planet / 2 * cos_a) ** 2
+    omega_n = math.sqrt(gs.stiffness.sun_planet_mean / (ms * mp / (ms + mp)))
+    rpm_per_omega = omega_n * (z.sun + z.ring) / (z.sun * z.ring) * 60 / (2 * math.pi)
+    hz_per_omega = omega_n / (2 * math.pi)
+    top, bottom = fig.axes[0], fig.axes[3]
+    labels = {}
+    for ax in (top, bottom):
+        for child in ax.child_axes:
+            labels[child.get_xlabel()] = (child, ax)
+    omegas = np.array([0.6, 0.8, 1.0])
+    rpm_axis, _ = next(v for k, v in labels.items() if "rpm" in k)
+    forward = rpm_axis._functions[0]  # the secondary axis's map from the primary values
+    np.testing.assert_allclose(forward(omegas), omegas * rpm_per_omega, rtol=1e-9)
+    hz_axis, _ = next(v for k, v in labels.items() if "Hz" in k)
+    np.testing.assert_allclose(hz_axis._functions[0](omegas), omegas * hz_per_omega, rtol=1e-9)
+    # the x limits follow the swept Ω (within 10 % of the range)
+    lo, hi = top.get_xlim()
+    assert 0.6 - 0.04 <= lo <= 0.6 and 1.0 <= hi <= 1.0 + 0.04
+    # physical force axis: F = k_m,sp b_c F̄
+    force_n = gs.stiffness.sun_planet_mean * float(ds.attrs["characteristic_length_m"])
+    right = [c for c in top.child_axes if "[N]" in c.get_ylabel()]
+    assert right
+    np.testing.assert_allclose(right[0]._functions[0](1.0), force_n, rtol=1e-9)
+    fig.savefig(tmp_path / "response.png")
