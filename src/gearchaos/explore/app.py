@@ -33,7 +33,7 @@ from ..errors import ParameterError
 from ..plot.regimes import REGIME_COLOURS
 from ..sweep.result import open_result
 from .compute import compute_point, run_zoom
-from .model import ExploreModel, Point, parameter_label
+from .model import ExploreModel, Point, parameter_axis_label, parameter_label
 
 __all__ = ["Explorer", "Workers", "explore", "serve"]
 
@@ -89,12 +89,14 @@ class Workers:
             pools, self._pools = self._pools, {}
         for pool in pools.values():
             procs = list(getattr(pool, "_processes", {}).values())
-            pool.shutdown(wait=False, cancel_futures=True)
+            for fut in list(self.running.values()):
+                fut.cancel()
             for p in procs:
                 if p.is_alive():
                     p.terminate()
             for p in procs:
                 p.join(timeout=5)
+            pool.shutdown(wait=True, cancel_futures=True)
 
 
 class Explorer(pn.viewable.Viewer):
@@ -125,7 +127,7 @@ class Explorer(pn.viewable.Viewer):
         self.info = pn.pane.Markdown("", sizing_mode="stretch_width")
         self.computed = pn.pane.Markdown("", sizing_mode="stretch_width")
         self.figure_png = pn.pane.PNG(None, width=880)
-        self.spinner = pn.indicators.LoadingSpinner(value=False, size=28, name="computing")
+        self.spinner = pn.indicators.LoadingSpinner(value=False, size=28)
         self.busy = pn.pane.Markdown("", margin=(0, 10))
         self.zoom_note = pn.pane.Markdown("")
         self.zoom_points = pn.widgets.IntInput(name="points", value=100, start=2, width=100)
@@ -240,7 +242,7 @@ class Explorer(pn.viewable.Viewer):
             x_range=x_range,
             title="bifurcation diagram: stored section values (click a point)",
             tools="pan,box_zoom,wheel_zoom,reset,save",
-            x_axis_label=parameter_label(name),
+            x_axis_label=parameter_axis_label(name),
             y_axis_label=m.var_label(),
         )
         src = ColumnDataSource(
@@ -261,7 +263,7 @@ class Explorer(pn.viewable.Viewer):
             tools="",
             toolbar_location=None,
             title="motion (stored labels)",
-            x_axis_label=parameter_label(name),
+            x_axis_label=parameter_axis_label(name),
         )
         band.yaxis.visible = False
         b = m.band()
@@ -269,7 +271,7 @@ class Explorer(pn.viewable.Viewer):
         band.rect("x", "y", "width", 1, source=bsrc, fill_color="colour", line_color=None)
         band.add_tools(HoverTool(tooltips=[(name, "@x{0.0000}"), ("motion", "@label")]))
         band.on_event(events.Tap, self._tapped)
-        self._legend(band, b["label"])
+        self._legend(fig, b["label"])
         self.x_range = x_range
         return _stack(fig, band)
 
@@ -282,8 +284,8 @@ class Explorer(pn.viewable.Viewer):
             width=760,
             title="regime map: stored motion labels (click a cell)",
             tools="pan,box_zoom,wheel_zoom,reset,save",
-            x_axis_label=parameter_label(m.vary[0]),
-            y_axis_label=parameter_label(m.vary[1]),
+            x_axis_label=parameter_axis_label(m.vary[0]),
+            y_axis_label=parameter_axis_label(m.vary[1]),
         )
         src = ColumnDataSource(b, name="map-source")
         fig.rect("x", "y", "width", "height", source=src, fill_color="colour", line_color=None)
@@ -307,7 +309,7 @@ class Explorer(pn.viewable.Viewer):
         fig.legend.location = "top_left"
         fig.legend.click_policy = "none"
         fig.legend.label_text_font_size = "11px"
-        fig.add_layout(fig.legend[0], "right" if fig.height > 200 else "below")
+        fig.add_layout(fig.legend[0], "above")
 
     # ------------------------------------------------------------------ selecting a point
     def _tapped(self, event: Any) -> None:
@@ -491,7 +493,6 @@ def serve(
         {"/": lambda: Explorer(store, var=var, planet=planet, workers=workers)},
         port=port,
         address="localhost",
-        websocket_origin="*",
         show=False,
         start=False,
         title=f"gearchaos explore · {Path(store).name}",

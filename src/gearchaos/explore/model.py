@@ -23,35 +23,43 @@ from ..plot._common import edges
 from ..plot.regimes import REGIME_COLOURS, regime_category
 from ..sweep.result import SweepResult
 
-__all__ = ["ExploreModel", "Point", "parameter_label", "variable_label"]
+__all__ = [
+    "ExploreModel",
+    "Point",
+    "parameter_axis_label",
+    "parameter_label",
+    "variable_label",
+]
 
-#: Unicode symbols of the section variables (``%d``: the planet).
+#: TeX symbols of the section variables (``%d``: the planet), as the seed writes them.
 _VAR_SYMBOLS = {
-    "delta_sp": "X̄_sp%d",
-    "delta_rp": "X̄_rp%d",
-    "force_sp": "F̄_sp%d",
-    "force_rp": "F̄_rp%d",
-    "x_s": "x̄_s",
-    "y_s": "ȳ_s",
-    "sigma": "σ̄",
+    "delta_sp": (r"\bar{X}_{sp%d}", r"\delta_{sp%d}/b_c"),
+    "delta_rp": (r"\bar{X}_{rp%d}", r"\delta_{rp%d}/b_c"),
+    "force_sp": (r"\bar{F}_{sp%d}", None),
+    "force_rp": (r"\bar{F}_{rp%d}", None),
+    "x_s": (r"\bar{x}_s", r"x_s/b_c"),
+    "y_s": (r"\bar{y}_s", r"y_s/b_c"),
+    "sigma": (r"\bar{\sigma}", None),
 }
 
 
 def variable_label(var: str, planet: int | None = None) -> str:
-    """Axis label of a section variable: ``delta_sp`` → ``X̄_sp1 = δ_sp1/b_c``,
-    ``delta_sp_dot`` → ``X̄′_sp1 = dX̄_sp1/dτ``; other names label themselves."""
+    """Axis label of a section variable in TeX (Bokeh renders ``$$…$$``): ``delta_sp`` →
+    X̄_sp1 = δ_sp1/b_c, ``delta_sp_dot`` → X̄′_sp1 = dX̄_sp1/dτ; other names label themselves."""
     base, dot = (var[:-4], True) if var.endswith("_dot") else (var, False)
-    sym = _VAR_SYMBOLS.get(base)
-    if sym is None:
+    if base not in _VAR_SYMBOLS:
         return var
-    if "%d" in sym:
-        sym = sym % (planet or 1)
+    sym, definition = _VAR_SYMBOLS[base]
+    n = planet or 1
+    sym = sym % n if "%d" in sym else sym
     if dot:
         head, _, tail = sym.partition("_")
-        return f"{head}′_{tail} = d{sym}/dτ" if tail else f"{sym}′ = d{sym}/dτ"
-    if base.startswith("delta_"):
-        return f"{sym} = δ_{base[6:]}{planet or 1}/b_c"
-    return sym
+        primed = f"{head}'_{tail}" if tail else f"{sym}'"
+        return f"$${primed} = \\mathrm{{d}}{sym}/\\mathrm{{d}}\\tau$$"
+    if definition is None:
+        return f"$${sym}$$"
+    definition = definition % n if "%d" in definition else definition
+    return f"$${sym} = {definition}$$"
 
 
 def parameter_label(name: str) -> str:
@@ -64,6 +72,14 @@ def parameter_label(name: str) -> str:
         return name
     unit = "" if field.unit in ("", "1") else f" [{field.unit}]"
     return f"{field.symbol}{unit} ({name})"
+
+
+def parameter_axis_label(name: str) -> str:
+    """Axis label of a swept parameter for a Bokeh axis: TeX for Ω (``Ω = ω/ω_n``), else
+    :func:`parameter_label`."""
+    if name == "omega":
+        return r"$$\Omega = \omega/\omega_n$$"
+    return parameter_label(name)
 
 
 @dataclass(frozen=True)
@@ -235,8 +251,8 @@ class ExploreModel:
             ok = np.isfinite(x) & np.isfinite(y)
             return x[ok], y[ok], self.var_label(), variable_label(dot, self.planet)
         x = x[np.isfinite(x)]
-        sym = self.var_label().split(" = ")[0]
-        return x[:-1], x[1:], f"{sym}(k)", f"{sym}(k+1)"
+        sym = self.var_label().strip("$").split(" = ")[0]
+        return x[:-1], x[1:], f"$${sym}(k)$$", f"$${sym}(k+1)$$"
 
     def var_label(self) -> str:
         return variable_label(self.var, self.planet)
