@@ -48,7 +48,7 @@ def test_a_point_shows_its_stored_section_label_and_count(gear_store: Path) -> N
         assert x.size == int(ok.sum()) == ds.sizes["section"]  # short protocol: every point ran
         np.testing.assert_array_equal(x, stored_x[ok])
         np.testing.assert_array_equal(y, stored_y[ok])
-        assert "X}_{sp1}" in xlabel and "X}'_{sp1}" in ylabel
+        assert xlabel.startswith("X̄ₛₚ₁") and ylabel.startswith("X̄′ₛₚ₁")
         assert model.label(point) == str(ds.motion.values[i])
         assert model.status(point) == "ok"
 

@@ -18,9 +18,7 @@ def explore(
         Path,
         typer.Argument(help="Sweep store written by `gearchaos bifurcation`.", show_default=False),
     ],
-    port: Annotated[
-        int, typer.Option("--port", help="Port on localhost; 0 picks a free one.")
-    ] = 0,
+    port: Annotated[int, typer.Option("--port", help="Port on localhost; 0 picks a free one.")] = 0,
     no_browser: Annotated[
         bool, typer.Option("--no-browser", help="Do not open a browser; only print the URL.")
     ] = False,

@@ -26,7 +26,8 @@ from typing import Any
 import numpy as np
 import panel as pn
 from bokeh import events
-from bokeh.models import ColumnDataSource, HoverTool, Range1d, Span
+from bokeh.models import ColumnDataSource, HoverTool, Range1d
+from bokeh.models.annotations import Span
 from bokeh.plotting import figure
 
 from ..errors import ParameterError
@@ -118,6 +119,8 @@ class Explorer(pn.viewable.Viewer):
         self.workers = workers if workers is not None else Workers()
         self.model = ExploreModel(open_result(store), var=var, planet=planet, store=self.root)
         self.point: Point | None = None
+        self.x_range: Any = None
+        self.y_range: Any = None
         self._zoom_key: tuple[Any, ...] | None = None
         self._syncing = False
         self.store_select = pn.widgets.Select(
@@ -140,9 +143,7 @@ class Explorer(pn.viewable.Viewer):
         self._poller = pn.state.add_periodic_callback(self._poll, period=POLL_MS, start=True)
 
     def __panel__(self) -> Any:
-        header = pn.pane.Markdown(
-            f"## gearchaos explore · {Path(self.root).name}", margin=(0, 10)
-        )
+        header = pn.pane.Markdown(f"## gearchaos explore · {Path(self.root).name}", margin=(0, 10))
         zoom = pn.Row(self.zoom_points, self.zoom_button, self.zoom_note)
         return pn.Column(header, self.store_select, self.body, zoom, sizing_mode="stretch_width")
 
@@ -175,7 +176,8 @@ class Explorer(pn.viewable.Viewer):
                 options=m.family_values(),
                 value=float(m.selection[m.family]),
             )
-            fam.param.watch(lambda e: self._reselect(m.family, e.new), "value")
+            family = m.family
+            fam.param.watch(lambda e: self._reselect(family, e.new), "value")
             selects.append(fam)
         if m.directions:
             dirs = pn.widgets.Select(
@@ -233,7 +235,7 @@ class Explorer(pn.viewable.Viewer):
         name = m.vary[0]
         xs = m.axis(name)
         pad = 0.02 * (xs.max() - xs.min()) if xs.size > 1 else 0.5
-        x_range = Range1d(xs.min() - pad, xs.max() + pad)
+        x_range = Range1d(start=float(xs.min() - pad), end=float(xs.max() + pad))
         data = m.diagram()
         fig = figure(
             name="diagram-figure",
@@ -259,7 +261,7 @@ class Explorer(pn.viewable.Viewer):
             height=110,
             width=760,
             x_range=x_range,
-            y_range=Range1d(0, 1),
+            y_range=Range1d(start=0.0, end=1.0),
             tools="",
             toolbar_location=None,
             title="motion (stored labels)",
@@ -291,8 +293,9 @@ class Explorer(pn.viewable.Viewer):
         fig.rect("x", "y", "width", "height", source=src, fill_color="colour", line_color=None)
         fig.add_tools(HoverTool(tooltips=[("motion", "@label"), ("", "(@x{0.0000}, @y{0.0000})")]))
         self.marker_src = ColumnDataSource({"x": [], "y": []})
-        fig.scatter("x", "y", source=self.marker_src, size=14, marker="x", color="black",
-                    line_width=3)
+        fig.scatter(
+            "x", "y", source=self.marker_src, size=14, marker="x", color="black", line_width=3
+        )
         fig.on_event(events.Tap, self._tapped)
         self._legend(fig, b["label"])
         self.x_range = fig.x_range
@@ -303,8 +306,14 @@ class Explorer(pn.viewable.Viewer):
     def _legend(fig: Any, labels: list[str]) -> None:
         present = [c for c in REGIME_COLOURS if c in set(labels)]
         for c in present:
-            fig.scatter([np.nan], [np.nan], marker="square", size=10, color=REGIME_COLOURS[c],
-                        legend_label=c)
+            fig.scatter(
+                [np.nan],
+                [np.nan],
+                marker="square",
+                size=10,
+                color=REGIME_COLOURS[c],
+                legend_label=c,
+            )
         fig.legend.orientation = "horizontal"
         fig.legend.location = "top_left"
         fig.legend.click_policy = "none"
@@ -331,7 +340,8 @@ class Explorer(pn.viewable.Viewer):
         x, y, xl, yl = m.section(point)
         self.poincare_src.data = {"x": x, "y": y}
         label = m.label(point)
-        self.poincare.title.text = f"{point.title()} · {label} · {x.size} stored section points"
+        title: Any = self.poincare.title
+        title.text = f"{point.title()} · {label} · {x.size} stored section points"
         self.poincare.xaxis.axis_label = xl
         self.poincare.yaxis.axis_label = yl
         lle = m.lle(point)
@@ -402,7 +412,7 @@ class Explorer(pn.viewable.Viewer):
         m = self.model
         if self._zoom_key is not None:
             return
-        ranges = [self.x_range] + ([self.y_range] if m.is_map else [])
+        ranges: list[Any] = [self.x_range] + ([self.y_range] if m.is_map else [])
         axes: dict[str, tuple[float, float, int]] = {}
         for name, r in zip(m.vary, ranges, strict=True):
             v = m.axis(name)
@@ -411,10 +421,11 @@ class Explorer(pn.viewable.Viewer):
             if not hi > lo:
                 self.zoom_note.object = f"the shown range of {name} holds no swept values"
                 return
-            axes[name] = (lo, hi, int(self.zoom_points.value))
+            axes[name] = (lo, hi, int(self.zoom_points.value or 2))
         self._zoom_key = ("zoom", m.store, tuple(sorted(axes.items())))
-        self.zoom_note.object = ", ".join(f"{k} {lo:.6g} … {hi:.6g}" for k, (lo, hi, _) in
-                                          axes.items())
+        self.zoom_note.object = ", ".join(
+            f"{k} {lo:.6g} … {hi:.6g}" for k, (lo, hi, _) in axes.items()
+        )
         self.workers.submit("zoom", self._zoom_key, run_zoom, m.store, axes)
 
 
@@ -441,9 +452,7 @@ def _computed_text(out: Mapping[str, Any]) -> str:
     return "  \n".join(lines)
 
 
-def explore(
-    store: str | os.PathLike[str], *, var: str = "delta_sp", planet: int = 1
-) -> Explorer:
+def explore(store: str | os.PathLike[str], *, var: str = "delta_sp", planet: int = 1) -> Explorer:
     """The explorer of a sweep store, as a Panel app (display it in a notebook, or serve it).
 
     Shows the bifurcation diagram — every stored section value X̄_k of ``var`` (default

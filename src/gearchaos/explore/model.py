@@ -31,35 +31,34 @@ __all__ = [
     "variable_label",
 ]
 
-#: TeX symbols of the section variables (``%d``: the planet), as the seed writes them.
+#: Symbols of the section variables as the seed writes them, in Unicode (``%s``: the
+#: planet's subscript): X̄_sp1 = δ_sp1/b_c.
 _VAR_SYMBOLS = {
-    "delta_sp": (r"\bar{X}_{sp%d}", r"\delta_{sp%d}/b_c"),
-    "delta_rp": (r"\bar{X}_{rp%d}", r"\delta_{rp%d}/b_c"),
-    "force_sp": (r"\bar{F}_{sp%d}", None),
-    "force_rp": (r"\bar{F}_{rp%d}", None),
-    "x_s": (r"\bar{x}_s", r"x_s/b_c"),
-    "y_s": (r"\bar{y}_s", r"y_s/b_c"),
-    "sigma": (r"\bar{\sigma}", None),
+    "delta_sp": ("X̄ₛₚ%s", "δₛₚ%s/b_c"),
+    "delta_rp": ("X̄ᵣₚ%s", "δᵣₚ%s/b_c"),
+    "force_sp": ("F̄ₛₚ%s", None),
+    "force_rp": ("F̄ᵣₚ%s", None),
+    "x_s": ("x̄ₛ", "xₛ/b_c"),
+    "y_s": ("ȳₛ", "yₛ/b_c"),
+    "sigma": ("σ̄", None),
 }
+_SUBSCRIPT_DIGITS = str.maketrans("0123456789", "₀₁₂₃₄₅₆₇₈₉")
 
 
 def variable_label(var: str, planet: int | None = None) -> str:
-    """Axis label of a section variable in TeX (Bokeh renders ``$$…$$``): ``delta_sp`` →
-    X̄_sp1 = δ_sp1/b_c, ``delta_sp_dot`` → X̄′_sp1 = dX̄_sp1/dτ; other names label themselves."""
+    """Axis label of a section variable: ``delta_sp`` → ``X̄ₛₚ₁ = δₛₚ₁/b_c``,
+    ``delta_sp_dot`` → ``X̄′ₛₚ₁ = dX̄ₛₚ₁/dτ``; other names label themselves."""
     base, dot = (var[:-4], True) if var.endswith("_dot") else (var, False)
     if base not in _VAR_SYMBOLS:
         return var
     sym, definition = _VAR_SYMBOLS[base]
-    n = planet or 1
-    sym = sym % n if "%d" in sym else sym
+    n = str(planet or 1).translate(_SUBSCRIPT_DIGITS)
+    sym = sym % n if "%s" in sym else sym
     if dot:
-        head, _, tail = sym.partition("_")
-        primed = f"{head}'_{tail}" if tail else f"{sym}'"
-        return f"$${primed} = \\mathrm{{d}}{sym}/\\mathrm{{d}}\\tau$$"
+        return f"{sym[:2]}′{sym[2:]} = d{sym}/dτ"
     if definition is None:
-        return f"$${sym}$$"
-    definition = definition % n if "%d" in definition else definition
-    return f"$${sym} = {definition}$$"
+        return sym
+    return f"{sym} = {definition % n if '%s' in definition else definition}"
 
 
 def parameter_label(name: str) -> str:
@@ -75,10 +74,10 @@ def parameter_label(name: str) -> str:
 
 
 def parameter_axis_label(name: str) -> str:
-    """Axis label of a swept parameter for a Bokeh axis: TeX for Ω (``Ω = ω/ω_n``), else
+    """Axis label of a swept parameter for a plot axis: ``Ω = ω/ωₙ`` for Ω, else
     :func:`parameter_label`."""
     if name == "omega":
-        return r"$$\Omega = \omega/\omega_n$$"
+        return "Ω = ω/ωₙ (dimensionless mesh frequency)"
     return parameter_label(name)
 
 
@@ -152,8 +151,7 @@ class ExploreModel:
             planets = [int(p) for p in np.asarray(ds["planet"].values)]
             if self.planet not in planets:
                 raise ParameterError(
-                    f"planet must be one of the store's observed planets {planets}: "
-                    f"got {planet!r}"
+                    f"planet must be one of the store's observed planets {planets}: got {planet!r}"
                 )
         lay = self.full.layout()
         self.directions = lay.directions
@@ -176,9 +174,7 @@ class ExploreModel:
         self.selection = chosen
         self.res = self.full.select(chosen)
         self._lead = self.full.lead_dims
-        self._fixed_index = {
-            d: self._index_of(d, v) for d, v in chosen.items() if d in self._lead
-        }
+        self._fixed_index = {d: self._index_of(d, v) for d, v in chosen.items() if d in self._lead}
 
     # ------------------------------------------------------------------ axes
     @property
@@ -206,13 +202,12 @@ class ExploreModel:
 
         Raises :class:`~gearchaos.errors.ParameterError` for a non-finite coordinate.
         """
-        coords = [x] if not self.is_map else [x, y]
+        coords: list[float | None] = [x] if not self.is_map else [x, y]
+        index = []
         for name, c in zip(self.vary, coords, strict=True):
             if c is None or not math.isfinite(float(c)):
                 raise ParameterError(f"a click on {name} must be a finite number: got {c!r}")
-        index = [int(np.argmin(np.abs(self.axis(n) - float(c)))) for n, c in zip(
-            self.vary, coords, strict=True
-        )]
+            index.append(int(np.argmin(np.abs(self.axis(name) - float(c)))))
         return self.point(*index)
 
     def point(self, *index: int) -> Point:
@@ -251,8 +246,8 @@ class ExploreModel:
             ok = np.isfinite(x) & np.isfinite(y)
             return x[ok], y[ok], self.var_label(), variable_label(dot, self.planet)
         x = x[np.isfinite(x)]
-        sym = self.var_label().strip("$").split(" = ")[0]
-        return x[:-1], x[1:], f"$${sym}(k)$$", f"$${sym}(k+1)$$"
+        sym = self.var_label().split(" = ")[0]
+        return x[:-1], x[1:], f"{sym}(k)", f"{sym}(k+1)"
 
     def var_label(self) -> str:
         return variable_label(self.var, self.planet)
@@ -335,4 +330,3 @@ class ExploreModel:
         cats = [str(c) for c in self.labels().ravel()]
         out = {c: cats.count(c) / len(cats) for c in REGIME_COLOURS if c in cats}
         return out
-
