@@ -76,8 +76,7 @@ SECTION_SIZE = "() => Bokeh.documents[0].get_model_by_name('poincare-source').da
 TITLE = "() => Bokeh.documents[0].get_model_by_name('poincare-figure').title.text"
 
 
-@pytest.fixture(scope="module")
-def server(gear_store: Path) -> Iterator[dict[str, Any]]:
+def _start(store: Path) -> dict[str, Any]:
     """``gearchaos explore STORE --port 0 --no-browser`` in its own process, and its URL."""
     proc = subprocess.Popen(
         [
@@ -85,7 +84,7 @@ def server(gear_store: Path) -> Iterator[dict[str, Any]]:
             "-m",
             "gearchaos",
             "explore",
-            str(gear_store),
+            str(store),
             "--port",
             "0",
             "--no-browser",
@@ -96,7 +95,8 @@ def server(gear_store: Path) -> Iterator[dict[str, Any]]:
         env={**os.environ, "COLUMNS": "200"},
     )
     lines: queue.Queue[str] = queue.Queue()
-    threading.Thread(target=lambda: [lines.put(line) for line in proc.stdout], daemon=True).start()
+    assert proc.stdout is not None
+    threading.Thread(target=lambda: [lines.put(ln) for ln in proc.stdout], daemon=True).start()
     url, out = None, []
     deadline = time.monotonic() + LOAD_MS / 1000
     while url is None and time.monotonic() < deadline and proc.poll() is None:
@@ -109,29 +109,51 @@ def server(gear_store: Path) -> Iterator[dict[str, Any]]:
             url = line[line.index("http://") :].split()[0]
     if url is None:
         proc.kill()
-        pytest.fail(f"the explorer printed no URL: {''.join(out)} {proc.stderr.read()}")
-    yield {"proc": proc, "url": url, "lines": lines}
-    if proc.poll() is None:
-        proc.kill()
-        proc.wait(timeout=30)
+        err = proc.stderr.read() if proc.stderr else ""
+        pytest.fail(f"the explorer printed no URL: {''.join(out)} {err}")
+    return {"proc": proc, "url": url, "lines": lines}
+
+
+def _stop(server: dict[str, Any]) -> None:
+    if server["proc"].poll() is None:
+        server["proc"].kill()
+        server["proc"].wait(timeout=30)
+
+
+def _open(browser: Any, url: str) -> Any:
+    page = browser.new_page(viewport={"width": 1400, "height": 1000})
+    page.set_default_timeout(LOAD_MS)
+    page.goto(url, timeout=LOAD_MS)
+    page.wait_for_function(
+        "() => window.Bokeh && Bokeh.documents.length > 0 && "
+        "Bokeh.documents[0].get_model_by_name('diagram-figure') !== null",
+        timeout=LOAD_MS,
+    )
+    return page
 
 
 @pytest.fixture(scope="module")
-def page(server: dict[str, Any]) -> Iterator[Any]:
+def browser() -> Iterator[Any]:
     from playwright.sync_api import sync_playwright
 
     with sync_playwright() as p:
-        browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
-        pg = browser.new_page(viewport={"width": 1400, "height": 1000})
-        pg.set_default_timeout(LOAD_MS)
-        pg.goto(server["url"], timeout=LOAD_MS)
-        pg.wait_for_function(
-            "() => window.Bokeh && Bokeh.documents.length > 0 && "
-            "Bokeh.documents[0].get_model_by_name('diagram-figure') !== null",
-            timeout=LOAD_MS,
-        )
-        yield pg
-        browser.close()
+        b = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+        yield b
+        b.close()
+
+
+@pytest.fixture(scope="module")
+def server(gear_store: Path) -> Iterator[dict[str, Any]]:
+    srv = _start(gear_store)
+    yield srv
+    _stop(srv)
+
+
+@pytest.fixture(scope="module")
+def page(server: dict[str, Any], browser: Any) -> Iterator[Any]:
+    pg = _open(browser, server["url"])
+    yield pg
+    pg.close()
 
 
 def _click(page: Any, omega: float, y: float) -> None:
@@ -171,6 +193,9 @@ def test_a_click_shows_the_points_label_and_stored_section(page: Any, gear_store
 
 
 def test_a_second_click_replaces_the_point(page: Any, gear_store: Path) -> None:
+    first, _, omega1 = _stored(gear_store, 1)
+    _click(page, omega1, float(np.median(first)))
+    page.wait_for_function(f"() => ({TITLE})().startsWith('Ω = {omega1:.6g} ')", timeout=CLICK_MS)
     x, label, omega = _stored(gear_store, 6)
     _click(page, omega - 0.01, float(np.median(x)))
     page.wait_for_function(f"() => ({TITLE})().startsWith('Ω = {omega:.6g} ')", timeout=CLICK_MS)
@@ -184,20 +209,28 @@ def test_a_second_click_replaces_the_point(page: Any, gear_store: Path) -> None:
 def test_the_point_is_computed_in_the_background(page: Any, gear_store: Path) -> None:
     """The worker's views of the selected point arrive (motion, λ₁, figure) while the page
     stays live."""
-    _, _, omega = _stored(gear_store, 6)
+    x, _, omega = _stored(gear_store, 4)
+    _click(page, omega, float(np.median(x)))
     page.get_by_text(f"computed at omega = {omega:.6g}").wait_for(timeout=COMPUTE_MS)
     page.locator("img").first.wait_for(timeout=CLICK_MS)
     page.screenshot(path=str(gear_store.parent / "explorer-computed.png"), full_page=True)
 
 
-def test_the_server_stops_cleanly(server: dict[str, Any], page: Any) -> None:
-    proc = server["proc"]
-    port = urlparse(server["url"]).port
-    proc.send_signal(signal.SIGTERM)
-    assert proc.wait(timeout=60) == 0
-    rest = []
-    while not server["lines"].empty():
-        rest.append(server["lines"].get())
-    assert "explorer stopped" in "".join(rest)
-    with socket.socket() as s:
-        assert s.connect_ex(("localhost", port)) != 0, "the port still accepts connections"
+def test_the_server_stops_cleanly(gear_store: Path, browser: Any) -> None:
+    """SIGTERM (as Ctrl-C) with a page open: exit code 0, ``explorer stopped``, port closed."""
+    server = _start(gear_store)
+    try:
+        port = urlparse(server["url"]).port
+        pg = _open(browser, server["url"])
+        proc = server["proc"]
+        proc.send_signal(signal.SIGTERM)
+        assert proc.wait(timeout=60) == 0
+        pg.close()
+        rest = []
+        while not server["lines"].empty():
+            rest.append(server["lines"].get())
+        assert "explorer stopped" in "".join(rest)
+        with socket.socket() as s:
+            assert s.connect_ex(("localhost", port)) != 0, "the port still accepts connections"
+    finally:
+        _stop(server)
