@@ -85,18 +85,19 @@ class Workers:
             return out
 
     def shutdown(self) -> None:
-        """Stop the worker processes now (a running sweep keeps its finished chunks)."""
+        """Stop the worker processes: idle ones end normally, busy ones are terminated at
+        once (a running sweep keeps its finished chunks and resumes when asked again)."""
         with self._lock:
             pools, self._pools = self._pools, {}
+            running, self.running = list(self.running.values()), {}
+        for fut in running:
+            fut.cancel()
+        busy = any(not fut.done() for fut in running)
         for pool in pools.values():
-            procs = list(getattr(pool, "_processes", {}).values())
-            for fut in list(self.running.values()):
-                fut.cancel()
-            for p in procs:
-                if p.is_alive():
-                    p.terminate()
-            for p in procs:
-                p.join(timeout=5)
+            if busy:
+                for proc in list(getattr(pool, "_processes", {}).values()):
+                    if proc.is_alive():
+                        proc.terminate()
             pool.shutdown(wait=True, cancel_futures=True)
 
 
@@ -124,7 +125,7 @@ class Explorer(pn.viewable.Viewer):
         self._zoom_key: tuple[Any, ...] | None = None
         self._syncing = False
         self.store_select = pn.widgets.Select(
-            name="store", options=[self.root], value=self.root, width=420
+            label="store", options=[self.root], value=self.root, width=420
         )
         self.store_select.param.watch(lambda e: self._open(e.new), "value")
         self.info = pn.pane.Markdown("", sizing_mode="stretch_width")
@@ -133,9 +134,9 @@ class Explorer(pn.viewable.Viewer):
         self.spinner = pn.indicators.LoadingSpinner(value=False, size=28)
         self.busy = pn.pane.Markdown("", margin=(0, 10))
         self.zoom_note = pn.pane.Markdown("")
-        self.zoom_points = pn.widgets.IntInput(name="points", value=100, start=2, width=100)
+        self.zoom_points = pn.widgets.IntInput(label="points", value=100, start=2, width=100)
         self.zoom_button = pn.widgets.Button(
-            name="Finer sweep of the shown range", button_type="primary"
+            label="Finer sweep of the shown range", color="primary"
         )
         self.zoom_button.on_click(lambda _e: self._zoom())
         self.body = pn.Column(sizing_mode="stretch_width")
@@ -172,7 +173,7 @@ class Explorer(pn.viewable.Viewer):
         selects = []
         if m.family:
             fam = pn.widgets.Select(
-                name=parameter_label(m.family),
+                label=parameter_label(m.family),
                 options=m.family_values(),
                 value=float(m.selection[m.family]),
             )
@@ -181,7 +182,7 @@ class Explorer(pn.viewable.Viewer):
             selects.append(fam)
         if m.directions:
             dirs = pn.widgets.Select(
-                name="branch", options=list(m.directions), value=m.selection["direction"]
+                label="branch", options=list(m.directions), value=m.selection["direction"]
             )
             dirs.param.watch(lambda e: self._reselect("direction", e.new), "value")
             selects.append(dirs)
@@ -209,7 +210,7 @@ class Explorer(pn.viewable.Viewer):
         if len(options) < values.size:  # values equal at 6 digits: label by index too
             options = {f"{v:.6g} (#{i})": i for i, v in enumerate(values)}
         slider = pn.widgets.DiscreteSlider(
-            name=parameter_label(name), options=options, value=0, width=420
+            label=parameter_label(name), options=options, value=0, width=420
         )
 
         def moved(event: Any) -> None:
