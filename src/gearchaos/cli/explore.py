@@ -23,8 +23,14 @@ def explore(
         bool, typer.Option("--no-browser", help="Do not open a browser; only print the URL.")
     ] = False,
     var: Annotated[
-        str, typer.Option("--var", help="Section variable drawn: delta_sp (X̄_sp), delta_rp, ...")
-    ] = "delta_sp",
+        str | None,
+        typer.Option(
+            "--var",
+            help="Section variable drawn (default: the store's first observed one, delta_sp "
+            "(X̄_sp) for gear sets).",
+            show_default=False,
+        ),
+    ] = None,
     planet: Annotated[int, typer.Option("--planet", help="Planet of per-planet variables.")] = 1,
 ) -> None:
     """Explore a sweep store in the browser: its bifurcation diagram with the band of motion

@@ -109,16 +109,17 @@ class Explorer(pn.viewable.Viewer):
         self,
         store: str | os.PathLike[str],
         *,
-        var: str = "delta_sp",
+        var: str | None = None,
         planet: int = 1,
         workers: Workers | None = None,
         **params: Any,
     ):
         super().__init__(**params)
         self.root = str(store)
-        self.var, self.planet = var, planet
+        self.planet = planet
         self.workers = workers if workers is not None else Workers()
         self.model = ExploreModel(open_result(store), var=var, planet=planet, store=self.root)
+        self.var = self.model.var
         self.point: Point | None = None
         self.x_range: Any = None
         self.y_range: Any = None
@@ -167,6 +168,8 @@ class Explorer(pn.viewable.Viewer):
             height=400,
             title="click the diagram to see a point",
             tools="pan,wheel_zoom,box_zoom,reset,save",
+            x_range=Range1d(start=0.0, end=1.0),
+            y_range=Range1d(start=0.0, end=1.0),
         )
         self.poincare.scatter("x", "y", source=self.poincare_src, size=6, color="#d62728")
         self.sliders = [self._slider(i, name) for i, name in enumerate(m.vary)]
@@ -186,7 +189,7 @@ class Explorer(pn.viewable.Viewer):
             )
             dirs.param.watch(lambda e: self._reselect("direction", e.new), "value")
             selects.append(dirs)
-        fractions = ", ".join(f"{k} {100 * v:.0f} %" for k, v in m.regime_fractions().items())
+        fractions = ", ".join(f"{k} {100 * v:.3g} %" for k, v in m.regime_fractions().items())
         summary = pn.pane.Markdown(
             f"**{' × '.join(f'{parameter_label(n)}: {m.axis(n).size} points' for n in m.vary)}**"
             f" · motions: {fractions}",
@@ -271,8 +274,10 @@ class Explorer(pn.viewable.Viewer):
         band.yaxis.visible = False
         b = m.band()
         bsrc = ColumnDataSource({**b, "y": [0.5] * len(b["x"])}, name="band-source")
-        band.rect("x", "y", "width", 1, source=bsrc, fill_color="colour", line_color=None)
-        band.add_tools(HoverTool(tooltips=[(name, "@x{0.0000}"), ("motion", "@label")]))
+        cells = band.rect("x", "y", "width", 1, source=bsrc, fill_color="colour", line_color=None)
+        band.add_tools(
+            HoverTool(renderers=[cells], tooltips=[(name, "@x{0.0000}"), ("motion", "@label")])
+        )
         band.on_event(events.Tap, self._tapped)
         self._legend(fig, b["label"])
         self.x_range = x_range
@@ -291,8 +296,15 @@ class Explorer(pn.viewable.Viewer):
             y_axis_label=parameter_axis_label(m.vary[1]),
         )
         src = ColumnDataSource(b, name="map-source")
-        fig.rect("x", "y", "width", "height", source=src, fill_color="colour", line_color=None)
-        fig.add_tools(HoverTool(tooltips=[("motion", "@label"), ("", "(@x{0.0000}, @y{0.0000})")]))
+        cells = fig.rect(
+            "x", "y", "width", "height", source=src, fill_color="colour", line_color=None
+        )
+        fig.add_tools(
+            HoverTool(
+                renderers=[cells],
+                tooltips=[("motion", "@label"), ("", "(@x{0.0000}, @y{0.0000})")],
+            )
+        )
         self.marker_src = ColumnDataSource({"x": [], "y": []})
         fig.scatter(
             "x", "y", source=self.marker_src, size=14, marker="x", color="black", line_width=3
@@ -340,6 +352,9 @@ class Explorer(pn.viewable.Viewer):
         self.point = point
         x, y, xl, yl = m.section(point)
         self.poincare_src.data = {"x": x, "y": y}
+        ranges: tuple[Any, Any] = (self.poincare.x_range, self.poincare.y_range)
+        for rng, v in zip(ranges, (x, y), strict=True):
+            rng.start, rng.end = readable_range(v)
         label = m.label(point)
         title: Any = self.poincare.title
         title.text = f"{point.title()} · {label} · {x.size} stored section points"
@@ -386,7 +401,8 @@ class Explorer(pn.viewable.Viewer):
         if self.point is not None:
             out = self.workers.collect(self._point_key(self.point))
             if out is None:
-                busy.append(f"computing {self.point.title()} …")
+                if self._point_key(self.point) in self.workers.running:
+                    busy.append(f"computing {self.point.title()} …")
             elif isinstance(out, Exception):
                 self.computed.object = f"**could not compute this point:** {out}"
                 self.figure_png.object = None
@@ -430,6 +446,20 @@ class Explorer(pn.viewable.Viewer):
         self.workers.submit("zoom", self._zoom_key, run_zoom, m.store, axes)
 
 
+def readable_range(v: np.ndarray, rel: float = 1e-3) -> tuple[float, float]:
+    """Axis limits around values ``v``: their span padded by 5 %, and at least ``rel`` of their
+    magnitude wide, so that a section of nearly equal points (a 1T orbit) reads as one point
+    with short tick labels rather than as a cloud at the ninth digit."""
+    v = np.asarray(v, dtype=np.float64)
+    v = v[np.isfinite(v)]
+    if v.size == 0:
+        return 0.0, 1.0
+    lo, hi = float(v.min()), float(v.max())
+    mid, half = 0.5 * (lo + hi), 0.525 * (hi - lo)
+    half = max(half, 0.5 * rel * max(abs(mid), 1.0))
+    return mid - half, mid + half
+
+
 def _stack(*figs: Any) -> Any:
     from bokeh.layouts import column
 
@@ -453,7 +483,7 @@ def _computed_text(out: Mapping[str, Any]) -> str:
     return "  \n".join(lines)
 
 
-def explore(store: str | os.PathLike[str], *, var: str = "delta_sp", planet: int = 1) -> Explorer:
+def explore(store: str | os.PathLike[str], *, var: str | None = None, planet: int = 1) -> Explorer:
     """The explorer of a sweep store, as a Panel app (display it in a notebook, or serve it).
 
     Shows the bifurcation diagram — every stored section value X̄_k of ``var`` (default
@@ -469,7 +499,7 @@ def explore(store: str | os.PathLike[str], *, var: str = "delta_sp", planet: int
     store
         Path of a sweep store (:func:`gearchaos.bifurcation`, ``gearchaos bifurcation``).
     var, planet
-        The section variable drawn and its planet.
+        The section variable drawn (default: the store's first observed one) and its planet.
 
     Returns
     -------
@@ -489,7 +519,7 @@ def serve(
     *,
     port: int = 0,
     show: bool = True,
-    var: str = "delta_sp",
+    var: str | None = None,
     planet: int = 1,
     ready: Callable[[str], None] | None = None,
 ) -> None:

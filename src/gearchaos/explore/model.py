@@ -120,7 +120,8 @@ class ExploreModel:
     res
         The store (:class:`~gearchaos.sweep.SweepResult` or a dataset).
     var, planet
-        The section variable drawn (default ``delta_sp`` of planet 1: X̄_sp1 = δ_sp1/b_c).
+        The section variable drawn (default: the store's first observed one, ``delta_sp`` of
+        planet 1 — X̄_sp1 = δ_sp1/b_c — for gear sets).
     select
         Values of the dimensions not drawn: the family value and the ``direction`` of a
         store with both branches (default: the first of each).
@@ -132,7 +133,7 @@ class ExploreModel:
         self,
         res: Any,
         *,
-        var: str = "delta_sp",
+        var: str | None = None,
         planet: int = 1,
         select: Mapping[str, Any] | None = None,
         store: str | None = None,
@@ -140,8 +141,12 @@ class ExploreModel:
         self.full = SweepResult.of(res)
         self.store = store
         ds = self.full.ds
+        have = [str(n) for n in ds.data_vars if "section" in ds[n].dims]
+        if var is None:
+            spec = self.full.spec
+            first = [n for n in (spec.observe if spec is not None else ()) if n in have]
+            var = (first or have or ["delta_sp"])[0]
         if var not in ds.data_vars or "section" not in ds[var].dims:
-            have = [str(n) for n in ds.data_vars if "section" in ds[n].dims]
             raise ParameterError(
                 f"var must be a section variable of the store ({', '.join(have)}): got {var!r}"
             )
