@@ -122,3 +122,19 @@ def test_a_finer_sweep_covers_the_range_with_the_stores_settings(gear_store: Pat
     assert finer.attrs["complete"] is True
     with pytest.raises(ParameterError, match="zoom range of omega"):
         run_zoom(str(gear_store), {"omega": (1.4, 1.3, 3)})
+
+
+def test_the_default_variable_is_the_stores_first_observed_one(linear_map_store: Path) -> None:
+    assert ExploreModel(open_result(linear_map_store)).var == "x"
+
+
+def test_poincare_limits_hold_the_points_and_stay_readable() -> None:
+    from gearchaos.explore.app import readable_range
+
+    one = 1.3956 + np.array([0.0, 2e-10, -1e-10])  # a 1T section: equal to the ninth digit
+    lo, hi = readable_range(one)
+    assert lo < one.min() and hi > one.max()
+    assert hi - lo == pytest.approx(1e-3 * 1.3956)
+    cloud = np.array([-0.4, 0.1, 0.3])
+    lo, hi = readable_range(cloud)
+    assert (lo, hi) == pytest.approx((-0.4 - 0.035, 0.3 + 0.035))

@@ -455,7 +455,7 @@ def readable_range(v: np.ndarray, rel: float = 1e-3) -> tuple[float, float]:
     if v.size == 0:
         return 0.0, 1.0
     lo, hi = float(v.min()), float(v.max())
-    mid, half = 0.5 * (lo + hi), 0.525 * (hi - lo)
+    mid, half = 0.5 * (lo + hi), 0.55 * (hi - lo)
     half = max(half, 0.5 * rel * max(abs(mid), 1.0))
     return mid - half, mid + half
 
