@@ -39,6 +39,7 @@ __all__ = [
     "StoreError",
     "System",
     "__version__",
+    "attractors",
     "backlash_oscillator",
     "bifurcation",
     "continuation",
@@ -59,6 +60,7 @@ __all__ = [
 
 if TYPE_CHECKING:
     from .analysis.arclength import continuation
+    from .analysis.coexistence import attractors
     from .analysis.orbits import PeriodicOrbit, periodic_orbit
     from .explore import explore
 
@@ -68,13 +70,15 @@ _LAZY_ATTRIBUTES = {
     "PeriodicOrbit": "analysis.orbits",
     "periodic_orbit": "analysis.orbits",
     "continuation": "analysis.arclength",
+    "attractors": "analysis.coexistence",
 }
 
 
 def __getattr__(name: str) -> object:
     """``gearchaos.plot`` etc. import on first use (matplotlib only when plotting; Panel only
     for ``gearchaos.explore``, a callable package: ``gearchaos.explore(store)``), and so do
-    the periodic-orbit front doors (``gc.periodic_orbit``, ``gc.continuation``)."""
+    the periodic-orbit front doors (``gc.periodic_orbit``, ``gc.continuation``,
+    ``gc.attractors``)."""
     import importlib
 
     if name in _LAZY_SUBPACKAGES:

@@ -165,10 +165,32 @@ def test_clearance_lines_from_attrs_and_from_the_swept_backlash() -> None:
 
     b = np.array([1.0, 4.0, 7.0])
     ds = sweep_dataset(np.array([1, 1, 2]), {"backlash.sun_planet": b})
-    ax = bifurcation(ds, clearance_lines=True)
+    ax = bifurcation(ds, clearance_lines=True, relative=False)
     assert ax.get_xlabel() == r"$\bar b_{sp}$"
     ys = sorted(tuple(line.get_ydata()) for line in gid_lines(ax, "clearance"))
     assert ys == [tuple(-b), tuple(b)]  # ±b̄ follows the swept backlash
+
+
+def test_swept_own_clearance_draws_the_deflection_beyond_it() -> None:
+    """Sweeping b̄_sp, X̄_sp grows with b̄ (a thin band along the diagonal); by default the
+    diagram shows X̄ − b̄ with the flank edges at 0 and −2b̄."""
+    b = np.array([1.0, 4.0, 7.0])
+    ds = sweep_dataset(np.array([1, 1, 2]), {"backlash.sun_planet": b})
+    ds["delta_sp"] = ds["delta_sp"] + xr.DataArray(b, dims="backlash.sun_planet")
+    ax = bifurcation(ds, clearance_lines=True)
+    assert ax.get_ylabel() == r"$\bar{X}_{sp1} - \bar b_{sp}$"
+    absolute = bifurcation(ds, relative=False)
+    y_rel = np.sort(ax.collections[0].get_offsets()[:, 1])
+    pts = absolute.collections[0].get_offsets()
+    x_abs = np.asarray(pts[:, 0])
+    y_expected = np.sort(np.asarray(pts[:, 1]) - np.interp(x_abs, b, b))
+    np.testing.assert_allclose(y_rel, y_expected, atol=1e-12)
+    ys = [np.asarray(line.get_ydata(), dtype=float) for line in gid_lines(ax, "clearance")]
+    assert any(np.all(y == 0.0) for y in ys)  # drive-flank edge X̄ = b̄
+    assert any(y.shape == b.shape and np.allclose(y, -2.0 * b) for y in ys)  # back flank
+    # the y axis follows the relative values, not the diagonal
+    lo, hi = ax.get_ylim()
+    assert hi - lo < 0.5 * (b[-1] - b[0])
 
 
 def test_resonance_lines_at_harmonics_meeting_natural_frequencies() -> None:

@@ -427,7 +427,8 @@ def continuation(
     Parameters
     ----------
     target
-        A :class:`~gearchaos.gearset.GearSet` or a :class:`~gearchaos.model.System`.
+        The gear set (:class:`~gearchaos.gearset.GearSet`) or
+        :class:`~gearchaos.model.System` whose orbits are continued.
     vary
         The parameter and its range: ``"omega=0.2:4"``, ``("backlash.sun_planet", 4, 1)`` or
         ``{"xi": (0.03, 0.11)}``. The branch starts at START (or at ``start``) heading towards

@@ -39,7 +39,7 @@ from .._version import provenance
 from ..errors import IntegrationError, ParameterError, Status
 from ..integrate.settings import SolverSettings
 from ..model.system import System
-from ..model.target import resolve
+from ..model.target import resolve, scale_attrs
 from .contact import contact_regime
 from .shooting import Problem, Solution, correct, section_time
 
@@ -296,11 +296,7 @@ def model_attrs(system: System) -> dict[str, Any]:
         "gearset_toml": gs.to_toml() if gs is not None else "",
         "model_parameters": "" if gs is not None else repr(model),
     }
-    if hasattr(model, "scales"):
-        a["omega_n_rad_s"] = float(model.scales.omega_n)
-        a["characteristic_length_m"] = float(model.scales.length)
-    for k, v in getattr(model, "clearances", {}).items():
-        a[f"clearance_{k}"] = float(v)
+    a.update(scale_attrs(model))
     return a
 
 

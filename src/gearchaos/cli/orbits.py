@@ -20,6 +20,14 @@ PeriodOpt = Annotated[
     int, typer.Option("--period", "-n", help="Period n of the orbit, in mesh periods.")
 ]
 
+GuessOpt = Annotated[
+    float,
+    typer.Option(
+        "--transient",
+        help="Mesh periods simulated from rest for the first guess of the (starting) orbit.",
+    ),
+]
+
 
 def _spinner(text: str, quiet: bool) -> contextlib.AbstractContextManager[Any]:
     err = c.stderr()
@@ -32,13 +40,7 @@ def orbit(
     gearset: c.GearsetOpt = None,
     set_: c.SetOpt = None,
     period: PeriodOpt = 1,
-    transient: Annotated[
-        float,
-        typer.Option(
-            "--transient",
-            help="Mesh periods simulated from rest for the first guess of the orbit.",
-        ),
-    ] = 50.0,
+    transient: GuessOpt = 50.0,
     rtol: c.RtolOpt = 1e-8,
     atol: c.AtolOpt = 1e-10,
     json_out: c.JsonOpt = False,
@@ -120,12 +122,7 @@ def continue_(
     gearset: c.GearsetOpt = None,
     set_: c.SetOpt = None,
     period: PeriodOpt = 1,
-    transient: Annotated[
-        float,
-        typer.Option(
-            "--transient", help="Mesh periods simulated from rest for the starting orbit."
-        ),
-    ] = 50.0,
+    transient: GuessOpt = 50.0,
     rtol: c.RtolOpt = 1e-8,
     atol: c.AtolOpt = 1e-10,
     max_points: Annotated[
@@ -218,3 +215,89 @@ def continue_(
         )
     out.print(events)
     c.wrote(Path(path))
+
+
+@c.app.command()
+def attractors(
+    preset: c.PresetOpt = None,
+    gearset: c.GearsetOpt = None,
+    set_: c.SetOpt = None,
+    starts: Annotated[
+        int,
+        typer.Option(
+            "--starts",
+            "-k",
+            help="Initial conditions: the state at rest and K − 1 seeded random states around "
+            "its motion.",
+        ),
+    ] = 8,
+    seed: Annotated[int, typer.Option("--seed", help="Seed of the random starts.")] = 0,
+    transient: c.TransientOpt = 200.0,
+    periods: c.PeriodsOpt = 100,
+    rtol: c.RtolOpt = 1e-8,
+    atol: c.AtolOpt = 1e-10,
+    json_out: c.JsonOpt = False,
+) -> None:
+    """List the distinct attractors at one operating point, from several initial conditions.
+
+    Each start is simulated (TRANSIENT + PERIODS mesh periods, with the largest Lyapunov
+    exponent λ₁) and labelled as a sweep labels its points; runs that end on the same
+    attractor are grouped. A periodic attractor is confirmed by shooting its orbit, whose
+    Floquet multipliers say how stable it is. **--json** prints a list of {label, lle, starts,
+    x_sp1, orbit: {period, converged, residual, max_multiplier, stable} or null}.
+
+    Example (a stable 1T orbit beside a chaotic attractor): **gearchaos attractors --set
+    omega=1.5**
+    """
+    from ..analysis.coexistence import attractors as find
+
+    with c.reported_errors():
+        omega, changes = c.parse_sets(set_ or [])
+        gs = c.load_gearset(preset, gearset, changes)
+        if omega is None:
+            omega = c.DEFAULT_OMEGA
+            c.default_omega_note(json_out, "set")
+        settings = c.solver_settings(transient, periods, rtol, atol)
+        with _spinner(f"simulating {starts} starts at Ω = {omega:g}…", json_out):
+            with c.warnings_to_stderr():
+                found = find(gs, starts=starts, seed=seed, settings=settings, omega=omega)
+    items = [a.summary() for a in found]
+    if json_out:
+        c.print_json(items)
+        return
+    out = c.stdout()
+    table = Table(
+        title=f"{len(found)} attractor(s) of {gs.name} at Ω = {omega:g} from {starts} starts",
+        title_justify="left",
+    )
+    for col in ("motion", "λ₁", "starts (0: at rest)", "X̄_sp1 at the section", "orbit"):
+        table.add_column(col)
+    for a, item in zip(found, items, strict=True):
+        xs = item["x_sp1"]
+        xs_text = ", ".join(f"{x:.5g}" for x in xs) if a.period else f"{xs[0]:.5g} … {xs[-1]:.5g}"
+        orb = item["orbit"]
+        orbit_text = (
+            "—"
+            if orb is None
+            else (
+                f"max |μ| = {orb['max_multiplier']:.4g}, "
+                + ("stable" if orb["stable"] else "unstable")
+                + ("" if orb["converged"] else " (not converged)")
+            )
+        )
+        table.add_row(
+            escape(a.label),
+            f"{a.lle:+.4g}",
+            escape(", ".join(str(s) for s in a.starts)),
+            escape(xs_text),
+            escape(orbit_text),
+        )
+    out.print(table)
+    if len(found) > 1:
+        out.print(
+            Text(
+                "several attractors coexist: which one a simulation or sweep shows depends on "
+                "where it starts",
+                style="dim",
+            )
+        )

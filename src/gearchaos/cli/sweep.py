@@ -41,6 +41,11 @@ def open_store(path: Path) -> Any:
     return open_result(path)
 
 
+StoreArg = Annotated[
+    Path,
+    typer.Argument(help="Sweep store written by `gearchaos bifurcation`.", show_default=False),
+]
+
 @c.app.command()
 def bifurcation(
     output: Annotated[
@@ -149,6 +154,17 @@ def bifurcation(
             ),
         ),
     ] = False,
+    orbits: Annotated[
+        bool,
+        typer.Option(
+            "--orbits",
+            help=(
+                "Confirm every label nT (n ≤ 8) by shooting a period-n orbit from the point's "
+                "final state; store orbit_residual, orbit_max_multiplier (largest |μ|) and "
+                "orbit_status (confirmed, unstable, shorter_period, not_converged, ...)."
+            ),
+        ),
+    ] = False,
     quiet: c.QuietOpt = False,
     json_out: c.JsonOpt = False,
 ) -> None:
@@ -215,6 +231,7 @@ def bifurcation(
             initial_conditions=ic,
             direction=direction,
             lyapunov=lyapunov,
+            orbits=orbits,
             solver=settings,
             store=output,
             overwrite=overwrite,
@@ -227,7 +244,21 @@ def bifurcation(
         res = sweep.SweepResult.of(ds)
         points, failed = int(res.status().size), res.n_failed
 
-    result = {"store": str(output), "points": points, "failed": failed, "seconds": seconds}
+    result: dict[str, Any] = {
+        "store": str(output),
+        "points": points,
+        "failed": failed,
+        "seconds": seconds,
+    }
+    if orbits:
+        import numpy as np
+
+        from ..sweep.orbits import ORBIT_STATUS
+
+        codes = np.asarray(res.ds["orbit_status"].values).ravel()
+        result["orbits"] = {
+            k: int(np.sum(codes == v)) for k, v in ORBIT_STATUS.items() if np.any(codes == v)
+        }
     if json_out:
         c.print_json(result)
         return
@@ -247,10 +278,14 @@ def bifurcation(
         Text(
             f"{transient:g} transient + {periods} recorded mesh periods, {ic} initial "
             f"conditions, rtol {rtol:g}, atol {atol:g}"
-            + (", largest Lyapunov exponents" if lyapunov else ""),
+            + (", largest Lyapunov exponents" if lyapunov else "")
+            + (", nT labels checked by periodic orbits" if orbits else ""),
             style="dim",
         )
     )
+    if orbits:
+        table2 = ", ".join(f"{k.replace('_', ' ')} {n}" for k, n in result["orbits"].items())
+        out.print(Text(f"periodic orbits behind the nT labels: {table2}", style="dim"))
     regimes = res.regime_table()
     if regimes:
         out.print(regime_table(regimes, title="motion regimes (fraction of the swept points)"))
@@ -259,10 +294,7 @@ def bifurcation(
 
 @c.app.command()
 def plot(
-    store: Annotated[
-        Path,
-        typer.Argument(help="Sweep store written by `gearchaos bifurcation`.", show_default=False),
-    ],
+    store: StoreArg,
     output: Annotated[
         Path,
         typer.Option("--output", "-o", help="Figure file: .png, .pdf or .svg.", show_default=False),
@@ -333,10 +365,7 @@ def plot(
 
 @c.app.command()
 def classify(
-    store: Annotated[
-        Path,
-        typer.Argument(help="Sweep store written by `gearchaos bifurcation`.", show_default=False),
-    ],
+    store: StoreArg,
     period_rtol: Annotated[
         float | None,
         typer.Option(

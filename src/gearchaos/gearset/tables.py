@@ -12,6 +12,20 @@ from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Final
 
+__all__ = [
+    "Backlash",
+    "Clearance",
+    "Damping",
+    "Eccentricity",
+    "Geometry",
+    "Inertia",
+    "Mass",
+    "MeshPhasing",
+    "Stiffness",
+    "Teeth",
+    "Torque",
+    "TransmissionError",
+]
 
 @dataclass(frozen=True)
 class Teeth:

@@ -17,8 +17,14 @@ Conventions
 * ``unresolved`` and ``failed`` points carry no information about the motion; the route and
   window checks drop them from the sequence along the swept axis, and a sweep with fewer than
   :data:`MIN_RESOLVED` of its points labelled is not used.
-* A *route to chaos* is read at every onset of chaos along the swept axis (a ``chaos`` point
-  whose previous labelled point is not chaotic), from the labels just before it:
+* A *route to chaos* of conclusions 4–6 is read from the bifurcation events of continued
+  branches when they are given (``branches``; :mod:`gearchaos.paper.routes`, which the report
+  computes): a PD event gives ``period doubling`` (citing its value), an NS event ``Hopf``, an
+  event of a period-3 branch ``3T channel``, no event of a followed branch near the onset
+  ``crisis``; the label reading below stays as a secondary line ("brute-force labels say").
+  Without branches, the route is read at every onset of chaos along the swept axis (a
+  ``chaos`` point whose previous labelled point is not chaotic), from the labels just before
+  it:
   ``period doubling`` (the periodic points before it double their period at least twice, or
   once to ≥ 4T, e.g. 1T → 2T → 4T), ``3T channel`` (a 3T or 6T window just before),
   ``Hopf`` (quasi-periodic motion just before — a Neimark–Sacker bifurcation), ``crisis``
@@ -54,6 +60,7 @@ from .evidence import (
     qp_near_3t,
     section_spread,
 )
+from .routes import onset_text, panel_routes
 
 __all__ = [
     "CONCLUSIONS",
@@ -75,6 +82,8 @@ VERDICTS = ("holds", "partly", "does not hold", "not evaluated")
 WEAK_COUPLING_RATIO = 0.2
 
 Stores = Mapping[str, Any]
+#: Event rows of the continued branches by figure (:func:`gearchaos.paper.routes.event_rows`).
+Branches = Mapping[str, Sequence[Mapping[str, Any]]]
 
 
 @dataclass(frozen=True)
@@ -298,14 +307,6 @@ def _k0(p: tuple[Any, ...]) -> float:
     return -math.inf if p[0] is None else float(p[0])
 
 
-def _routes(ds: Any) -> list[dict[str, Any]]:
-    out = []
-    for fv, x, lab, sec in panels(ds):
-        for o in chaos_onsets(x, lab, sec):
-            out.append({**o, "panel": fv})
-    return out
-
-
 def _route_counts(onsets: list[dict[str, Any]]) -> dict[str, int]:
     counts: dict[str, int] = {}
     for o in onsets:
@@ -313,17 +314,9 @@ def _route_counts(onsets: list[dict[str, Any]]) -> dict[str, int]:
     return counts
 
 
-def _onset_text(onsets: list[dict[str, Any]], family: str, limit: int = 8) -> str:
-    items = [
-        f"{o['route']} at {o['at']:.3g}"
-        + ("" if o["panel"] is None else f" ({family}={o['panel']:g})")
-        for o in onsets[:limit]
-    ]
-    more = f" … (+{len(onsets) - limit})" if len(onsets) > limit else ""
-    return "; ".join(items) + more
-
-
-def _gather_routes(stores: Stores, figures: Sequence[str]) -> tuple[list[Any], list[str], bool]:
+def _gather_routes(
+    stores: Stores, figures: Sequence[str], branches: Branches | None = None
+) -> tuple[list[Any], list[str], bool]:
     onsets: list[dict[str, Any]] = []
     texts = []
     informative = True  # every sweep of the group must be mostly labelled
@@ -332,22 +325,35 @@ def _gather_routes(stores: Stores, figures: Sequence[str]) -> tuple[list[Any], l
             continue
         ds = stores[f]
         informative = informative and _informative(ds)
-        o = _routes(ds)
+        rows = None if branches is None else branches.get(f)
+        o = panel_routes(ds, rows)
         for item in o:
             item["figure"] = f
         onsets.extend(o)
+        fam = _family_name(ds)
+        if rows is None:
+            texts.append(
+                f"{f}: {len(o)} onset(s) of chaos, routes from labels only (no continued "
+                "branches)" + (f" — {onset_text(o, fam)}" if o else "")
+            )
+            continue
+        label_side = [{**x, "route": x.get("label_route", x["route"]), "event": None} for x in o]
         texts.append(
-            f"{f}: {len(o)} onset(s) of chaos"
-            + (f" — {_onset_text(o, _family_name(ds))}" if o else "")
+            f"{f}: {len(o)} onset(s) of chaos, routes from "
+            f"{sum(1 for r in rows if r['kind'] != 'branch')} event(s) of the continued branches"
+            + (f" — {onset_text(o, fam)}" if o else "")
+            + (f"; brute-force labels say: {onset_text(label_side, fam)}" if o else "")
         )
     return onsets, texts, informative
 
 
-def conclusion_4(stores: Stores, figures: Sequence[str] = ("fig4",)) -> Verdict:
+def conclusion_4(
+    stores: Stores, figures: Sequence[str] = ("fig4",), branches: Branches | None = None
+) -> Verdict:
     """Onsets of chaos along Ω: is crisis (a jump of the attractor) among their routes?"""
     if not any(f in stores for f in figures):
         return _missing(4, list(figures))
-    onsets, texts, informative = _gather_routes(stores, figures)
+    onsets, texts, informative = _gather_routes(stores, figures, branches)
     counts = _route_counts(onsets)
     measured = {"route_counts": counts, "onsets": onsets}
     evidence = "; ".join(texts) + f"; routes: {counts or 'none'}"
@@ -363,11 +369,13 @@ def conclusion_4(stores: Stores, figures: Sequence[str] = ("fig4",)) -> Verdict:
     return _verdict(4, verdict, evidence, measured)
 
 
-def conclusion_5(stores: Stores, figures: Sequence[str] = ("fig6", "fig8")) -> Verdict:
+def conclusion_5(
+    stores: Stores, figures: Sequence[str] = ("fig6", "fig8"), branches: Branches | None = None
+) -> Verdict:
     """Onsets of chaos along b̄_sp: both crisis and period doubling found?"""
     if not any(f in stores for f in figures):
         return _missing(5, list(figures))
-    onsets, texts, informative = _gather_routes(stores, figures)
+    onsets, texts, informative = _gather_routes(stores, figures, branches)
     counts = _route_counts(onsets)
     found = [r for r in ("crisis", "period doubling") if counts.get(r)]
     measured = {"route_counts": counts, "onsets": onsets, "found": found}
@@ -386,11 +394,13 @@ def conclusion_5(stores: Stores, figures: Sequence[str] = ("fig6", "fig8")) -> V
 ROUTE_TYPES = ("period doubling", "crisis", "Hopf", "3T channel")
 
 
-def conclusion_6(stores: Stores, figures: Sequence[str] = ("fig9", "fig11")) -> Verdict:
+def conclusion_6(
+    stores: Stores, figures: Sequence[str] = ("fig9", "fig11"), branches: Branches | None = None
+) -> Verdict:
     """Onsets of chaos along b̄_rp: how many of the paper's four route types coexist?"""
     if not any(f in stores for f in figures):
         return _missing(6, list(figures))
-    onsets, texts, informative = _gather_routes(stores, figures)
+    onsets, texts, informative = _gather_routes(stores, figures, branches)
     counts = _route_counts(onsets)
     kinds = [r for r in ROUTE_TYPES if counts.get(r)]
     measured = {"route_counts": counts, "route_types": kinds, "onsets": onsets}
@@ -521,8 +531,12 @@ CONCLUSIONS: dict[int, Callable[[Stores], Verdict]] = {
 }
 
 
-def evaluate_conclusions(stores: Stores) -> list[Verdict]:
+def evaluate_conclusions(stores: Stores, branches: Branches | None = None) -> list[Verdict]:
     """Every conclusion of the seed's Section 4 checked on ``stores`` (figure name → dataset).
+
+    ``branches`` (figure name → event rows of its continued branches, see :mod:`.routes`)
+    makes the routes to chaos of conclusions 4–6 come from detected bifurcation events; a
+    figure without rows falls back to the labels (and says so in the evidence).
 
     A check that raises gives ``not evaluated`` with the error as evidence, so one broken store
     never hides the other verdicts.
@@ -530,7 +544,10 @@ def evaluate_conclusions(stores: Stores) -> list[Verdict]:
     out = []
     for cid, fn in CONCLUSIONS.items():
         try:
-            out.append(fn(stores))
+            if cid in (4, 5, 6):
+                out.append(fn(stores, branches=branches))  # type: ignore[call-arg]
+            else:
+                out.append(fn(stores))
         except Exception as exc:
             out.append(
                 _verdict(cid, "not evaluated", f"check failed: {type(exc).__name__}: {exc}", {})

@@ -110,6 +110,9 @@ class Landmark:
         In axis units.
     min_fraction
         Fraction of points with an expected label needed for *holds* (label, window).
+    event
+        The bifurcation the statement names (``period_doubling``, ``neimark_sacker`` — the
+        seed's "Hopf" — or ``period_3``, a 3T channel), or "".
     """
 
     id: str
@@ -127,6 +130,7 @@ class Landmark:
     from_labels: tuple[str, ...] = ()
     min_fraction: float = 0.8
     note: str = ""
+    event: str = ""
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "panel", _freeze(self.panel))
@@ -189,8 +193,11 @@ def _params(where: str, key: str, v: Any) -> dict[str, float]:
 
 _KEYS = {
     "id", "figure", "panel", "quote", "axis", "kind", "lo", "hi", "at", "expected", "from",
-    "fixed", "tolerance", "min_fraction", "note",
+    "fixed", "tolerance", "min_fraction", "note", "event",
 }  # fmt: skip
+#: Bifurcations a landmark may name (``event``): checked on continued branches when the
+#: report has them (:func:`gearchaos.paper.routes.landmarks_from_events`).
+EVENTS = ("period_doubling", "neimark_sacker", "period_3")
 
 
 def _landmark(i: int, d: Mapping[str, Any]) -> Landmark:
@@ -243,6 +250,9 @@ def _landmark(i: int, d: Mapping[str, Any]) -> Landmark:
     note = d.get("note", "")
     if not isinstance(note, str):
         raise ParameterError(f"{where}: note must be a string: got {note!r}")
+    event = d.get("event", "")
+    if event not in ("", *EVENTS):
+        raise ParameterError(f"{where}: event must be one of {', '.join(EVENTS)}: got {event!r}")
     mark = Landmark(
         id=d["id"],
         figure=d["figure"],
@@ -259,6 +269,7 @@ def _landmark(i: int, d: Mapping[str, Any]) -> Landmark:
         from_labels=from_labels,
         min_fraction=min_fraction,
         note=note,
+        event=event,
     )
     if "tolerance" in d:
         tol = _number(where, "tolerance", d["tolerance"])

@@ -150,7 +150,9 @@ def _open_stores(results: Mapping[str, Mapping[str, Any]]) -> dict[str, Any]:
     return stores
 
 
-def _landmark_rows(stores: Mapping[str, Any]) -> tuple[list[dict[str, Any]], str]:
+def _landmark_rows(
+    stores: Mapping[str, Any], branches: Mapping[str, Any] | None = None
+) -> tuple[list[dict[str, Any]], str]:
     try:
         from . import landmarks as lm_mod  # written alongside; optional
     except ImportError as exc:
@@ -158,6 +160,10 @@ def _landmark_rows(stores: Mapping[str, Any]) -> tuple[list[dict[str, Any]], str
     try:
         lms = lm_mod.load_landmarks()
         results = lm_mod.evaluate_all(lms, dict(stores))
+        if branches:
+            from .routes import landmarks_from_events
+
+            results = landmarks_from_events(results, branches)
     except Exception as exc:
         return [], f"landmark evaluation failed: {type(exc).__name__}: {exc}"
     rows = []
@@ -173,6 +179,30 @@ def _landmark_rows(stores: Mapping[str, Any]) -> tuple[list[dict[str, Any]], str
             }
         )
     return rows, ""
+
+
+def _branches_note(followed: Mapping[str, Any]) -> str:
+    """One sentence on the continued branches the routes to chaos are read from."""
+    if not followed:
+        return (
+            "No branches were continued: the routes to chaos (C4–C6) are read from label "
+            "changes only."
+        )
+    parts = []
+    for fig, d in followed.items():
+        if "error" in d:
+            parts.append(f"{fig}: continuation failed ({d['error']}), routes from labels")
+        else:
+            parts.append(
+                f"{fig}: {d['events']} event(s) on {d['branches']} branch(es) of "
+                f"{d['panels']} panel(s), {d['seconds']:.0f} s"
+            )
+    return (
+        "Routes to chaos (C4–C6) and the landmarks that name a period doubling, a Hopf "
+        "(Neimark–Sacker) bifurcation or a 3T channel are read from bifurcation events located "
+        "on continued branches of periodic orbits (1T from every 1T stretch, 3T from every 3T "
+        "stretch, switched at period doublings): " + "; ".join(parts) + "."
+    )
 
 
 def _regime_rank(label: str) -> tuple[int, int, str]:
@@ -195,9 +225,7 @@ def _regime_table(ds: Any) -> str:
     head = "".join(f"<th>{_e(k)}</th>" for k in kinds)
     body = []
     for panel, fr in table.items():
-        cells = "".join(
-            f"<td>{100 * float(fr.get(k, 0.0)):.0f} %</td>" for k in kinds
-        )
+        cells = "".join(f"<td>{100 * float(fr.get(k, 0.0)):.0f} %</td>" for k in kinds)
         body.append(f"<tr><th>{_e(panel)}</th>{cells}</tr>")
     return (
         f"<table class='regime'><tr><th>panel</th>{head}</tr>{''.join(body)}</table>"
@@ -244,6 +272,7 @@ def render_html(
     landmark_rows: Sequence[Mapping[str, Any]],
     landmark_note: str,
     total_seconds: float,
+    branches_note: str = "",
     outdir: Path,
     gearset_label: str | None = None,
 ) -> str:
@@ -346,6 +375,8 @@ def render_html(
         "<p class='note'>Every verdict below is computed from the runs above "
         "(gearchaos.paper.conclusions, gearchaos.paper.landmarks), never written by hand.</p>"
     )
+    if branches_note:
+        p.append(f"<p class='note'>{_e(branches_note)}</p>")
     p.append(
         "<table id='conclusions'><tr><th>#</th><th>statement</th><th>measured evidence</th>"
         "<th>verdict</th></tr>"
@@ -414,8 +445,11 @@ def build_report(
     t0 = time.perf_counter()
     results = _run_figures(out, quick, progress, workers, gearset)
     stores = _open_stores(results)
-    verdicts = evaluate_conclusions(stores)
-    lm_rows, lm_note = _landmark_rows(stores)
+    from .routes import report_branches
+
+    branches, followed = report_branches(stores, out, quick=quick, gearset=gearset)
+    verdicts = evaluate_conclusions(stores, branches=branches)
+    lm_rows, lm_note = _landmark_rows(stores, branches)
     page = render_html(
         quick=quick,
         results=results,
@@ -424,6 +458,7 @@ def build_report(
         landmark_rows=lm_rows,
         landmark_note=lm_note,
         total_seconds=time.perf_counter() - t0,
+        branches_note=_branches_note(followed),
         outdir=out,
         gearset_label=label,
     )
@@ -440,6 +475,7 @@ def build_report(
             {"id": v.conclusion_id, "verdict": v.verdict, "evidence": v.evidence} for v in verdicts
         ],
         "landmarks": lm_rows,
+        "branches": followed,
     }
     (out / "report.json").write_text(
         json.dumps(summary, indent=2, ensure_ascii=False, default=str) + "\n", encoding="utf-8"

@@ -113,9 +113,10 @@ def bifurcation(
     clearance_lines: bool = False,
     resonances: bool = False,
     color: Any = None,
-    s: float = 0.3,
+    s: float | None = None,
     branches: Sequence[Any] = (),
     physical: bool = True,
+    relative: bool | None = None,
 ) -> Any:
     """Bifurcation diagram: the section values of ``var`` against the swept parameter.
 
@@ -152,7 +153,9 @@ def bifurcation(
         the h-th mesh harmonic (h = 1 solid, 2 dashed, 3 dotted) meets a natural frequency
         ω_k of the linear model (:func:`gearchaos.analysis.derived.gearset_info`).
     color, s
-        Dot colour (default black; up/down branches C0/C3) and size in points².
+        Dot colour (default black; up/down branches C0/C3) and size in points² (default:
+        from 0.3 for 10⁴ or more drawn values up to 6 for a few hundred, so that a coarse
+        sweep stays visible and a fine one keeps its structure).
     branches
         Continued branches of periodic orbits (:func:`gearchaos.continuation`) to overlay:
         those of the x-axis parameter whose fixed values agree with ``select`` are drawn,
@@ -161,6 +164,12 @@ def bifurcation(
     physical
         Physical axes opposite the dimensionless ones: the variable in µm (mm/s, N) on the
         right, and when the x axis is Ω the sun speed in rpm on top (gear sets only).
+    relative
+        Draw X̄ − b̄ (the deflection beyond the drive-flank edge of the clearance) instead of
+        X̄. ``None`` (default) does so exactly when the swept parameter is the clearance of
+        ``var`` itself (b̄_sp for X̄_sp …) and no branches are overlaid: X̄ then grows with b̄
+        and the attractor would be a thin band along the diagonal X̄ = b̄; the clearance edges
+        become X̄ − b̄ = 0 (drive flank) and −2b̄ (back flank).
 
     Returns
     -------
@@ -178,6 +187,25 @@ def bifurcation(
     x_name = res.line_axis("a bifurcation diagram", var)
     ax = get_ax(ax)
     x = np.asarray(sub[x_name].values, dtype=np.float64)
+    found = res.clearance(var)
+    b_line: np.ndarray = np.full(x.shape, np.nan)  # the clearance along the x axis
+    clear_sym = ""
+    if found is not None:
+        b_line = np.asarray(found[0], dtype=np.float64)
+        if b_line.ndim > 1:  # a direction dimension: the clearance does not depend on it
+            b_line = b_line.reshape(-1, b_line.shape[-1])[0]
+        clear_sym = found[1]
+    if relative is None:
+        relative = bool(
+            found is not None
+            and b_line.size == x.size > 1
+            and not np.all(b_line == b_line[0])
+            and not branches
+        )
+    if relative and (found is None or b_line.size != x.size):
+        raise ParameterError(
+            f"relative=True needs a clearance of {var!r} along the swept axis {x_name!r}"
+        )
 
     parts: list[tuple[str | None, Any]] = []
     if lay.directions:
@@ -196,6 +224,8 @@ def bifurcation(
             n_missing += int(np.sum(status == _NOT_RUN))
             n_failed += int(np.sum((status != 0) & (status != _NOT_RUN)))
             y = np.where((status == 0)[:, None], y, np.nan)
+        if relative:
+            y = y - b_line[:, None]
         xs, ys = _scatter_points(x, y)
         all_y.append(ys)
         if direction is None:
@@ -208,7 +238,7 @@ def bifurcation(
         ax.scatter(
             xs,
             ys,
-            s=s,
+            s=float(np.clip(3000.0 / max(xs.size, 1), 0.3, 6.0)) if s is None else s,
             color=c,
             marker="o",
             linewidths=0,
@@ -217,11 +247,17 @@ def bifurcation(
             zorder=2,
         )
 
-    found = res.clearance(var) if clearance_lines else None
-    if found is not None:
-        b = np.asarray(found[0], dtype=np.float64)
-        if b.ndim > 1:  # a direction dimension: the clearance does not depend on it
-            b = b.reshape(-1, b.shape[-1])[0]
+    if not clearance_lines:
+        found = None
+    if found is not None and relative:
+        b, sym = b_line, found[1]
+        lines = [ax.axhline(0.0), *ax.plot(x, -2.0 * b)]
+        label = rf"flank edges $\bar X = \pm {sym}$"
+        for k, line in enumerate(lines):
+            line.set(gid=CLEARANCE_GID, zorder=1, label=label if k == 0 else None)
+            line.set(**_CLEARANCE_STYLE)
+    elif found is not None:
+        b = b_line
         sym = found[1]
         if np.all(b == b[0]):
             lines = [ax.axhline(b[0]), ax.axhline(-b[0])]
@@ -251,10 +287,27 @@ def bifurcation(
     # the y axis follows the section values (the clearance lines and branches never widen it)
     fit_to_data(ax, None, np.concatenate(all_y) if all_y else None)
     levels = np.asarray(found[0], dtype=np.float64).ravel() if found is not None else None
-    if found is not None and levels is not None and np.all(levels == levels[0]):
-        clearance_notes(ax, "y", (-levels[0], levels[0]), found[1])
+    if found is not None and relative:
+        edge = rf"drive-flank edge $\bar X = {found[1]}$"
+        if clearance_notes(ax, "y", (0.0,), found[1], text=edge) and np.all(
+            -2.0 * b_line < ax.get_ylim()[0]
+        ):
+            for line in ax.get_lines():  # the edges are off the axes: the note replaces them
+                if line.get_gid() == CLEARANCE_GID:
+                    line.set_label("_nolegend_")
+    elif found is not None and levels is not None and np.all(levels == levels[0]):
+        if clearance_notes(ax, "y", (-levels[0], levels[0]), found[1]) and not (
+            ax.get_ylim()[0] <= levels[0] <= ax.get_ylim()[1]
+            or ax.get_ylim()[0] <= -levels[0] <= ax.get_ylim()[1]
+        ):
+            for line in ax.get_lines():  # both lines off the axes: the notes replace them
+                if line.get_gid() == CLEARANCE_GID:
+                    line.set_label("_nolegend_")
     ax.set_xlabel(axis_label(x_name))
-    ax.set_ylabel(f"${var_symbol(var, planet if 'planet' in sub[var].dims else None)}$")
+    symbol = var_symbol(var, planet if "planet" in sub[var].dims else None)
+    if relative:
+        symbol += f" - {clear_sym}"
+    ax.set_ylabel(f"${symbol}$")
     no_offset(ax.yaxis)
     if physical:
         scales = PhysicalScales.of_sweep(res)

@@ -177,17 +177,24 @@ def fit_to_data(ax: Any, x: Any = None, y: Any = None, *, joint: bool = False) -
             formatter.set_useOffset(False)
 
 
-def clearance_notes(ax: Any, axis: str, values: Any, symbol: str) -> list[Any]:
-    """Mark each clearance level of ``values`` (scalars) that lies outside the limits of
-    ``axis`` with a small note at that edge (``−b̄_sp = −3 ↓``); returns the notes."""
+def clearance_notes(
+    ax: Any, axis: str, values: Any, symbol: str, text: str | None = None
+) -> list[Any]:
+    """Mark the clearance levels of ``values`` (scalars) that lie outside the limits of
+    ``axis`` with a small note at that edge (``−b̄_sp = −3 ↓``, or ``text`` for every level;
+    levels beyond the same edge share one note); returns the notes."""
     lo, hi = ax.get_ylim() if axis == "y" else ax.get_xlim()
-    notes = []
+    edges: dict[bool, list[str]] = {True: [], False: []}  # below/left → texts
     for v in sorted({float(v) for v in np.ravel(values) if np.isfinite(v)}):
         if lo <= v <= hi:
             continue
-        below = v < lo
         sign = "−" if v < 0 else "+"
-        text = f"{sign}${symbol}$ = {v:g}".replace("-", "−")
+        edges[v < lo].append(text or f"{sign}${symbol}$ = {v:g}".replace("-", "−"))
+    notes = []
+    for below, texts in edges.items():
+        if not texts:
+            continue
+        text = ", ".join(texts)
         if axis == "y":
             xy, ha, va = (
                 ((0.99, 0.01), "right", "bottom") if below else ((0.99, 0.99), "right", "top")

@@ -29,6 +29,11 @@ __all__ = ["classify_dataset", "classify_store"]
 
 LABEL_DTYPE = "<U10"
 
+#: Default tolerance of period detection, relative to the attractor's size, and the longest
+#: period recognised as nT (of :func:`classify_store` and of the labels ``--orbits`` confirms).
+PERIOD_RTOL = 1e-3
+MAX_PERIOD = 64
+
 
 def _section_pair(res: SweepResult) -> np.ndarray:
     """(X_k, X'_k) of the first two observed section variables, first observed planet."""
@@ -46,7 +51,9 @@ def _section_pair(res: SweepResult) -> np.ndarray:
     return np.stack(cols, axis=-1)
 
 
-def classify_dataset(ds: Any, *, period_rtol: float = 1e-3, max_period: int = 64) -> dict[str, Any]:
+def classify_dataset(
+    ds: Any, *, period_rtol: float = PERIOD_RTOL, max_period: int = MAX_PERIOD
+) -> dict[str, Any]:
     """Labels and indicators for every point of a sweep dataset (nothing written)."""
     from ..analysis.classify import classify_sections, regime_table
 
@@ -93,6 +100,31 @@ def classify_dataset(ds: Any, *, period_rtol: float = 1e-3, max_period: int = 64
     }
 
 
+def label_periods(
+    pts: np.ndarray,
+    status: np.ndarray,
+    *,
+    lle: np.ndarray | None = None,
+    run_periods: int | None = None,
+    forcing_period: np.ndarray | None = None,
+) -> np.ndarray:
+    """Period n of the label nT that :func:`classify_store` gives each point (0 where the label
+    is QP, chaos, unresolved or failed), from its section pairs ``pts`` (..., section, 2), its
+    integration ``status`` and, when the sweep has them, the Lyapunov exponents."""
+    from ..analysis.classify import classify_sections
+
+    kw: dict[str, Any] = {"rtol": PERIOD_RTOL, "max_period": MAX_PERIOD}
+    if lle is not None:
+        kw.update(lle=lle, run_periods=run_periods, forcing_period=forcing_period)
+    labels = classify_sections(pts, **kw)
+    out = np.zeros(labels.shape, dtype=int)
+    for idx in np.ndindex(*labels.shape):
+        lab = str(labels[idx])
+        if status[idx] == 0 and lab.endswith("T") and lab[:-1].isdigit():
+            out[idx] = int(lab[:-1])
+    return out
+
+
 CONTACT_CODES = {"none": 0, "single_sided": 1, "double_sided": 2}
 
 
@@ -114,7 +146,10 @@ def _contact(res: SweepResult) -> dict[str, Any]:
 
 
 def classify_store(
-    store: str | os.PathLike[str] | Any, *, period_rtol: float = 1e-3, max_period: int = 64
+    store: str | os.PathLike[str] | Any,
+    *,
+    period_rtol: float = PERIOD_RTOL,
+    max_period: int = MAX_PERIOD,
 ) -> dict[str, Any]:
     """Label every point of a sweep store in place; returns the regime table.
 

@@ -23,9 +23,11 @@ import numpy as np
 from .._version import provenance
 from ..errors import ParameterError, Status
 from ..integrate._chains import ChainOutput, ChainRun
+from ..model.target import scale_attrs
 from .execute import EXECUTION_OPTIONS, Execution, InProcess, executor
 from .grid import Grid, Task
 from .integrity import StoreLock
+from .orbits import ORBIT_VARIABLES, status_attrs, task_orbits
 from .spec import DEFAULT_OBSERVE, SweepSpec
 from .store import SweepStore
 
@@ -89,6 +91,11 @@ class _Layout:
                 },
             )
             chunks["lle"] = ch
+        if spec.orbits:
+            for nm, (doc, dtype, fill) in ORBIT_VARIABLES.items():
+                extra = status_attrs() if nm == "orbit_status" else {}
+                var[nm] = (lead, (shp, dtype), fill, {"long_name": doc, **extra})
+                chunks[nm] = ch
         n = len(self.state_names)
         var["final_state"] = (
             (*lead, "state"),
@@ -136,6 +143,8 @@ class _Layout:
                 data["final_state"][pos] = out.final_state[c, j, :n_st]
                 if spec.lyapunov:
                     data["lle"][pos] = lle[c, j, 0]
+        if spec.orbits:
+            data.update(task_orbits(self.grid, self.observed, task, run, data))
         return data
 
 
@@ -178,11 +187,7 @@ def _attrs(target: Any, grid: Grid) -> dict[str, Any]:
         a["omega_fixed"] = float(ref.omega)
     # clearances and scales of the base gear set with the fixed overrides (not of a grid point)
     model = grid.base_model()
-    if hasattr(model, "scales"):
-        a["omega_n_rad_s"] = float(model.scales.omega_n)
-        a["characteristic_length_m"] = float(model.scales.length)
-    for k, v in getattr(model, "clearances", {}).items():
-        a[f"clearance_{k}"] = float(v)
+    a.update(scale_attrs(model))
     return a
 
 
@@ -535,6 +540,10 @@ def bifurcation(
             Also store the largest Lyapunov exponent ``lle`` of every point (variational
             equations integrated with the trajectory, under the same error control, so section
             values agree with a sweep without it to the tolerance, not bitwise).
+        ``orbits``
+            Confirm every label nT (n ≤ 8) by shooting a period-n orbit from the point's final
+            state and store ``orbit_residual``, ``orbit_max_multiplier`` (max |μ|),
+            ``orbit_period`` and ``orbit_status`` (:mod:`gearchaos.sweep.orbits`).
         ``transient_periods`` (100), ``periods`` (100), ``rtol``, ``atol``, ``max_steps``
             Protocol and tolerances (:class:`~gearchaos.integrate.settings.SolverSettings`),
             or ``solver=SolverSettings(...)``.

@@ -157,7 +157,7 @@ def _axes(items: Any) -> tuple[Axis, ...]:
 SWEEP_SOLVER = SolverSettings(transient_periods=100, periods=100)
 
 #: The options of :meth:`SweepSpec.build` besides the axes and the fixed values.
-SPEC_OPTIONS = ("observe", "planets", "initial_conditions", "direction", "lyapunov")
+SPEC_OPTIONS = ("observe", "planets", "initial_conditions", "direction", "lyapunov", "orbits")
 
 
 def _names(what: str, items: Any) -> tuple[str, ...]:
@@ -203,6 +203,10 @@ class SweepSpec:
         Transient and recorded periods, tolerances (one sample per period: the section).
     lyapunov
         Also integrate the largest Lyapunov exponent of every point.
+    orbits
+        Confirm every label nT (n ≤ 8) by a converged period-n orbit shot from the point's
+        final state, and store its residual, largest multiplier modulus and a status flag
+        (:mod:`gearchaos.sweep.orbits`).
     """
 
     vary: tuple[Axis, ...]
@@ -214,6 +218,7 @@ class SweepSpec:
     direction: str = "up"
     solver: SolverSettings = SWEEP_SOLVER
     lyapunov: bool = False
+    orbits: bool = False
     extra: tuple[tuple[str, Any], ...] = field(default=())
 
     def __post_init__(self) -> None:
@@ -259,6 +264,7 @@ class SweepSpec:
                 f"got samples_per_period={self.solver.samples_per_period}"
             )
         check_bool("lyapunov", self.lyapunov)
+        check_bool("orbits", self.orbits)
 
     @classmethod
     def build(
@@ -356,6 +362,7 @@ class SweepSpec:
             f"lyapunov = {val(self.lyapunov)}",
             f"observe = {val(list(self.observe))}",
             f"planets = {val(list(self.planets))}",
+            *([f"orbits = {val(self.orbits)}"] if self.orbits else []),
             "",
         ]
         for a in self.vary:
@@ -402,6 +409,7 @@ class SweepSpec:
                     atol=d["atol"],
                 ),
                 lyapunov=bool(d.get("lyapunov", False)),
+                orbits=bool(d.get("orbits", False)),
                 extra=tuple(sorted(d.get("extra", {}).items())),
             )
         except (tomllib.TOMLDecodeError, KeyError, TypeError, ValueError, AttributeError) as exc:

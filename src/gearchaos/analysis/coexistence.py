@@ -1,0 +1,276 @@
+"""Coexisting attractors at one operating point: :func:`attractors`.
+
+A forced gear train with clearances often has more than one attractor at the same parameters
+(a stable 1T orbit beside a chaotic attractor, two 2T orbits …); which one a simulation shows
+depends on where it starts. :func:`attractors` simulates from K initial conditions in one
+compiled call — the state at rest (the seed's start) and K − 1 states drawn (seeded) around
+the rest start's motion, each component uniform in mid ± s·range with s = 1, 2, 3, 4 in turn,
+``mid`` and ``range`` the middle and the extent of the component over the rest start's
+recorded window — integrates the largest Lyapunov exponent with each, labels each run as a
+sweep labels its points (:func:`~gearchaos.analysis.classify.classify_sections`) and groups
+the runs into distinct attractors:
+
+* two periodic runs are the same attractor when they have the same period n and every section
+  point of one lies within ``tol`` of a section point of the other (states scaled per
+  component by the spread of all runs' section points, at least 1);
+* two non-periodic runs (QP, chaos, unresolved) with the same label are the same attractor
+  when, for every state component, the 10 %, 50 % and 90 % quantiles of their section
+  points agree to ``spread_fraction`` (0.25) of the largest extent of the two sets together;
+* a periodic and a non-periodic run are never the same.
+
+Each periodic attractor is confirmed by shooting its period-n orbit from the run's final state
+(:func:`~gearchaos.analysis.orbit_batch.periodic_orbits`), which gives its Floquet multipliers.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .._checks import check_int, check_real
+from ..integrate._chains import ChainRun, run_chains
+from ..integrate.settings import SolverSettings
+from ..model.target import resolve
+from .orbits import PeriodicOrbit, split_values
+
+__all__ = ["ATTRACTOR_SETTINGS", "Attractor", "attractors"]
+
+#: Default protocol: 200 transient + 100 recorded forcing periods per start.
+ATTRACTOR_SETTINGS = SolverSettings(transient_periods=200, periods=100)
+
+
+@dataclass(frozen=True, eq=False)
+class Attractor:
+    """One attractor found from one or more starts.
+
+    Attributes
+    ----------
+    label : motion label (``1T`` … ``nT``, ``QP``, ``chaos``, ``unresolved``).
+    period : n for an nT label, else 0.
+    lle : largest Lyapunov exponent λ₁ per unit τ of its first run (the mean over its runs).
+    starts : indices of the starts that reached it (0 is the start at rest).
+    initial_states : (len(starts), n_state) those starts.
+    final_state : the state at the end of its first run (on the section).
+    section_states : (periods, n_state) the states at the section points of its first run.
+    sections : (periods, n_obs) the observables there.
+    system : the :class:`~gearchaos.model.System` (model and Ω).
+    orbit : the period-n orbit shot from ``final_state`` (periodic attractors), else None.
+    """
+
+    label: str
+    period: int
+    lle: float
+    starts: tuple[int, ...]
+    initial_states: np.ndarray
+    final_state: np.ndarray
+    section_states: np.ndarray
+    sections: np.ndarray
+    system: Any
+    orbit: PeriodicOrbit | None = None
+    values: Mapping[str, Any] = field(default_factory=dict)
+
+    @property
+    def max_multiplier(self) -> float:
+        """max |μ| of the orbit (NaN without one)."""
+        return self.orbit.max_multiplier if self.orbit is not None else math.nan
+
+    @property
+    def stable(self) -> bool | None:
+        """Whether the orbit is converged and every |μ| < 1 (None without an orbit)."""
+        return None if self.orbit is None else self.orbit.stable
+
+    def section(self, name: str, planets: Any = None) -> np.ndarray:
+        """The section values of a state or observable of the first run by name (as
+        :meth:`~gearchaos.analysis.orbits.PeriodicOrbit.section`)."""
+        ob = self.system.observable(name, planets)
+        return np.asarray(ob.take(self.section_states, self.sections))
+
+    def summary(self) -> dict[str, Any]:
+        """A JSON-serialisable summary: ``label``, ``lle``, ``starts``, ``x_sp1`` (the distinct
+        section values of the first observable, at most 8, else its range), ``orbit`` (period,
+        converged, residual, max_multiplier, stable) or None."""
+        x = self.sections[:, 0]
+        distinct = np.unique(np.round(x, 6))
+        out: dict[str, Any] = {
+            "label": self.label,
+            "lle": float(self.lle),
+            "starts": [int(s) for s in self.starts],
+            "x_sp1": [float(v) for v in distinct]
+            if distinct.size <= 8
+            else [float(np.min(x)), float(np.max(x))],
+            "orbit": None,
+        }
+        if self.orbit is not None:
+            o = self.orbit
+            out["orbit"] = {
+                "period": int(o.period),
+                "converged": bool(o.converged),
+                "residual": float(o.residual),
+                "max_multiplier": float(o.max_multiplier),
+                "stable": bool(o.stable),
+            }
+        return out
+
+
+def _starts(system: Any, cfg: SolverSettings, k: int, seed: int) -> np.ndarray:
+    """The start at rest and k − 1 seeded random starts around its motion."""
+    from ..integrate.simulate import integrate
+
+    m = system.n_state
+    y0 = np.zeros((k, m))
+    traj = integrate(system, cfg.replace(samples_per_period=16))
+    st = np.asarray(traj.states, dtype=float)
+    ok = np.all(np.isfinite(st), axis=1)
+    st = st[ok] if np.any(ok) else np.zeros((1, m))
+    lo, hi = st.min(axis=0), st.max(axis=0)
+    mid = 0.5 * (lo + hi)
+    span = np.maximum(hi - lo, 1e-3 * np.maximum(1.0, np.abs(mid)))
+    rng = np.random.default_rng(seed)
+    for j in range(1, k):
+        scale = 1 + (j - 1) % 4
+        y0[j] = mid + rng.uniform(-1.0, 1.0, m) * scale * span
+    return y0
+
+
+def _same_periodic(a: np.ndarray, b: np.ndarray, tol: float) -> bool:
+    d = np.max(np.abs(a[:, None, :] - b[None, :, :]), axis=2)
+    return bool(np.all(d.min(axis=1) <= tol) and np.all(d.min(axis=0) <= tol))
+
+
+def _same_set(a: np.ndarray, b: np.ndarray, fraction: float) -> bool:
+    """Whether two section sets (points × components) are samples of one set: every
+    component's 10 %, 50 % and 90 % quantiles agree to ``fraction`` of the union's extent."""
+    q = np.array([0.1, 0.5, 0.9])
+    qa, qb = np.quantile(a, q, axis=0), np.quantile(b, q, axis=0)
+    both = np.concatenate([a, b])
+    size = float(np.max(np.ptp(both, axis=0)))
+    return bool(np.max(np.abs(qa - qb)) <= fraction * max(size, 1e-12))
+
+
+def attractors(
+    target: Any,
+    *,
+    starts: int = 8,
+    seed: int = 0,
+    settings: SolverSettings | None = None,
+    params: Mapping[str, Any] | None = None,
+    tol: float = 1e-4,
+    spread_fraction: float = 0.25,
+    **values_and_settings: Any,
+) -> list[Attractor]:
+    """Distinct attractors at one operating point, from several initial conditions.
+
+    Parameters
+    ----------
+    target
+        A :class:`~gearchaos.gearset.GearSet` or a :class:`~gearchaos.model.System`.
+    starts
+        K, the number of initial conditions: the state at rest and K − 1 seeded random states
+        around the rest start's motion (see the module doc).
+    seed
+        Seed of the random starts.
+    settings, params, **values_and_settings
+        Parameter values by name (``omega=1.5``; dotted names in ``params``) and solver
+        settings (``transient_periods`` (200), ``periods`` (100), ``rtol``, ``atol`` …), as
+        for :func:`~gearchaos.analysis.orbits.periodic_orbit`.
+    tol
+        Two periodic runs are one attractor when their section states agree to ``tol``
+        (scaled per component by max(1, spread)).
+    spread_fraction
+        Two non-periodic runs with one label are one attractor when the quantiles of their
+        section sets agree to this fraction of their extent.
+
+    Returns
+    -------
+    list of Attractor
+        Distinct attractors, the one reached from rest first, then by how many starts reached
+        them. Periodic ones carry their shot orbit (multipliers, stability); every one carries
+        λ₁ (> 0 for chaos, < 0 for a stable orbit: ln max|μ| / nT).
+    """
+    from .classify import classify_sections
+    from .orbit_batch import periodic_orbits
+
+    k = check_int("starts", starts, lo=1, hi=10_000)
+    check_int("seed", seed, lo=0)
+    check_real("tol", tol, lo=0.0, lo_open=True)
+    check_real("spread_fraction", spread_fraction, lo=0.0, hi=1.0, lo_open=True)
+    values, cfg = split_values(values_and_settings, settings, params, ATTRACTOR_SETTINGS)
+    cfg = cfg.replace(samples_per_period=1)
+    system = resolve(target, values)
+    y0 = _starts(system, cfg, k, seed)
+    run = ChainRun.from_systems([[system]] * k, cfg, y0=y0, n_tangent=1)
+    out = run_chains(run)
+    lle = out.lyapunov(run.dt)[:, 0, 0]
+    m = system.n_state
+    states = out.states[:, 0, :, :m]
+    obs = out.observables[:, 0]
+    first = system.obs_names[0]
+    nt = system.n_track
+    pair_names = [first, system.obs_names[nt]] if len(system.obs_names) > nt else [first]
+    cols = [system.obs_names.index(n) for n in pair_names]
+    labels = classify_sections(
+        obs[:, :, cols],
+        lle=lle,
+        run_periods=int(cfg.periods),
+        forcing_period=np.full(k, system.period),
+    )
+    ok = out.status[:, 0] == 0
+    runs = [j for j in range(k) if ok[j]]
+    finite = np.concatenate([states[j] for j in runs]) if runs else np.ones((1, m))
+    scale = np.maximum(1.0, np.ptp(finite, axis=0))
+    groups: list[list[int]] = []
+    for j in runs:
+        lab = str(labels[j])
+        periodic = lab.endswith("T") and lab[:-1].isdigit()
+        for g in groups:
+            i = g[0]
+            if str(labels[i]) != lab:
+                continue
+            a, b = states[j] / scale, states[i] / scale
+            n = int(lab[:-1]) if periodic else 0
+            same = (
+                _same_periodic(a[-n:], b[-n:], tol)
+                if periodic
+                else _same_set(a, b, spread_fraction)
+            )
+            if same:
+                g.append(j)
+                break
+        else:
+            groups.append([j])
+    groups.sort(key=lambda g: (g[0] != 0, -len(g)))
+    found = []
+    for g in groups:
+        lab = str(labels[g[0]])
+        n = int(lab[:-1]) if lab.endswith("T") and lab[:-1].isdigit() else 0
+        found.append(
+            Attractor(
+                label=lab,
+                period=n,
+                lle=float(np.mean(lle[g])),
+                starts=tuple(g),
+                initial_states=y0[g],
+                final_state=out.final_state[g[0], 0, :m].copy(),
+                section_states=states[g[0]].copy(),
+                sections=obs[g[0]].copy(),
+                system=system,
+                values=dict(values),
+            )
+        )
+    for n in sorted({a.period for a in found if a.period}):
+        idx = [i for i, a in enumerate(found) if a.period == n]
+        orbits = periodic_orbits(
+            target,
+            [values] * len(idx),
+            period=n,
+            guesses=np.stack([found[i].final_state for i in idx]),
+            settings=cfg,
+        )
+        for i, orb in zip(idx, orbits, strict=True):
+            found[i] = dataclasses.replace(found[i], orbit=orb)
+    return found
