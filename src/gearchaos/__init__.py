@@ -44,6 +44,7 @@ __all__ = [
     "bifurcation",
     "continuation",
     "duffing",
+    "explore",
     "export",
     "linear_oscillator",
     "linear_system",
@@ -62,8 +63,9 @@ if TYPE_CHECKING:
     from .analysis.arclength import continuation
     from .analysis.coexistence import attractors
     from .analysis.orbits import PeriodicOrbit, periodic_orbit
+    from .explore import explore
 
-_LAZY_SUBPACKAGES = ("analysis", "plot", "paper")
+_LAZY_SUBPACKAGES = ("analysis", "plot", "paper", "explore")
 #: Functions of the lazy subpackages exported here, by the module that defines them.
 _LAZY_ATTRIBUTES = {
     "PeriodicOrbit": "analysis.orbits",
@@ -74,7 +76,8 @@ _LAZY_ATTRIBUTES = {
 
 
 def __getattr__(name: str) -> object:
-    """``gearchaos.plot`` etc. import on first use (matplotlib only when plotting), and so do
+    """``gearchaos.plot`` etc. import on first use (matplotlib only when plotting; Panel only
+    for ``gearchaos.explore``, a callable package: ``gearchaos.explore(store)``), and so do
     the periodic-orbit front doors (``gc.periodic_orbit``, ``gc.continuation``,
     ``gc.attractors``)."""
     import importlib

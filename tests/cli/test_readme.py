@@ -44,11 +44,14 @@ def test_python_example_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) ->
 
 
 def test_ci_runs_exactly_the_readme_commands() -> None:
-    (install,) = re.findall(r"```bash\n(.*?)\n```", _section("Install"), flags=re.S)
+    install = re.findall(r"```bash\n(.*?)\n```", _section("Install"), flags=re.S)
     (tests,) = re.findall(r"```bash\n(.*?)\n```", _section("Run the tests"), flags=re.S)
     ci = (ROOT / ".ci" / "run").read_text(encoding="utf-8").splitlines()
-    assert install in ci
+    assert install and all(command in ci for command in install)
     assert tests in ci
+    # Chromium is installed before the tests run, so that the browser tests run, not skip
+    (chromium,) = [c for c in install if "apt-get install -y chromium" in c]
+    assert ci.index(chromium) < ci.index(tests)
     assert "set -euo pipefail" in ci
 
 

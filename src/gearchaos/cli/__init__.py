@@ -1,5 +1,5 @@
 """Command-line interface: ``gearchaos simulate | info | presets | init-gearset |
-bifurcation | response | plot | classify | poincare | reproduce | calibrate``.
+bifurcation | response | plot | classify | explore | poincare | reproduce | calibrate``.
 
 Every command takes the gear set the same way: ``--preset NAME`` (default ``sheng2016``) or
 ``--gearset FILE.toml`` (one of the two), then any number of ``--set NAME=VALUE`` changes by
@@ -15,7 +15,7 @@ One module per group of commands (:mod:`.simulate`, :mod:`.gearset`, :mod:`.swee
 
 # isort: off
 # the import order is the order of the commands in `gearchaos --help`
-from . import simulate, gearset, sweep, response, gallery, orbits, paper, export  # noqa: F401
+from . import simulate, gearset, sweep, response, gallery, orbits, paper, export, explore  # noqa: F401
 
 # isort: on
 from ._common import (
@@ -40,6 +40,7 @@ __all__ = [
     "INTERRUPTED_MESSAGE",
     "PAPER_FIGURES",
     "app",
+    "explore",
     "export",
     "gallery",
     "gearset",

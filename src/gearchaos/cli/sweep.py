@@ -35,21 +35,10 @@ def _axis_name(item: str) -> str:
 
 def open_store(path: Path) -> Any:
     """A sweep store as a :class:`~gearchaos.sweep.SweepResult`; a missing, unreadable or
-    foreign one is invalid input (exit 2)."""
-    if not path.exists():
-        raise ParameterError(f"store not found: {str(path)!r}")
-    from ..errors import StoreError
-    from ..sweep import SweepResult
+    foreign one is invalid input (exit 2; :func:`gearchaos.sweep.result.open_result`)."""
+    from ..sweep.result import open_result
 
-    try:
-        res = SweepResult.open(path)
-    except StoreError:
-        raise
-    except Exception as exc:  # zarr raises several types for a directory that is no store
-        raise ParameterError(f"{str(path)!r} is not a readable sweep store: {exc}") from None
-    if "status" not in res.ds.data_vars:
-        raise ParameterError(f"{str(path)!r} is not a gearchaos sweep store (no 'status')")
-    return res
+    return open_result(path)
 
 
 StoreArg = Annotated[

@@ -23,7 +23,7 @@ from ..errors import ParameterError, Status, StoreError
 from ..gearset.schema import CLEARANCES, FIELDS, OMEGA
 from .store import open_sweep
 
-__all__ = ["NON_SWEEP_DIMS", "SweepLayout", "SweepResult"]
+__all__ = ["NON_SWEEP_DIMS", "SweepLayout", "SweepResult", "open_result"]
 
 
 #: Dimensions of a sweep variable that are not swept.
@@ -355,3 +355,25 @@ class SweepResult:
 
 
 _UNSET: Any = object()
+
+
+def open_result(path: str | os.PathLike[str]) -> SweepResult:
+    """A sweep store opened for reading, as :class:`SweepResult`, or one clear error.
+
+    The check every reader of a user's store shares (``gearchaos plot``, ``classify``,
+    ``explore``): a missing path is a :class:`~gearchaos.errors.ParameterError`
+    (``store not found: 'RUN.zarr'``), a damaged or foreign store a
+    :class:`~gearchaos.errors.StoreError` or a ``ParameterError`` naming the path and why.
+    """
+    root = os.fspath(path)
+    if not os.path.exists(root):
+        raise ParameterError(f"store not found: {root!r}")
+    try:
+        res = SweepResult.open(root)
+    except StoreError:
+        raise
+    except Exception as exc:  # zarr raises several types for a directory that is no store
+        raise ParameterError(f"{root!r} is not a readable sweep store: {exc}") from None
+    if "status" not in res.ds.data_vars:
+        raise ParameterError(f"{root!r} is not a gearchaos sweep store (no 'status')")
+    return res

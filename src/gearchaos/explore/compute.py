@@ -1,0 +1,234 @@
+"""What the explorer computes off the server: one point examined, one finer sweep.
+
+Both functions run in a worker process (the compiled kernels hold the GIL, so a thread would
+stall the web server) and return plain, picklable values: numbers, text and PNG bytes. They
+reuse the library's front doors — :func:`~gearchaos.analysis.point.analyse_point` (simulation,
+λ₁ and the motion label), :func:`~gearchaos.analysis.orbits.periodic_orbit` (Floquet
+multipliers of an nT orbit), the plots of :mod:`gearchaos.plot` (phase portrait, time
+histories, spectrum with the mesh harmonics labelled) and :func:`~gearchaos.sweep.run_sweep`
+(a resumable sweep into a store).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import io
+import math
+import os
+import warnings
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError, StoreError
+from ..gearset.schema import OMEGA
+
+__all__ = ["POINT_SAMPLES", "compute_point", "point_target", "run_zoom"]
+
+#: Samples per forcing period of the on-demand simulation (smooth orbits, a spectrum up to
+#: 32 mesh harmonics).
+POINT_SAMPLES = 64
+#: Longest period n whose orbit is looked for by shooting (multipliers).
+MAX_ORBIT_PERIOD = 8
+
+
+def point_target(res: Any, values: Mapping[str, float]) -> tuple[Any, dict[str, float]]:
+    """The gear set and parameter values (dotted names, Ω included) of one point of a store.
+
+    ``values`` are the point's swept values; Ω is added from the store's fixed values when it
+    was not swept. Raises :class:`~gearchaos.errors.StoreError` for a store that does not hold
+    a gear set (reference systems): their points can be read, not recomputed.
+    """
+    gs = res.gearset
+    if gs is None:
+        raise StoreError(
+            "this store's model is not a gear set (no gearset_toml): its stored sections can be "
+            "explored, but points cannot be recomputed from it"
+        )
+    out = {str(k): float(v) for k, v in values.items()}
+    if OMEGA not in out:
+        omega = res.fixed_value(OMEGA)
+        if omega is None:
+            raw = res.ds.attrs.get("omega_fixed")
+            omega = float(raw) if raw is not None else None
+        if omega is None:
+            raise StoreError("the store neither sweeps omega nor records a fixed value of it")
+        out[OMEGA] = omega
+    return gs, out
+
+
+def compute_point(
+    store: str,
+    values: Mapping[str, float],
+    var: str = "delta_sp",
+    planet: int = 1,
+    history_periods: float = 10.0,
+) -> dict[str, Any]:
+    """Examine one point of a sweep store: simulate, λ₁, motion, multipliers, one figure.
+
+    The point is simulated from rest with the store's protocol (its transient, recorded
+    periods and tolerances; :data:`POINT_SAMPLES` samples per forcing period T = 2π/Ω instead
+    of one), as ``gearchaos simulate`` would, and its largest Lyapunov exponent λ₁ is
+    integrated with the same settings (:func:`~gearchaos.analysis.point.analyse_point`). When
+    the motion is nT with n ≤ 8, the period-n orbit is found by shooting from the simulation
+    and its Floquet multipliers μ (eigenvalues of the monodromy matrix) are returned.
+
+    Parameters
+    ----------
+    store
+        Path of the sweep store.
+    values
+        The point's swept values by dotted name (``{"omega": 1.43}``).
+    var, planet
+        The variable of the phase portrait and the first time history (``delta_sp`` of planet
+        1: X̄_sp1 = δ_sp1/b_c); the second time history is its mesh's contact force.
+    history_periods
+        Forcing periods shown in the time histories (the last ones recorded).
+
+    Returns
+    -------
+    dict
+        ``values``, ``motion``, ``lle`` (λ₁ per unit τ, or ``None``), ``status``,
+        ``distinct`` (distinct section points), ``summary`` (of
+        :func:`~gearchaos.analysis.summary.summarize`), ``multipliers`` (a list of
+        ``(re, im)``, largest modulus first, or ``None``), ``orbit_note`` and ``png``
+        (a 2×2 figure: phase portrait, X̄ and contact force against time, spectrum).
+    """
+    from ..analysis.point import analyse_point
+    from ..sweep.result import open_result
+
+    res = open_result(store)
+    target, vals = point_target(res, values)
+    settings = res.spec.solver.replace(samples_per_period=POINT_SAMPLES)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        point = analyse_point(target, vals, settings, lyapunov=True)
+    summary = point.summary
+    motion = str(summary.get("motion", ""))
+    multipliers, note = None, ""
+    n = _period(motion)
+    if n is not None and point.ok and n <= MAX_ORBIT_PERIOD:
+        multipliers, note = _multipliers(target, vals, settings, n, point.result)
+    return {
+        "values": dict(vals),
+        "motion": motion,
+        "lle": point.lle,
+        "status": point.result.status.name.lower(),
+        "distinct": summary.get("distinct_section_points"),
+        "summary": _plain(summary),
+        "multipliers": multipliers,
+        "orbit_note": note,
+        "png": _figure_png(point.result, var, planet, history_periods) if point.ok else b"",
+    }
+
+
+def _period(motion: str) -> int | None:
+    if motion.endswith("T") and motion[:-1].isdigit():
+        return int(motion[:-1])
+    return None
+
+
+def _multipliers(
+    target: Any, values: dict[str, float], settings: Any, n: int, guess: Any
+) -> tuple[list[tuple[float, float]] | None, str]:
+    from ..analysis.orbits import periodic_orbit
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        orbit = periodic_orbit(
+            target,
+            period=n,
+            guess=guess,
+            settings=settings.replace(samples_per_period=1),
+            params=values,
+        )
+    if not orbit.converged:
+        return None, f"no period-{n} orbit found by shooting ({orbit.message})"
+    mu = np.asarray(orbit.multipliers)
+    stable = "stable" if orbit.stable else "unstable"
+    return [(float(m.real), float(m.imag)) for m in mu], f"period-{n} orbit, {stable}"
+
+
+def _plain(obj: Any) -> Any:
+    """A copy with numpy scalars turned into Python ones (picklable, printable)."""
+    if isinstance(obj, Mapping):
+        return {str(k): _plain(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [_plain(v) for v in obj]
+    if isinstance(obj, np.generic):
+        return obj.item()
+    return obj
+
+
+def _figure_png(result: Any, var: str, planet: int, periods: float) -> bytes:
+    """Phase portrait, X̄ and contact force against time, and spectrum, as PNG bytes."""
+    from matplotlib.figure import Figure
+
+    from ..plot import phase_portrait, spectrum, time_history
+
+    force = "force_sp" if var in ("delta_sp", "force_sp") else "force_rp"
+    fig = Figure(figsize=(11.0, 7.2), dpi=90, layout="constrained")
+    axs = fig.subplots(2, 2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        phase_portrait(result, var, planet, ax=axs[0, 0], periods=periods)
+        axs[0, 0].set_title("phase portrait")
+        time_history(result, var, planet, ax=axs[0, 1], periods=periods)
+        axs[0, 1].set_title("time history")
+        try:
+            time_history(result, force, planet, ax=axs[1, 0], periods=periods)
+            axs[1, 0].set_title("contact force of the mesh")
+        except ParameterError as exc:
+            axs[1, 0].text(0.5, 0.5, str(exc), ha="center", wrap=True)
+        spectrum(result, var, planet, ax=axs[1, 1])
+        axs[1, 1].set_title("amplitude spectrum (mesh harmonics labelled)")
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png")
+    return buf.getvalue()
+
+
+def zoom_path(store: str, axes: Mapping[str, tuple[float, float, int]]) -> str:
+    """Where the finer sweep over ``axes`` (name → (lo, hi, count)) of ``store`` is written:
+    a sibling store in ``<store stem>.zoom/`` next to it, named by the ranges, so that the
+    same zoom resumes the same store."""
+    root = os.path.abspath(os.fspath(store)).rstrip(os.sep)
+    parent, name = os.path.split(root)
+    stem = name[:-5] if name.endswith(".zarr") else name
+    parts = [f"{k}_{lo:.6g}_{hi:.6g}_{n}" for k, (lo, hi, n) in axes.items()]
+    return os.path.join(parent, f"{stem}.zoom", "__".join(parts) + ".zarr")
+
+
+def run_zoom(store: str, axes: Mapping[str, tuple[float, float, int]]) -> str:
+    """A finer sweep of ``store`` over the ranges ``axes`` (name → (lo, hi, count)) of its
+    varied parameters, into the sibling store :func:`zoom_path` (resumable: an interrupted
+    zoom continues when asked again). Every other setting — family, fixed values, observed
+    variables, initial conditions, protocol, tolerances, Lyapunov — is the store's own.
+
+    Returns the path of the finer store.
+    """
+    from ..sweep.result import open_result
+    from ..sweep.run import run_sweep
+    from ..sweep.spec import Axis
+
+    res = open_result(store)
+    spec = res.spec
+    if spec is None or res.base_gearset is None:
+        raise StoreError("a finer sweep needs a store of a gear set with its sweep specification")
+    vary = []
+    for axis in spec.vary:
+        if axis.name in axes:
+            lo, hi, n = axes[axis.name]
+            if not (math.isfinite(lo) and math.isfinite(hi) and hi > lo and n >= 2):
+                raise ParameterError(
+                    f"zoom range of {axis.name} must be finite with hi > lo and >= 2 points: "
+                    f"got {lo!r}..{hi!r} ({n} points)"
+                )
+            vary.append(Axis(axis.name, tuple(float(v) for v in np.linspace(lo, hi, int(n)))))
+        else:
+            vary.append(axis)
+    finer = dataclasses.replace(spec, vary=tuple(vary))
+    path = zoom_path(store, axes)
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    run_sweep(res.base_gearset, finer, store=path, progress=False)
+    return path
