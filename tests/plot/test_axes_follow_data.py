@@ -59,3 +59,22 @@ def test_poincare_axes_lie_within_ten_percent_of_the_data(
     # the point size shrinks with the number of points (structure of a dense attractor)
     sizes = ax.collections[0].get_sizes()
     assert sizes.size and (sizes[0] < 1.0 if n == 10_000 else sizes[0] > 4.0)
+
+
+def test_sun_at_rest_shows_the_clearance_not_round_off() -> None:
+    """Equally spaced planets meshing in phase cancel their transverse forces on the sun
+    (Parker–Lin), so from rest the sun centre stays at the origin up to round-off; the panel
+    must show the bearing clearance and say the sun is at rest, not magnify 1e-13 noise."""
+    from gearchaos.plot.phase import sun_orbit
+
+    gs = gc.preset("sheng2016")
+    res = gc.simulate(gs, omega=1.5, transient_periods=5, periods=5, samples_per_period=16)
+    b = float(gs.sun_bearing_clearance_bar())
+    assert float(np.max(np.abs(res.series("x_s")))) < 1e-9 * b
+    ax = sun_orbit(res)
+    lo, hi = ax.get_xlim()
+    assert lo <= -b and hi >= b
+    assert any("at rest" in t.get_text() for t in ax.texts)
+    import matplotlib.pyplot as plt
+
+    plt.close(ax.figure)

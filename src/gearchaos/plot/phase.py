@@ -37,6 +37,10 @@ def _with_dot(result: Any, var: str | None, planet: int) -> VarInfo:
     return info
 
 
+#: An orbit within this fraction of the bearing clearance b̄_s is round-off around the centre.
+_AT_REST = 1e-9
+
+
 def _section_points(ax: Any, xs: np.ndarray, ys: np.ndarray) -> None:
     """Overlay Poincaré section points, sized and faded by their number (:func:`section_style`)."""
     style = section_style(xs.size)
@@ -190,9 +194,26 @@ def sun_orbit(result: Any, ax: Any = None, periods: float | None = None) -> Any:
         )
     data_x = np.concatenate([xs, x[sample_window(result, periods)]])
     data_y = np.concatenate([ys, y[sample_window(result, periods)]])
-    fit_to_data(ax, data_x, data_y, joint=True)
-    if b is not None and b > 0:
-        clearance_notes(ax, "x", (-b, b), r"\bar{b}_s")
+    extent = float(np.nanmax(np.abs(np.concatenate([data_x, data_y])), initial=0.0))
+    if b is not None and b > 0 and extent < _AT_REST * b:
+        # round-off of a sun held at the centre by symmetric meshes: show the clearance, not
+        # a magnified cloud of 1e-13 noise that would read as motion
+        ax.set_xlim(-1.1 * b, 1.1 * b)
+        ax.set_ylim(-1.1 * b, 1.1 * b)
+        ax.text(
+            0.5,
+            0.55,
+            f"sun centre at rest\n(|x̄_s|, |ȳ_s| < {max(extent, 1e-300):.0e})",
+            transform=ax.transAxes,
+            ha="center",
+            va="bottom",
+            fontsize="small",
+            color="0.2",
+        )
+    else:
+        fit_to_data(ax, data_x, data_y, joint=True)
+        if b is not None and b > 0:
+            clearance_notes(ax, "x", (-b, b), r"\bar{b}_s")
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel(xi.label)
     ax.set_ylabel(yi.label)
