@@ -80,7 +80,7 @@ def analyse_point(
         Raise :class:`~gearchaos.errors.IntegrationError` when the simulation fails, instead of
         returning a result labelled ``failed``.
     """
-    cfg = settings if settings is not None else SolverSettings()
+    cfg = SolverSettings.build(settings)
     system = resolve(target, values, default_omega=default_omega)
     result = run_simulation(system, cfg, check=check_bool("check", check))
     lle: float | None = None

@@ -12,6 +12,7 @@ from rich.text import Text
 
 from ._common import (
     EXIT_FAILURE,
+    EXIT_INVALID,
     GearsetOpt,
     JsonOpt,
     PresetOpt,
@@ -91,6 +92,8 @@ def init_gearset(
     explained); edit it, then run **gearchaos simulate --gearset FILE**."""
     from ..gearset import template_toml
 
+    if file.exists() and not file.is_file():  # a FIFO would block the write forever
+        fail(f"{file} exists and is not a regular file; choose another path", EXIT_INVALID)
     if file.exists() and not force:
         fail(f"{file} already exists; pass --force to overwrite it", EXIT_FAILURE)
     with reported_errors():

@@ -102,6 +102,10 @@ def reproduce(
     """
     gs = None
     label = None
+    with reported_errors():
+        from ..sweep.execute import Execution
+
+        Execution(workers=workers)  # refused before any directory is made
     if preset is not None or gearset is not None:
         with reported_errors():
             gs = load_gearset(preset, gearset)

@@ -18,8 +18,9 @@ from typing import Any
 
 import numpy as np
 
+from .._files import check_regular_file
 from .._version import provenance
-from ..errors import ParameterError
+from ..errors import ParameterError, StoreError
 from .trajectory import Trajectory
 
 __all__ = ["SimulationResult", "open_simulation"]
@@ -237,7 +238,19 @@ class SimulationResult(Trajectory):
 
 
 def open_simulation(path: str | os.PathLike[str]) -> Any:
-    """Open a file written by :meth:`SimulationResult.save` as an :class:`xarray.Dataset`."""
+    """Open a file written by :meth:`SimulationResult.save` as an :class:`xarray.Dataset`.
+
+    A path that is not a regular file (missing, a directory, a FIFO or device) or a file that
+    is not netCDF-4 raises :class:`~gearchaos.errors.StoreError` naming the file (a FIFO is
+    never opened blocking); a path of the wrong type raises
+    :class:`~gearchaos.errors.ParameterError`.
+    """
     import xarray as xr
 
-    return xr.load_dataset(os.fspath(path), engine="h5netcdf")
+    name = check_regular_file(path, what="simulation file")
+    try:
+        return xr.load_dataset(name, engine="h5netcdf")
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise StoreError(
+            f"simulation file {name!r} is not a readable netCDF-4 file ({type(exc).__name__})"
+        ) from None

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from .._checks import check_bool
 from .._version import provenance
 from ..errors import ParameterError, Status
 from ..integrate._chains import ChainOutput, ChainRun
@@ -231,6 +232,8 @@ def run_sweep(
 ) -> Any:
     """Run (or resume) a sweep described by ``spec`` on ``execution`` (default: in-process on
     all cores) into ``store``; return its :class:`xarray.Dataset`."""
+    overwrite, progress = check_bool("overwrite", overwrite), check_bool("progress", progress)
+    classify = check_bool("classify", classify)
     grid = Grid(target, spec, chunk_points=chunk_points)
     layout = _Layout(grid)
     path = _store_path(store)
