@@ -77,7 +77,7 @@ def integrate_batch(
         if not isinstance(s, System):
             raise ParameterError(f"systems[{i}] must be a System: got {type(s).__name__}")
     m, n = len(systems), systems[0].n_state
-    if max_step != np.inf:
+    if not (isinstance(max_step, float) and max_step == np.inf):  # inf: no limit
         check_real("max_step", max_step, lo=0.0, lo_open=True)
     if y0 is not None:
         try:

@@ -31,18 +31,22 @@ _DEFAULT = SolverSettings()
 def _initial_state(system: System, y0: Any) -> np.ndarray | None:
     if y0 is None:
         return None
+    names = ", ".join(system.state_names)
     try:
-        y = np.array(y0, dtype=np.float64).reshape(-1)
-    except (TypeError, ValueError):
+        raw = np.asarray(y0)
+        if raw.dtype.kind not in "fiu":  # bools, text, complex numbers, objects
+            raise TypeError(raw.dtype)
+        y = raw.astype(np.float64)
+    except (TypeError, ValueError, OverflowError):
         raise ParameterError(
-            f"y0 must be {system.n_state} numbers ({', '.join(system.state_names)}): got {y0!r}"
+            f"y0 must be {system.n_state} numbers ({names}): got {type(y0).__name__}"
         ) from None
-    if y.size != system.n_state:
+    if y.ndim != 1 or y.size != system.n_state:
         raise ParameterError(
-            f"y0 must have {system.n_state} entries ({', '.join(system.state_names)}): got {y.size}"
+            f"y0 must be a vector of {system.n_state} entries ({names}): got shape {y.shape}"
         )
     if not np.all(np.isfinite(y)):
-        raise ParameterError(f"y0 must be finite: got {y!r}")
+        raise ParameterError(f"y0 must be finite: got {y.tolist()}")
     return y
 
 
@@ -89,7 +93,7 @@ def integrate(
     k = check_int("n_tangent", n_tangent, lo=0, hi=n)
     t_start = check_real("t0", t0)
     step_max = math.inf
-    if max_step != math.inf:
+    if not (isinstance(max_step, float) and max_step == math.inf):  # inf: no limit
         step_max = check_real("max_step", max_step, lo=0.0, lo_open=True)
     h0 = None if first_step is None else check_real("first_step", first_step, lo=0.0, lo_open=True)
     cfg.check_memory(n * (1 + k) + system.n_obs + 1)

@@ -100,11 +100,14 @@ class System:
     params: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
+        from .._checks import check_real
         from ..errors import ParameterError
 
-        om = float(self.omega)
-        if not math.isfinite(om) or om <= 0.0:
-            raise ParameterError(f"omega must be a finite number > 0: got {self.omega!r}")
+        om = check_real("omega", self.omega, lo=0.0, lo_open=True)
+        if not hasattr(self.model, "pack"):
+            raise ParameterError(
+                f"model must be a gearchaos model: got {type(self.model).__name__}"
+            )
         object.__setattr__(self, "omega", om)
         p = np.ascontiguousarray(self.model.pack(om), dtype=np.float64)
         if not np.all(np.isfinite(p)):

@@ -177,6 +177,9 @@ def run_gallery(
         raise ParameterError(f"title must be text or None: got {type(title).__name__}")
     # resolve every point first: a bad name or value fails before anything runs
     systems = [resolve(gs, {**fixed, param: v}) for v in vals]
+    n_planets = getattr(systems[0].model, "n_planets", None)
+    if n_planets is not None and planet > n_planets:
+        raise ParameterError(f"planet must be one of 1..{n_planets}: got {planet}")
     results: list[Any] = []
     summaries: list[dict[str, Any]] = []
     rows: list[dict[str, Any]] = []
@@ -238,7 +241,7 @@ def _gallery_values(param: str, values: Any) -> list[float]:
             )
         vals.append(check_real(f"values[{i}] ({param})", v))
     if not vals:
-        raise ParameterError(f"{param} needs at least one value: got none")
+        raise ParameterError(f"values must hold at least one value of {param}: got none")
     return vals
 
 

@@ -22,6 +22,7 @@ be checked against the command that would resume it.
 from __future__ import annotations
 
 import difflib
+import numbers
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -31,6 +32,7 @@ import numpy as np
 from .._checks import check_bool, check_choice, check_int
 from ..errors import ParameterError, StoreError
 from ..integrate.settings import SolverSettings
+from ..model.target import OMEGA, check_omega
 
 __all__ = ["Axis", "SweepSpec", "parse_axis", "parse_values"]
 
@@ -99,6 +101,10 @@ def parse_values(name: str, text: str | float | Sequence[float] | np.ndarray) ->
             raise ParameterError(f"{name} values must be finite: got {_shown(text)}") from None
     else:
         try:
+            if isinstance(text, list | tuple) and any(
+                isinstance(v, bool | np.bool_) or not isinstance(v, numbers.Real) for v in text
+            ):
+                raise TypeError("not numbers")
             raw = np.asarray(text)
             if raw.dtype.kind not in "fiu":  # complex, bool, text, objects: not values
                 raise TypeError(raw.dtype)
@@ -155,6 +161,8 @@ def parse_axis(item: str | tuple[str, Any] | Axis) -> Axis:
             )
         name, _, text = item.partition("=")
         name = name.strip()
+        if not name:
+            raise ParameterError(f"an axis must be NAME=VALUES: the name is missing in {item!r}")
         return Axis(name, parse_values(name, text))
     if not isinstance(item, tuple | list) or len(item) != 2 or not isinstance(item[0], str):
         raise ParameterError(
@@ -252,9 +260,15 @@ class SweepSpec:
         dup = {n for n in names if names.count(n) > 1}
         if dup:
             raise ParameterError(f"each parameter may be swept once: {sorted(dup)} repeated")
-        for k, _ in self.fixed:
+        for k, v in self.fixed:
             if k in names:
                 raise ParameterError(f"{k} is both swept and fixed (--set); choose one")
+            if k == OMEGA:
+                check_omega(v)
+        for a in self.axes:
+            if a.name == OMEGA:
+                for v in a.values:
+                    check_omega(v)
         check_choice("initial_conditions", self.initial_conditions, INITIAL_CONDITIONS)
         check_choice("direction", self.direction, DIRECTIONS)
         if self.direction != "up" and self.initial_conditions == "fresh":
@@ -325,7 +339,7 @@ class SweepSpec:
             vary=_axes(vary),
             family=fam[0] if fam else None,
             fixed=tuple(sorted((fixed or {}).items())),
-            solver=SolverSettings.build(solver or SWEEP_SOLVER, **settings),
+            solver=SolverSettings.build(SWEEP_SOLVER if solver is None else solver, **settings),
             **own,
         )
 
