@@ -304,3 +304,57 @@ def option_number_text(value: Any) -> str:
     if isinstance(value, float):
         return repr(value)
     return str(value)
+
+
+# ----------------------------------------------------------------------------- hostile files
+#: Kinds of paths no reader may hang on, crash on, or read as valid input.
+HOSTILE_FILES = [
+    "missing",
+    "directory",
+    "fifo",
+    "binary",
+    "huge",
+    "empty",
+    "loop",
+    "dangling",
+    "under_file",
+    "junk_toml",
+    "nested",
+    "/dev/zero",
+    "/dev/urandom",
+    "/dev/null",
+]
+
+
+def hostile_file(kind: str, path: Path, draw: Any, huge_bytes: int = 3 << 20) -> Path:
+    """Create a hostile file of ``kind`` at ``path`` (devices are returned as they are)."""
+    if kind.startswith("/dev/"):
+        return Path(kind)
+    if kind == "directory":
+        path.mkdir()
+    elif kind == "fifo":
+        os.mkfifo(path)
+    elif kind == "binary":
+        data = draw(st.binary(min_size=1, max_size=2_000))
+        path.write_bytes(b"\xff\xfe" + data)  # never UTF-8
+    elif kind == "huge":
+        path.write_bytes(b"#" * huge_bytes)
+    elif kind == "empty":
+        path.write_bytes(b"")
+    elif kind == "loop":
+        other = path.with_name(path.name + ".b")
+        path.symlink_to(other)
+        other.symlink_to(path)
+    elif kind == "dangling":
+        path.symlink_to(path.with_name("nowhere"))
+    elif kind == "under_file":
+        path.write_text("x")
+        path = path / "x.toml"
+    elif kind == "junk_toml":
+        path.write_text(draw(st.sampled_from(["x = [1", "= 3", "[[a]]\nb = ", "a = 1\na = 2"])))
+    elif kind == "nested":
+        depth = draw(st.integers(1_000, 100_000))
+        path.write_text("x = " + "[" * depth + "]" * depth, encoding="utf-8")
+    else:
+        assert kind == "missing"
+    return path

@@ -271,8 +271,6 @@ def calibrate(
         from ..paper.landmarks import load_landmarks
 
         marks = load_landmarks(landmarks)  # a bad file is refused before anything runs
-        if out.parent and not out.parent.exists():
-            out.parent.mkdir(parents=True, exist_ok=True)
         result = run_calibration(
             marks,
             out,

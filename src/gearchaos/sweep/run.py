@@ -251,8 +251,10 @@ def _store_path(store: Any) -> str | None:
     if not isinstance(store, str | os.PathLike):
         raise ParameterError(f"store must be a path such as 'run.zarr' or None: got {store!r}")
     path = os.fspath(store)
-    if not path.strip():
-        raise ParameterError("store must be a path such as 'run.zarr': got an empty string")
+    if not isinstance(path, str) or not path.strip():
+        raise ParameterError(f"store must be a path such as 'run.zarr': got {path!r}")
+    if "\0" in path:
+        raise ParameterError(f"store must not contain a NUL character: got {path!r}")
     if os.path.basename(os.path.normpath(path)) in ("", ".", ".."):
         raise ParameterError(
             f"store must name a directory to create, such as 'run.zarr': got {path!r}"
