@@ -142,7 +142,7 @@ def verify_attributes(root: str, ds: Any) -> Any:
     _verify_target(root, attrs)
     swept = OMEGA in [a.name for a in spec.axes]
     raw = attrs.get("omega_fixed")
-    if swept and raw is not None:
+    if swept and "omega_fixed" in attrs:
         raise _damaged(root, f"omega is swept but the attribute omega_fixed is {_short(raw)}")
     if not swept:
         if (
@@ -207,10 +207,7 @@ def verify_progress(root: str, progress_dir: str) -> None:
                 raise TypeError(type(chunks).__name__)
         except (OSError, ValueError, KeyError, TypeError):
             continue  # a marker torn by a kill: its task is simply not finished
-        try:
-            problems = verify_chunks(root, chunks)
-        except (TypeError, ValueError):
-            continue  # not a marker this package wrote: the task is computed again on resume
+        problems = verify_chunks(root, chunks)
         if problems:
             shown = "; ".join(problems[:5])
             raise _damaged(root, f"{shown} (task {name[:-5]})")
