@@ -45,8 +45,11 @@ def verify_metadata(root: str) -> None:
     """Every metadata file of a consolidated store equals its consolidated copy, and every
     array directory is listed there."""
     zmeta = os.path.join(root, ".zmetadata")
-    if not os.path.exists(zmeta):
-        return  # not consolidated: readers read the files themselves (and report junk)
+    if not os.path.exists(zmeta):  # every store is consolidated when it is created
+        raise StoreError(
+            f"{root!r} is not a readable sweep store: its consolidated metadata .zmetadata is "
+            f"missing (damaged, or not written by gearchaos); {_RERUN}"
+        )
     try:
         listed = _load_json(zmeta)["metadata"]
         if not isinstance(listed, dict):
