@@ -289,7 +289,9 @@ FILE_DOORS = {
 }
 #: Files a door may read as valid: an empty --out is a calibration not started yet, and lines
 #: that are not JSON are torn lines of a killed run, skipped.
-VALID_FOR = {"calibrate --out": {"missing", "dangling", "empty", "/dev/null", "junk_toml", "nested", "huge"}}
+VALID_FOR = {
+    "calibrate --out": {"missing", "dangling", "empty", "/dev/null", "junk_toml", "nested", "huge"}
+}
 
 
 @pytest.mark.parametrize("profile", PROFILES)
@@ -423,9 +425,14 @@ def test_commands_refuse_stray_arguments_and_wrong_combinations(
         (["reproduce", "fig99", "-o", "r"], ("FIG",)),
         (["reproduce", "fig4", "--preset", "nope", "-o", "r"], ("nope",)),
         (["calibrate", "--quick", "--out", ""], ("--out",)),
+        (["simulate", *TINY, "-o", "file"], ("--output",)),
+        (["bifurcation", "-o", "file", "--vary", "omega=1:2:2", *TINY], ("file",)),
+        (["reproduce", "fig4", "--quick", "-o", "file"], ("--output",)),
+        (["plot", "missing.zarr", "-o", "file/f.png"], ("missing.zarr",)),
     ]
-    for args, names in cases:
-        with inside(tmp_path / "w"):
+    with inside(tmp_path / "w") as here:
+        (here / "file").write_text("x")
+        for args, names in cases:
             cli_refused(f"CLI {args[0]}", args, *names)
 
 

@@ -394,6 +394,16 @@ ROWS = [
         st.one_of(not_integers(), ints_outside(1, 10_000)),
     ),
     Row("SweepResult.open", "path", lambda v: SweepResult.open(v), NOT_PATH, "path", "store"),
+    Row(
+        "SweepSpec.from_toml",
+        "text",
+        lambda v: SweepSpec.from_toml(v),
+        st.one_of(
+            st.text(max_size=200),
+            st.sampled_from(["", "vary = []", "[[vary]]\nname = 5", 5, None, b"x"]),
+        ),
+        "sweep specification",
+    ),
     Row("SweepResult", "ds", lambda v: SweepResult(v), NOT_TARGET, "Dataset"),
     Row(
         "preset",

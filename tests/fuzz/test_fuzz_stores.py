@@ -36,7 +36,15 @@ from typing import Any
 
 import numpy as np
 import pytest
-from fuzz_helpers import cli_refused, hsettings, inside, profiles, refused
+from fuzz_helpers import (
+    HOSTILE_FILES,
+    cli_refused,
+    hostile_file,
+    hsettings,
+    inside,
+    profiles,
+    refused,
+)
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -325,3 +333,34 @@ def test_a_damaged_finished_task_of_an_interrupted_store_is_reported(
     # undamaged, the interrupted store is read (plotted with its missing points noted)
     ds = gc.open_sweep(interrupted)
     assert int(np.sum(ds.status.values == 4)) == 3
+
+
+# ----------------------------------------------------------------------------- hostile paths
+PATH_READERS: dict[str, Callable[[Path], object]] = {
+    "open_sweep": lambda p: gc.open_sweep(p),
+    "SweepResult.open": lambda p: SweepResult.open(p),
+    "classify_store": lambda p: classify_store(p),
+    "open_simulation": lambda p: gc.open_simulation(p),
+}
+
+
+@pytest.mark.parametrize("profile", PROFILES)
+@pytest.mark.parametrize("kind", HOSTILE_FILES)
+def test_hostile_paths_are_refused_by_every_python_reader(
+    profile: dict[str, int], kind: str, tmp_path: Path
+) -> None:
+    """Missing paths, directories that are no store, FIFOs (never opened blocking), devices,
+    binary, huge and junk files, link loops: a StoreError (or ParameterError) naming the path."""
+    if kind.startswith("/dev/") and not os.path.exists(kind):
+        pytest.skip(f"no {kind}")
+    serial = itertools.count()
+
+    @hsettings(profile["damage"])
+    @given(st.data(), st.sampled_from(sorted(PATH_READERS)))
+    def check(data: st.DataObject, reader: str) -> None:
+        here = tmp_path / f"e{next(serial)}"
+        here.mkdir()
+        path = hostile_file(kind, here / "input.zarr", data.draw, huge_bytes=1 << 16)
+        refused(f"{reader} (hostile path)", lambda: PATH_READERS[reader](path), str(path))
+
+    check()
