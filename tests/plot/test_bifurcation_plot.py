@@ -310,3 +310,20 @@ def test_linear_regime_sweep_gives_one_dot_per_omega() -> None:
     assert sorted(float(line.get_ydata()[0]) for line in gid_lines(ax, "clearance")) == [-1, 1]
     # default variable of a reference-system store: its first observed one
     assert bifurcation(ds).get_ylabel() == "$x$"
+
+
+def test_axes_follow_an_attractor_beside_the_backlash() -> None:
+    """An attractor spanning X̄ ∈ [2.8, 3.25] beside b̄_sp = 3: the y limits lie within 10 % of
+    the data range; +b̄ (inside) is drawn, −b̄ (far outside) is an edge note, not a limit."""
+    from gearchaos.plot.units import CLEARANCE_NOTE_GID
+
+    ds = sweep_dataset(np.zeros(5, int), {"omega": np.linspace(1.0, 2.0, 5)})
+    v = ds["delta_sp"].values
+    ds["delta_sp"] = (ds["delta_sp"].dims, 2.8 + 0.45 * (v - v.min()) / np.ptp(v))
+    ax = bifurcation(ds, clearance_lines=True)
+    lo, hi = ax.get_ylim()
+    assert lo <= 2.8 and hi >= 3.25
+    assert lo >= 2.8 - 0.045 and hi <= 3.25 + 0.045
+    notes = [t.get_text() for t in ax.texts if t.get_gid() == CLEARANCE_NOTE_GID]
+    assert len(notes) == 1 and "−" in notes[0] and "3" in notes[0]
+    assert sorted(float(line.get_ydata()[0]) for line in gid_lines(ax, "clearance")) == [-3, 3]

@@ -15,7 +15,7 @@ One module per group of commands (:mod:`.simulate`, :mod:`.gearset`, :mod:`.swee
 
 # isort: off
 # the import order is the order of the commands in `gearchaos --help`
-from . import simulate, gearset, sweep, gallery, paper
+from . import simulate, gearset, sweep, gallery, orbits, paper, export
 
 # isort: on
 from ._common import (
@@ -40,8 +40,10 @@ __all__ = [
     "INTERRUPTED_MESSAGE",
     "PAPER_FIGURES",
     "app",
+    "export",
     "gallery",
     "gearset",
+    "orbits",
     "paper",
     "parse_sets",
     "simulate",

@@ -85,7 +85,16 @@ def wrote(path: Path | str) -> None:
 
 @contextlib.contextmanager
 def reported_errors() -> Iterator[None]:
-    """Turn the package's exceptions into one line on stderr and an exit code."""
+    """Turn the package's exceptions into one line on stderr and an exit code; say so on
+    stderr before the first compilation of the numerical kernels in this process."""
+    from .._numba import on_first_compile
+
+    on_first_compile(
+        lambda: stderr().print(
+            "compiling numerical kernels (first run only, about a minute; later runs load "
+            "them from the cache)…"
+        )
+    )
     try:
         yield
     except (ParameterError, StoreError) as exc:

@@ -10,30 +10,11 @@ import typer
 
 from ..errors import ParameterError
 from ..model.target import DEFAULT_OMEGA
-from ._common import (
-    AtolOpt,
-    GearsetOpt,
-    JsonOpt,
-    PeriodsOpt,
-    PresetOpt,
-    QuietOpt,
-    RtolOpt,
-    SetOpt,
-    TransientOpt,
-    app,
-    default_omega_note,
-    load_gearset,
-    parse_sets,
-    print_json,
-    reported_errors,
-    solver_settings,
-    stdout,
-    wrote,
-)
+from . import _common as c
 from ._render import gallery_rows_table
 
 
-@app.command()
+@c.app.command()
 def poincare(
     vary: Annotated[
         str | None,
@@ -52,11 +33,11 @@ def poincare(
         Path | None,
         typer.Option("--output", "-o", help="Figure file: .png, .pdf or .svg.", show_default=False),
     ] = None,
-    preset: PresetOpt = None,
-    gearset: GearsetOpt = None,
-    set_: SetOpt = None,
-    transient: TransientOpt = 100.0,
-    periods: PeriodsOpt = 300,
+    preset: c.PresetOpt = None,
+    gearset: c.GearsetOpt = None,
+    set_: c.SetOpt = None,
+    transient: c.TransientOpt = 100.0,
+    periods: c.PeriodsOpt = 300,
     with_: Annotated[
         str | None,
         typer.Option(
@@ -66,10 +47,10 @@ def poincare(
         ),
     ] = None,
     planet: Annotated[int, typer.Option("--planet", help="Planet of X̄_sp.")] = 1,
-    rtol: RtolOpt = 1e-8,
-    atol: AtolOpt = 1e-10,
-    quiet: QuietOpt = False,
-    json_out: JsonOpt = False,
+    rtol: c.RtolOpt = 1e-8,
+    atol: c.AtolOpt = 1e-10,
+    quiet: c.QuietOpt = False,
+    json_out: c.JsonOpt = False,
 ) -> None:
     """A gallery of Poincaré maps (X̄_sp1 against X̄'_sp1) along a parameter path, each panel
     titled with the value, its motion label and its largest Lyapunov exponent λ₁.
@@ -84,7 +65,7 @@ def poincare(
     """
     from ..plot.figure import SAVE_FORMATS
 
-    with reported_errors():
+    with c.reported_errors():
         if not vary:
             raise ParameterError(
                 "--vary is required: give NAME=VALUES, e.g. --vary omega=1.2,1.5,1.875"
@@ -105,17 +86,17 @@ def poincare(
                 f"--with must be phase, spectrum or phase,spectrum: got {with_!r}"
             ) from None
         axis = parse_axis(vary)
-        omega, changes = parse_sets(set_ or [])
+        omega, changes = c.parse_sets(set_ or [])
         fixed: dict[str, Any] = dict(changes)
         if axis.name in fixed or (axis.name == "omega" and omega is not None):
             raise ParameterError(f"{axis.name} is both varied and set with --set; choose one")
         if axis.name != "omega":
             if omega is None:
                 omega = DEFAULT_OMEGA
-                default_omega_note(quiet or json_out, "varied")
+                c.default_omega_note(quiet or json_out, "varied")
             fixed["omega"] = omega
-        settings = solver_settings(transient, periods, rtol, atol)
-        gs = load_gearset(preset, gearset)
+        settings = c.solver_settings(transient, periods, rtol, atol)
+        gs = c.load_gearset(preset, gearset)
 
         import matplotlib
 
@@ -144,7 +125,7 @@ def poincare(
             plt.close(fig)
         seconds = time.perf_counter() - t0
     if json_out:
-        print_json(
+        c.print_json(
             {
                 "figure": str(output),
                 "param": axis.name,
@@ -158,5 +139,5 @@ def poincare(
         return
     if quiet:
         return
-    stdout().print(gallery_rows_table(rows, axis.name, title=f"Poincaré gallery of {gs.name}"))
-    wrote(output)
+    c.stdout().print(gallery_rows_table(rows, axis.name, title=f"Poincaré gallery of {gs.name}"))
+    c.wrote(output)

@@ -10,40 +10,25 @@ import typer
 from rich.table import Table
 from rich.text import Text
 
-from ._common import (
-    EXIT_FAILURE,
-    EXIT_INVALID,
-    GearsetOpt,
-    JsonOpt,
-    PresetOpt,
-    SetOpt,
-    app,
-    fail,
-    load_gearset,
-    parse_sets,
-    print_json,
-    reported_errors,
-    stdout,
-    wrote,
-)
+from . import _common as c
 from ._render import info_renderables
 
 
-@app.command()
+@c.app.command()
 def info(
-    preset: PresetOpt = None,
-    gearset: GearsetOpt = None,
-    set_: SetOpt = None,
-    json_out: JsonOpt = False,
+    preset: c.PresetOpt = None,
+    gearset: c.GearsetOpt = None,
+    set_: c.SetOpt = None,
+    json_out: c.JsonOpt = False,
 ) -> None:
     """Linear properties of a gear set: radii, equivalent masses, ω_n, damping coefficients,
     dimensionless groups, mesh phasing and natural frequencies with their mode classes.
 
     With **--set omega=...** the operating point (mesh frequency, sun speed) is added.
     """
-    with reported_errors():
-        omega, changes = parse_sets(set_ or [])
-        gs = load_gearset(preset, gearset, changes)
+    with c.reported_errors():
+        omega, changes = c.parse_sets(set_ or [])
+        gs = c.load_gearset(preset, gearset, changes)
         from ..analysis.derived import gearset_info
 
         data = dict(gearset_info(gs))
@@ -55,9 +40,9 @@ def info(
                 "sun_speed_rpm": gs.sun_speed_rpm(omega),
             }
     if json_out:
-        print_json(data)
+        c.print_json(data)
         return
-    out = stdout()
+    out = c.stdout()
     out.print(Text.assemble(("gear set ", "dim"), (gs.name, "bold")))
     if gs.description:
         out.print(Text(gs.description, style="dim"))
@@ -66,7 +51,7 @@ def info(
         out.print(renderable)
 
 
-@app.command()
+@c.app.command()
 def presets() -> None:
     """List the built-in gear sets (use one with --preset NAME)."""
     from ..gearset import list_presets
@@ -76,10 +61,10 @@ def presets() -> None:
     table.add_column("description")
     for name, description in list_presets():
         table.add_row(name, description)
-    stdout().print(table)
+    c.stdout().print(table)
 
 
-@app.command("init-gearset")
+@c.app.command("init-gearset")
 def init_gearset(
     file: Annotated[
         Path, typer.Argument(help="TOML file to write.", dir_okay=False, show_default=False)
@@ -93,12 +78,12 @@ def init_gearset(
     from ..gearset import template_toml
 
     if file.exists() and not file.is_file():  # a FIFO would block the write forever
-        fail(f"{file} exists and is not a regular file; choose another path", EXIT_INVALID)
+        c.fail(f"{file} exists and is not a regular file; choose another path", c.EXIT_INVALID)
     if file.exists() and not force:
-        fail(f"{file} already exists; pass --force to overwrite it", EXIT_FAILURE)
-    with reported_errors():
+        c.fail(f"{file} already exists; pass --force to overwrite it", c.EXIT_FAILURE)
+    with c.reported_errors():
         file.write_text(template_toml(), encoding="utf-8")
-    wrote(file)
-    stdout().print(
+    c.wrote(file)
+    c.stdout().print(
         Text(f"next: gearchaos simulate --gearset {file} --set omega=1.5 -o out/", style="dim")
     )

@@ -12,24 +12,7 @@ from rich.markup import escape
 from rich.text import Text
 
 from ..errors import ParameterError
-from ._common import (
-    EXIT_INTERRUPTED,
-    EXIT_INVALID,
-    GearsetOpt,
-    JsonOpt,
-    OverwriteOpt,
-    PresetOpt,
-    QuietOpt,
-    WorkersOpt,
-    app,
-    fail,
-    interruptible,
-    load_gearset,
-    print_json,
-    reported_errors,
-    stderr,
-    stdout,
-)
+from . import _common as c
 from ._render import fmt, gallery_rows_table, pairs_table
 
 #: Figures of the seed paper that ``gearchaos reproduce`` knows: bifurcation diagrams
@@ -39,7 +22,7 @@ PAPER_FIGURES = ("fig4", "fig5", "fig6", "fig7", "fig8", "fig9", "fig10", "fig11
 GALLERY_FIGURES = ("fig5", "fig7", "fig10")
 
 
-@app.command()
+@c.app.command()
 def reproduce(
     figure: Annotated[
         str | None,
@@ -74,12 +57,12 @@ def reproduce(
     quick: Annotated[
         bool, typer.Option("--quick", help="A coarse version (fewer points and periods), for CI.")
     ] = False,
-    workers: WorkersOpt = None,
-    overwrite: OverwriteOpt = False,
-    preset: PresetOpt = None,
-    gearset: GearsetOpt = None,
-    quiet: QuietOpt = False,
-    json_out: JsonOpt = False,
+    workers: c.WorkersOpt = None,
+    overwrite: c.OverwriteOpt = False,
+    preset: c.PresetOpt = None,
+    gearset: c.GearsetOpt = None,
+    quiet: c.QuietOpt = False,
+    json_out: c.JsonOpt = False,
 ) -> None:
     """Run the exact sweep of one of the seed paper's bifurcation figures with the default gear
     set (or --preset / --gearset) and draw it in the paper's layout (resumable like
@@ -102,23 +85,23 @@ def reproduce(
     """
     gs = None
     label = None
-    with reported_errors():
+    with c.reported_errors():
         from ..sweep.execute import Execution
 
         Execution(workers=workers)  # refused before any directory is made
     if preset is not None or gearset is not None:
-        with reported_errors():
-            gs = load_gearset(preset, gearset)
+        with c.reported_errors():
+            gs = c.load_gearset(preset, gearset)
         label = f"preset {preset}" if preset is not None else f"file {gearset} ({gs.name})"
     if all_figures:
         if figure is not None:
-            fail("give either FIG or --all, not both", EXIT_INVALID)
+            c.fail("give either FIG or --all, not both", c.EXIT_INVALID)
         if output is None:
-            fail(
+            c.fail(
                 "--all writes a report of many files: give its directory with -o, e.g. -o report/",
-                EXIT_INVALID,
+                c.EXIT_INVALID,
             )
-        with reported_errors(), interruptible():
+        with c.reported_errors(), c.interruptible():
             from ..paper.report import build_report
 
             index = build_report(
@@ -130,14 +113,14 @@ def reproduce(
                 gearset_label=label,
             )
         if json_out:
-            print_json({"report": str(index)})
+            c.print_json({"report": str(index)})
         elif not quiet:
-            stdout().print(escape(str(index)), soft_wrap=True)
+            c.stdout().print(escape(str(index)), soft_wrap=True)
         return
     if figure is None:
-        fail("give a figure (FIG) or --all", EXIT_INVALID)
+        c.fail("give a figure (FIG) or --all", c.EXIT_INVALID)
     output = Path(".") if output is None else output
-    with reported_errors(), interruptible():
+    with c.reported_errors(), c.interruptible():
         name = figure.strip().lower()
         if name not in PAPER_FIGURES:
             close = difflib.get_close_matches(name, PAPER_FIGURES, n=1)
@@ -147,7 +130,7 @@ def reproduce(
             )
         if name in GALLERY_FIGURES:
             if workers is not None and not (quiet or json_out):
-                stderr().print(
+                c.stderr().print(
                     Text(
                         f"--workers does not apply to {name} (a gallery runs its "
                         f"{name} values one after the other)",
@@ -181,7 +164,7 @@ def reproduce(
                 )
             )
     if json_out:
-        print_json(result)
+        c.print_json(result)
         return
     if quiet:
         return
@@ -189,7 +172,7 @@ def reproduce(
     if rows is not None:
         from ..paper.galleries import get_gallery
 
-        stdout().print(
+        c.stdout().print(
             gallery_rows_table(rows, get_gallery(name).param, title=f"Poincaré gallery {name}")
         )
     table = pairs_table(f"gearchaos reproduce {name}" + (" (quick)" if quick else ""))
@@ -201,10 +184,10 @@ def reproduce(
     for key, value in result.items():
         if key not in ("figure", "store", "points", "failed", "seconds"):
             table.add_row(escape(str(key)), escape(fmt(value)))
-    stdout().print(table)
+    c.stdout().print(table)
 
 
-@app.command()
+@c.app.command()
 def calibrate(
     landmarks: Annotated[
         Path | None,
@@ -241,8 +224,8 @@ def calibrate(
     quick: Annotated[
         bool, typer.Option("--quick", help="3 candidates on tiny sweeps, for CI.")
     ] = False,
-    quiet: QuietOpt = False,
-    json_out: JsonOpt = False,
+    quiet: c.QuietOpt = False,
+    json_out: c.JsonOpt = False,
 ) -> None:
     """Search the quantities of the seed's lost Table 1 (N and tooth numbers, input torque,
     transmission-error amplitude, stiffness ratios, mass ratios, b_c, load mode) for the gear set
@@ -254,7 +237,7 @@ def calibrate(
     from ..paper.calibrate import calibrate as run_calibration
 
     show = not (quiet or json_out)
-    err = stderr()
+    err = c.stderr()
 
     def on_record(rec: Mapping[str, Any], now: bool) -> None:
         if show:
@@ -267,7 +250,7 @@ def calibrate(
                 )
             )
 
-    with reported_errors():
+    with c.reported_errors():
         from ..paper.landmarks import load_landmarks
 
         marks = load_landmarks(landmarks)  # a bad file is refused before anything runs
@@ -292,7 +275,7 @@ def calibrate(
         "top": result.top(3),
     }
     if json_out:
-        print_json(summary)
+        c.print_json(summary)
     elif not quiet:
         table = pairs_table("gearchaos calibrate: best candidate" + (" (quick)" if quick else ""))
         best = result.best or {}
@@ -308,10 +291,10 @@ def calibrate(
             else "no: " + "; ".join(result.problems)
         )
         table.add_row("physically plausible", escape(verdict))
-        stdout().print(table)
+        c.stdout().print(table)
     if result.stopped == "interrupted":
-        fail(
+        c.fail(
             f"interrupted: every finished candidate is in {out}; run the same command again "
             "to resume",
-            EXIT_INTERRUPTED,
+            c.EXIT_INTERRUPTED,
         )

@@ -10,39 +10,17 @@ import typer
 from rich.text import Text
 
 from ..errors import ParameterError
-from ._common import (
-    DEFAULT_OMEGA,
-    AtolOpt,
-    GearsetOpt,
-    JsonOpt,
-    PeriodsOpt,
-    PresetOpt,
-    RtolOpt,
-    SetOpt,
-    TransientOpt,
-    app,
-    load_gearset,
-    output_path,
-    parse_sets,
-    print_json,
-    reported_errors,
-    solver_settings,
-    stderr,
-    stdout,
-    warn,
-    warnings_to_stderr,
-    wrote,
-)
+from . import _common as c
 from ._render import add_motion_rows
 
 
-@app.command()
+@c.app.command()
 def simulate(
-    preset: PresetOpt = None,
-    gearset: GearsetOpt = None,
-    set_: SetOpt = None,
-    transient: TransientOpt = 100.0,
-    periods: PeriodsOpt = 200,
+    preset: c.PresetOpt = None,
+    gearset: c.GearsetOpt = None,
+    set_: c.SetOpt = None,
+    transient: c.TransientOpt = 100.0,
+    periods: c.PeriodsOpt = 200,
     samples_per_period: Annotated[
         int,
         typer.Option(
@@ -50,8 +28,8 @@ def simulate(
             help="Samples per mesh period of the time history (figure, spectra).",
         ),
     ] = 64,
-    rtol: RtolOpt = 1e-8,
-    atol: AtolOpt = 1e-10,
+    rtol: c.RtolOpt = 1e-8,
+    atol: c.AtolOpt = 1e-10,
     output_dir: Annotated[
         str | None,
         typer.Option(
@@ -65,7 +43,7 @@ def simulate(
             show_default=False,
         ),
     ] = None,
-    json_out: JsonOpt = False,
+    json_out: c.JsonOpt = False,
     plot: Annotated[
         bool, typer.Option("--plot/--no-plot", help="Write the summary figure (with -o).")
     ] = True,
@@ -91,19 +69,19 @@ def simulate(
 
     Example: **gearchaos simulate --preset sheng2016 --set omega=1.5 --set xi=0.05 -o out/**
     """
-    with reported_errors():
-        output = output_path(output_dir)
+    with c.reported_errors():
+        output = c.output_path(output_dir)
         if output is not None and output.exists() and not output.is_dir():
             raise ParameterError(f"--output must be a directory: {str(output)!r} is a file")
-        omega, changes = parse_sets(set_ or [])
-        gs = load_gearset(preset, gearset, changes)
-        omega = DEFAULT_OMEGA if omega is None else omega
-        settings = solver_settings(transient, periods, rtol, atol, samples_per_period)
+        omega, changes = c.parse_sets(set_ or [])
+        gs = c.load_gearset(preset, gearset, changes)
+        omega = c.DEFAULT_OMEGA if omega is None else omega
+        settings = c.solver_settings(transient, periods, rtol, atol, samples_per_period)
         if output is not None:
             output.mkdir(parents=True, exist_ok=True)
         from ..analysis.point import analyse_point
 
-        err = stderr()
+        err = c.stderr()
         spinner: contextlib.AbstractContextManager[Any] = contextlib.nullcontext()
         if not json_out and err.is_terminal:
             total = transient + periods
@@ -111,10 +89,10 @@ def simulate(
             spinner = err.status(
                 f"integrating {gs.name} at Ω = {omega:g}, {total:g} mesh periods{what}…"
             )
-        with spinner, warnings_to_stderr():
+        with spinner, c.warnings_to_stderr():
             point = analyse_point(gs, {"omega": omega}, settings, lyapunov=lyapunov, check=True)
         if lyapunov and point.lle is None and point.lyapunov_status is not None:
-            warn(f"the Lyapunov exponent could not be computed: {point.lyapunov_status.message}")
+            c.warn(f"the Lyapunov exponent could not be computed: {point.lyapunov_status.message}")
         result, summary = point.result, point.summary
         written: list[Path] = []
         if output is not None:
@@ -125,13 +103,13 @@ def simulate(
                 written.append(_save_figure(result, output / "simulation.png"))
 
     if json_out:
-        print_json(summary)
+        c.print_json(summary)
         for path in written:
-            stderr().print(f"wrote {path}", soft_wrap=True)
+            c.stderr().print(f"wrote {path}", soft_wrap=True)
         return
     from ..analysis.summary import format_summary
 
-    out = stdout()
+    out = c.stdout()
     table = format_summary(summary, title=f"gearchaos simulation of {gs.name} at Ω = {omega:g}")
     add_motion_rows(table, summary)
     out.print(table)
@@ -143,7 +121,7 @@ def simulate(
         )
     )
     for path in written:
-        wrote(path)
+        c.wrote(path)
 
 
 def _save_figure(result: Any, path: Path) -> Path:

@@ -13,29 +13,7 @@ from rich.text import Text
 
 from ..errors import ParameterError
 from ..gearset.parsing import parse_int
-from ._common import (
-    AtolOpt,
-    GearsetOpt,
-    JsonOpt,
-    OverwriteOpt,
-    PresetOpt,
-    QuietOpt,
-    RtolOpt,
-    SetOpt,
-    TransientOpt,
-    WorkersOpt,
-    app,
-    default_omega_note,
-    interruptible,
-    load_gearset,
-    parse_sets,
-    print_json,
-    reported_errors,
-    solver_settings,
-    stdout,
-    warn,
-    wrote,
-)
+from . import _common as c
 from ._render import pairs_table, regime_table
 
 
@@ -74,7 +52,12 @@ def open_store(path: Path) -> Any:
     return res
 
 
-@app.command()
+StoreArg = Annotated[
+    Path,
+    typer.Argument(help="Sweep store written by `gearchaos bifurcation`.", show_default=False),
+]
+
+@c.app.command()
 def bifurcation(
     output: Annotated[
         Path,
@@ -110,9 +93,9 @@ def bifurcation(
             show_default=False,
         ),
     ] = None,
-    preset: PresetOpt = None,
-    gearset: GearsetOpt = None,
-    set_: SetOpt = None,
+    preset: c.PresetOpt = None,
+    gearset: c.GearsetOpt = None,
+    set_: c.SetOpt = None,
     observe: Annotated[
         list[str] | None,
         typer.Option(
@@ -147,14 +130,14 @@ def bifurcation(
             help="up, down or both (continuation only; both overlays the branches).",
         ),
     ] = "up",
-    transient: TransientOpt = 100.0,
+    transient: c.TransientOpt = 100.0,
     periods: Annotated[
         int,
         typer.Option("--periods", help="Mesh periods recorded at every point (section points)."),
     ] = 100,
-    rtol: RtolOpt = 1e-8,
-    atol: AtolOpt = 1e-10,
-    workers: WorkersOpt = None,
+    rtol: c.RtolOpt = 1e-8,
+    atol: c.AtolOpt = 1e-10,
+    workers: c.WorkersOpt = None,
     scheduler: Annotated[
         str | None,
         typer.Option(
@@ -171,7 +154,7 @@ def bifurcation(
             show_default=False,
         ),
     ] = None,
-    overwrite: OverwriteOpt = False,
+    overwrite: c.OverwriteOpt = False,
     lyapunov: Annotated[
         bool,
         typer.Option(
@@ -182,8 +165,8 @@ def bifurcation(
             ),
         ),
     ] = False,
-    quiet: QuietOpt = False,
-    json_out: JsonOpt = False,
+    quiet: c.QuietOpt = False,
+    json_out: c.JsonOpt = False,
 ) -> None:
     """Sweep one or two parameters and store the Poincaré section values of every point.
 
@@ -201,7 +184,7 @@ def bifurcation(
     """
     from ..model.target import DEFAULT_OMEGA
 
-    with reported_errors(), interruptible():
+    with c.reported_errors(), c.interruptible():
         if not vary:
             raise ParameterError(
                 "--vary is required: give NAME=VALUES once (e.g. --vary omega=0.1:4:800) "
@@ -220,9 +203,9 @@ def bifurcation(
                 f"--direction {direction} needs --ic continuation "
                 "(fresh starts do not depend on the sweep direction)"
             )
-        settings = solver_settings(transient, periods, rtol, atol)
-        omega, changes = parse_sets(set_ or [])
-        gs = load_gearset(preset, gearset)
+        settings = c.solver_settings(transient, periods, rtol, atol)
+        omega, changes = c.parse_sets(set_ or [])
+        gs = c.load_gearset(preset, gearset)
         swept = {_axis_name(v) for v in vary} | ({_axis_name(family)} if family else set())
         fixed: dict[str, Any] = dict(changes)
         for name in swept & set(fixed):
@@ -230,7 +213,7 @@ def bifurcation(
         if "omega" not in swept:
             if omega is None:
                 omega = DEFAULT_OMEGA
-                default_omega_note(quiet or json_out)
+                c.default_omega_note(quiet or json_out)
             fixed["omega"] = omega
         elif omega is not None:
             raise ParameterError("omega is both swept and set with --set; choose one")
@@ -262,7 +245,7 @@ def bifurcation(
 
     result = {"store": str(output), "points": points, "failed": failed, "seconds": seconds}
     if json_out:
-        print_json(result)
+        c.print_json(result)
         return
     if quiet:
         return
@@ -274,7 +257,7 @@ def bifurcation(
     if seconds > 0:
         table.add_row("points/s", f"{points / seconds:.3g}")
     table.add_row("store", escape(str(output)))
-    out = stdout()
+    out = c.stdout()
     out.print(table)
     out.print(
         Text(
@@ -290,12 +273,9 @@ def bifurcation(
     out.print(Text(f"next: gearchaos plot {output} -o {output.stem}.png", style="dim"))
 
 
-@app.command()
+@c.app.command()
 def plot(
-    store: Annotated[
-        Path,
-        typer.Argument(help="Sweep store written by `gearchaos bifurcation`.", show_default=False),
-    ],
+    store: StoreArg,
     output: Annotated[
         Path,
         typer.Option("--output", "-o", help="Figure file: .png, .pdf or .svg.", show_default=False),
@@ -319,6 +299,15 @@ def plot(
             "(Ω sweeps).",
         ),
     ] = False,
+    branch: Annotated[
+        list[Path] | None,
+        typer.Option(
+            "--branch",
+            help="Branch file of `gearchaos continue`, repeatable: drawn over the diagrams of its "
+            "parameter (stable solid, unstable dashed, events marked and named).",
+            show_default=False,
+        ),
+    ] = None,
 ) -> None:
     """Draw a sweep store: bifurcation diagrams (one panel per family value, with a band of
     motion labels under each) for a 1-D sweep, maps coloured by motion label (1T, 2T, …, QP,
@@ -328,7 +317,7 @@ def plot(
     """
     from ..plot.figure import SAVE_FORMATS
 
-    with reported_errors():
+    with c.reported_errors():
         if output.suffix.lower() not in SAVE_FORMATS:
             raise ParameterError(
                 f"--output must end in one of {', '.join(SAVE_FORMATS)}: got {str(output)!r}"
@@ -337,23 +326,27 @@ def plot(
         import matplotlib
 
         matplotlib.use("Agg")
+        from ..analysis.branch import open_branch
         from ..plot import savefig, sweep_figure
 
+        branches = [open_branch(b) for b in branch or []]
         fig = sweep_figure(
-            res, var=var, planet=planet, clearance_lines=clearance, resonances=resonances
+            res,
+            var=var,
+            planet=planet,
+            clearance_lines=clearance,
+            resonances=resonances,
+            branches=branches,
         )
         if output.parent != Path(""):
             output.parent.mkdir(parents=True, exist_ok=True)
         savefig(fig, output)
-    wrote(output)
+    c.wrote(output)
 
 
-@app.command()
+@c.app.command()
 def classify(
-    store: Annotated[
-        Path,
-        typer.Argument(help="Sweep store written by `gearchaos bifurcation`.", show_default=False),
-    ],
+    store: StoreArg,
     period_rtol: Annotated[
         float | None,
         typer.Option(
@@ -372,7 +365,7 @@ def classify(
     max_period: Annotated[
         int, typer.Option("--max-period", help="Longest period n recognised as nT.")
     ] = 64,
-    json_out: JsonOpt = False,
+    json_out: c.JsonOpt = False,
 ) -> None:
     """(Re)label every point of a sweep store without re-simulating: 1T … nT (period of the
     stored section sequence), QP or chaos (by the stored largest Lyapunov exponent when the
@@ -385,12 +378,12 @@ def classify(
 
     Example: **gearchaos classify fig4.zarr --period-rtol 1e-4**
     """
-    with reported_errors():
+    with c.reported_errors():
         option, tol = "--period-rtol", period_rtol
         if rtol is not None:
             if period_rtol is not None:
                 raise ParameterError("give --period-rtol only (--rtol is its deprecated name)")
-            warn(
+            c.warn(
                 "classify --rtol is deprecated: it is the period tolerance, not the "
                 "integrator's rtol; use --period-rtol"
             )
@@ -405,9 +398,9 @@ def classify(
 
         table = classify_store(store, period_rtol=tol, max_period=max_period)
     if json_out:
-        print_json(table)
+        c.print_json(table)
         return
-    out = stdout()
+    out = c.stdout()
     out.print(regime_table(table, title=f"motion regimes of {store} (fraction of the points)"))
     out.print(
         Text(

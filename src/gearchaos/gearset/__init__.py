@@ -11,7 +11,6 @@ from .records import UNITS, GearSet
 from .tables import *  # noqa: F403 - the record classes, listed in tables.__all__
 
 __all__ = [
-    *(name for name in tables.__all__ if name != "RECORD_CLASSES"),
     "UNITS",
     "GearSet",
     "from_toml",
@@ -21,3 +20,4 @@ __all__ = [
     "template_toml",
     "to_toml",
 ]
+__all__ += tables.__all__

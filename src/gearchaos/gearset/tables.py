@@ -13,7 +13,6 @@ from types import MappingProxyType
 from typing import Final
 
 __all__ = [
-    "RECORD_CLASSES",
     "Backlash",
     "Clearance",
     "Damping",
@@ -27,7 +26,6 @@ __all__ = [
     "Torque",
     "TransmissionError",
 ]
-
 
 @dataclass(frozen=True)
 class Teeth:

@@ -19,7 +19,7 @@ import numpy as np
 from .._numba import call_literal
 from ..errors import ParameterError, Status
 from ..model.system import System
-from .settings import SolverSettings
+from .settings import SampleTimes, SolverSettings
 
 __all__ = ["ChainOutput", "ChainRun", "SampleArrays", "run_chains"]
 
@@ -93,18 +93,53 @@ class ChainRun:
                 P[c, j] = s.params
                 SW[c, j] = s.switch_widths
                 T[c, j] = s.period
+        t_start = np.full((C, L), float(t0))
+        times = settings.sample_times(T, t0=t_start)
+        return cls.from_arrays(
+            ref,
+            P,
+            SW,
+            t_start,
+            times,
+            settings,
+            y0=y0,
+            n_tangent=n_tangent,
+            continuation=continuation,
+            first_step=first_step,
+            max_step=max_step,
+        )
+
+    @classmethod
+    def from_arrays(
+        cls,
+        ref: System,
+        P: np.ndarray,
+        SW: np.ndarray,
+        t0: np.ndarray,
+        times: SampleTimes,
+        settings: SolverSettings,
+        *,
+        y0: np.ndarray | None = None,
+        n_tangent: int = 0,
+        continuation: bool = False,
+        first_step: float | None = None,
+        max_step: float = np.inf,
+    ) -> ChainRun:
+        """A run from packed parameters ``P`` and switch widths ``SW`` (C, L, …) of systems
+        like ``ref``, start times ``t0`` and sample times (C, L): the one place a run is laid
+        out, for callers that pack their own points (shooting, a hot path)."""
+        C = P.shape[0]
         n = ref.n_state
         k = int(n_tangent)
         Y0 = np.zeros((C, n * (1 + k)))
         if y0 is not None:
             Y0[:, :n] = y0
-        times = settings.sample_times(T, t0=np.full((C, L), float(t0)))
         return cls(
             kind=ref.kind,
             Y0=Y0,
             P=P,
             SW=SW,
-            t0=np.full((C, L), float(t0)),
+            t0=t0,
             t_rec=times.t_rec,
             dt=times.dt,
             t_end=times.t_end,

@@ -14,6 +14,10 @@ step factor 0.9·err^(−1/5) clipped to [0.2, 10] (no growth right after a reje
 Hairer's starting-step heuristic. After a step clipped to land on a sample the pre-clip step size
 is restored, so sampling does not throttle the integration.
 
+The stages are written out with the coefficients of :data:`~gearchaos.integrate.tableau.DOPRI5`
+as compile-time constants; the inner stages ask the right-hand side for no observables, the last
+(FSAL) stage for the tracked ones only, or for all of them on a sample step.
+
 Kernels never raise: they return a :class:`~gearchaos.errors.Status` code.
 """
 
@@ -24,17 +28,27 @@ import math
 import numba
 import numpy as np
 
-from ..model.kernels import rhs, tangent
+from ..model.kernels import OBS_ALL, OBS_NONE, OBS_TRACK, rhs, tangent
+from ._switch import first_switch, track
 from .tableau import DOPRI5
 
 __all__ = ["dopri_chains", "dopri_run"]
 
 # ---------------------------------------------------------------------------- constants from data
 STAGES = DOPRI5.stages
-TAB_A = DOPRI5.a_matrix()  # frozen into the machine code as constants
-TAB_C = np.array([float(x) for x in DOPRI5.c])
-TAB_E = np.array([float(x) for x in DOPRI5.error_weights])
-assert DOPRI5.fsal  # the last row of A is b, so the last stage value is y_{n+1}
+assert STAGES == 7 and DOPRI5.fsal  # the last row of A is b: the last stage value is y_{n+1}
+_A = DOPRI5.a_matrix()
+_E = [float(x) for x in DOPRI5.error_weights]
+# the unrolled stages below skip these zero coefficients
+assert _A[6, 1] == 0.0 and _E[1] == 0.0
+C2, C3, C4, C5 = (float(x) for x in DOPRI5.c[1:5])
+A21 = float(_A[1, 0])
+A31, A32 = (float(x) for x in _A[2, :2])
+A41, A42, A43 = (float(x) for x in _A[3, :3])
+A51, A52, A53, A54 = (float(x) for x in _A[4, :4])
+A61, A62, A63, A64, A65 = (float(x) for x in _A[5, :5])
+A71, A73, A74, A75, A76 = (float(_A[6, q]) for q in (0, 2, 3, 4, 5))
+E1, E3, E4, E5, E6, E7 = (_E[q] for q in (0, 2, 3, 4, 5, 6))
 
 SAFETY = 0.9
 MIN_FACTOR = 0.2
@@ -47,16 +61,6 @@ ST_OK = 0
 ST_MAX_STEPS = 1
 ST_UNDERFLOW = 2
 ST_NON_FINITE = 3
-
-
-@numba.njit(cache=True, inline="always")
-def _scaled_norm(v, y, ynew, rtol, atol, n):  # pragma: no cover - compiled
-    acc = 0.0
-    for i in range(n):
-        sc = atol + rtol * max(abs(y[i]), abs(ynew[i]))
-        r = v[i] / sc
-        acc += r * r
-    return math.sqrt(acc / n)
 
 
 @numba.njit(cache=True)
@@ -74,7 +78,7 @@ def initial_step(kind, t, y, f0, p, rtol, atol, obs, n):  # pragma: no cover - c
     h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
     y1 = y + h0 * f0
     f1 = np.empty(y.size)
-    rhs(kind, t + h0, y1, p, f1, obs)
+    rhs(kind, t + h0, y1, p, f1, obs, OBS_NONE)
     d2 = 0.0
     for i in range(n):
         sc = atol + rtol * abs(y[i])
@@ -87,119 +91,11 @@ def initial_step(kind, t, y, f0, p, rtol, atol, obs, n):  # pragma: no cover - c
     return min(100.0 * h0, h1)
 
 
-@numba.njit(cache=True, inline="always")
-def _track(obs_prev, obs, dt, n_track, omin, omax):  # pragma: no cover - compiled
-    """Update running extrema over one accepted step (values and Hermite interior extremum)."""
-    for k in range(n_track):
-        v0 = obs_prev[k]
-        v1 = obs[k]
-        if v1 < omin[k]:
-            omin[k] = v1
-        if v1 > omax[k]:
-            omax[k] = v1
-        d0 = obs_prev[n_track + k] * dt
-        d1 = obs[n_track + k] * dt
-        if d0 * d1 < 0.0:
-            # derivative of the cubic Hermite interpolant: a s² + b s + c on s ∈ [0, 1]
-            a = 6.0 * (v0 - v1) + 3.0 * (d0 + d1)
-            b = -6.0 * (v0 - v1) - 4.0 * d0 - 2.0 * d1
-            c = d0
-            if abs(a) < 1e-14 * (abs(b) + abs(c)):
-                s = -c / b
-            else:
-                disc = max(b * b - 4.0 * a * c, 0.0)
-                q = -0.5 * (b + math.copysign(math.sqrt(disc), b))
-                s1 = q / a
-                s2 = c / q if q != 0.0 else -1.0
-                s = s1 if 0.0 <= s1 <= 1.0 else s2
-            if 0.0 < s < 1.0:
-                s2_ = s * s
-                s3_ = s2_ * s
-                v = (
-                    (2.0 * s3_ - 3.0 * s2_ + 1.0) * v0
-                    + (s3_ - 2.0 * s2_ + s) * d0
-                    + (-2.0 * s3_ + 3.0 * s2_) * v1
-                    + (s3_ - s2_) * d1
-                )
-                if v < omin[k]:
-                    omin[k] = v
-                if v > omax[k]:
-                    omax[k] = v
-
-
-@numba.njit(cache=True, inline="always")
-def _hermite(v0, v1, d0, d1, s):  # pragma: no cover - compiled
-    """Cubic Hermite interpolant on s ∈ [0, 1] (d0, d1 already multiplied by the step)."""
-    s2 = s * s
-    s3 = s2 * s
-    return (
-        (2.0 * s3 - 3.0 * s2 + 1.0) * v0
-        + (s3 - 2.0 * s2 + s) * d0
-        + (-2.0 * s3 + 3.0 * s2) * v1
-        + (s3 - s2) * d1
-    )
-
-
 @numba.njit(cache=True)
-def first_switch(obs_prev, obs, dt, n_track, sw):  # pragma: no cover - compiled
-    """Fraction θ ∈ (0, 1) of the step at which the first dead-zone switch obs_k = ±b_k is
-    crossed, located on the cubic Hermite interpolant of obs_k (Illinois iteration); 2.0 when
-    no observable changes contact state over the step."""
-    best = 2.0
-    for k in range(n_track):
-        b = sw[k]
-        if not b < np.inf:
-            continue
-        v0 = obs_prev[k]
-        v1 = obs[k]
-        r0 = 0 if v0 < -b else (2 if v0 > b else 1)
-        r1 = 0 if v1 < -b else (2 if v1 > b else 1)
-        if r0 == r1:
-            continue
-        if r0 == 2:
-            level = b
-        elif r0 == 0:
-            level = -b
-        else:
-            level = b if r1 == 2 else -b
-        d0 = obs_prev[n_track + k] * dt
-        d1 = obs[n_track + k] * dt
-        lo = 0.0
-        flo = v0 - level
-        hi = 1.0
-        fhi = v1 - level
-        side = 0
-        sc = 1e-15 * (abs(level) + abs(v0) + abs(v1))
-        x = 0.5
-        for _ in range(100):
-            if fhi == flo:
-                x = 0.5 * (lo + hi)
-            else:
-                x = (lo * fhi - hi * flo) / (fhi - flo)
-            fx = _hermite(v0, v1, d0, d1, x) - level
-            if abs(fx) <= sc or hi - lo < 1e-14:
-                break
-            if (fx > 0.0) == (fhi > 0.0):
-                hi = x
-                fhi = fx
-                if side == -1:
-                    flo *= 0.5
-                side = -1
-            else:
-                lo = x
-                flo = fx
-                if side == 1:
-                    fhi *= 0.5
-                side = 1
-        if x < best:
-            best = x
-    return best
-
-
-@numba.njit(cache=True)
-def _renormalize(kind, t, y, p, obs, K, kbuf, n, k, lsum, tan_on):  # pragma: no cover - compiled
+def _renormalize(kind, t, y, p, obs, K, n, k, lsum, tan_on):  # pragma: no cover - compiled
     """Tangent vectors in y[n:]: set them orthonormal (first call) or re-orthonormalise them by
-    modified Gram–Schmidt, adding log stretch factors to ``lsum``; refresh their FSAL stage."""
+    modified Gram–Schmidt, adding log stretch factors to ``lsum``; refresh their FSAL stage
+    ``K[0]`` (``obs`` holds all observables at (t, y))."""
     numba.literally(kind)
     if not tan_on:
         for r in range(k):
@@ -223,9 +119,7 @@ def _renormalize(kind, t, y, p, obs, K, kbuf, n, k, lsum, tan_on):  # pragma: no
             lsum[r] += math.log(nrm)
             for i in range(n):
                 y[o + i] /= nrm
-    tangent(kind, t, y, p, obs, kbuf, n, k)
-    for i in range(n, y.size):
-        K[0, i] = kbuf[i]
+    tangent(kind, t, y, p, obs, K[0], n, k)
     return True
 
 
@@ -280,13 +174,11 @@ def dopri_run(
     numba.literally(kind)
     n = y0.size
     y = y0.copy()
-    ynew = np.empty(n)
     yt = np.empty(n)
-    K = np.empty((STAGES, n))
-    kbuf = np.empty(n)
-    ev = np.empty(n)
+    K = np.zeros((STAGES, n))  # tangent components stay zero until the tangents start
     obs = np.empty(n_obs)
-    obs_prev = np.empty(n_obs)
+    n_tr2 = 2 * n_track
+    obs_prev = np.empty(n_tr2)
     for k in range(n_track):
         obs_min[k] = np.inf
         obs_max[k] = -np.inf
@@ -296,21 +188,16 @@ def dopri_run(
     tan_on = False
     for r in range(n_tan):
         lsum[r] = 0.0
-    rhs(kind, t, y, p, kbuf, obs)
-    kbuf[n_base:] = 0.0
-    k1 = K[0]
-    k1[:] = kbuf
+    rhs(kind, t, y, p, K[0], obs, OBS_ALL)
     n_acc = 0
     n_rej = 0
     status = ST_OK
     for i in range(n):
-        if not math.isfinite(k1[i]) or not math.isfinite(y[i]):
+        if not math.isfinite(K[0, i]) or not math.isfinite(y[i]):
             status = ST_NON_FINITE
     h = h_init
     if status == ST_OK and h <= 0.0:
-        obs_prev[:] = obs
-        h = initial_step(kind, t, y, k1, p, rtol, atol, obs, n_base)
-        obs[:] = obs_prev  # the observables of the current point
+        h = initial_step(kind, t, y, K[0], p, rtol, atol, np.empty(n_obs), n_base)
     if h > max_step:
         h = max_step
 
@@ -318,7 +205,7 @@ def dopri_run(
     tracking = False
     if status == ST_OK and n_samples > 0 and t >= t_rec:
         if n_tan > 0:
-            tan_on = _renormalize(kind, t, y, p, obs, K, kbuf, n_base, n_tan, lsum, tan_on)
+            tan_on = _renormalize(kind, t, y, p, obs, K, n_base, n_tan, lsum, tan_on)
         out_t[0] = t
         out_y[0, :] = y
         out_obs[0, :] = obs
@@ -327,7 +214,7 @@ def dopri_run(
         for k in range(n_track):
             obs_min[k] = obs[k]
             obs_max[k] = obs[k]
-    obs_prev[:] = obs
+    obs_prev[:] = obs[:n_tr2]
     last_rejected = False
     nonfinite = False
     has_switch = False
@@ -363,37 +250,58 @@ def dopri_run(
             event_step = False
 
         t_new = target if clipped else t + hs
-        # stages 2..7 from the tableau data; stage 7 is evaluated at (t_new, y_new) (FSAL)
+        # the stages; the last one is evaluated at (t_new, y_new) (FSAL)
+        last_level = OBS_ALL if (clipped or tan_on) else OBS_TRACK
         for s in range(1, STAGES):
-            for i in range(n):
-                acc = 0.0
-                for q in range(s):
-                    acc += TAB_A[s, q] * K[q, i]
-                yt[i] = y[i] + hs * acc
-            ts = t_new if s == STAGES - 1 else t + TAB_C[s] * hs
-            rhs(kind, ts, yt, p, kbuf, obs)
-            if n_tan > 0:
-                if tan_on:
-                    tangent(kind, ts, yt, p, obs, kbuf, n_base, n_tan)
-                else:
-                    kbuf[n_base:] = 0.0
-            for i in range(n):
-                K[s, i] = kbuf[i]
+            if s == 1:
+                for i in range(n):
+                    yt[i] = y[i] + hs * (A21 * K[0, i])
+                ts = t + C2 * hs
+            elif s == 2:
+                for i in range(n):
+                    yt[i] = y[i] + hs * (A31 * K[0, i] + A32 * K[1, i])
+                ts = t + C3 * hs
+            elif s == 3:
+                for i in range(n):
+                    yt[i] = y[i] + hs * (A41 * K[0, i] + A42 * K[1, i] + A43 * K[2, i])
+                ts = t + C4 * hs
+            elif s == 4:
+                for i in range(n):
+                    yt[i] = y[i] + hs * (
+                        A51 * K[0, i] + A52 * K[1, i] + A53 * K[2, i] + A54 * K[3, i]
+                    )
+                ts = t + C5 * hs
+            elif s == 5:
+                for i in range(n):
+                    yt[i] = y[i] + hs * (
+                        A61 * K[0, i] + A62 * K[1, i] + A63 * K[2, i] + A64 * K[3, i]
+                        + A65 * K[4, i]
+                    )  # fmt: skip
+                ts = t + hs
+            else:
+                for i in range(n):
+                    yt[i] = y[i] + hs * (
+                        A71 * K[0, i] + A73 * K[2, i] + A74 * K[3, i] + A75 * K[4, i]
+                        + A76 * K[5, i]
+                    )  # fmt: skip
+                ts = t_new
+            level = last_level if s == STAGES - 1 else (OBS_ALL if tan_on else OBS_NONE)
+            rhs(kind, ts, yt, p, K[s], obs, level)
+            if tan_on:
+                tangent(kind, ts, yt, p, obs, K[s], n_base, n_tan)
+        # yt is y_{n+1}; the scaled RMS norm of the embedded error estimate, which is NaN
+        # also when y_{n+1} is not finite
+        acc = 0.0
         for i in range(n):
-            ynew[i] = yt[i]
-            acc = 0.0
-            for q in range(STAGES):
-                acc += TAB_E[q] * K[q, i]
-            ev[i] = hs * acc
-        err = _scaled_norm(ev, y, ynew, rtol, atol, n)
+            e = hs * (
+                E1 * K[0, i] + E3 * K[2, i] + E4 * K[3, i] + E5 * K[4, i] + E6 * K[5, i]
+                + E7 * K[6, i]
+            )  # fmt: skip
+            r = e / (atol + rtol * max(abs(y[i]), abs(yt[i])))
+            acc += r * r + 0.0 * yt[i]
+        err = math.sqrt(acc / n)
 
-        finite = math.isfinite(err)
-        if finite:
-            for i in range(n):
-                if not math.isfinite(ynew[i]):
-                    finite = False
-                    break
-        if not finite:
+        if not math.isfinite(err):
             nonfinite = True
             n_rej += 1
             h = hs * MIN_FACTOR
@@ -424,13 +332,13 @@ def dopri_run(
             h = min(h_next, max_step)
             t = t_new
             for i in range(n):
-                y[i] = ynew[i]
+                y[i] = yt[i]
                 K[0, i] = K[STAGES - 1, i]
             if tracking:
-                _track(obs_prev, obs, hs, n_track, obs_min, obs_max)
+                track(obs_prev, obs, hs, n_track, obs_min, obs_max)
             if clipped and j < n_samples:
                 if n_tan > 0:
-                    tan_on = _renormalize(kind, t, y, p, obs, K, kbuf, n_base, n_tan, lsum, tan_on)
+                    tan_on = _renormalize(kind, t, y, p, obs, K, n_base, n_tan, lsum, tan_on)
                 out_t[j] = t
                 out_y[j, :] = y
                 out_obs[j, :] = obs
@@ -440,7 +348,7 @@ def dopri_run(
                         obs_min[k] = obs[k]
                         obs_max[k] = obs[k]
                 j += 1
-            obs_prev[:] = obs
+            obs_prev[:] = obs[:n_tr2]
         else:
             n_rej += 1
             h = hs * max(MIN_FACTOR, SAFETY * err**ERR_EXPONENT)
@@ -546,6 +454,7 @@ def _guard() -> None:
         kernels.__file__,
         layout.__file__,
         os.path.join(here, "dopri.py"),
+        os.path.join(here, "_switch.py"),
         os.path.join(here, "tableau.py"),
     ]
     _numba.guard_cache([dopri_run, dopri_chains], sources)

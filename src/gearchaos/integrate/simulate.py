@@ -29,25 +29,7 @@ _DEFAULT = SolverSettings()
 
 
 def _initial_state(system: System, y0: Any) -> np.ndarray | None:
-    if y0 is None:
-        return None
-    names = ", ".join(system.state_names)
-    try:
-        raw = np.asarray(y0)
-        if raw.dtype.kind not in "fiu":  # bools, text, complex numbers, objects
-            raise TypeError(raw.dtype)
-        y = raw.astype(np.float64)
-    except (TypeError, ValueError, OverflowError):
-        raise ParameterError(
-            f"y0 must be {system.n_state} numbers ({names}): got {type(y0).__name__}"
-        ) from None
-    if y.ndim != 1 or y.size != system.n_state:
-        raise ParameterError(
-            f"y0 must be a vector of {system.n_state} entries ({names}): got shape {y.shape}"
-        )
-    if not np.all(np.isfinite(y)):
-        raise ParameterError(f"y0 must be finite: got {y.tolist()}")
-    return y
+    return None if y0 is None else system.check_state(y0, "y0")
 
 
 def integrate(

@@ -1,10 +1,13 @@
 """Compiled right-hand sides of every built-in system, behind one dispatch function.
 
-Signature of every kernel: ``rhs(t, y, p, dydt, obs)`` — time, state, packed parameters, output
-derivative, output observables. ``obs`` always starts with the ``n_track`` observables whose
-running extrema the integrator records, followed by their time derivatives, then any extras
-(mesh forces). The integrator reads ``obs`` after the last stage of an accepted step, which the
-Dormand–Prince FSAL property evaluates exactly at the new point, so observables cost nothing.
+Signature of every kernel: ``rhs(t, y, p, dydt, obs, level)`` — time, state, packed parameters,
+output derivative, output observables, and how many observables to write: ``OBS_NONE`` (none:
+the inner stages of a step), ``OBS_TRACK`` (the first ``2 n_track``: the ``n_track`` observables
+whose running extrema the integrator records and whose dead-zone switches it locates, followed
+by their time derivatives) or ``OBS_ALL`` (all, including extras such as mesh forces: samples and
+the variational equations). A kernel may write more than asked for, never less. The integrator
+reads ``obs`` after the last stage of a step, which the Dormand–Prince FSAL property evaluates
+exactly at the new point, so observables cost next to nothing.
 
 One dispatch function (:func:`rhs`) keeps numba's on-disk cache effective: a cached kernel that
 receives a jitted function as an argument cannot be cached, and closures over dispatchers are
@@ -96,7 +99,12 @@ from .layout import (
     P_ZS,
 )
 
-__all__ = ["dead_zone", "observe_many", "rhs", "tangent"]
+__all__ = ["OBS_ALL", "OBS_NONE", "OBS_TRACK", "dead_zone", "observe_many", "rhs", "tangent"]
+
+#: observables a right-hand side writes (see the module docstring)
+OBS_NONE = 0
+OBS_TRACK = 1
+OBS_ALL = 2
 
 
 @numba.njit(cache=True, inline="always")
@@ -106,7 +114,7 @@ def dead_zone(x: float, b: float) -> float:
 
 
 @numba.njit(cache=True, inline="always")  # inlined at the single stage call site
-def planetary_rhs(t, y, p, dydt, obs):  # pragma: no cover - compiled
+def planetary_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
     """Minimal relative-coordinate equations of MODEL.md §7.
 
     State y = (x̄_s, ȳ_s, p̄_1..p̄_N, σ̄, then their τ-derivatives).
@@ -136,6 +144,7 @@ def planetary_rhs(t, y, p, dydt, obs):  # pragma: no cover - compiled
     brp = p[P_BRP]
     asp = p[P_ASP]
     arp = p[P_ARP]
+    inv_mup = p[P_INV_MUP]
     nh_sp = int(p[P_NH_SP])
     nh_rp = int(p[P_NH_RP])
     h0 = P_HEADER + N_BLOCKS * N  # first harmonic amplitude
@@ -232,22 +241,24 @@ def planetary_rhs(t, y, p, dydt, obs):  # pragma: no cover - compiled
         drp_d = sigd - pid - erp_d
         fsp = ksp * dead_zone(dsp, bsp) + csp * dsp_d
         frp = krp * dead_zone(drp, brp) + crp * drp_d
+        dydt[n + 2 + i] = (frp - fsp) * inv_mup  # completed below
 
-        obs[i] = dsp
-        obs[N + i] = drp
-        obs[2 * N + 2 + i] = dsp_d
-        obs[3 * N + 2 + i] = drp_d
-        obs[4 * N + 4 + i] = fsp
-        obs[5 * N + 4 + i] = frp
-        obs[6 * N + 4 + i] = ksp
-        obs[7 * N + 4 + i] = krp
+        if level >= OBS_TRACK:
+            obs[i] = dsp
+            obs[N + i] = drp
+            obs[2 * N + 2 + i] = dsp_d
+            obs[3 * N + 2 + i] = drp_d
+            if level >= OBS_ALL:
+                obs[4 * N + 4 + i] = fsp
+                obs[5 * N + 4 + i] = frp
+                obs[6 * N + 4 + i] = ksp
+                obs[7 * N + 4 + i] = krp
         sum_fsp += fsp
         sum_frp += frp
         sum_fx += fsp * si
         sum_fy -= fsp * ci
 
     inv_mus = p[P_INV_MUS]
-    inv_mup = p[P_INV_MUP]
     inv_muc = p[P_INV_MUC]
     cas = p[P_COS_AS]
     car = p[P_COS_AR]
@@ -263,17 +274,18 @@ def planetary_rhs(t, y, p, dydt, obs):  # pragma: no cover - compiled
     dydt[n] = (sum_fx - cb * xd - kb * dead_zone(x, bs)) * inv_ms
     dydt[n + 1] = (sum_fy - cb * yd - kb * dead_zone(yy, bs)) * inv_ms
     qcp = cas * qc
-    obs[2 * N] = x
-    obs[2 * N + 1] = yy
-    obs[4 * N + 2] = xd
-    obs[4 * N + 3] = yd
+    if level >= OBS_TRACK:
+        obs[2 * N] = x
+        obs[2 * N + 1] = yy
+        obs[4 * N + 2] = xd
+        obs[4 * N + 3] = yd
     for i in range(N):
-        dydt[n + 2 + i] = qs + (obs[5 * N + 4 + i] - obs[4 * N + 4 + i]) * inv_mup - qcp
+        dydt[n + 2 + i] = qs + dydt[n + 2 + i] - qcp
     dydt[n + N + 2] = qs - (cas + car) * qc
 
 
 @numba.njit(cache=True)
-def backlash_oscillator_rhs(t, y, p, dydt, obs):  # pragma: no cover - compiled
+def backlash_oscillator_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
     """x'' + 2ζx' + (1 + ε cos Ωτ) f(x; b) = F_m + F_a Ω^q cos Ωτ;
     obs = (x, x', contact force, stiffness 1 + ε cos Ωτ)."""
     c = math.cos(p[BO_OMEGA] * t)
@@ -289,7 +301,7 @@ def backlash_oscillator_rhs(t, y, p, dydt, obs):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def linear_rhs(t, y, p, dydt, obs):  # pragma: no cover - compiled
+def linear_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
     """y' = A y + f cos Ωτ + g sin Ωτ; obs = (y, y')."""
     n = int(p[LIN_N])
     om = p[LIN_OMEGA]
@@ -308,7 +320,7 @@ def linear_rhs(t, y, p, dydt, obs):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def duffing_rhs(t, y, p, dydt, obs):  # pragma: no cover - compiled
+def duffing_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
     """x'' + δx' + αx + βx³ = γ cos Ωτ; obs = (x, x')."""
     x = y[0]
     v = y[1]
@@ -324,7 +336,7 @@ def duffing_rhs(t, y, p, dydt, obs):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def lorenz_rhs(t, y, p, dydt, obs):  # pragma: no cover - compiled
+def lorenz_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
     """Lorenz (1963): x' = σ(y − x), y' = x(ρ − z) − y, z' = xy − βz;
     obs = (x, y, z, x', y', z')."""
     dydt[0] = p[LZ_SIGMA] * (y[1] - y[0])
@@ -484,18 +496,19 @@ _KERNELS = {
 }
 
 
-def rhs(kind, t, y, p, dydt, obs):
-    """Right-hand side of system ``kind`` (see :mod:`gearchaos.model.layout`).
+def rhs(kind, t, y, p, dydt, obs, level):
+    """Right-hand side of system ``kind`` (see :mod:`gearchaos.model.layout`); ``level`` says
+    which observables to write (module docstring).
 
     Inside compiled code ``kind`` must be a compile-time literal (callers use
     ``numba.literally(kind)``): each kind then gets its own specialised, on-disk-cached machine
     code with a direct call and no run-time dispatch. From Python it simply dispatches.
     """
-    _KERNELS[int(kind)](t, y, p, dydt, obs)
+    _KERNELS[int(kind)](t, y, p, dydt, obs, level)
 
 
 @overload(rhs, inline="always")
-def _rhs_overload(kind, t, y, p, dydt, obs):  # pragma: no cover - compiled
+def _rhs_overload(kind, t, y, p, dydt, obs, level):  # pragma: no cover - compiled
     if not isinstance(kind, types.IntegerLiteral):
         raise numba.errors.TypingError(
             "gearchaos.model.kernels.rhs: 'kind' must be a compile-time literal; "
@@ -506,8 +519,8 @@ def _rhs_overload(kind, t, y, p, dydt, obs):  # pragma: no cover - compiled
         raise numba.errors.TypingError(f"unknown system kind {k}")
     fn = _KERNELS[k]
 
-    def impl(kind, t, y, p, dydt, obs):
-        fn(t, y, p, dydt, obs)
+    def impl(kind, t, y, p, dydt, obs, level):
+        fn(t, y, p, dydt, obs, level)
 
     return impl
 
@@ -522,7 +535,7 @@ def observe_many(kind, t, Y, p, n_obs):  # pragma: no cover - compiled
     ob = np.empty(n_obs)
     dd = np.empty((m, Y.shape[1]))
     for k in range(m):
-        rhs(kind, t[k], Y[k], p, d, ob)
+        rhs(kind, t[k], Y[k], p, d, ob, OBS_ALL)
         out[k, :] = ob
         dd[k, :] = d
     return out, dd

@@ -175,6 +175,46 @@ class System:
             cols = [cols[int(p) - 1] for p in planets]
         return Observable(name, source, np.array(cols), True)
 
+    def tracked_groups(self) -> list[tuple[str, np.ndarray, bool]]:
+        """The tracked observables grouped as sweeps and orbits store them: per-planet groups
+        (``delta_sp`` → its columns, True) and scalars (``x_s`` → one column, False)."""
+        names = self.obs_names[: self.n_track]
+        out: list[tuple[str, np.ndarray, bool]] = []
+        seen: set[str] = set()
+        for k, nm in enumerate(names):
+            head, _, tail = nm.rpartition("_")
+            if tail.isdigit():
+                if head not in seen:
+                    seen.add(head)
+                    idx = [j for j, m in enumerate(names) if m.rpartition("_")[0] == head]
+                    out.append((head, np.array(idx), True))
+            else:
+                out.append((nm, np.array([k]), False))
+        return out
+
+    def check_state(self, value: Any, what: str = "y0") -> np.ndarray:
+        """``value`` as a state of this system: ``n_state`` finite numbers, else a
+        :class:`~gearchaos.errors.ParameterError` naming ``what`` and the components."""
+        from ..errors import ParameterError
+
+        names = ", ".join(self.state_names)
+        try:
+            raw = np.asarray(value)
+            if raw.dtype.kind not in "fiu":  # bools, text, complex numbers, objects
+                raise TypeError(raw.dtype)
+            y = raw.astype(np.float64)
+        except (TypeError, ValueError, OverflowError):
+            raise ParameterError(
+                f"{what} must be {self.n_state} numbers ({names}): got {type(value).__name__}"
+            ) from None
+        if y.ndim != 1 or y.size != self.n_state:
+            raise ParameterError(
+                f"{what} must be a vector of {self.n_state} entries ({names}): got shape {y.shape}"
+            )
+        if not np.all(np.isfinite(y)):
+            raise ParameterError(f"{what} must be finite: got {y.tolist()}")
+        return y
+
     @property
     def switch_widths(self) -> np.ndarray:
         """Half clearances b_k of the dead zones acting on the tracked observables.

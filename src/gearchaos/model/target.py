@@ -30,6 +30,7 @@ __all__ = [
     "model_for",
     "parameter_names",
     "resolve",
+    "scale_attrs",
     "split_omega",
 ]
 
@@ -146,3 +147,16 @@ def resolve(
     if isinstance(target, System) and not changes:
         return target if omega == target.omega else target.at(omega)
     return System(model_for(target, changes), omega)
+
+
+def scale_attrs(model: Any) -> dict[str, float]:
+    """A model's scales and clearances as store attributes: ``omega_n_rad_s`` (ω_n),
+    ``characteristic_length_m`` (b_c) where the model has physical scales, and
+    ``clearance_<name>`` for each of its clearances."""
+    a: dict[str, float] = {}
+    if hasattr(model, "scales"):
+        a["omega_n_rad_s"] = float(model.scales.omega_n)
+        a["characteristic_length_m"] = float(model.scales.length)
+    for k, v in getattr(model, "clearances", {}).items():
+        a[f"clearance_{k}"] = float(v)
+    return a

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 import string
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -38,7 +38,16 @@ from ._common import (
     resonance_lines,
     var_symbol,
 )
+from .branch import branch_matches, branch_overlay
 from .regimes import regime_band, regime_categories, regime_legend_below
+from .units import (
+    PhysicalScales,
+    clearance_notes,
+    fit_to_data,
+    notes_clear_of,
+    secondary_axis,
+    var_quantity,
+)
 
 __all__ = ["bifurcation", "bifurcation_figure", "resolve_var", "suptitle"]
 
@@ -105,6 +114,8 @@ def bifurcation(
     resonances: bool = False,
     color: Any = None,
     s: float = 0.3,
+    branches: Sequence[Any] = (),
+    physical: bool = True,
 ) -> Any:
     """Bifurcation diagram: the section values of ``var`` against the swept parameter.
 
@@ -142,6 +153,14 @@ def bifurcation(
         ω_k of the linear model (:func:`gearchaos.analysis.derived.gearset_info`).
     color, s
         Dot colour (default black; up/down branches C0/C3) and size in points².
+    branches
+        Continued branches of periodic orbits (:func:`gearchaos.continuation`) to overlay:
+        those of the x-axis parameter whose fixed values agree with ``select`` are drawn,
+        stable solid, unstable dashed, with their events marked and named
+        (:func:`~gearchaos.plot.branch.branch_overlay`).
+    physical
+        Physical axes opposite the dimensionless ones: the variable in µm (mm/s, N) on the
+        right, and when the x axis is Ω the sun speed in rpm on top (gear sets only).
 
     Returns
     -------
@@ -160,14 +179,15 @@ def bifurcation(
     ax = get_ax(ax)
     x = np.asarray(sub[x_name].values, dtype=np.float64)
 
-    branches: list[tuple[str | None, Any]] = []
+    parts: list[tuple[str | None, Any]] = []
     if lay.directions:
-        branches = [(d, sub.isel(direction=i)) for i, d in enumerate(lay.directions)]
+        parts = [(d, sub.isel(direction=i)) for i, d in enumerate(lay.directions)]
     else:
-        branches = [(None, sub)]
+        parts = [(None, sub)]
 
     n_failed = n_missing = n_points = 0
-    for direction, part in branches:
+    all_y: list[np.ndarray] = []
+    for direction, part in parts:
         da = _planet_sel(part[var], planet).transpose(x_name, "section")
         y = np.asarray(da.values, dtype=np.float64)
         status = np.asarray(part["status"].transpose(x_name).values) if "status" in part else None
@@ -177,6 +197,7 @@ def bifurcation(
             n_failed += int(np.sum((status != 0) & (status != _NOT_RUN)))
             y = np.where((status == 0)[:, None], y, np.nan)
         xs, ys = _scatter_points(x, y)
+        all_y.append(ys)
         if direction is None:
             c = "k" if color is None else color
             label = None
@@ -196,24 +217,25 @@ def bifurcation(
             zorder=2,
         )
 
-    if clearance_lines:
-        found = res.clearance(var)
-        if found is not None:
-            b = np.asarray(found[0], dtype=np.float64)
-            if b.ndim > 1:  # a direction dimension: the clearance does not depend on it
-                b = b.reshape(-1, b.shape[-1])[0]
-            sym = found[1]
-            if np.all(b == b[0]):
-                lines = [ax.axhline(b[0]), ax.axhline(-b[0])]
-            else:
-                lines = [*ax.plot(x, b), *ax.plot(x, -b)]
-            label = rf"$\pm {sym} = \pm {b[0]:g}$" if np.all(b == b[0]) else rf"$\pm {sym}$"
-            for k, line in enumerate(lines):
-                line.set(gid=CLEARANCE_GID, zorder=1, label=label if k == 0 else None)
-                line.set(**_CLEARANCE_STYLE)
+    found = res.clearance(var) if clearance_lines else None
+    if found is not None:
+        b = np.asarray(found[0], dtype=np.float64)
+        if b.ndim > 1:  # a direction dimension: the clearance does not depend on it
+            b = b.reshape(-1, b.shape[-1])[0]
+        sym = found[1]
+        if np.all(b == b[0]):
+            lines = [ax.axhline(b[0]), ax.axhline(-b[0])]
+        else:
+            lines = [*ax.plot(x, b), *ax.plot(x, -b)]
+        label = rf"$\pm {sym} = \pm {b[0]:g}$" if np.all(b == b[0]) else rf"$\pm {sym}$"
+        for k, line in enumerate(lines):
+            line.set(gid=CLEARANCE_GID, zorder=1, label=label if k == 0 else None)
+            line.set(**_CLEARANCE_STYLE)
 
     if resonances and x_name == "omega" and x.size:
         resonance_lines(ax, res.gearset, float(np.min(x)), float(np.max(x)))
+    for k, branch in enumerate(b for b in branches if branch_matches(b, x_name, select)):
+        branch_overlay(branch, ax, var=var, planet=planet, color=f"C{(k + 4) % 10}")
 
     notes = []
     if n_failed:
@@ -226,11 +248,27 @@ def bifurcation(
         lo, hi = float(np.min(x)), float(np.max(x))
         pad = 0.01 * (hi - lo)
         ax.set_xlim(lo - pad, hi + pad)
+    # the y axis follows the section values (the clearance lines and branches never widen it)
+    fit_to_data(ax, None, np.concatenate(all_y) if all_y else None)
+    levels = np.asarray(found[0], dtype=np.float64).ravel() if found is not None else None
+    if found is not None and levels is not None and np.all(levels == levels[0]):
+        clearance_notes(ax, "y", (-levels[0], levels[0]), found[1])
     ax.set_xlabel(axis_label(x_name))
     ax.set_ylabel(f"${var_symbol(var, planet if 'planet' in sub[var].dims else None)}$")
     no_offset(ax.yaxis)
-    if lay.directions or ((clearance_lines or resonances) and ax.get_legend_handles_labels()[0]):
-        ax.legend(loc="best", fontsize="small", markerscale=6 / max(math.sqrt(s), 0.1))
+    if physical:
+        scales = PhysicalScales.of_sweep(res)
+        secondary_axis(ax, "y", var_quantity(var), scales)
+        if x_name == "omega":
+            secondary_axis(ax, "x", "omega", scales)
+    if lay.directions or (
+        (clearance_lines or resonances or branches) and ax.get_legend_handles_labels()[0]
+    ):
+        legend = ax.legend(loc="best", fontsize="small")
+        for handle in legend.legend_handles:  # the diagram's dots are too small for a legend
+            if handle is not None and hasattr(handle, "set_sizes") and len(handle.get_sizes()):
+                handle.set_sizes([max(float(handle.get_sizes()[0]), 16.0)])
+        notes_clear_of(ax, legend)
     return ax
 
 
@@ -313,6 +351,7 @@ def bifurcation_figure(
     resonances: bool = False,
     regimes: bool | None = None,
     figsize: tuple[float, float] | None = None,
+    branches: Sequence[Any] = (),
 ) -> Any:
     """Bifurcation diagrams of a 1-D sweep, one panel per family value.
 
@@ -381,6 +420,7 @@ def bifurcation_figure(
             select=select,
             clearance_lines=clearance_lines,
             resonances=resonances,
+            branches=branches,
         )
         if family:
             ax.set_title(_panel_title(k, family, value, letters=len(values) > 1), loc="left")

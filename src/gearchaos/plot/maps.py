@@ -11,7 +11,7 @@
 from __future__ import annotations
 
 import string
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -200,6 +200,7 @@ def sweep_figure(
     max_count: int = 16,
     regimes: bool | None = None,
     figsize: tuple[float, float] | None = None,
+    branches: Sequence[Any] = (),
 ) -> Any:
     """The figure of a sweep: :func:`bifurcation_figure` for a 1-D sweep, one map per family
     value (and per direction) for a 2-D sweep.
@@ -208,7 +209,8 @@ def sweep_figure(
     bands under their panels and 2-D sweeps are drawn as regime maps
     (:func:`~gearchaos.plot.regimes.regime_map`, one categorical legend for the figure);
     without, 2-D sweeps are :func:`distinct_map` s. ``clearance_lines`` applies to bifurcation
-    diagrams only; ``max_count`` to distinct-point maps only.
+    diagrams only; ``max_count`` to distinct-point maps only; ``branches`` (continued branches
+    of periodic orbits, drawn over the diagrams of their parameter) to 1-D sweeps only.
 
     Returns
     -------
@@ -230,6 +232,7 @@ def sweep_figure(
             resonances=resonances,
             regimes=regimes,
             figsize=figsize,
+            branches=branches,
         )
     if regimes is None:
         regimes = "motion" in ds.data_vars

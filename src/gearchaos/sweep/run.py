@@ -9,8 +9,10 @@ result as an :class:`xarray.Dataset`.
 from __future__ import annotations
 
 import contextlib
+import math
 import os
 import signal
+import sys
 import threading
 import time
 from collections.abc import Iterator
@@ -22,6 +24,7 @@ from .._checks import check_bool
 from .._version import provenance
 from ..errors import ParameterError, Status
 from ..integrate._chains import ChainOutput, ChainRun
+from ..model.target import scale_attrs
 from .execute import EXECUTION_OPTIONS, Execution, InProcess, executor
 from .grid import Grid, Task
 from .integrity import StoreLock
@@ -29,23 +32,6 @@ from .spec import DEFAULT_OBSERVE, SweepSpec
 from .store import SweepStore
 
 __all__ = ["bifurcation", "run_sweep"]
-
-
-def _tracked_groups(system: Any) -> list[tuple[str, np.ndarray, bool]]:
-    """Tracked observables grouped: per-planet groups (delta_sp …) and scalars (x_s …)."""
-    names = system.obs_names[: system.n_track]
-    out: list[tuple[str, np.ndarray, bool]] = []
-    seen: set[str] = set()
-    for k, nm in enumerate(names):
-        head, _, tail = nm.rpartition("_")
-        if tail.isdigit():
-            if head not in seen:
-                seen.add(head)
-                idx = [j for j, m in enumerate(names) if m.rpartition("_")[0] == head]
-                out.append((head, np.array(idx), True))
-        else:
-            out.append((nm, np.array([k]), False))
-    return out
 
 
 class _Layout:
@@ -57,7 +43,7 @@ class _Layout:
         self.lead_dims = grid.dims
         self.lead_shape = grid.shape
         self.observed = [ref.observable(nm, spec.planets) for nm in spec.observe]
-        self.tracked = _tracked_groups(ref)
+        self.tracked = ref.tracked_groups()
         self.n_planets = int(getattr(ref.model, "n_planets", 0))
         self.state_names = ref.state_names
 
@@ -194,11 +180,7 @@ def _attrs(target: Any, grid: Grid) -> dict[str, Any]:
         a["omega_fixed"] = float(ref.omega)
     # clearances and scales of the base gear set with the fixed overrides (not of a grid point)
     model = grid.base_model()
-    if hasattr(model, "scales"):
-        a["omega_n_rad_s"] = float(model.scales.omega_n)
-        a["characteristic_length_m"] = float(model.scales.length)
-    for k, v in getattr(model, "clearances", {}).items():
-        a[f"clearance_{k}"] = float(v)
+    a.update(scale_attrs(model))
     return a
 
 
@@ -412,7 +394,11 @@ def _run_pool(
 
 
 class _Bar:
-    """Rich progress bar (points done, points/s, ETA) on stderr; silent when disabled."""
+    """Rich progress bar (points done, points/s, ETA) on stderr in a terminal; elsewhere (a
+    log file, a pipe, a batch job) one plain line per 5 % of the points; silent when
+    disabled."""
+
+    STEP = 0.05  # fraction of the points between two plain lines
 
     def __init__(self, enabled: bool, total: int, done: int):
         self.enabled = enabled
@@ -420,10 +406,18 @@ class _Bar:
         self.t0 = time.perf_counter()
         self.started_at = done
         self._p: Any = None
+        self._plain = False
+        self._next_line = 0.0
+        self._what = ""
 
     def __enter__(self) -> _Bar:
         if self.enabled:
             from rich.console import Console
+
+            if not Console(stderr=True).is_terminal:
+                self._plain = True
+                self._next_line = self.done / max(self.total, 1) + self.STEP
+                return self
             from rich.progress import (
                 BarColumn,
                 MofNCompleteColumn,
@@ -454,12 +448,32 @@ class _Bar:
             self._p.__exit__(*exc)
 
     def describe(self, text: str) -> None:
+        self._what = f" ({text})"
         if self._p is not None:
             self._p.update(self._id, description=f"({text})")
+
+    def _line(self) -> str:
+        dt = time.perf_counter() - self.t0
+        new = self.done - self.started_at
+        rate = new / dt if dt > 0 else 0.0
+        left = (self.total - self.done) / rate if rate > 0 else float("nan")
+        eta = time.strftime("%H:%M:%S", time.gmtime(left)) if math.isfinite(left) else "–"
+        pct = 100.0 * self.done / max(self.total, 1)
+        return (
+            f"sweep{self._what}: {self.done} of {self.total} points ({pct:.0f} %) · "
+            f"{rate:.1f} points/s · failed {self.failed} · elapsed "
+            f"{time.strftime('%H:%M:%S', time.gmtime(dt))} · ETA {eta}"
+        )
 
     def advance(self, n: int, failed: int) -> None:
         self.done += n
         self.failed += failed
+        if self._plain and (
+            self.done / max(self.total, 1) >= self._next_line or self.done >= self.total
+        ):
+            print(self._line(), file=sys.stderr, flush=True)
+            while self._next_line <= self.done / max(self.total, 1):
+                self._next_line += self.STEP
         if self._p is not None:
             dt = time.perf_counter() - self.t0
             rate = (self.done - self.started_at) / dt if dt > 0 else 0.0

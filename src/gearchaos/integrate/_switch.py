@@ -1,0 +1,263 @@
+"""Compiled helpers of the integrator for the tracked observables: contact switches and extrema.
+
+The first ``n_track`` observables of every system are the arguments of its dead zones (or just
+variables worth tracking), followed by their τ-derivatives. A *switch* is a crossing of one of
+the levels ±b_k (b_k the half clearance; ``inf``: none) where the vector field has a kink. The
+integrator keeps every step on one side of every switch (DOPRI5's error estimate can miss a kink
+inside a step): it *predicts* the next switch before a step and shortens the step to end just
+past it, *checks* every accepted step for a switch it missed and retries that step to end just
+past it, and treats a switch that lies within the fraction ``LAND`` of either end of a step as
+landed on. The extrema of the tracked observables are refined inside each accepted step.
+
+Interpolants (all on the values v and derivatives v' of an observable at accepted points):
+
+* the cubic Hermite interpolant of one step, for the check and the extrema (4th order);
+* the quintic Hermite interpolant of the last three accepted points, extrapolated forward for the
+  prediction (6th order), in Newton form on the confluent nodes (0, 0, −h₁, −h₁, −h₁−h₂,
+  −h₁−h₂) of local time u = τ − τ_n. Only points since the last switch are used (v''' jumps at a
+  kink); with two of them the cubic is extrapolated instead.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+__all__ = ["LAND", "check_step", "predict_switch", "track"]
+
+#: A switch within this fraction of a step from either end counts as landed on. The local error
+#: a kink at distance δ from a step end leaves is ~ b·h·J·δ v' (J the contact stiffness over
+#: mass, b ≈ 0.1 a quadrature weight), far below the tolerance for δ ≤ 1e-6 h.
+LAND = 1e-6
+#: Relative margin by which a predicted or retried step is aimed past the switch.
+AIM = 0.5 * LAND
+
+
+@numba.njit(cache=True, inline="always")
+def _hermite(v0, v1, d0, d1, s):  # pragma: no cover - compiled
+    """Cubic Hermite interpolant on s ∈ [0, 1] (d0, d1 already multiplied by the step)."""
+    s2 = s * s
+    s3 = s2 * s
+    return (
+        (2.0 * s3 - 3.0 * s2 + 1.0) * v0
+        + (s3 - 2.0 * s2 + s) * d0
+        + (-2.0 * s3 + 3.0 * s2) * v1
+        + (s3 - s2) * d1
+    )
+
+
+@numba.njit(cache=True, inline="always")
+def _region(v, b):  # pragma: no cover - compiled
+    return 0 if v < -b else (2 if v > b else 1)
+
+
+@numba.njit(cache=True, inline="always")
+def _first_level(r0, r1, b):  # pragma: no cover - compiled
+    """The level crossed first when the region changes from r0 to r1."""
+    if r0 == 2:
+        return b
+    if r0 == 0:
+        return -b
+    return b if r1 == 2 else -b
+
+
+@numba.njit(cache=True)
+def _hermite_root(v0, v1, d0, d1, level):  # pragma: no cover - compiled
+    """Root s ∈ (0, 1) of the cubic Hermite interpolant minus ``level`` (Illinois iteration),
+    given v0 − level and v1 − level of opposite signs."""
+    lo = 0.0
+    flo = v0 - level
+    hi = 1.0
+    fhi = v1 - level
+    side = 0
+    sc = 1e-15 * (abs(level) + abs(v0) + abs(v1))
+    x = 0.5
+    for _ in range(100):
+        if fhi == flo:
+            x = 0.5 * (lo + hi)
+        else:
+            x = (lo * fhi - hi * flo) / (fhi - flo)
+        fx = _hermite(v0, v1, d0, d1, x) - level
+        if abs(fx) <= sc or hi - lo < 1e-14:
+            break
+        if (fx > 0.0) == (fhi > 0.0):
+            hi = x
+            fhi = fx
+            if side == -1:
+                flo *= 0.5
+            side = -1
+        else:
+            lo = x
+            flo = fx
+            if side == 1:
+                fhi *= 0.5
+            side = 1
+    return x
+
+
+@numba.njit(cache=True)
+def check_step(obs_prev, obs, dt, n_track, sw):  # pragma: no cover - compiled
+    """Switches inside one accepted step, located on the cubic Hermite interpolant.
+
+    Returns ``(theta, where)``: ``theta`` ∈ (LAND, 1 − LAND) the fraction of the step at the
+    first switch that the step misses (the step must be retried to end there), 2.0 if none;
+    ``where`` 0 if no switch was crossed, 1 if the switches crossed lie at the start of the
+    step only, 2 if one lies at its end (landed on).
+    """
+    best = 2.0
+    where = 0
+    for k in range(n_track):
+        b = sw[k]
+        if not b < np.inf:
+            continue
+        v0 = obs_prev[k]
+        v1 = obs[k]
+        r0 = _region(v0, b)
+        r1 = _region(v1, b)
+        if r0 == r1:
+            continue
+        level = _first_level(r0, r1, b)
+        x = _hermite_root(v0, v1, obs_prev[n_track + k] * dt, obs[n_track + k] * dt, level)
+        if x <= LAND:
+            if where == 0:
+                where = 1
+        elif x >= 1.0 - LAND:
+            where = 2
+        elif x < best:
+            best = x
+    return best, where
+
+
+@numba.njit(cache=True)
+def first_switch(obs_prev, obs, dt, n_track, sw):  # pragma: no cover - compiled
+    """Fraction θ ∈ (0, 1) of the step at which the first switch is crossed; 2.0 if none."""
+    best = 2.0
+    for k in range(n_track):
+        b = sw[k]
+        if not b < np.inf:
+            continue
+        v0 = obs_prev[k]
+        v1 = obs[k]
+        r0 = _region(v0, b)
+        r1 = _region(v1, b)
+        if r0 == r1:
+            continue
+        level = _first_level(r0, r1, b)
+        x = _hermite_root(v0, v1, obs_prev[n_track + k] * dt, obs[n_track + k] * dt, level)
+        if x < best:
+            best = x
+    return best
+
+
+@numba.njit(cache=True)
+def track(obs_prev, obs, dt, n_track, omin, omax):  # pragma: no cover - compiled
+    """Update running extrema over one accepted step (values and Hermite interior extremum)."""
+    for k in range(n_track):
+        v0 = obs_prev[k]
+        v1 = obs[k]
+        if v1 < omin[k]:
+            omin[k] = v1
+        if v1 > omax[k]:
+            omax[k] = v1
+        d0 = obs_prev[n_track + k] * dt
+        d1 = obs[n_track + k] * dt
+        if d0 * d1 < 0.0:
+            # derivative of the cubic Hermite interpolant: a s² + b s + c on s ∈ [0, 1]
+            a = 6.0 * (v0 - v1) + 3.0 * (d0 + d1)
+            b = -6.0 * (v0 - v1) - 4.0 * d0 - 2.0 * d1
+            c = d0
+            if abs(a) < 1e-14 * (abs(b) + abs(c)):
+                s = -c / b
+            else:
+                disc = max(b * b - 4.0 * a * c, 0.0)
+                q = -0.5 * (b + math.copysign(math.sqrt(disc), b))
+                s1 = q / a
+                s2 = c / q if q != 0.0 else -1.0
+                s = s1 if 0.0 <= s1 <= 1.0 else s2
+            if 0.0 < s < 1.0:
+                v = _hermite(v0, v1, d0, d1, s)
+                if v < omin[k]:
+                    omin[k] = v
+                if v > omax[k]:
+                    omax[k] = v
+
+
+@numba.njit(cache=True, inline="always")
+def _newton(u, ub, ua, c0, c1, c2, c3, c4, c5):  # pragma: no cover - compiled
+    """Newton form on the nodes (0, 0, ub, ub, ua, ua) evaluated at u."""
+    w = u - ua
+    acc = c5 * w + c4
+    w = u - ub
+    acc = (acc * w + c3) * w + c2
+    return (acc * u + c1) * u + c0
+
+
+@numba.njit(cache=True)
+def predict_switch(hist, n_pts, t_hist, n_track, sw, h):  # pragma: no cover - compiled
+    """Time from the current point to the first switch predicted within (0, h], or −1.
+
+    ``hist`` holds the tracked observables and derivatives of the last three accepted points,
+    newest first (rows 0, 1, 2) at times ``t_hist``; only the ``n_pts`` ≥ 2 newest are used
+    (those since the last switch). Observables far from every level are skipped by a cheap
+    bound; for the others the Hermite interpolant through the points is extrapolated to
+    τ_n + h and, if it changes contact region, its root is found by bisection.
+    """
+    u1 = t_hist[1] - t_hist[0]  # < 0
+    u2 = t_hist[2] - t_hist[0]
+    best = -1.0
+    for k in range(n_track):
+        b = sw[k]
+        if not b < np.inf:
+            continue
+        v0 = hist[0, k]
+        d0 = hist[0, n_track + k]
+        d1 = hist[1, n_track + k]
+        r0 = _region(v0, b)
+        gap = min(abs(v0 - b), abs(v0 + b))
+        # a crossing within h needs |Δv| ≥ gap; |v'| is bounded generously by the two last
+        # derivatives and their trend
+        reach = h * (abs(d0) + abs(d0 - d1) * (1.0 + h / -u1))
+        if gap > 2.0 * reach:
+            continue
+        v1 = hist[1, k]
+        # confluent divided differences, nodes 0, 0, u1, u1 (, u2, u2)
+        s01 = (v1 - v0) / u1
+        c2 = (s01 - d0) / u1
+        f12 = (d1 - s01) / u1
+        c3 = (f12 - c2) / u1
+        c4 = 0.0
+        c5 = 0.0
+        if n_pts >= 3:
+            v2 = hist[2, k]
+            d2 = hist[2, n_track + k]
+            s12 = (v2 - v1) / (u2 - u1)
+            g2 = (s12 - d1) / (u2 - u1)
+            g3 = (d2 - s12) / (u2 - u1)
+            f23 = (g2 - f12) / u2
+            f34 = (g3 - g2) / (u2 - u1)
+            e3 = (f34 - f23) / (u2 - 0.0)
+            c4 = (f23 - c3) / u2
+            c5 = (e3 - c4) / u2
+        ve = _newton(h, u1, u2, v0, d0, c2, c3, c4, c5)
+        re = _region(ve, b)
+        if re == r0:
+            continue
+        level = _first_level(r0, re, b)
+        lo = 0.0
+        hi = h
+        f_lo = v0 - level
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            fm = _newton(mid, u1, u2, v0, d0, c2, c3, c4, c5) - level
+            if (fm > 0.0) == (f_lo > 0.0):
+                lo = mid
+                f_lo = fm
+            else:
+                hi = mid
+            if hi - lo <= 1e-9 * h:
+                break
+        if best < 0.0 or hi < best:
+            best = hi
+    return best
