@@ -43,6 +43,8 @@ from typing import Any
 
 import numpy as np
 
+from .._checks import check_bool
+from .._files import check_regular_file
 from .._version import provenance
 from ..errors import ParameterError, StoreError
 from .orbits import (
@@ -56,6 +58,7 @@ __all__ = [
     "branch_dataset",
     "branch_multipliers",
     "branch_summary",
+    "check_observe",
     "check_store",
     "fixed_json",
     "open_branch",
@@ -68,6 +71,24 @@ def _default_observe(system: Any) -> tuple[str, ...]:
         return ("delta_sp", "delta_sp_dot")
     names, nt = system.obs_names, system.n_track
     return (names[0], names[nt]) if len(names) > nt else (names[0],)
+
+
+def check_observe(system: Any, observe: Any) -> tuple[str, ...]:
+    """The variables a branch stores at its section points: ``observe`` (a name or a list of
+    distinct names of ``system``'s variables) or the default; refused before any run."""
+    if observe is None:
+        return _default_observe(system)
+    names = (observe,) if isinstance(observe, str) else observe
+    if (
+        not isinstance(names, tuple | list)
+        or not names
+        or not all(isinstance(nm, str) and nm for nm in names)
+        or len(set(names)) != len(names)
+    ):
+        raise ParameterError(f"observe must be distinct variable names: got {observe!r}")
+    for nm in names:
+        system.observable(nm)  # an unknown name is refused by name
+    return tuple(names)
 
 
 def _start_text(start: Any) -> str:
@@ -96,8 +117,7 @@ def branch_dataset(
     names = list(ref.state_names)
     m, n = len(names), br.n
     P = len(pts)
-    obs_names = (observe,) if isinstance(observe, str) else tuple(observe or ())
-    observed = [ref.observable(nm) for nm in (obs_names or _default_observe(ref))]
+    observed = [ref.observable(nm) for nm in check_observe(ref, observe)]
     tracked = ref.tracked_groups()
     levels = br.levels
     n_planets = int(getattr(ref.model, "n_planets", 0))
@@ -272,7 +292,12 @@ def branch_multipliers(ds: Any) -> np.ndarray:
 def check_store(path: str | os.PathLike[str], overwrite: bool = False) -> str:
     """The kind of a branch file (``zarr`` or ``netcdf``) from its suffix; refuses other
     suffixes and, unless ``overwrite``, existing paths (before any computation)."""
+    if not isinstance(path, str | os.PathLike) or not os.fspath(path).strip():
+        raise ParameterError(f"store must be a path ending in .nc or .zarr: got {path!r}")
     path = os.fspath(path)
+    if not isinstance(path, str) or "\0" in path:
+        raise ParameterError(f"store must be a path ending in .nc or .zarr: got {path!r}")
+    check_bool("overwrite", overwrite)
     if path.endswith(".zarr"):
         kind = "zarr"
     elif path.endswith((".nc", ".nc4", ".h5")):
@@ -298,7 +323,8 @@ def save_branch(ds: Any, path: str | os.PathLike[str], *, overwrite: bool = Fals
     elif os.path.exists(tmp):
         os.remove(tmp)
     if kind == "zarr":
-        ds.to_zarr(tmp, mode="w", consolidated=True, zarr_format=2)
+        # every chunk written (none skipped as all fill values): a missing chunk is damage
+        ds.to_zarr(tmp, mode="w", consolidated=True, zarr_format=2, write_empty_chunks=True)
     else:
         ds.to_netcdf(tmp, engine="h5netcdf")
     if os.path.isdir(path):
@@ -313,13 +339,46 @@ def open_branch(path: str | os.PathLike[str]) -> Any:
     """Open a branch written by :func:`save_branch` (loaded into memory)."""
     import xarray as xr
 
+    if not isinstance(path, str | os.PathLike) or not os.fspath(path) or "\0" in str(path):
+        raise ParameterError(f"branch must be a path (BRANCH.nc or BRANCH.zarr): got {path!r}")
     path = os.fspath(path)
-    if not os.path.exists(path):
-        raise StoreError(f"{path} does not exist")
-    if path.endswith(".zarr"):
-        ds = xr.open_zarr(path, consolidated=True).load()
-    else:
-        ds = xr.load_dataset(path, engine="h5netcdf")
+    if not os.path.lexists(path):
+        raise StoreError(f"branch {path} does not exist")
+    try:
+        if os.path.isdir(path):
+            _check_chunks(path)
+            ds = xr.open_zarr(path, consolidated=True).load()
+        else:
+            ds = xr.load_dataset(check_regular_file(path, what="branch file"), engine="h5netcdf")
+    except (StoreError, ParameterError):
+        raise
+    except Exception as exc:  # zarr, h5py and blosc raise many types for damaged files
+        raise StoreError(
+            f"branch {path} is not a readable branch file ({type(exc).__name__})"
+        ) from None
     if "parameter" not in ds.attrs or "multiplier_re" not in ds:
         raise StoreError(f"{path} is not a gearchaos branch (no 'parameter' attribute)")
     return ds
+
+
+def _check_chunks(path: str) -> None:
+    """Every chunk of every array of a Zarr branch is on disk and not empty (a missing chunk
+    would be read as fill values)."""
+    import itertools
+    import math
+
+    for name in sorted(os.listdir(path)):
+        meta = os.path.join(path, name, ".zarray")
+        if not os.path.isfile(meta):
+            continue
+        with open(meta, encoding="utf-8") as f:
+            spec = json.load(f)
+        counts = [math.ceil(n / c) for n, c in zip(spec["shape"], spec["chunks"], strict=True)]
+        sep = spec.get("dimension_separator", ".")
+        for idx in itertools.product(*(range(k) for k in counts)):
+            key = sep.join(map(str, idx)) if idx else "0"
+            chunk = os.path.join(path, name, *key.split("/"))
+            if not os.path.isfile(chunk) or os.path.getsize(chunk) == 0:
+                raise StoreError(
+                    f"branch {path} is damaged: chunk {name}/{key} is missing or empty"
+                )

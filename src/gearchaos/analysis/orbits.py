@@ -46,6 +46,7 @@ from .shooting import Problem, Solution, correct, section_time
 __all__ = [
     "ORBIT_SETTINGS",
     "PeriodicOrbit",
+    "check_tol",
     "contact_levels",
     "minimal_period",
     "orbit_contacts",
@@ -311,6 +312,8 @@ def split_values(
     names = set(SolverSettings.field_names())
     solver = {k: v for k, v in values_and_settings.items() if k in names}
     values = {k: v for k, v in values_and_settings.items() if k not in names}
+    if params is not None and not isinstance(params, Mapping):
+        raise ParameterError(f"params must be a mapping of names to values: got {params!r}")
     for k, v in (params or {}).items():
         if k in values:
             raise ParameterError(f"parameter {k!r} is given twice (keyword and params)")
@@ -323,6 +326,13 @@ def default_tol(settings: SolverSettings) -> float:
     """The default Newton tolerance: rtol/10, at least 1e-12 (the map evaluated with and
     without tangents differs by ~rtol/30 relative, its noise floor is far lower)."""
     return max(1e-12, 0.1 * float(settings.rtol))
+
+
+def check_tol(tol: Any, settings: SolverSettings) -> float:
+    """A relative residual tolerance in (0, 0.1], or the default (:func:`default_tol`)."""
+    if tol is None:
+        return default_tol(settings)
+    return check_real("tol", tol, lo=0.0, hi=0.1, lo_open=True)
 
 
 def initial_guess(system: System, guess: Any, n: int, cfg: SolverSettings) -> np.ndarray:
@@ -418,8 +428,8 @@ def periodic_orbit(
         from ..gearset.validation import warn_if_eccentric
 
         warn_if_eccentric(gs, "Poincaré section")
-    eps = default_tol(cfg) if tol is None else check_real("tol", tol, lo=0.0, lo_open=True)
-    iters = check_int("max_iterations", max_iterations, lo=1)
+    eps = check_tol(tol, cfg)
+    iters = check_int("max_iterations", max_iterations, lo=1, hi=10_000)
     y = initial_guess(system, guess, n, cfg)
     return solve_orbit(system, y, n, cfg, eps, iters, values=values)
 
