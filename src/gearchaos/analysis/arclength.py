@@ -505,6 +505,8 @@ def continuation(
     br.stop = b
     if grid is not None:
         try:
+            if np.asarray(grid).dtype.kind not in "fiu":  # bools, text, objects
+                raise TypeError(grid)
             values_grid = np.asarray(grid, dtype=float).reshape(-1)
         except (TypeError, ValueError):
             raise ParameterError(f"grid must be numbers: got {grid!r}") from None
@@ -523,7 +525,7 @@ def continuation(
     if guess is None or (isinstance(guess, PeriodicOrbit) and guess.period != n):
         y0 = initial_guess(system0, None, n, cfg)
     else:
-        y0 = initial_guess(system0, guess, n, cfg)
+        y0 = initial_guess(system0, guess, n, cfg, what="start")
     if switch is None:
         orbit = solve_orbit(system0, y0, n, cfg, eps, 40)
         if not orbit.converged:

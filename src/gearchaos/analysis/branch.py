@@ -323,10 +323,18 @@ def save_branch(ds: Any, path: str | os.PathLike[str], *, overwrite: bool = Fals
     elif os.path.exists(tmp):
         os.remove(tmp)
     if kind == "zarr":
-        # every chunk written (none skipped as all fill values): a missing chunk is damage
+        # every chunk written (none skipped as all fill values) and its digest kept
         ds.to_zarr(tmp, mode="w", consolidated=True, zarr_format=2, write_empty_chunks=True)
-    else:
-        ds.to_netcdf(tmp, engine="h5netcdf")
+        digests = {key: _digest(os.path.join(tmp, key)) for key in _chunk_files(tmp)}
+        with open(os.path.join(tmp, MANIFEST), "w", encoding="utf-8") as f:
+            json.dump(digests, f)
+    else:  # HDF5 Fletcher-32 checksums: a damaged chunk is an error when read, never data
+        encoding = {
+            name: {"fletcher32": True}
+            for name, var in ds.variables.items()
+            if var.ndim and var.size and var.dtype.kind in "biuf"
+        }
+        ds.to_netcdf(tmp, engine="h5netcdf", encoding=encoding)
     if os.path.isdir(path):
         shutil.rmtree(path)
     elif os.path.exists(path):
@@ -354,31 +362,51 @@ def open_branch(path: str | os.PathLike[str]) -> Any:
         raise
     except Exception as exc:  # zarr, h5py and blosc raise many types for damaged files
         raise StoreError(
-            f"branch {path} is not a readable branch file ({type(exc).__name__})"
+            f"branch {path} is damaged or no branch file ({type(exc).__name__})"
         ) from None
     if "parameter" not in ds.attrs or "multiplier_re" not in ds:
         raise StoreError(f"{path} is not a gearchaos branch (no 'parameter' attribute)")
     return ds
 
 
-def _check_chunks(path: str) -> None:
-    """Every chunk of every array of a Zarr branch is on disk and not empty (a missing chunk
-    would be read as fill values)."""
-    import itertools
-    import math
+#: The digests of a Zarr branch's chunks, written last by :func:`save_branch`.
+MANIFEST = ".gearchaos_chunks.json"
 
-    for name in sorted(os.listdir(path)):
-        meta = os.path.join(path, name, ".zarray")
-        if not os.path.isfile(meta):
-            continue
-        with open(meta, encoding="utf-8") as f:
-            spec = json.load(f)
-        counts = [math.ceil(n / c) for n, c in zip(spec["shape"], spec["chunks"], strict=True)]
-        sep = spec.get("dimension_separator", ".")
-        for idx in itertools.product(*(range(k) for k in counts)):
-            key = sep.join(map(str, idx)) if idx else "0"
-            chunk = os.path.join(path, name, *key.split("/"))
-            if not os.path.isfile(chunk) or os.path.getsize(chunk) == 0:
-                raise StoreError(
-                    f"branch {path} is damaged: chunk {name}/{key} is missing or empty"
-                )
+
+def _chunk_files(root: str) -> list[str]:
+    """The chunk files of a Zarr store (every file not starting with a dot), sorted."""
+    found = []
+    for d, dirs, files in os.walk(root):
+        dirs[:] = sorted(x for x in dirs if not x.startswith("."))
+        found += [os.path.relpath(os.path.join(d, f), root) for f in files if f[0] != "."]
+    return sorted(found)
+
+
+def _digest(path: str) -> str:
+    import hashlib
+
+    with open(path, "rb") as f:
+        return hashlib.sha256(f.read()).hexdigest()
+
+
+def _check_chunks(path: str) -> None:
+    """Every chunk of a Zarr branch is the one :func:`save_branch` wrote (its manifest of
+    SHA-256 digests): a deleted, emptied or overwritten chunk, or one added, is reported by
+    name instead of being read as data (fill values, junk)."""
+    try:
+        with open(os.path.join(path, MANIFEST), encoding="utf-8") as f:
+            manifest = json.load(f)
+        if not isinstance(manifest, dict) or not all(
+            isinstance(k, str) and isinstance(v, str) for k, v in manifest.items()
+        ):
+            raise ValueError(manifest)
+    except (OSError, ValueError, UnicodeDecodeError):
+        raise StoreError(
+            f"branch {path} is damaged: its chunk manifest is missing or unreadable"
+        ) from None
+    on_disk = set(_chunk_files(path))
+    for key in sorted(set(manifest) | on_disk):
+        if key not in manifest:
+            raise StoreError(f"branch {path} is damaged: chunk {key} is not in its manifest")
+        if key not in on_disk or _digest(os.path.join(path, key)) != manifest[key]:
+            raise StoreError(f"branch {path} is damaged: chunk {key} is missing or altered")

@@ -318,7 +318,7 @@ def split_values(
         if k in values:
             raise ParameterError(f"parameter {k!r} is given twice (keyword and params)")
         values[k] = v
-    cfg = SolverSettings.build(settings or default, **solver)
+    cfg = SolverSettings.build(default if settings is None else settings, **solver)
     return values, cfg
 
 
@@ -335,7 +335,9 @@ def check_tol(tol: Any, settings: SolverSettings) -> float:
     return check_real("tol", tol, lo=0.0, hi=0.1, lo_open=True)
 
 
-def initial_guess(system: System, guess: Any, n: int, cfg: SolverSettings) -> np.ndarray:
+def initial_guess(
+    system: System, guess: Any, n: int, cfg: SolverSettings, what: str = "guess"
+) -> np.ndarray:
     """The Newton start: a state, an orbit's state, or the section point of a simulation
     (``guess=None``: ``transient_periods`` from rest) that best repeats after n periods."""
     if isinstance(guess, PeriodicOrbit):
@@ -353,12 +355,12 @@ def initial_guess(system: System, guess: Any, n: int, cfg: SolverSettings) -> np
         secs = np.asarray(guess.states)[guess.section_index]
         if secs.shape[0] < n + 1:
             raise ParameterError(
-                f"guess must record at least {n + 1} section points for period {n}: "
+                f"{what} must record at least {n + 1} section points for period {n}: "
                 f"got {secs.shape[0]}"
             )
         secs = secs[-2 * n :] if secs.shape[0] >= 2 * n else secs
     else:
-        return system.check_state(guess, "guess")
+        return system.check_state(guess, what)
     m = secs.shape[0] - n
     gaps = [np.max(np.abs(secs[j + n] - secs[j])) for j in range(m)]
     return np.array(secs[int(np.argmin(gaps)) + n], dtype=np.float64)

@@ -150,7 +150,12 @@ def export(source: Any, path: str | os.PathLike[str], *, to: str | None = None) 
     to
         ``csv`` or ``mat``; default: from the suffix of ``path``.
     """
-    if not isinstance(path, str | os.PathLike) or not os.fspath(path).strip():
+    if (
+        not isinstance(path, str | os.PathLike)
+        or not isinstance(os.fspath(path), str)
+        or not os.fspath(path).strip()
+        or "\0" in os.fspath(path)
+    ):
         raise ParameterError(f"the output must be a file path: got {path!r}")
     out = Path(os.fspath(path))
     fmt = to if to is not None else out.suffix.lower().lstrip(".")
