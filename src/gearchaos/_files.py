@@ -25,7 +25,7 @@ from pathlib import Path
 
 from .errors import ParameterError, StoreError
 
-__all__ = ["MissingFileError", "check_regular_file", "read_text_file"]
+__all__ = ["MissingFileError", "check_output_file", "check_regular_file", "read_text_file"]
 
 _KINDS = (
     (stat.S_ISDIR, "a directory"),
@@ -169,3 +169,24 @@ def read_text_file(path: object, *, what: str, max_bytes: int) -> str:
             f"{shown}: not UTF-8 text ({what}): byte 0x{data[exc.start]:02x} at offset "
             f"{exc.start} cannot be decoded"
         ) from None
+
+
+def check_output_file(path: object, *, what: str) -> str:
+    """The path of a file about to be written (under a temporary name, then renamed over it),
+    as text: refuses what is not a path (wrong type, empty, a NUL character) with
+    :class:`~gearchaos.errors.ParameterError`, and an existing path that is not a regular file
+    (a directory, a FIFO, a device such as ``/dev/null``, a socket) with
+    :class:`~gearchaos.errors.StoreError` — a rename would replace it."""
+    text = os.fspath(path) if isinstance(path, str | os.PathLike) else None
+    if not isinstance(text, str) or not text.strip() or "\0" in text:
+        raise ParameterError(f"{what} must be a file path: got {path!r}")
+    try:
+        mode = os.stat(text).st_mode
+    except FileNotFoundError:
+        return text
+    except OSError as exc:
+        raise StoreError(f"{what} {text!r} cannot be written: {exc.strerror or exc}") from None
+    if not stat.S_ISREG(mode):
+        kind = next((k for test, k in _KINDS if test(mode)), "not a regular file")
+        raise StoreError(f"{what} {text!r} is {kind}, not a regular file; choose another path")
+    return text

@@ -542,3 +542,59 @@ def test_a_damaged_branch_is_reported_never_read(
             refused("open_branch", lambda: open_branch(path), names)
 
     check()
+
+
+# ----------------------------------------------------------------------------- outputs
+@pytest.fixture(scope="module")
+def results(branch_files: dict[str, Path]) -> dict[str, Any]:
+    sim = gc.simulate(gc.preset("hindawi2021"), omega=1.5, transient_periods=1, periods=2)
+    return {"sim": sim, "branch": open_branch(branch_files["nc"])}
+
+
+OUTPUT_WRITERS = {
+    "SimulationResult.save": (".nc", lambda p, r: r["sim"].save(p)),
+    "export": (".csv", lambda p, r: gc.export(r["sim"].to_dataset(), p, to="csv")),
+    "save_branch": (".nc", lambda p, r: save_branch(r["branch"], p, overwrite=True)),
+    "save_branch (zarr)": (".zarr", lambda p, r: save_branch(r["branch"], p, overwrite=True)),
+    "savefig": (".png", lambda p, r: __import__("gearchaos.plot").plot.savefig(_figure(), p)),
+}
+
+
+def _figure() -> Any:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt.figure()
+
+
+@pytest.mark.parametrize("writer", sorted(OUTPUT_WRITERS))
+@pytest.mark.parametrize("kind", ["fifo", "directory", "under_file", "not a path"])
+def test_writers_never_replace_what_is_no_regular_file(
+    writer: str, kind: str, tmp_path: Path, results: dict[str, Any]
+) -> None:
+    """A FIFO or a directory (or a device such as /dev/null, never touched here) at the output
+    path is refused, never replaced by the rename that ends a write; nothing is left behind."""
+    suffix, write = OUTPUT_WRITERS[writer]
+    if writer == "save_branch (zarr)" and kind == "directory":
+        pytest.skip("a Zarr branch is a directory: overwrite=True replaces it (documented)")
+    path: Any = tmp_path / f"out{suffix}"
+    if kind == "fifo":
+        os.mkfifo(path)
+    elif kind == "directory":
+        path.mkdir()
+    elif kind == "under_file":
+        (tmp_path / "file").write_text("x")
+        path = tmp_path / "file" / f"out{suffix}"
+    before = sorted(os.listdir(tmp_path))
+    if kind == "not a path":
+        for value in ("", " ", "a\0b" + suffix, 5, None, b"x" + suffix.encode(), [str(path)]):
+            refused(writer, lambda v=value: write(v, results))
+    else:
+        refused(writer, lambda: write(path, results), str(path))
+    assert sorted(os.listdir(tmp_path)) == before, "a refused write left a file"
+    if kind == "fifo":
+        import stat
+
+        assert stat.S_ISFIFO(os.stat(path).st_mode), "the FIFO was replaced"

@@ -306,6 +306,13 @@ def check_store(path: str | os.PathLike[str], overwrite: bool = False) -> str:
         raise ParameterError(f"store must end in .nc or .zarr: got {path!r}")
     if os.path.exists(path) and not overwrite:
         raise StoreError(f"{path} exists; choose another path or pass overwrite=True")
+    if os.path.exists(path) and not (os.path.isdir if kind == "zarr" else os.path.isfile)(path):
+        raise StoreError(f"{path} exists and is no {kind} branch file; choose another path")
+    up = os.path.dirname(os.path.abspath(path))
+    while not os.path.exists(up) and os.path.dirname(up) != up:
+        up = os.path.dirname(up)
+    if not os.path.isdir(up):  # checked before any computation
+        raise StoreError(f"cannot write {path}: {up} is not a directory")
     return kind
 
 
@@ -322,6 +329,7 @@ def save_branch(ds: Any, path: str | os.PathLike[str], *, overwrite: bool = Fals
         shutil.rmtree(tmp)
     elif os.path.exists(tmp):
         os.remove(tmp)
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     if kind == "zarr":
         # every chunk written (none skipped as all fill values) and its digest kept
         ds.to_zarr(tmp, mode="w", consolidated=True, zarr_format=2, write_empty_chunks=True)

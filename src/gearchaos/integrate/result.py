@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from .._files import check_regular_file
+from .._files import check_output_file, check_regular_file
 from .._version import provenance
 from ..errors import ParameterError, StoreError
 from .trajectory import Trajectory
@@ -228,13 +228,23 @@ class SimulationResult(Trajectory):
 
     # ------------------------------------------------------------------ files
     def save(self, path: str | os.PathLike[str]) -> str:
-        """Write the dataset to a netCDF-4 file (h5netcdf); returns the path."""
+        """Write the dataset to a netCDF-4 file (h5netcdf); returns the path.
+
+        ``path`` must be a file path whose directory exists; an existing regular file is
+        replaced, anything else there (a directory, a FIFO, a device such as ``/dev/null``)
+        is refused with :class:`~gearchaos.errors.StoreError`, as is a failed write.
+        """
+        text = check_output_file(path, what="simulation file")
         ds = self.to_dataset()
-        path = os.fspath(path)
-        tmp = path + ".partial"
-        ds.to_netcdf(tmp, engine="h5netcdf", invalid_netcdf=True)
-        os.replace(tmp, path)  # never leave a half-written file under the final name
-        return path
+        tmp = text + ".partial"
+        try:
+            ds.to_netcdf(tmp, engine="h5netcdf", invalid_netcdf=True)
+            os.replace(tmp, text)  # never leave a half-written file under the final name
+        except OSError as exc:
+            if os.path.isfile(tmp):
+                os.remove(tmp)
+            raise StoreError(f"cannot write {text!r}: {exc.strerror or exc}") from None
+        return text
 
 
 def open_simulation(path: str | os.PathLike[str]) -> Any:
