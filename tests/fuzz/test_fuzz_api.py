@@ -326,6 +326,17 @@ def _huge_array() -> np.ndarray:
 
 
 #: vary/family values that are not a valid axis: wrong types, shapes, sizes and values.
+def _number_vector(v: Any) -> bool:
+    """A 1-D array of finite real numbers: valid axis values, not a bad object."""
+    return (
+        isinstance(v, np.ndarray)
+        and v.ndim == 1
+        and v.size > 0
+        and v.dtype.kind in "fiu"
+        and bool(np.all(np.isfinite(v)))
+    )
+
+
 BAD_AXIS_OBJECTS = st.one_of(
     st.sampled_from(
         [
@@ -363,7 +374,8 @@ BAD_AXIS_OBJECTS = st.one_of(
     st.just("huge").map(lambda _: {"omega": _huge_array()}),
     st.dictionaries(  # text values are VALUES specifications (malformed ones: above)
         st.sampled_from(["omega", "xi"]),
-        NOT_NUMBERS.filter(lambda v: not isinstance(v, str)),
+        # not text (VALUES specifications, above) and not a vector of numbers (a valid axis)
+        NOT_NUMBERS.filter(lambda v: not isinstance(v, str) and not _number_vector(v)),
         min_size=1,
         max_size=2,
     ),

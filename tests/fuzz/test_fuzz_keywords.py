@@ -465,7 +465,9 @@ ROWS = [
         "cos_forcing",
         lambda v: gc.linear_system([[0.0, 1.0], [-1.0, 0.0]], 1.0, cos_forcing=v),
         st.one_of(
-            NOT_NUMBERS.filter(lambda v: not (isinstance(v, list) and len(v) == 2)),
+            NOT_NUMBERS.filter(  # a list or array of 2 numbers is valid
+                lambda v: not (isinstance(v, list | np.ndarray) and len(v) == 2)
+            ),
             st.sampled_from([[1.0], [math.nan, 0.0], np.zeros((2, 2))]),
         ),
     ),
