@@ -327,7 +327,9 @@ def _huge_array() -> np.ndarray:
 
 #: vary/family values that are not a valid axis: wrong types, shapes, sizes and values.
 def _number_vector(v: Any) -> bool:
-    """A 1-D array of finite real numbers: valid axis values, not a bad object."""
+    """A 1-D array or list of finite real numbers: valid axis values, not a bad object."""
+    if isinstance(v, list) and v and not any(isinstance(x, bool) for x in v):
+        v = np.asarray(v) if all(isinstance(x, int | float) for x in v) else None
     return (
         isinstance(v, np.ndarray)
         and v.ndim == 1
