@@ -25,7 +25,7 @@ from pathlib import Path
 
 from .errors import ParameterError, StoreError
 
-__all__ = ["MissingFileError", "read_text_file"]
+__all__ = ["MissingFileError", "check_output_file", "check_regular_file", "read_text_file"]
 
 _KINDS = (
     (stat.S_ISDIR, "a directory"),
@@ -54,6 +54,53 @@ def _kind(mode: int) -> str:
         if test(mode):
             return name
     return "not a regular file"  # pragma: no cover - every other type is listed above
+
+
+def _open_regular(path: object, what: str) -> tuple[int, str, str]:
+    """(open descriptor, path, path as shown) of a regular file; the errors of
+    :func:`read_text_file`. The caller closes the descriptor."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise ParameterError(f"{what} path must be a str or path-like: got {type(path).__name__}")
+    try:
+        name = os.fspath(path)
+    except TypeError as exc:  # a PathLike whose __fspath__ returns neither str nor bytes
+        raise ParameterError(f"{what} path must be a str or path-like: {exc}") from None
+    if not isinstance(name, str):
+        raise ParameterError(f"{what} path must be text: got {type(name).__name__}")
+    if not name:
+        raise ParameterError(f"{what} path must not be empty: got ''")
+    if "\0" in name:
+        raise ParameterError(f"{what} path must not contain a NUL character: got {name!r}")
+    shown = str(Path(name))
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0)
+    flags |= getattr(os, "O_CLOEXEC", 0)
+    try:
+        fd = os.open(name, flags)
+    except FileNotFoundError:
+        raise MissingFileError(f"{what} not found: '{shown}'") from None
+    except OSError as exc:
+        reason = exc.strerror or str(exc)
+        if exc.errno == errno.ELOOP:
+            reason = "a loop of symbolic links"
+        raise StoreError(f"{what} '{shown}' cannot be opened: {reason}") from None
+    try:
+        mode = os.fstat(fd).st_mode
+    except OSError as exc:  # pragma: no cover - fstat of an open descriptor
+        os.close(fd)
+        raise StoreError(f"{what} '{shown}' cannot be read: {exc.strerror or exc}") from None
+    if not stat.S_ISREG(mode):
+        os.close(fd)
+        raise StoreError(f"{what} '{shown}' is {_kind(mode)}, not a regular file")
+    return fd, name, shown
+
+
+def check_regular_file(path: object, *, what: str) -> str:
+    """The path of an existing regular file, as text, for readers that open it themselves
+    (netCDF): refuses what :func:`read_text_file` refuses before reading (not a path, missing,
+    a directory, FIFO, device or socket, a link loop, no permission)."""
+    fd, name, _ = _open_regular(path, what)
+    os.close(fd)
+    return name
 
 
 def read_text_file(path: object, *, what: str, max_bytes: int) -> str:
@@ -93,34 +140,8 @@ def read_text_file(path: object, *, what: str, max_bytes: int) -> str:
     the check and the read. At most ``max_bytes`` + 1 bytes are read whatever size the file
     claims, which also bounds files that grow or report size 0 (``/proc``).
     """
-    if not isinstance(path, (str, os.PathLike)):
-        raise ParameterError(f"{what} path must be a str or path-like: got {type(path).__name__}")
+    fd, _, shown = _open_regular(path, what)
     try:
-        name = os.fspath(path)
-    except TypeError as exc:  # a PathLike whose __fspath__ returns neither str nor bytes
-        raise ParameterError(f"{what} path must be a str or path-like: {exc}") from None
-    if not isinstance(name, str):
-        raise ParameterError(f"{what} path must be text: got {type(name).__name__}")
-    if not name:
-        raise ParameterError(f"{what} path must not be empty: got ''")
-    if "\0" in name:
-        raise ParameterError(f"{what} path must not contain a NUL character: got {name!r}")
-    shown = str(Path(name))
-    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0)
-    flags |= getattr(os, "O_CLOEXEC", 0)
-    try:
-        fd = os.open(name, flags)
-    except FileNotFoundError:
-        raise MissingFileError(f"{what} not found: '{shown}'") from None
-    except OSError as exc:
-        reason = exc.strerror or str(exc)
-        if exc.errno == errno.ELOOP:
-            reason = "a loop of symbolic links"
-        raise StoreError(f"{what} '{shown}' cannot be opened: {reason}") from None
-    try:
-        mode = os.fstat(fd).st_mode
-        if not stat.S_ISREG(mode):
-            raise StoreError(f"{what} '{shown}' is {_kind(mode)}, not a regular file")
         size = os.fstat(fd).st_size
         if size > max_bytes:
             raise StoreError(
@@ -148,3 +169,24 @@ def read_text_file(path: object, *, what: str, max_bytes: int) -> str:
             f"{shown}: not UTF-8 text ({what}): byte 0x{data[exc.start]:02x} at offset "
             f"{exc.start} cannot be decoded"
         ) from None
+
+
+def check_output_file(path: object, *, what: str) -> str:
+    """The path of a file about to be written (under a temporary name, then renamed over it),
+    as text: refuses what is not a path (wrong type, empty, a NUL character) with
+    :class:`~gearchaos.errors.ParameterError`, and an existing path that is not a regular file
+    (a directory, a FIFO, a device such as ``/dev/null``, a socket) with
+    :class:`~gearchaos.errors.StoreError` — a rename would replace it."""
+    text = os.fspath(path) if isinstance(path, str | os.PathLike) else None
+    if not isinstance(text, str) or not text.strip() or "\0" in text:
+        raise ParameterError(f"{what} must be a file path: got {path!r}")
+    try:
+        mode = os.stat(text).st_mode
+    except FileNotFoundError:
+        return text
+    except OSError as exc:
+        raise StoreError(f"{what} {text!r} cannot be written: {exc.strerror or exc}") from None
+    if not stat.S_ISREG(mode):
+        kind = next((k for test, k in _KINDS if test(mode)), "not a regular file")
+        raise StoreError(f"{what} {text!r} is {kind}, not a regular file; choose another path")
+    return text

@@ -230,3 +230,31 @@ def test_a_damaged_finished_task_is_recomputed_on_resume(
     ref = tmp_path / "ref.zarr"
     run_sweep(sheng, spec, store=ref, progress=False, chunk_points=3)
     assert_bitwise_equal(open_store(path), open_store(ref))
+
+
+def test_a_classification_interrupted_before_it_consolidated_is_redone(
+    base_store: Path, tmp_path: Path
+) -> None:
+    """A run killed in its classification (label arrays written, root attributes changed, not
+    yet consolidated) is no damage: readers use .zmetadata, the next classification rewrites
+    the labels and they equal the uninterrupted ones. Any other unlisted array still is."""
+    store = _copy(base_store, tmp_path / "s.zarr")
+    zmeta = json.loads((store / ".zmetadata").read_text())
+    for key in [k for k in zmeta["metadata"] if k.startswith("contact_rp/")]:
+        del zmeta["metadata"][key]  # as if contact_rp had been created after consolidation
+    (store / ".zmetadata").write_text(json.dumps(zmeta))
+    attrs = json.loads((store / ".zattrs").read_text())
+    (store / ".zattrs").write_text(json.dumps({**attrs, "regime_table": "{}"}))
+    gc.open_sweep(store)  # read as it was consolidated
+    gc.sweep.classify_store(store)
+    redone, base = gc.open_sweep(store), gc.open_sweep(base_store)
+    for name in ("motion", "period", "contact_sp", "contact_rp"):
+        np.testing.assert_array_equal(redone[name].values, base[name].values)
+    assert redone.attrs["regime_table"] == base.attrs["regime_table"]
+    other = _copy(base_store, tmp_path / "o.zarr")
+    zmeta = json.loads((other / ".zmetadata").read_text())
+    for key in [k for k in zmeta["metadata"] if k.startswith("steps_accepted/")]:
+        del zmeta["metadata"][key]
+    (other / ".zmetadata").write_text(json.dumps(zmeta))
+    with pytest.raises(StoreError, match="steps_accepted"):
+        gc.open_sweep(other)

@@ -41,7 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from .._checks import check_int, check_real
+from .._checks import check_bool, check_int, check_real
 from ..errors import IntegrationError, ParameterError
 from ..integrate.settings import SolverSettings
 from ..model.system import System
@@ -50,8 +50,8 @@ from . import branch_events as ev
 from .orbits import (
     ORBIT_SETTINGS,
     PeriodicOrbit,
+    check_tol,
     contact_levels,
-    default_tol,
     initial_guess,
     orbit_contacts,
     solve_orbit,
@@ -81,7 +81,7 @@ def parse_vary(vary: Any) -> tuple[str, float, float]:
         name = name.strip()
     elif isinstance(vary, Mapping) and len(vary) == 1:
         ((name, rng),) = vary.items()
-        if len(rng) != 2:
+        if not isinstance(rng, tuple | list) or len(rng) != 2:
             raise ParameterError(f"vary must map one name to (start, stop): got {vary!r}")
         a, b = rng
     elif isinstance(vary, tuple | list) and len(vary) == 3:
@@ -91,6 +91,8 @@ def parse_vary(vary: Any) -> tuple[str, float, float]:
             f"vary must be 'NAME=START:STOP', (NAME, START, STOP) or {{NAME: (START, STOP)}}: "
             f"got {vary!r}"
         )
+    if not isinstance(name, str) or not name.strip():
+        raise ParameterError(f"vary must name a parameter: got {vary!r}")
     a = check_real("vary start", a)
     b = check_real("vary stop", b)
     if a == b:
@@ -475,11 +477,12 @@ def continuation(
         events; attributes with the stop reason and provenance
         (see :func:`gearchaos.analysis.branch.branch_dataset`).
     """
-    from .branch import branch_dataset, check_store, save_branch
+    from .branch import branch_dataset, check_observe, check_store, save_branch
 
     name, a, b = parse_vary(vary)
     if store is not None:
         check_store(store, overwrite)
+    check_bool("overwrite", overwrite)
     values, cfg = split_values(values_and_settings, settings, params, ORBIT_SETTINGS)
     if name in values:
         raise ParameterError(f"{name} is varied and cannot also be fixed")
@@ -489,11 +492,11 @@ def continuation(
         initial=_pos("step", step, span / 200.0),
         minimum=_pos("min_step", min_step, span * 1e-6),
         maximum=_pos("max_step", max_step, span / 100.0),
-        max_points=check_int("max_points", max_points, lo=2),
-        max_corrector=check_int("max_corrector", max_corrector, lo=2),
+        max_points=check_int("max_points", max_points, lo=2, hi=1_000_000),
+        max_corrector=check_int("max_corrector", max_corrector, lo=2, hi=1000),
         event_tol=_pos("event_tol", event_tol, span * 1e-6),
     )
-    eps = default_tol(cfg) if tol is None else check_real("tol", tol, lo=0.0, lo_open=True)
+    eps = check_tol(tol, cfg)
 
     n, lam0, guess, switch = _start(start, period, name, a)
     if not lo <= lam0 <= hi:
@@ -502,6 +505,8 @@ def continuation(
     br.stop = b
     if grid is not None:
         try:
+            if np.asarray(grid).dtype.kind not in "fiu":  # bools, text, objects
+                raise TypeError(grid)
             values_grid = np.asarray(grid, dtype=float).reshape(-1)
         except (TypeError, ValueError):
             raise ParameterError(f"grid must be numbers: got {grid!r}") from None
@@ -509,6 +514,8 @@ def continuation(
             raise ParameterError(f"grid must be finite numbers: got {grid!r}")
         br.grid = np.unique(values_grid)
     system0 = br.system(lam0)
+    br.system(b)  # the range's other end must be a valid value too (refused before any run)
+    check_observe(system0, observe)
     gs = getattr(system0.model, "gearset", None)
     if gs is not None and gs.has_eccentricity:
         from ..gearset.validation import warn_if_eccentric
@@ -518,7 +525,7 @@ def continuation(
     if guess is None or (isinstance(guess, PeriodicOrbit) and guess.period != n):
         y0 = initial_guess(system0, None, n, cfg)
     else:
-        y0 = initial_guess(system0, guess, n, cfg)
+        y0 = initial_guess(system0, guess, n, cfg, what="start")
     if switch is None:
         orbit = solve_orbit(system0, y0, n, cfg, eps, 40)
         if not orbit.converged:

@@ -43,6 +43,8 @@ from typing import Any
 
 import numpy as np
 
+from .._checks import check_bool
+from .._files import check_regular_file
 from .._version import provenance
 from ..errors import ParameterError, StoreError
 from .orbits import (
@@ -56,6 +58,7 @@ __all__ = [
     "branch_dataset",
     "branch_multipliers",
     "branch_summary",
+    "check_observe",
     "check_store",
     "fixed_json",
     "open_branch",
@@ -68,6 +71,24 @@ def _default_observe(system: Any) -> tuple[str, ...]:
         return ("delta_sp", "delta_sp_dot")
     names, nt = system.obs_names, system.n_track
     return (names[0], names[nt]) if len(names) > nt else (names[0],)
+
+
+def check_observe(system: Any, observe: Any) -> tuple[str, ...]:
+    """The variables a branch stores at its section points: ``observe`` (a name or a list of
+    distinct names of ``system``'s variables) or the default; refused before any run."""
+    if observe is None:
+        return _default_observe(system)
+    names = (observe,) if isinstance(observe, str) else observe
+    if (
+        not isinstance(names, tuple | list)
+        or not names
+        or not all(isinstance(nm, str) and nm for nm in names)
+        or len(set(names)) != len(names)
+    ):
+        raise ParameterError(f"observe must be distinct variable names: got {observe!r}")
+    for nm in names:
+        system.observable(nm)  # an unknown name is refused by name
+    return tuple(names)
 
 
 def _start_text(start: Any) -> str:
@@ -96,8 +117,7 @@ def branch_dataset(
     names = list(ref.state_names)
     m, n = len(names), br.n
     P = len(pts)
-    obs_names = (observe,) if isinstance(observe, str) else tuple(observe or ())
-    observed = [ref.observable(nm) for nm in (obs_names or _default_observe(ref))]
+    observed = [ref.observable(nm) for nm in check_observe(ref, observe)]
     tracked = ref.tracked_groups()
     levels = br.levels
     n_planets = int(getattr(ref.model, "n_planets", 0))
@@ -272,7 +292,12 @@ def branch_multipliers(ds: Any) -> np.ndarray:
 def check_store(path: str | os.PathLike[str], overwrite: bool = False) -> str:
     """The kind of a branch file (``zarr`` or ``netcdf``) from its suffix; refuses other
     suffixes and, unless ``overwrite``, existing paths (before any computation)."""
+    if not isinstance(path, str | os.PathLike) or not os.fspath(path).strip():
+        raise ParameterError(f"store must be a path ending in .nc or .zarr: got {path!r}")
     path = os.fspath(path)
+    if not isinstance(path, str) or "\0" in path:
+        raise ParameterError(f"store must be a path ending in .nc or .zarr: got {path!r}")
+    check_bool("overwrite", overwrite)
     if path.endswith(".zarr"):
         kind = "zarr"
     elif path.endswith((".nc", ".nc4", ".h5")):
@@ -281,6 +306,13 @@ def check_store(path: str | os.PathLike[str], overwrite: bool = False) -> str:
         raise ParameterError(f"store must end in .nc or .zarr: got {path!r}")
     if os.path.exists(path) and not overwrite:
         raise StoreError(f"{path} exists; choose another path or pass overwrite=True")
+    if os.path.exists(path) and not (os.path.isdir if kind == "zarr" else os.path.isfile)(path):
+        raise StoreError(f"{path} exists and is no {kind} branch file; choose another path")
+    up = os.path.dirname(os.path.abspath(path))
+    while not os.path.exists(up) and os.path.dirname(up) != up:
+        up = os.path.dirname(up)
+    if not os.path.isdir(up):  # checked before any computation
+        raise StoreError(f"cannot write {path}: {up} is not a directory")
     return kind
 
 
@@ -297,10 +329,20 @@ def save_branch(ds: Any, path: str | os.PathLike[str], *, overwrite: bool = Fals
         shutil.rmtree(tmp)
     elif os.path.exists(tmp):
         os.remove(tmp)
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     if kind == "zarr":
-        ds.to_zarr(tmp, mode="w", consolidated=True, zarr_format=2)
-    else:
-        ds.to_netcdf(tmp, engine="h5netcdf")
+        # every chunk written (none skipped as all fill values) and its digest kept
+        ds.to_zarr(tmp, mode="w", consolidated=True, zarr_format=2, write_empty_chunks=True)
+        digests = {key: _digest(os.path.join(tmp, key)) for key in _chunk_files(tmp)}
+        with open(os.path.join(tmp, MANIFEST), "w", encoding="utf-8") as f:
+            json.dump(digests, f)
+    else:  # HDF5 Fletcher-32 checksums: a damaged chunk is an error when read, never data
+        encoding = {
+            name: {"fletcher32": True}
+            for name, var in ds.variables.items()
+            if var.ndim and var.size and var.dtype.kind in "biuf"
+        }
+        ds.to_netcdf(tmp, engine="h5netcdf", encoding=encoding)
     if os.path.isdir(path):
         shutil.rmtree(path)
     elif os.path.exists(path):
@@ -313,13 +355,66 @@ def open_branch(path: str | os.PathLike[str]) -> Any:
     """Open a branch written by :func:`save_branch` (loaded into memory)."""
     import xarray as xr
 
+    if not isinstance(path, str | os.PathLike) or not os.fspath(path) or "\0" in str(path):
+        raise ParameterError(f"branch must be a path (BRANCH.nc or BRANCH.zarr): got {path!r}")
     path = os.fspath(path)
-    if not os.path.exists(path):
-        raise StoreError(f"{path} does not exist")
-    if path.endswith(".zarr"):
-        ds = xr.open_zarr(path, consolidated=True).load()
-    else:
-        ds = xr.load_dataset(path, engine="h5netcdf")
+    if not os.path.lexists(path):
+        raise StoreError(f"branch {path} does not exist")
+    try:
+        if os.path.isdir(path):
+            _check_chunks(path)
+            ds = xr.open_zarr(path, consolidated=True).load()
+        else:
+            ds = xr.load_dataset(check_regular_file(path, what="branch file"), engine="h5netcdf")
+    except (StoreError, ParameterError):
+        raise
+    except Exception as exc:  # zarr, h5py and blosc raise many types for damaged files
+        raise StoreError(
+            f"branch {path} is damaged or no branch file ({type(exc).__name__})"
+        ) from None
     if "parameter" not in ds.attrs or "multiplier_re" not in ds:
         raise StoreError(f"{path} is not a gearchaos branch (no 'parameter' attribute)")
     return ds
+
+
+#: The digests of a Zarr branch's chunks, written last by :func:`save_branch`.
+MANIFEST = ".gearchaos_chunks.json"
+
+
+def _chunk_files(root: str) -> list[str]:
+    """The chunk files of a Zarr store (every file not starting with a dot), sorted."""
+    found = []
+    for d, dirs, files in os.walk(root):
+        dirs[:] = sorted(x for x in dirs if not x.startswith("."))
+        found += [os.path.relpath(os.path.join(d, f), root) for f in files if f[0] != "."]
+    return sorted(found)
+
+
+def _digest(path: str) -> str:
+    import hashlib
+
+    with open(path, "rb") as f:
+        return hashlib.sha256(f.read()).hexdigest()
+
+
+def _check_chunks(path: str) -> None:
+    """Every chunk of a Zarr branch is the one :func:`save_branch` wrote (its manifest of
+    SHA-256 digests): a deleted, emptied or overwritten chunk, or one added, is reported by
+    name instead of being read as data (fill values, junk)."""
+    try:
+        with open(os.path.join(path, MANIFEST), encoding="utf-8") as f:
+            manifest = json.load(f)
+        if not isinstance(manifest, dict) or not all(
+            isinstance(k, str) and isinstance(v, str) for k, v in manifest.items()
+        ):
+            raise ValueError(manifest)
+    except (OSError, ValueError, UnicodeDecodeError):
+        raise StoreError(
+            f"branch {path} is damaged: its chunk manifest is missing or unreadable"
+        ) from None
+    on_disk = set(_chunk_files(path))
+    for key in sorted(set(manifest) | on_disk):
+        if key not in manifest:
+            raise StoreError(f"branch {path} is damaged: chunk {key} is not in its manifest")
+        if key not in on_disk or _digest(os.path.join(path, key)) != manifest[key]:
+            raise StoreError(f"branch {path} is damaged: chunk {key} is missing or altered")

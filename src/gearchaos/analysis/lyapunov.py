@@ -23,7 +23,7 @@ import numpy as np
 
 from .._checks import check_int
 from ..errors import ParameterError, Status
-from ..integrate.settings import SolverSettings
+from ..integrate.settings import MAX_SAMPLES_PER_PERIOD, SolverSettings
 from ..integrate.simulate import integrate
 from ..model.system import System
 
@@ -77,9 +77,14 @@ def lyapunov_spectrum(
         regular orbit's like log(·)/periods), ``rtol`` and ``atol`` (of the state and of the
         normalised tangent vectors), ``max_steps``.
     """
-    cfg = SolverSettings.build(settings or LYAPUNOV_SETTINGS, **solver).replace(
-        samples_per_period=renormalizations_per_period
+    if not isinstance(system, System):
+        raise ParameterError(f"system must be a System: got {type(system).__name__}")
+    per_period = check_int(
+        "renormalizations_per_period", renormalizations_per_period, lo=1, hi=MAX_SAMPLES_PER_PERIOD
     )
+    cfg = SolverSettings.build(
+        LYAPUNOV_SETTINGS if settings is None else settings, **solver
+    ).replace(samples_per_period=per_period)
     n = system.n_state
     k = n if n_exponents is None else check_int("n_exponents", n_exponents, lo=1, hi=n)
     if cfg.n_samples < 2:

@@ -46,6 +46,7 @@ from .shooting import Problem, Solution, correct, section_time
 __all__ = [
     "ORBIT_SETTINGS",
     "PeriodicOrbit",
+    "check_tol",
     "contact_levels",
     "minimal_period",
     "orbit_contacts",
@@ -311,11 +312,13 @@ def split_values(
     names = set(SolverSettings.field_names())
     solver = {k: v for k, v in values_and_settings.items() if k in names}
     values = {k: v for k, v in values_and_settings.items() if k not in names}
+    if params is not None and not isinstance(params, Mapping):
+        raise ParameterError(f"params must be a mapping of names to values: got {params!r}")
     for k, v in (params or {}).items():
         if k in values:
             raise ParameterError(f"parameter {k!r} is given twice (keyword and params)")
         values[k] = v
-    cfg = SolverSettings.build(settings or default, **solver)
+    cfg = SolverSettings.build(default if settings is None else settings, **solver)
     return values, cfg
 
 
@@ -325,7 +328,16 @@ def default_tol(settings: SolverSettings) -> float:
     return max(1e-12, 0.1 * float(settings.rtol))
 
 
-def initial_guess(system: System, guess: Any, n: int, cfg: SolverSettings) -> np.ndarray:
+def check_tol(tol: Any, settings: SolverSettings) -> float:
+    """A relative residual tolerance in (0, 0.1], or the default (:func:`default_tol`)."""
+    if tol is None:
+        return default_tol(settings)
+    return check_real("tol", tol, lo=0.0, hi=0.1, lo_open=True)
+
+
+def initial_guess(
+    system: System, guess: Any, n: int, cfg: SolverSettings, what: str = "guess"
+) -> np.ndarray:
     """The Newton start: a state, an orbit's state, or the section point of a simulation
     (``guess=None``: ``transient_periods`` from rest) that best repeats after n periods."""
     if isinstance(guess, PeriodicOrbit):
@@ -343,12 +355,12 @@ def initial_guess(system: System, guess: Any, n: int, cfg: SolverSettings) -> np
         secs = np.asarray(guess.states)[guess.section_index]
         if secs.shape[0] < n + 1:
             raise ParameterError(
-                f"guess must record at least {n + 1} section points for period {n}: "
+                f"{what} must record at least {n + 1} section points for period {n}: "
                 f"got {secs.shape[0]}"
             )
         secs = secs[-2 * n :] if secs.shape[0] >= 2 * n else secs
     else:
-        return system.check_state(guess, "guess")
+        return system.check_state(guess, what)
     m = secs.shape[0] - n
     gaps = [np.max(np.abs(secs[j + n] - secs[j])) for j in range(m)]
     return np.array(secs[int(np.argmin(gaps)) + n], dtype=np.float64)
@@ -418,8 +430,8 @@ def periodic_orbit(
         from ..gearset.validation import warn_if_eccentric
 
         warn_if_eccentric(gs, "Poincaré section")
-    eps = default_tol(cfg) if tol is None else check_real("tol", tol, lo=0.0, lo_open=True)
-    iters = check_int("max_iterations", max_iterations, lo=1)
+    eps = check_tol(tol, cfg)
+    iters = check_int("max_iterations", max_iterations, lo=1, hi=10_000)
     y = initial_guess(system, guess, n, cfg)
     return solve_orbit(system, y, n, cfg, eps, iters, values=values)
 

@@ -81,12 +81,14 @@ def analyse_point(
         Raise :class:`~gearchaos.errors.IntegrationError` when the simulation fails, instead of
         returning a result labelled ``failed``.
     """
-    cfg = settings if settings is not None else SIMULATION
+    cfg = SIMULATION if settings is None else SolverSettings.build(settings)
+    want_lyapunov = check_bool("lyapunov", lyapunov)  # flags checked before any run
+    check = check_bool("check", check)
     system = resolve(target, values, default_omega=default_omega)
-    result = run_simulation(system, cfg, check=check_bool("check", check))
+    result = run_simulation(system, cfg, check=check)
     lle: float | None = None
     lstatus: Status | None = None
-    if check_bool("lyapunov", lyapunov) and result.status.ok:
+    if want_lyapunov and result.status.ok:
         lr = lyapunov_spectrum(system, cfg.replace(samples_per_period=1), n_exponents=1)
         lstatus = lr.status
         if lr.status.ok and math.isfinite(lr.largest):

@@ -26,7 +26,7 @@ from rich.text import Text
 from .._version import __version__
 from ..errors import IntegrationError, ParameterError, StoreError
 from ..gearset.parsing import parse_text
-from ..model.target import DEFAULT_OMEGA, OMEGA
+from ..model.target import DEFAULT_OMEGA, OMEGA, check_omega
 
 if TYPE_CHECKING:
     from ..gearset import GearSet
@@ -183,9 +183,7 @@ def parse_sets(items: Sequence[str]) -> tuple[float | None, dict[str, object]]:
         if not sep or not key:
             raise ParameterError(f"--set expects NAME=VALUE (e.g. omega=1.5): got {item!r}")
         if key == OMEGA:
-            omega = float(parse_text(OMEGA, raw))  # type: ignore[arg-type]
-            if not (math.isfinite(omega) and omega > 0):
-                raise ParameterError(f"omega must be a finite number > 0: got {raw!r}")
+            omega = check_omega(parse_text(OMEGA, raw))
         else:
             changes[key] = parse_text(key, raw)
     return omega, changes

@@ -77,6 +77,8 @@ def init_gearset(
     explained); edit it, then run **gearchaos simulate --gearset FILE**."""
     from ..gearset import template_toml
 
+    if file.exists() and not file.is_file():  # a FIFO would block the write forever
+        c.fail(f"{file} exists and is not a regular file; choose another path", c.EXIT_INVALID)
     if file.exists() and not force:
         c.fail(f"{file} already exists; pass --force to overwrite it", c.EXIT_FAILURE)
     with c.reported_errors():

@@ -85,6 +85,10 @@ def reproduce(
     """
     gs = None
     label = None
+    with c.reported_errors():
+        from ..sweep.execute import Execution
+
+        Execution(workers=workers)  # refused before any directory is made
     if preset is not None or gearset is not None:
         with c.reported_errors():
             gs = c.load_gearset(preset, gearset)
@@ -250,8 +254,6 @@ def calibrate(
         from ..paper.landmarks import load_landmarks
 
         marks = load_landmarks(landmarks)  # a bad file is refused before anything runs
-        if out.parent and not out.parent.exists():
-            out.parent.mkdir(parents=True, exist_ok=True)
         result = run_calibration(
             marks,
             out,

@@ -20,8 +20,8 @@ from ._render import pairs_table, regime_table
 def _parse_planets(raw: str | None) -> tuple[int, ...]:
     if raw is None:
         return (1,)
-    items = [item.strip() for item in raw.split(",") if item.strip()]
-    if not items:
+    items = [item.strip() for item in raw.split(",")]
+    if not all(items):
         raise ParameterError(f"--planets must be planet numbers such as 1,2: got {raw!r}")
     planets = tuple(parse_int("--planets", item) for item in items)
     if any(p < 1 for p in planets):

@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from .._checks import check_real
 from ..errors import ParameterError, Status
 from ..model.system import System
 from ._chains import ChainRun, SampleArrays, run_chains
@@ -65,6 +66,10 @@ def integrate_batch(
     solver failure: each point carries its own status.
     """
     cfg = SolverSettings.build(settings, **solver)
+    if isinstance(systems, System) or not isinstance(systems, Sequence):
+        raise ParameterError(
+            f"systems must be a sequence of Systems (a list): got {type(systems).__name__}"
+        )
     systems = tuple(systems)
     if not systems:
         raise ParameterError("systems must contain at least one System: got none")
@@ -72,8 +77,15 @@ def integrate_batch(
         if not isinstance(s, System):
             raise ParameterError(f"systems[{i}] must be a System: got {type(s).__name__}")
     m, n = len(systems), systems[0].n_state
+    if not (isinstance(max_step, float) and max_step == np.inf):  # inf: no limit
+        check_real("max_step", max_step, lo=0.0, lo_open=True)
     if y0 is not None:
-        y0 = np.array(y0, dtype=np.float64)
+        try:
+            y0 = np.array(y0, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise ParameterError(
+                f"y0 must be an array of shape ({m}, {n}): got {type(y0).__name__}"
+            ) from None
         if y0.shape != (m, n):
             raise ParameterError(f"y0 must have shape ({m}, {n}): got {y0.shape}")
         if not np.all(np.isfinite(y0)):

@@ -21,8 +21,9 @@ from typing import Any
 
 import numpy as np
 
+from .._files import check_output_file, check_regular_file
 from .._version import provenance
-from ..errors import ParameterError
+from ..errors import ParameterError, StoreError
 from .trajectory import Trajectory
 
 __all__ = ["SimulationResult", "open_simulation"]
@@ -248,17 +249,39 @@ class SimulationResult(Trajectory):
 
     # ------------------------------------------------------------------ files
     def save(self, path: str | os.PathLike[str]) -> str:
-        """Write the dataset to a netCDF-4 file (h5netcdf); returns the path."""
+        """Write the dataset to a netCDF-4 file (h5netcdf); returns the path.
+
+        ``path`` must be a file path whose directory exists; an existing regular file is
+        replaced, anything else there (a directory, a FIFO, a device such as ``/dev/null``)
+        is refused with :class:`~gearchaos.errors.StoreError`, as is a failed write.
+        """
+        text = check_output_file(path, what="simulation file")
         ds = self.to_dataset()
-        path = os.fspath(path)
-        tmp = path + ".partial"
-        ds.to_netcdf(tmp, engine="h5netcdf", invalid_netcdf=True)
-        os.replace(tmp, path)  # never leave a half-written file under the final name
-        return path
+        tmp = text + ".partial"
+        try:
+            ds.to_netcdf(tmp, engine="h5netcdf", invalid_netcdf=True)
+            os.replace(tmp, text)  # never leave a half-written file under the final name
+        except OSError as exc:
+            if os.path.isfile(tmp):
+                os.remove(tmp)
+            raise StoreError(f"cannot write {text!r}: {exc.strerror or exc}") from None
+        return text
 
 
 def open_simulation(path: str | os.PathLike[str]) -> Any:
-    """Open a file written by :meth:`SimulationResult.save` as an :class:`xarray.Dataset`."""
+    """Open a file written by :meth:`SimulationResult.save` as an :class:`xarray.Dataset`.
+
+    A path that is not a regular file (missing, a directory, a FIFO or device) or a file that
+    is not netCDF-4 raises :class:`~gearchaos.errors.StoreError` naming the file (a FIFO is
+    never opened blocking); a path of the wrong type raises
+    :class:`~gearchaos.errors.ParameterError`.
+    """
     import xarray as xr
 
-    return xr.load_dataset(os.fspath(path), engine="h5netcdf")
+    name = check_regular_file(path, what="simulation file")
+    try:
+        return xr.load_dataset(name, engine="h5netcdf")
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise StoreError(
+            f"simulation file {name!r} is not a readable netCDF-4 file ({type(exc).__name__})"
+        ) from None

@@ -111,6 +111,10 @@ class SolverSettings:
     def build(cls, base: SolverSettings | None = None, /, **changes: Any) -> SolverSettings:
         """``base`` (default: the defaults) with ``changes`` applied; ``None`` values keep the
         base value. Unknown names are refused with the closest valid name."""
+        if base is not None and not isinstance(base, SolverSettings):
+            raise ParameterError(
+                f"settings must be a SolverSettings or None: got {type(base).__name__}"
+            )
         names = cls.field_names()
         for key in changes:
             if key not in names:

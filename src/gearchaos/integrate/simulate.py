@@ -75,7 +75,7 @@ def integrate(
     k = check_int("n_tangent", n_tangent, lo=0, hi=n)
     t_start = check_real("t0", t0)
     step_max = math.inf
-    if max_step != math.inf:
+    if not (isinstance(max_step, float) and max_step == math.inf):  # inf: no limit
         step_max = check_real("max_step", max_step, lo=0.0, lo_open=True)
     h0 = None if first_step is None else check_real("first_step", first_step, lo=0.0, lo_open=True)
     cfg.check_memory(n * (1 + k) + system.n_obs + 1)

@@ -14,10 +14,13 @@ They let users and tests check the integrator and every analysis on textbook pro
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
+from .._checks import check_real
 from ..errors import ParameterError
 from . import layout as L
 from .system import System
@@ -36,14 +39,12 @@ __all__ = [
 
 
 def _check(name: str, value: float, rule: str) -> float:
-    v = float(value)
-    if not math.isfinite(v):
-        raise ParameterError(f"{name} must be finite: got {value!r}")
-    if rule == ">=0" and v < 0:
-        raise ParameterError(f"{name} must be >= 0: got {v!r}")
-    if rule == ">0" and v <= 0:
-        raise ParameterError(f"{name} must be > 0: got {v!r}")
-    return v
+    """A finite real number (not a bool, not text), >= 0 or > 0 when ``rule`` says so."""
+    if rule == ">=0":
+        return check_real(name, value, lo=0.0)
+    if rule == ">0":
+        return check_real(name, value, lo=0.0, lo_open=True)
+    return check_real(name, value)
 
 
 @dataclass(frozen=True)
@@ -74,11 +75,16 @@ class BacklashOscillator:
         _check("b", self.b, ">=0")
         _check("f_mean", self.f_mean, "")
         _check("f_alt", self.f_alt, "")
-        if not 0.0 <= self.eps < 1.0:
+        if not 0.0 <= _check("eps", self.eps, "") < 1.0:
             raise ParameterError(
                 f"eps must be in [0, 1) (stiffness would turn negative): got {self.eps!r}"
             )
-        if self.omega_power not in (0, 2):
+        power = self.omega_power
+        if (
+            isinstance(power, bool)
+            or not isinstance(power, numbers.Integral)
+            or power not in (0, 2)
+        ):
             raise ParameterError(f"omega_power must be 0 or 2: got {self.omega_power!r}")
 
     @property
@@ -181,6 +187,10 @@ class Lorenz:
     state_names: tuple[str, ...] = ("x", "y", "z")
     obs_names: tuple[str, ...] = ("x", "y", "z", "x_dot", "y_dot", "z_dot")
 
+    def __post_init__(self) -> None:
+        for k in ("sigma", "rho", "beta"):
+            _check(k, getattr(self, k), "")
+
     @property
     def clearances(self) -> dict[str, float]:
         return {}
@@ -203,6 +213,22 @@ def backlash_oscillator(
     return System(BacklashOscillator(zeta, eps, b, f_mean, f_alt, omega_power), omega)
 
 
+def _real_array(name: str, value: Any) -> np.ndarray:
+    """An array of finite real numbers (no bools, text or complex numbers)."""
+    try:
+        raw = np.asarray(value)
+        if raw.dtype.kind not in "fiu":
+            raise TypeError(raw.dtype)
+        a = raw.astype(np.float64)
+    except (TypeError, ValueError, OverflowError):
+        raise ParameterError(
+            f"{name} must be an array of real numbers: got {type(value).__name__}"
+        ) from None
+    if not np.all(np.isfinite(a)):
+        raise ParameterError(f"{name} must be finite: got NaN or inf")
+    return a
+
+
 def linear_system(
     matrix: np.ndarray | list[list[float]],
     omega: float = 1.0,
@@ -211,12 +237,12 @@ def linear_system(
     sin_forcing: np.ndarray | None = None,
 ) -> System:
     """y' = A y + f cos Ωτ + g sin Ωτ."""
-    a = np.asarray(matrix, dtype=float)
+    a = _real_array("matrix", matrix)
     if a.ndim != 2 or a.shape[0] != a.shape[1] or a.shape[0] < 1:
         raise ParameterError(f"matrix must be square and non-empty: got shape {a.shape}")
     n = a.shape[0]
-    f = np.zeros(n) if cos_forcing is None else np.asarray(cos_forcing, dtype=float)
-    g = np.zeros(n) if sin_forcing is None else np.asarray(sin_forcing, dtype=float)
+    f = np.zeros(n) if cos_forcing is None else _real_array("cos_forcing", cos_forcing)
+    g = np.zeros(n) if sin_forcing is None else _real_array("sin_forcing", sin_forcing)
     for name, v in (("cos_forcing", f), ("sin_forcing", g)):
         if v.shape != (n,):
             raise ParameterError(f"{name} must have shape ({n},): got {v.shape}")
@@ -230,6 +256,7 @@ def linear_system(
 
 def linear_oscillator(omega: float = 1.0, *, zeta: float = 0.05, force: float = 0.0) -> System:
     """x'' + 2ζx' + x = F cos Ωτ as a first-order linear system."""
+    zeta, force = _check("zeta", zeta, ""), _check("force", force, "")
     return linear_system(
         [[0.0, 1.0], [-1.0, -2.0 * zeta]], omega, cos_forcing=np.array([0.0, force])
     )
@@ -246,4 +273,5 @@ def lorenz(
     *, sigma: float = 10.0, rho: float = 28.0, beta: float = 8.0 / 3.0, sample_interval: float = 1.0
 ) -> System:
     """Lorenz system; samples are taken every ``sample_interval`` time units."""
-    return System(Lorenz(sigma, rho, beta), 2.0 * math.pi / sample_interval)
+    interval = _check("sample_interval", sample_interval, ">0")
+    return System(Lorenz(sigma, rho, beta), 2.0 * math.pi / interval)

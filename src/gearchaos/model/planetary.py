@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import ParameterError
 from ..gearset import GearSet
 from ..gearset.validation import warn_if_eccentric
 from . import layout as L
@@ -119,6 +120,8 @@ class PlanetaryParameters:
 
 def nondimensionalise(gs: GearSet) -> tuple[PlanetaryParameters, Scales]:
     """Dimensionless parameters (MODEL.md §7) and scales of a gear set."""
+    if not isinstance(gs, GearSet):
+        raise ParameterError(f"gs must be a GearSet: got {type(gs).__name__}")
     st = gs.stiffness
     me = gs.equivalent_mass_mesh
     k = st.sun_planet_mean
@@ -352,4 +355,6 @@ class PlanetaryModel:
 
 def planetary_system(gs: GearSet, omega: float) -> System:
     """The planetary model of ``gs`` at dimensionless mesh frequency Ω = ω/ω_n."""
+    if not isinstance(gs, GearSet):
+        raise ParameterError(f"gs must be a GearSet: got {type(gs).__name__}")
     return System(PlanetaryModel.from_gearset(gs), omega)

@@ -100,11 +100,14 @@ class System:
     params: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
+        from .._checks import check_real
         from ..errors import ParameterError
 
-        om = float(self.omega)
-        if not math.isfinite(om) or om <= 0.0:
-            raise ParameterError(f"omega must be a finite number > 0: got {self.omega!r}")
+        om = check_real("omega", self.omega, lo=0.0, lo_open=True)
+        if not hasattr(self.model, "pack"):
+            raise ParameterError(
+                f"model must be a gearchaos model: got {type(self.model).__name__}"
+            )
         object.__setattr__(self, "omega", om)
         p = np.ascontiguousarray(self.model.pack(om), dtype=np.float64)
         if not np.all(np.isfinite(p)):
@@ -208,15 +211,20 @@ class System:
 
         names = ", ".join(self.state_names)
         try:
-            y = np.array(value, dtype=np.float64).reshape(-1)
-        except (TypeError, ValueError):
+            raw = np.asarray(value)
+            if raw.dtype.kind not in "fiu":  # bools, text, complex numbers, objects
+                raise TypeError(raw.dtype)
+            y = raw.astype(np.float64)
+        except (TypeError, ValueError, OverflowError):
             raise ParameterError(
-                f"{what} must be {self.n_state} numbers ({names}): got {value!r}"
+                f"{what} must be {self.n_state} numbers ({names}): got {type(value).__name__}"
             ) from None
-        if y.size != self.n_state:
-            raise ParameterError(f"{what} must have {self.n_state} entries ({names}): got {y.size}")
+        if y.ndim != 1 or y.size != self.n_state:
+            raise ParameterError(
+                f"{what} must be a vector of {self.n_state} entries ({names}): got shape {y.shape}"
+            )
         if not np.all(np.isfinite(y)):
-            raise ParameterError(f"{what} must be finite: got {y!r}")
+            raise ParameterError(f"{what} must be finite: got {y.tolist()}")
         return y
 
     @property

@@ -127,6 +127,13 @@ def resolve(
         Ω when ``values`` has none: a gear set needs one (else :class:`ParameterError`); a
         system keeps its own Ω when neither is given.
     """
+    if values is not None and not isinstance(values, Mapping):
+        raise ParameterError(
+            "parameter values must be a mapping of dotted names to values "
+            f"(e.g. {{'omega': 1.5}}): got {type(values).__name__}"
+        )
+    if default_omega is not None:
+        default_omega = check_omega(default_omega)
     omega, changes = split_omega(values or {})
     if omega is None:
         if default_omega is not None:

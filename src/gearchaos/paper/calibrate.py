@@ -53,8 +53,9 @@ from typing import Any, TypeVar
 
 import numpy as np
 
-from .._checks import check_bool, check_int
-from ..errors import ParameterError
+from .._checks import check_bool, check_int, check_real
+from .._files import MissingFileError, read_text_file
+from ..errors import ParameterError, StoreError
 from ..integrate.settings import SolverSettings
 from .search_space import (
     BASE_PRESET,
@@ -290,18 +291,40 @@ def read_results(path: str | os.PathLike[str]) -> dict[str, dict[str, Any]]:
     """Finished evaluations of a calibration file by candidate key (a torn last line, left by
     a kill during a write, is ignored)."""
     out: dict[str, dict[str, Any]] = {}
-    p = Path(path)
-    if not p.exists():
+    try:  # a regular UTF-8 file of bounded size: never a FIFO, a device or a directory
+        text = read_text_file(path, what="calibration file", max_bytes=MAX_RESULTS_BYTES)
+    except MissingFileError:
         return out
-    for line in p.read_text(encoding="utf-8").splitlines():
+    for number, line in enumerate(text.splitlines(), start=1):
         if not line.strip():
             continue
         try:
             rec = json.loads(line)
-        except json.JSONDecodeError:
+        except (json.JSONDecodeError, RecursionError):
             continue
+        if not _is_record(rec):
+            raise StoreError(
+                f"calibration file '{path}': line {number} is not a calibration record "
+                "(key, index, score, variables); use another --out file"
+            )
         out[rec["key"]] = rec
     return out
+
+
+#: Largest calibration file read (a record is about 2 KB: 100 000 candidates).
+MAX_RESULTS_BYTES = 256 * 2**20
+
+
+def _is_record(rec: Any) -> bool:
+    """A line this module wrote: a key, an index, a numeric score and the variables."""
+    if not isinstance(rec, dict) or not isinstance(rec.get("key"), str):
+        return False
+    index, score = rec.get("index"), rec.get("score")
+    if isinstance(index, bool) or not isinstance(index, int):
+        return False
+    if isinstance(score, bool) or not isinstance(score, int | float) or math.isnan(score):
+        return False
+    return isinstance(rec.get("variables"), dict)
 
 
 _R = TypeVar("_R", bound=Mapping[str, Any])
@@ -402,16 +425,19 @@ def calibrate(
         The best candidate's gear set is written to ``best.toml`` next to ``out``. Ctrl-C stops
         after the last finished candidate (``stopped == "interrupted"``).
     """
+    if max_candidates is not None:
+        check_int("max_candidates", max_candidates, lo=1)
+    check_real("budget_minutes", budget_minutes, lo=0.0, lo_open=True)
+    check_int("seed", seed, lo=0)
+    quick = check_bool("quick", quick)
+    if not isinstance(out, str | os.PathLike) or not str(os.fspath(out)).strip():
+        raise ParameterError(f"out must be the path of a JSON-lines file: got {out!r}")
     out_path = Path(out)
     if quick:
         max_candidates = 3 if max_candidates is None else min(max_candidates, 3)
         n_initial = n_initial or 3
         settings = settings or SweepSettings.quick()
     n_initial = n_initial or 48
-    if max_candidates is not None and max_candidates < 1:
-        raise ParameterError(f"max_candidates must be >= 1: got {max_candidates}")
-    if not budget_minutes > 0:
-        raise ParameterError(f"budget_minutes must be > 0: got {budget_minutes}")
     if objective is None:
         from .landmarks import load_landmarks
 
@@ -422,6 +448,7 @@ def calibrate(
         )
         objective = landmark_objective(lms, settings)
     done = read_results(out_path)
+    out_path.parent.mkdir(parents=True, exist_ok=True)
     base = _base()
     history = _History()
     records: list[dict[str, Any]] = []

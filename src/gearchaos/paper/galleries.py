@@ -38,6 +38,7 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
+from .._checks import check_bool, check_int, check_real
 from ..errors import ParameterError
 from ..gearset.schema import display_symbol, tex
 from ..integrate.settings import SolverSettings
@@ -155,17 +156,30 @@ def run_gallery(
     from ..plot import axis_symbol
     from ..plot.gallery import parse_extras, poincare_gallery
 
+    if with_ is not None and not isinstance(with_, str | Iterable):
+        raise ParameterError(f"with_ must be 'phase', 'spectrum' or both: got {with_!r}")
     extras = parse_extras(with_)
-    base = SolverSettings.build(settings or GALLERY_SETTINGS, **solver)
+    base = SolverSettings.build(GALLERY_SETTINGS if settings is None else settings, **solver)
     settings = base.replace(samples_per_period=64 if extras else 1)
+    if not isinstance(param, str):
+        raise ParameterError(f"param must be a dotted parameter name: got {param!r}")
+    if fixed is not None and not isinstance(fixed, Mapping):
+        raise ParameterError(
+            f"fixed must be a mapping of dotted names to values: got {type(fixed).__name__}"
+        )
     fixed = dict(fixed or {})
     if param in fixed:
         raise ParameterError(f"{param} is both varied and fixed; choose one")
-    vals = [float(v) for v in values]
-    if not vals:
-        raise ParameterError(f"{param} needs at least one value: got none")
+    vals = _gallery_values(param, values)
+    progress = check_bool("progress", progress)
+    planet = check_int("planet", planet, lo=1)
+    if title is not None and not isinstance(title, str):
+        raise ParameterError(f"title must be text or None: got {type(title).__name__}")
     # resolve every point first: a bad name or value fails before anything runs
     systems = [resolve(gs, {**fixed, param: v}) for v in vals]
+    n_planets = getattr(systems[0].model, "n_planets", None)
+    if n_planets is not None and planet > n_planets:
+        raise ParameterError(f"planet must be one of 1..{n_planets}: got {planet}")
     results: list[Any] = []
     summaries: list[dict[str, Any]] = []
     rows: list[dict[str, Any]] = []
@@ -205,6 +219,30 @@ def run_gallery(
         results, summaries, param=param, values=vals, with_=extras, planet=planet, title=title
     )
     return fig, rows
+
+
+#: Most panels a gallery draws (the seed's galleries have 8 or 9).
+MAX_GALLERY_VALUES = 64
+
+
+def _gallery_values(param: str, values: Any) -> list[float]:
+    """The values of a gallery's path: 1 to :data:`MAX_GALLERY_VALUES` finite numbers."""
+    if isinstance(values, str | bytes) or not isinstance(values, Iterable):
+        raise ParameterError(
+            f"values must be a sequence of numbers (the values of {param}): "
+            f"got {type(values).__name__}"
+        )
+    vals = []
+    for i, v in enumerate(values):
+        if i >= MAX_GALLERY_VALUES:
+            raise ParameterError(
+                f"values: a gallery draws at most {MAX_GALLERY_VALUES} panels: got more "
+                f"values of {param}"
+            )
+        vals.append(check_real(f"values[{i}] ({param})", v))
+    if not vals:
+        raise ParameterError(f"values must hold at least one value of {param}: got none")
+    return vals
 
 
 def _fmt(v: Any) -> str:

@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 
+from .._files import check_output_file
 from ..errors import ParameterError
 from ._common import is_planetary, message
 from .phase import phase_portrait, poincare_map, sun_orbit
@@ -206,7 +207,7 @@ def savefig(fig: Any, path: str | os.PathLike[str], *, dpi: float = 150) -> str:
     Raises :class:`~gearchaos.errors.ParameterError` for any other suffix, and writes under a
     temporary name first so that a failed write never leaves a partial file at ``path``.
     """
-    p = Path(os.fspath(path))
+    p = Path(check_output_file(path, what="figure file"))  # never replaces /dev/null or a FIFO
     suffix = p.suffix.lower()
     if suffix not in SAVE_FORMATS:
         raise ParameterError(

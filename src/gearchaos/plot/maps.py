@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from .._checks import check_bool, check_int, check_real
 from ..errors import ParameterError, Status
 from ..sweep.result import SweepResult
 from ._common import (
@@ -168,6 +169,27 @@ def distinct_map(
 
 
 # --------------------------------------------------------------------------- sweep_figure
+#: Largest figure side in inches (a 200-inch side at 100 dpi is 20 000 pixels).
+MAX_FIGURE_INCHES = 200.0
+
+
+def _check_options(
+    planet: Any, clearance_lines: Any, resonances: Any, max_count: Any, regimes: Any, figsize: Any
+) -> None:
+    """The options of :func:`sweep_figure`, checked before anything is read or drawn."""
+    check_int("planet", planet, lo=1)
+    check_bool("clearance_lines", clearance_lines)
+    check_bool("resonances", resonances)
+    check_int("max_count", max_count, lo=1, hi=10_000)
+    if regimes is not None:
+        check_bool("regimes", regimes)
+    if figsize is not None:
+        if not isinstance(figsize, tuple | list) or len(figsize) != 2:
+            raise ParameterError(f"figsize must be (width, height) in inches: got {figsize!r}")
+        for side in figsize:
+            check_real("figsize", side, lo=0.0, hi=MAX_FIGURE_INCHES, lo_open=True)
+
+
 def sweep_figure(
     ds: Any,
     *,
@@ -197,6 +219,7 @@ def sweep_figure(
     from matplotlib.figure import Figure
 
     res = SweepResult.of(ds)
+    _check_options(planet, clearance_lines, resonances, max_count, regimes, figsize)
     ds = res.ds
     var = resolve_var(ds, var)
     lay = res.layout(var)

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from .._checks import check_int, check_real
-from ..errors import StoreError
+from ..errors import ParameterError, StoreError
 from .result import SweepResult
 from .store import SweepStore, consolidate, foreign_files_ignored, open_sweep
 
@@ -162,11 +162,23 @@ def classify_store(
 
     check_real("period_rtol", period_rtol, lo=0.0, hi=1.0, lo_open=True, hi_open=True)
     check_int("max_period", max_period, lo=1, hi=10_000)
+    from zarr.abc.store import Store
+
+    if not isinstance(store, str | os.PathLike | Store):
+        raise ParameterError(
+            "store must be the path of a sweep store such as 'run.zarr': "
+            f"got {type(store).__name__}"
+        )
     zstore = os.fspath(store) if isinstance(store, str | os.PathLike) else store
     if isinstance(zstore, str):
         open_sweep(zstore)  # a damaged or foreign store is reported, never relabelled
-    with foreign_files_ignored():
-        ds = xr.open_zarr(zstore, chunks=None, consolidated=False)
+    try:
+        with foreign_files_ignored():
+            ds = xr.open_zarr(zstore, chunks=None, consolidated=False)
+    except Exception as exc:  # zarr and xarray raise many types for damaged metadata
+        raise StoreError(
+            f"{zstore!r} is not a readable sweep store ({type(exc).__name__}: {exc})"
+        ) from None
     res = classify_dataset(ds, period_rtol=period_rtol, max_period=max_period)
     g = zarr.open_group(zstore, mode="a", use_consolidated=False)
     dims = list(res["dims"])

@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from .._files import check_output_file
 from ..errors import ParameterError, StoreError
 
 __all__ = ["FORMATS", "export", "open_result", "table"]
@@ -150,9 +151,9 @@ def export(source: Any, path: str | os.PathLike[str], *, to: str | None = None) 
     to
         ``csv`` or ``mat``; default: from the suffix of ``path``.
     """
-    if not isinstance(path, str | os.PathLike) or not os.fspath(path).strip():
-        raise ParameterError(f"the output must be a file path: got {path!r}")
-    out = Path(os.fspath(path))
+    if isinstance(path, str | os.PathLike) and os.path.isdir(path):
+        raise ParameterError(f"the output must be a file: {os.fspath(path)!r} is a directory")
+    out = Path(check_output_file(path, what="the output"))
     fmt = to if to is not None else out.suffix.lower().lstrip(".")
     if fmt not in FORMATS:
         raise ParameterError(

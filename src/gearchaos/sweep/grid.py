@@ -55,6 +55,7 @@ class Grid:
         names = [a.name for a in spec.axes]
         check_names(target, [*names, *self.fixed])
         self.fixed_omega, self._fixed_changes = split_omega(self.fixed)
+        model_for(target, self._fixed_changes)  # the fixed values are valid (or refused) first
         if OMEGA not in names and self.fixed_omega is None:
             if isinstance(target, System):
                 self.fixed_omega = target.omega

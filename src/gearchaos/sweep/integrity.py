@@ -187,9 +187,21 @@ def all_chunks(root: str) -> list[str]:
 def verify_chunks(root: str, chunks: Mapping[str, Any]) -> list[str]:
     """The problems of the listed chunks under ``root``: a chunk written then deleted, or with
     another size or checksum; a chunk listed as not written (``None``) that appeared."""
+    if not isinstance(chunks, Mapping):
+        return ["the record of its chunks is not readable"]
     problems = []
     for rel, expected in chunks.items():
+        if not isinstance(rel, str):
+            problems.append(f"the record names a chunk {rel!r}")
+            continue
         path = os.path.join(root, *rel.split("/"))
+        if expected is not None and not (
+            isinstance(expected, list)
+            and len(expected) == 2
+            and all(isinstance(v, int) and not isinstance(v, bool) for v in expected)
+        ):
+            problems.append(f"chunk {rel} has no readable size and checksum in the record")
+            continue
         if expected is None:
             if os.path.exists(path):
                 problems.append(f"chunk {rel} appeared after it was written as empty")
@@ -238,10 +250,14 @@ def verify_manifest(root: str, arrays: Iterable[str] | None = None) -> None:
     if manifest is None:
         return
     listed: dict[str, Any] = manifest["chunks"]
+    problems = []
     if arrays is not None:
         wanted = set(arrays)
         listed = {k: v for k, v in listed.items() if k.split("/", 1)[0] in wanted}
-    problems = verify_chunks(root, listed)
+    else:  # a chunk the manifest does not know was not written by the sweep
+        unknown = sorted(set(all_chunks(root)) - set(listed))
+        problems += [f"chunk {key} is not in the manifest" for key in unknown]
+    problems += verify_chunks(root, listed)
     if problems:
         shown = "; ".join(problems[:5]) + (
             f"; and {len(problems) - 5} more" if len(problems) > 5 else ""

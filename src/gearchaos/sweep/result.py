@@ -68,6 +68,13 @@ class SweepResult:
     _gearset: Any
 
     def __init__(self, ds: Any, *, _parsed: SweepResult | None = None):
+        import xarray as xr
+
+        if not isinstance(ds, xr.Dataset):
+            raise ParameterError(
+                "a sweep result must be an xarray.Dataset (gearchaos.open_sweep, "
+                f"gearchaos.bifurcation) or a SweepResult: got {type(ds).__name__}"
+            )
         self.ds = ds
         if _parsed is not None:
             self.spec = _parsed.spec

@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from .._checks import check_bool
 from .._version import provenance
 from ..errors import ParameterError, Status
 from ..integrate._chains import ChainOutput, ChainRun
@@ -240,6 +241,8 @@ def run_sweep(
 ) -> Any:
     """Run (or resume) a sweep described by ``spec`` on ``execution`` (default: in-process on
     all cores) into ``store``; return its :class:`xarray.Dataset`."""
+    overwrite, progress = check_bool("overwrite", overwrite), check_bool("progress", progress)
+    classify = check_bool("classify", classify)
     grid = Grid(target, spec, chunk_points=chunk_points)
     layout = _Layout(grid)
     path = _store_path(store)
@@ -257,8 +260,10 @@ def _store_path(store: Any) -> str | None:
     if not isinstance(store, str | os.PathLike):
         raise ParameterError(f"store must be a path such as 'run.zarr' or None: got {store!r}")
     path = os.fspath(store)
-    if not path.strip():
-        raise ParameterError("store must be a path such as 'run.zarr': got an empty string")
+    if not isinstance(path, str) or not path.strip():
+        raise ParameterError(f"store must be a path such as 'run.zarr': got {path!r}")
+    if "\0" in path:
+        raise ParameterError(f"store must not contain a NUL character: got {path!r}")
     if os.path.basename(os.path.normpath(path)) in ("", ".", ".."):
         raise ParameterError(
             f"store must name a directory to create, such as 'run.zarr': got {path!r}"

@@ -22,6 +22,7 @@ be checked against the command that would resume it.
 from __future__ import annotations
 
 import difflib
+import numbers
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -31,6 +32,7 @@ import numpy as np
 from .._checks import check_bool, check_choice, check_int
 from ..errors import ParameterError, StoreError
 from ..integrate.settings import SolverSettings
+from ..model.target import OMEGA, check_omega
 
 __all__ = ["Axis", "SweepSpec", "parse_axis", "parse_values"]
 
@@ -82,18 +84,33 @@ def parse_values(name: str, text: str | float | Sequence[float] | np.ndarray) ->
                 a, b = float(parts[0]), float(parts[1])
                 vals = np.linspace(a, b, _count(name, parts[2], text))
             else:
-                vals = np.array([float(v) for v in t.split(",") if v.strip()])
-        except ValueError:
+                items = t.split(",")
+                if len(items) > 1 and not all(v.strip() for v in items):
+                    raise ParameterError(f"{name}: an empty value in the list: got {text!r}")
+                vals = np.array([float(v) for v in items if v.strip()])
+        except ValueError as exc:
+            if isinstance(exc, ParameterError):
+                raise
             raise _syntax(name, text) from None
     elif isinstance(text, bool) or text is None:
         raise _syntax(name, text)
     elif isinstance(text, int | float | np.floating | np.integer):
-        vals = np.array([float(text)])
+        try:
+            vals = np.array([float(text)])
+        except OverflowError:
+            raise ParameterError(f"{name} values must be finite: got {_shown(text)}") from None
     else:
         try:
-            vals = np.asarray(text, dtype=float)
-        except (TypeError, ValueError):
-            raise _syntax(name, text) from None
+            if isinstance(text, list | tuple) and any(
+                isinstance(v, bool | np.bool_) or not isinstance(v, numbers.Real) for v in text
+            ):
+                raise TypeError("not numbers")
+            raw = np.asarray(text)
+            if raw.dtype.kind not in "fiu":  # complex, bool, text, objects: not values
+                raise TypeError(raw.dtype)
+            vals = raw.astype(float)
+        except (TypeError, ValueError, OverflowError):
+            raise _syntax(name, _shown(text)) from None
         if vals.ndim != 1:
             raise ParameterError(
                 f"{name} values must be a one-dimensional sequence: got an array of shape "
@@ -108,6 +125,12 @@ def parse_values(name: str, text: str | float | Sequence[float] | np.ndarray) ->
     if not np.all(np.isfinite(vals)):
         raise ParameterError(f"{name} values must be finite: got {vals.tolist()}")
     return tuple(float(v) for v in vals)
+
+
+def _shown(value: Any, limit: int = 60) -> Any:
+    """A value as shown in messages: long reprs shortened."""
+    r = repr(value)
+    return value if len(r) <= limit else f"{r[: limit - 3]}..."
 
 
 @dataclass(frozen=True)
@@ -138,18 +161,30 @@ def parse_axis(item: str | tuple[str, Any] | Axis) -> Axis:
             )
         name, _, text = item.partition("=")
         name = name.strip()
+        if not name:
+            raise ParameterError(f"an axis must be NAME=VALUES: the name is missing in {item!r}")
         return Axis(name, parse_values(name, text))
+    if not isinstance(item, tuple | list) or len(item) != 2 or not isinstance(item[0], str):
+        raise ParameterError(
+            "an axis must be NAME=VALUES, a (name, values) pair or a mapping "
+            f"{{name: values}}: got {_shown(item)}"
+        )
     name, vals = item
-    return Axis(str(name), parse_values(str(name), vals))
+    return Axis(name, parse_values(name, vals))
 
 
-def _axes(items: Any) -> tuple[Axis, ...]:
+def _axes(items: Any, what: str = "vary") -> tuple[Axis, ...]:
     if items is None:
         return ()
     if isinstance(items, Mapping):
         return tuple(parse_axis((k, v)) for k, v in items.items())
     if isinstance(items, str | Axis):
         return (parse_axis(items),)
+    if not isinstance(items, list | tuple):
+        raise ParameterError(
+            f"{what} must be NAME=VALUES (e.g. omega=0.1:4:800), a list of them or a mapping "
+            f"{{name: values}}: got {_shown(items)} ({type(items).__name__})"
+        )
     return tuple(parse_axis(i) for i in items)
 
 
@@ -249,9 +284,15 @@ class SweepSpec:
         dup = {n for n in names if names.count(n) > 1}
         if dup:
             raise ParameterError(f"each parameter may be swept once: {sorted(dup)} repeated")
-        for k, _ in self.fixed:
+        for k, v in self.fixed:
             if k in names:
                 raise ParameterError(f"{k} is both swept and fixed (--set); choose one")
+            if k == OMEGA:
+                check_omega(v)
+        for a in self.axes:
+            if a.name == OMEGA:
+                for v in a.values:
+                    check_omega(v)
         check_choice("initial_conditions", self.initial_conditions, INITIAL_CONDITIONS)
         check_choice("direction", self.direction, DIRECTIONS)
         if self.direction != "up" and self.initial_conditions == "fresh":
@@ -300,7 +341,7 @@ class SweepSpec:
         the spec's own (``observe``, ``planets``, ``initial_conditions``, ``direction``,
         ``lyapunov``) and the solver settings by name (``transient_periods``, ``periods``,
         ``rtol``, ``atol``, ``max_steps``), which override ``solver``."""
-        fam = _axes(family)
+        fam = _axes(family, "family")
         if len(fam) > 1:
             raise ParameterError(f"family must be a single axis: got {len(fam)}")
         if fixed is not None and not isinstance(fixed, Mapping):
@@ -325,7 +366,10 @@ class SweepSpec:
             family=fam[0] if fam else None,
             fixed=tuple(sorted((fixed or {}).items())),
             solver=SolverSettings.build(
-                solver or (RESPONSE_SOLVER if own.get("response") else SWEEP_SOLVER), **settings
+                (RESPONSE_SOLVER if own.get("response") else SWEEP_SOLVER)
+                if solver is None
+                else solver,
+                **settings,
             ),
             **own,
         )

@@ -35,6 +35,7 @@ from .integrity import (
     verify_manifest,
     write_json_atomic,
 )
+from .storecheck import verify_attributes, verify_metadata, verify_progress
 
 __all__ = ["SweepStore", "open_sweep"]
 
@@ -82,6 +83,7 @@ def open_sweep(path: str | os.PathLike[str], *, verify: bool = True) -> Any:
         raise StoreError(f"{root!r} is not a readable sweep store (no Zarr group metadata .zgroup)")
     if verify:
         verify_manifest(root)
+        verify_metadata(root)
     consolidated = os.path.exists(os.path.join(root, ".zmetadata"))
     try:
         ds = xr.open_zarr(root, chunks=None, consolidated=consolidated)
@@ -91,6 +93,10 @@ def open_sweep(path: str | os.PathLike[str], *, verify: bool = True) -> Any:
         ) from None
     if "status" not in ds.data_vars:
         raise StoreError(f"{root!r} is not a gearchaos sweep store (no 'status' variable)")
+    if verify:
+        verify_attributes(root, ds)
+        if ds.attrs.get("complete") is not True:
+            verify_progress(root, PROGRESS)
     return ds
 
 
@@ -237,7 +243,8 @@ class SweepStore:
                 assert isinstance(arr, zarr.Array)
                 self._arrays[name] = arr
         keys: list[str] = []
-        for name, values in data.items():
+        # status last: a point whose status says it ran has every other variable written
+        for name, values in sorted(data.items(), key=lambda item: item[0] == "status"):
             arr = self._arrays[name]
             sl = block + (slice(None),) * (arr.ndim - len(block))
             arr[sl] = values

@@ -1,0 +1,239 @@
+"""What every reader of a sweep store checks before it trusts it (issue 10).
+
+The chunk manifest (:mod:`.integrity`) covers the data; this module covers the rest of a store:
+
+* :func:`verify_metadata` — every metadata file (``.zgroup``, ``.zattrs``, ``.zarray``) is
+  readable JSON equal to its copy in the consolidated metadata ``.zmetadata``, which readers
+  use; a metadata file damaged or edited behind the writer's back is reported by name instead
+  of being trusted by one reader and failing in another.
+* :func:`verify_attributes` — the attributes agree with the stored sweep specification
+  (``sweep_toml``): the dimensions, sizes and coordinates, the solver settings repeated as
+  attributes, the gear set (``gearset_toml``) and Ω when it is fixed (``omega_fixed``).
+* :func:`verify_progress` — in an interrupted store, the chunks of every finished task match
+  the checksums in its marker.
+
+Each raises :class:`~gearchaos.errors.StoreError` whose message starts with the store's path.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError, StoreError
+from .integrity import verify_chunks
+
+__all__ = ["verify_attributes", "verify_metadata", "verify_progress"]
+
+_RERUN = "run the sweep again with --overwrite (overwrite=True)"
+
+
+#: What the classification of a store (:func:`gearchaos.sweep.classify.classify_store`) writes
+#: before it consolidates: a run interrupted there leaves these arrays unlisted, or these root
+#: attributes changed, and the next classification rewrites them (readers use .zmetadata).
+CLASSIFY_ARRAYS = frozenset(
+    {"motion", "period", "k01", "indicators_agree", "contact_sp", "contact_rp"}
+)
+CLASSIFY_ATTRS = frozenset({"regime_table", "classification_rtol"})
+
+
+def _classification_left(key: str, actual: Any, consolidated: Any) -> bool:
+    """Whether the root ``.zattrs`` differs from its consolidated copy only in the attributes
+    an interrupted classification writes."""
+    if key != ".zattrs" or not isinstance(actual, dict) or not isinstance(consolidated, dict):
+        return False
+    keys = set(actual) | set(consolidated)
+    return all(actual.get(k) == consolidated.get(k) for k in keys - CLASSIFY_ATTRS)
+
+
+def _damaged(root: str, what: str) -> StoreError:
+    return StoreError(f"{root} is damaged: {what}. Its data cannot be trusted; {_RERUN}")
+
+
+def _load_json(path: str) -> Any:
+    with open(path, encoding="utf-8") as f:
+        return json.load(f)
+
+
+def verify_metadata(root: str) -> None:
+    """Every metadata file of a consolidated store equals its consolidated copy, and every
+    array directory is listed there."""
+    zmeta = os.path.join(root, ".zmetadata")
+    if not os.path.exists(zmeta):  # every store is consolidated when it is created
+        raise StoreError(
+            f"{root!r} is not a readable sweep store: its consolidated metadata .zmetadata is "
+            f"missing (damaged, or not written by gearchaos); {_RERUN}"
+        )
+    try:
+        listed = _load_json(zmeta)["metadata"]
+        if not isinstance(listed, dict):
+            raise TypeError(type(listed).__name__)
+    except (OSError, ValueError, KeyError, TypeError):
+        raise _damaged(root, "the consolidated metadata .zmetadata is not readable") from None
+    for key, consolidated in listed.items():
+        if not isinstance(key, str) or ".." in key.split("/"):
+            raise _damaged(root, f".zmetadata lists a foreign entry {key!r}")
+        path = os.path.join(root, *key.split("/"))
+        try:
+            actual = _load_json(path)
+        except FileNotFoundError:
+            raise _damaged(root, f"the metadata file {key} is missing") from None
+        except (OSError, ValueError):
+            raise _damaged(root, f"the metadata file {key} is not readable JSON") from None
+        if actual != consolidated and not _classification_left(key, actual, consolidated):
+            raise _damaged(root, f"the metadata file {key} differs from .zmetadata")
+    for entry in sorted(os.listdir(root)):
+        if os.path.exists(os.path.join(root, entry, ".zarray")) and (
+            f"{entry}/.zarray" not in listed and entry not in CLASSIFY_ARRAYS
+        ):
+            raise _damaged(root, f"the array {entry} is not in the consolidated metadata")
+
+
+def _same(got: Any, want: Any) -> bool:
+    """Equal, and of the same kind (a bool is not the number 1, a list not a string)."""
+    if isinstance(want, bool) or isinstance(got, bool):
+        return got is want
+    if isinstance(want, int | float):
+        return isinstance(got, int | float) and float(got) == float(want)
+    return type(got) is type(want) and bool(got == want)
+
+
+def verify_attributes(root: str, ds: Any) -> Any:
+    """Check a sweep dataset's attributes against its sweep specification; return the
+    :class:`~gearchaos.sweep.spec.SweepSpec`."""
+    from ..gearset.schema import OMEGA
+    from .spec import SweepSpec
+
+    attrs = ds.attrs
+    text = attrs.get("sweep_toml")
+    if not isinstance(text, str) or not text.strip():
+        raise _damaged(
+            root,
+            f"the attribute sweep_toml (the sweep specification) must be TOML text: got "
+            f"{_short(text)}",
+        )
+    try:
+        spec = SweepSpec.from_toml(text)
+    except StoreError as exc:
+        raise _damaged(root, f"sweep_toml: {exc}") from None
+    dims = tuple(str(d) for d in ds["status"].dims)
+    if dims != spec.dims:
+        raise _damaged(
+            root, f"status has the dimensions {dims}, the sweep specification {spec.dims}"
+        )
+    shape = tuple(int(ds.sizes[d]) for d in dims)
+    if shape != spec.shape:
+        raise _damaged(root, f"status has the shape {shape}, the sweep specification {spec.shape}")
+    for axis in spec.axes:
+        try:
+            values = np.asarray(ds[axis.name].values, dtype=np.float64)
+        except (KeyError, TypeError, ValueError):
+            raise _damaged(root, f"the coordinate {axis.name} is not readable") from None
+        if values.tobytes() != np.asarray(axis.values, dtype=np.float64).tobytes():
+            raise _damaged(root, f"the coordinate {axis.name} differs from the sweep specification")
+    if "section" in ds.dims and int(ds.sizes["section"]) != spec.solver.periods:
+        raise _damaged(
+            root,
+            f"{ds.sizes['section']} section points per sweep point, the sweep specification "
+            f"records {spec.solver.periods} periods",
+        )
+    expected = {
+        "periods": spec.solver.periods,
+        "transient_periods": float(spec.solver.transient_periods),
+        "rtol": float(spec.solver.rtol),
+        "atol": float(spec.solver.atol),
+        "initial_conditions": spec.initial_conditions,
+        "direction": spec.direction,
+        "dims": list(spec.dims),
+    }
+    for key, want in expected.items():
+        if not _same(attrs.get(key), want):
+            raise _damaged(
+                root,
+                f"the attribute {key} is {_short(attrs.get(key))}, the sweep specification "
+                f"says {want!r}",
+            )
+    if not isinstance(attrs.get("complete"), bool):
+        got = _short(attrs.get("complete"))
+        raise _damaged(root, f"the attribute complete must be true or false: got {got}")
+    _verify_target(root, attrs)
+    swept = OMEGA in [a.name for a in spec.axes]
+    raw = attrs.get("omega_fixed")
+    if swept and "omega_fixed" in attrs:
+        raise _damaged(root, f"omega is swept but the attribute omega_fixed is {_short(raw)}")
+    if not swept:
+        if (
+            isinstance(raw, bool)
+            or not isinstance(raw, int | float)
+            or not (math.isfinite(raw) and raw > 0)
+        ):
+            raise _damaged(
+                root, f"the attribute omega_fixed (Ω) must be a number > 0: got {_short(raw)}"
+            )
+        fixed = dict(spec.fixed).get(OMEGA)
+        if fixed is not None and not _same(raw, fixed):
+            raise _damaged(
+                root,
+                f"the attribute omega_fixed is {raw!r}, the sweep specification fixes "
+                f"omega = {fixed!r}",
+            )
+    table = attrs.get("regime_table")
+    if table is not None:
+        try:
+            parsed = json.loads(table) if isinstance(table, str) else None
+        except ValueError:
+            parsed = None
+        if not isinstance(parsed, dict):
+            raise _damaged(root, "the attribute regime_table is not a JSON table")
+    return spec
+
+
+def _verify_target(root: str, attrs: Any) -> None:
+    """``model`` names the model; a planetary store's ``gearset_toml`` is a valid gear set."""
+    model, gtext = attrs.get("model"), attrs.get("gearset_toml")
+    if not isinstance(model, str) or not model:
+        raise _damaged(root, f"the attribute model must name the model: got {_short(model)}")
+    if not isinstance(gtext, str):
+        raise _damaged(root, f"the attribute gearset_toml must be text: got {_short(gtext)}")
+    if model == "planetary":
+        from ..gearset import GearSet
+
+        if not gtext.strip():
+            raise _damaged(root, "the attribute gearset_toml (the gear set) is empty")
+        try:
+            GearSet.from_toml_string(gtext)
+        except ParameterError as exc:
+            raise _damaged(root, f"the stored gear set (gearset_toml) is invalid: {exc}") from None
+    elif gtext:
+        raise _damaged(root, f"a {model} store carries a gear set (gearset_toml)")
+
+
+def verify_progress(root: str, progress_dir: str) -> None:
+    """The chunks of every finished task of an interrupted store match their marker."""
+    d = os.path.join(root, progress_dir)
+    if not os.path.isdir(d):
+        return
+    for name in sorted(os.listdir(d)):
+        if not name.endswith(".done"):
+            continue
+        try:
+            with open(os.path.join(d, name), encoding="utf-8") as f:
+                text = f.read()
+            chunks = json.loads(text)["chunks"] if text.strip() else {}
+            if not isinstance(chunks, dict):
+                raise TypeError(type(chunks).__name__)
+        except (OSError, ValueError, KeyError, TypeError):
+            continue  # a marker torn by a kill: its task is simply not finished
+        problems = verify_chunks(root, chunks)
+        if problems:
+            shown = "; ".join(problems[:5])
+            raise _damaged(root, f"{shown} (task {name[:-5]})")
+
+
+def _short(value: Any, limit: int = 60) -> str:
+    r = repr(value)
+    return r if len(r) <= limit else r[: limit - 3] + "..."
