@@ -37,3 +37,9 @@ def linear_map_store(tmp_path_factory: pytest.TempPathFactory) -> Path:
         **LINEAR_PROTOCOL,
     )
     return path
+
+
+@pytest.fixture(scope="session")
+def linear_parameters() -> dict[str, float]:
+    """The linear oscillator's parameters (Duffing with β = 0) of :func:`linear_map_store`."""
+    return dict(LINEAR)

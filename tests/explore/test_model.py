@@ -10,7 +10,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
-from conftest import LINEAR
 
 import gearchaos as gc
 from gearchaos.errors import ParameterError, StoreError
@@ -70,7 +69,7 @@ def test_the_diagram_holds_every_stored_section_value(gear_store: Path) -> None:
 
 
 def test_a_linear_oscillator_map_shows_1T_points_on_the_analytic_orbit(
-    linear_map_store: Path,
+    linear_map_store: Path, linear_parameters: dict[str, float]
 ) -> None:
     """x'' + δx' + αx = γ cos Ωτ has the one periodic response x = Re[γ e^{iΩτ}/(α − Ω² + iδΩ)]:
     every cell of the map is 1T, and the section at τ_k = 2πk/Ω is that response at phase 0."""
@@ -82,7 +81,7 @@ def test_a_linear_oscillator_map_shows_1T_points_on_the_analytic_orbit(
     point = model.nearest(1.12, 0.27)  # nearest of Ω ∈ {0.6, 0.85, 1.1, 1.35, 1.6}, γ ∈ {.., .3}
     assert point.values == pytest.approx({"omega": 1.1, "gamma": 0.3})
     omega, gamma = point.values["omega"], point.values["gamma"]
-    z = gamma / (LINEAR["alpha"] - omega**2 + 1j * LINEAR["delta"] * omega)
+    z = gamma / (linear_parameters["alpha"] - omega**2 + 1j * linear_parameters["delta"] * omega)
     x, y, _, _ = model.section(point)
     assert x.size == 8
     np.testing.assert_allclose(x, z.real, rtol=0, atol=1e-5)
