@@ -137,6 +137,16 @@ def _bif(**kw: Any) -> Any:
     return gc.bifurcation(BASE, VARY, **{"progress": False, **TINY, **kw})
 
 
+def _resp(**kw: Any) -> Any:
+    return gc.response(BASE, VARY, **{"progress": False, **TINY, **kw})
+
+
+def _explore(**kw: Any) -> Any:
+    from gearchaos.explore import explore
+
+    return explore(**kw)
+
+
 def _build(**kw: Any) -> Any:
     return SweepSpec.build(VARY, **kw)
 
@@ -196,6 +206,27 @@ ROWS = [
         UNKNOWN_OPTION.filter(lambda v: v not in _OPTIONS),
         "unknown",
     ),
+    # response: a continuation sweep with the response quantities (the sweep's doors)
+    Row(
+        "response",
+        "target",
+        lambda v: gc.response(v, VARY, progress=False, **TINY),
+        NOT_TARGET.filter(lambda v: not isinstance(v, str) or v != ""),
+        "target",
+    ),
+    Row("response", "fixed", lambda v: _resp(fixed=v), NOT_MAPPING),
+    Row("response", "store", lambda v: _resp(store=v), NOT_PATH, "store", "path"),
+    Row("response", "overwrite", lambda v: _resp(overwrite=v), NOT_BOOL),
+    Row("response", "progress", lambda v: _resp(progress=v), NOT_BOOL),
+    Row(
+        "response",
+        "direction",
+        lambda v: _resp(direction=v),
+        NOT_CHOICE.filter(lambda v: v not in ("up", "down", "both")),
+    ),
+    Row("response", "solver", lambda v: _resp(solver=v), NOT_SETTINGS, "solver", "settings"),
+    # explore: the store is read (and refused) before any server starts
+    Row("explore", "store", lambda v: _explore(store=v), NOT_PATH, "store", "path"),
     Row("SweepSpec.build", "fixed", lambda v: _build(fixed=v), NOT_MAPPING),
     Row(
         "SweepSpec.build",
