@@ -29,7 +29,7 @@ import numba
 import numpy as np
 
 from ..model.kernels import OBS_ALL, OBS_NONE, OBS_TRACK, rhs, tangent
-from ._switch import first_switch, track
+from ._switch import check_step, predict_switch, track
 from .tableau import DOPRI5
 
 __all__ = ["dopri_chains", "dopri_run"]
@@ -56,6 +56,8 @@ MAX_FACTOR = 10.0
 ERR_EXPONENT = -1.0 / 5.0  # −1/(q+1), q = 4 the lower order of the pair
 
 SWITCH_MIN = 1e-6  # switches closer than this fraction to the step start are not re-located
+
+_CFG = np.array([0.04, 1e-6, 1.0, 0.5e-6])  # dev: beta, land, predict, aim
 
 ST_OK = 0
 ST_MAX_STEPS = 1
@@ -150,6 +152,8 @@ def dopri_run(
     y_final,
     info,
     lsum,
+    cfg,
+    dbg,
 ):  # pragma: no cover - compiled
     """Integrate one system; fill the output arrays; return the status code.
 
@@ -178,7 +182,6 @@ def dopri_run(
     K = np.zeros((STAGES, n))  # tangent components stay zero until the tangents start
     obs = np.empty(n_obs)
     n_tr2 = 2 * n_track
-    obs_prev = np.empty(n_tr2)
     for k in range(n_track):
         obs_min[k] = np.inf
         obs_max[k] = -np.inf
@@ -214,7 +217,13 @@ def dopri_run(
         for k in range(n_track):
             obs_min[k] = obs[k]
             obs_max[k] = obs[k]
-    obs_prev[:] = obs[:n_tr2]
+    # tracked observables at the last three accepted points, newest first, and their times;
+    # n_pts of them lie on the current smooth piece (since the last switch)
+    hist = np.empty((3, n_tr2))
+    t_hist = np.zeros(3)
+    hist[0, :] = obs[:n_tr2]
+    t_hist[0] = t
+    n_pts = 1
     last_rejected = False
     nonfinite = False
     has_switch = False
@@ -222,6 +231,11 @@ def dopri_run(
         if sw[k] < np.inf:
             has_switch = True
     h_event = -1.0
+    beta = cfg[0]
+    land = cfg[1]
+    use_pred = cfg[2] > 0.0
+    expo = 0.2 - 0.75 * beta
+    err_old = 1e-4
 
     while status == ST_OK:
         if j < n_samples:
@@ -238,16 +252,29 @@ def dopri_run(
             status = ST_NON_FINITE if nonfinite else ST_UNDERFLOW
             break
         clipped = False
-        event_step = False
+        shortened = False
+        npp_used = 0
         hs = h
         if h_event > 0.0:
             hs = h_event
-            event_step = True
+            shortened = True
             h_event = -1.0
+        elif has_switch and use_pred and (n_pts >= 2 or (cfg[4] > 0 and n_acc >= 2)):
+            npp = n_pts if n_pts >= 2 else 3
+            hc = min(h, target - t)
+            hp = predict_switch(hist, npp, t_hist, n_track, sw, hc)
+            if n_pts < 2 and hp > cfg[4] * hc:
+                hp = -1.0
+            if hp > land * hs and hp > hmin:
+                hs = hp + 0.5 * land * hs  # end just past the predicted switch
+                shortened = True
+                npp_used = npp if n_pts >= 2 else 1
+                if dbg.size > 4:
+                    dbg[4] += 1
         if t + hs >= target:
             hs = target - t
             clipped = True
-            event_step = False
+            shortened = False
 
         t_new = target if clipped else t + hs
         # the stages; the last one is evaluated at (t_new, y_new) (FSAL)
@@ -309,50 +336,87 @@ def dopri_run(
             continue
         nonfinite = False
 
-        if err <= 1.0 and has_switch and not event_step:
-            theta = first_switch(obs_prev, obs, hs, n_track, sw)
-            if SWITCH_MIN < theta < 1.0:
-                # a contact switch lies inside the step: retry, ending exactly on it
-                h_event = theta * hs
+        where = 0
+        if has_switch:
+            # a switch within land·h of either end of the step counts as landed on (h the
+            # proposal: a shortened step must not make that window shrink)
+            win = land * max(h, hs)
+            theta, where = check_step(hist[0], obs, hs, n_track, sw, win)
+            if theta < 1.0 and theta * hs > hmin:
+                # a switch lies inside the step: retry, ending just past it
+                h_event = theta * hs + 0.5 * win
+                if h_event >= hs:
+                    h_event = theta * hs
                 n_rej += 1
+                if dbg.size > 5:
+                    dbg[5] += 1
+                    if shortened:
+                        dbg[6] += 1
+                        if npp_used > 0 and dbg.size > 20:
+                            dbg[12 + 3 + npp_used - 1] += 1
+                    elif dbg.size > 11:
+                        dbg[7 + n_pts] += 1
                 continue
 
-        if err <= 1.0:
-            n_acc += 1
-            if err == 0.0:
-                factor = MAX_FACTOR
-            else:
-                factor = min(MAX_FACTOR, SAFETY * err**ERR_EXPONENT)
-            if last_rejected and factor > 1.0:
-                factor = 1.0
-            last_rejected = False
-            h_next = hs * factor
-            if (clipped or event_step) and h_next < h:
-                h_next = h  # restore the proposal made before clipping to a sample or switch
-            h = min(h_next, max_step)
-            t = t_new
-            for i in range(n):
-                y[i] = yt[i]
-                K[0, i] = K[STAGES - 1, i]
-            if tracking:
-                track(obs_prev, obs, hs, n_track, obs_min, obs_max)
-            if clipped and j < n_samples:
-                if n_tan > 0:
-                    tan_on = _renormalize(kind, t, y, p, obs, K, n_base, n_tan, lsum, tan_on)
-                out_t[j] = t
-                out_y[j, :] = y
-                out_obs[j, :] = obs
-                if not tracking:
-                    tracking = True
-                    for k in range(n_track):
-                        obs_min[k] = obs[k]
-                        obs_max[k] = obs[k]
-                j += 1
-            obs_prev[:] = obs[:n_tr2]
-        else:
+        if err > 1.0:
             n_rej += 1
-            h = hs * max(MIN_FACTOR, SAFETY * err**ERR_EXPONENT)
+            if dbg.size > 25:
+                dbg[21 + min(n_pts, 3) - 1] += 1
+                if shortened:
+                    dbg[24] += 1
+                if last_rejected:
+                    dbg[25] += 1
+            h = hs * max(MIN_FACTOR, SAFETY * err**-expo)
             last_rejected = True
+            continue
+
+        n_acc += 1
+        if dbg.size > 7 and shortened and where == 0:
+            dbg[7] += 1
+        if dbg.size > 20 and npp_used > 0:
+            dbg[12 + (6 if where == 0 else 0) + npp_used - 1] += 1
+        # PI step-size control (Gustafsson; HNW II §IV.2 and Hairer's DOPRI5)
+        if err == 0.0:
+            factor = MAX_FACTOR
+        else:
+            factor = min(MAX_FACTOR, max(MIN_FACTOR, SAFETY * err**-expo * err_old**beta))
+        if last_rejected and factor > 1.0:
+            factor = 1.0
+        last_rejected = False
+        h_next = hs * factor
+        if clipped or shortened:
+            hr = h * cfg[5] if where == 2 else h
+            if h_next < hr:
+                h_next = hr  # restore the proposal made before clipping to a sample or switch
+        else:
+            err_old = max(err, 1e-4)
+        h = min(h_next, max_step)
+        t = t_new
+        for i in range(n):
+            y[i] = yt[i]
+            K[0, i] = K[STAGES - 1, i]
+        if tracking:
+            track(hist[0], obs, hs, n_track, obs_min, obs_max)
+        if clipped and j < n_samples:
+            if n_tan > 0:
+                tan_on = _renormalize(kind, t, y, p, obs, K, n_base, n_tan, lsum, tan_on)
+            out_t[j] = t
+            out_y[j, :] = y
+            out_obs[j, :] = obs
+            if not tracking:
+                tracking = True
+                for k in range(n_track):
+                    obs_min[k] = obs[k]
+                    obs_max[k] = obs[k]
+            j += 1
+        # the smooth piece: a switch at the end starts a new one, at the start one of two points
+        n_pts = 1 if where == 2 else (2 if where == 1 else min(n_pts + 1, 3))
+        hist[2, :] = hist[1]
+        hist[1, :] = hist[0]
+        hist[0, :] = obs[:n_tr2]
+        t_hist[2] = t_hist[1]
+        t_hist[1] = t_hist[0]
+        t_hist[0] = t
 
     y_final[:] = y
     info[0] = n_acc
@@ -435,6 +499,8 @@ def dopri_chains(
                 y_final[c, j],
                 info[c, j],
                 LSUM[c, j],
+                _CFG,
+                np.zeros(0),
             )
             status[c, j] = st
             if continuation and st == ST_OK:
