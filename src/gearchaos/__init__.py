@@ -10,6 +10,8 @@ errors, sun–planet and planet–ring backlash and sun bearing clearance.
 >>> res.to_dataset().delta_sp.sel(planet=1)   # doctest: +SKIP
 """
 
+from typing import TYPE_CHECKING
+
 from ._version import __version__
 from .errors import IntegrationError, ParameterError, Status, StoreError
 from .gearset import GearSet, preset
@@ -25,11 +27,13 @@ from .model import (
     planetary_system,
 )
 from .sweep import bifurcation, open_sweep
+from .sweep.exports import export
 
 __all__ = [
     "GearSet",
     "IntegrationError",
     "ParameterError",
+    "PeriodicOrbit",
     "SimulationResult",
     "Status",
     "StoreError",
@@ -37,25 +41,41 @@ __all__ = [
     "__version__",
     "backlash_oscillator",
     "bifurcation",
+    "continuation",
     "duffing",
+    "export",
     "linear_oscillator",
     "linear_system",
     "lorenz",
     "nondimensionalise",
     "open_simulation",
     "open_sweep",
+    "periodic_orbit",
     "planetary_system",
     "preset",
     "simulate",
 ]
 
+if TYPE_CHECKING:
+    from .analysis.arclength import continuation
+    from .analysis.orbits import PeriodicOrbit, periodic_orbit
+
 _LAZY_SUBPACKAGES = ("analysis", "plot", "paper")
+#: Functions of the lazy subpackages exported here, by the module that defines them.
+_LAZY_ATTRIBUTES = {
+    "PeriodicOrbit": "analysis.orbits",
+    "periodic_orbit": "analysis.orbits",
+    "continuation": "analysis.arclength",
+}
 
 
 def __getattr__(name: str) -> object:
-    """``gearchaos.plot`` etc. import on first use (matplotlib only when plotting)."""
-    if name in _LAZY_SUBPACKAGES:
-        import importlib
+    """``gearchaos.plot`` etc. import on first use (matplotlib only when plotting), and so do
+    the periodic-orbit front doors (``gc.periodic_orbit``, ``gc.continuation``)."""
+    import importlib
 
+    if name in _LAZY_SUBPACKAGES:
         return importlib.import_module(f"{__name__}.{name}")
+    if name in _LAZY_ATTRIBUTES:
+        return getattr(importlib.import_module(f"{__name__}.{_LAZY_ATTRIBUTES[name]}"), name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

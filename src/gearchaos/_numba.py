@@ -14,9 +14,31 @@ from typing import Any
 from numba import typeof, types
 from numba.core.errors import NumbaIRAssumptionWarning
 
-__all__ = ["call_literal"]
+__all__ = ["call_literal", "on_first_compile"]
 
 _ENTRIES: dict[tuple[Any, ...], Any] = {}
+#: Called once per process before the first kernel that is not in numba's on-disk cache.
+_FIRST_COMPILE: list[Any] = []
+
+
+def on_first_compile(callback: Any) -> None:
+    """Call ``callback()`` once, before this process first compiles a kernel that numba's
+    on-disk cache does not hold (the command line says "compiling numerical kernels (first
+    run only…)" there); ``None`` removes it."""
+    _FIRST_COMPILE.clear()
+    if callback is not None:
+        _FIRST_COMPILE.append(callback)
+
+
+def _in_disk_cache(dispatcher: Any) -> bool:
+    """Whether numba's cache index of ``dispatcher`` exists (its kernels were compiled and
+    saved before); True where that cannot be told."""
+    import os
+
+    try:
+        return bool(os.path.exists(dispatcher._cache._cache_file._index_path))
+    except AttributeError:
+        return True
 
 
 def call_literal(dispatcher: Any, kind: int, *args: Any) -> Any:
@@ -25,6 +47,8 @@ def call_literal(dispatcher: Any, kind: int, *args: Any) -> Any:
     key = (dispatcher, kind, *(typeof(a) for a in args))
     entry = _ENTRIES.get(key)
     if entry is None:
+        if _FIRST_COMPILE and not _in_disk_cache(dispatcher):
+            _FIRST_COMPILE.pop()()
         with warnings.catch_warnings():
             # numba's IR inliner emits an internal "pedantic" NumbaIRAssumptionWarning for the
             # inlined right-hand side; it is harmless and not actionable for users

@@ -97,10 +97,22 @@ def test_format_summary_renders(planetary: gc.SimulationResult) -> None:
     assert "sun_planet_5" in text and "none" in text
 
 
-def test_format_summary_shows_many_distinct_points() -> None:
-    """More than 64 distinct section points (count 65) reads as "many", whatever the label."""
+def test_format_summary_shows_the_true_count_of_distinct_points() -> None:
+    """The count is the true number of distinct points among the recorded ones, shown with
+    that number (issue 12: a counter's cap, 65, used to read as data)."""
     from rich.console import Console
 
     console = Console(record=True, width=120)
-    console.print(format_summary({"distinct_section_points": 65, "motion": "chaos"}))
-    assert "> 64 (many)" in console.export_text()
+    summary = {"distinct_section_points": 200, "recorded_section_points": 200, "motion": "chaos"}
+    console.print(format_summary(summary))
+    assert "200 of 200" in console.export_text()
+
+
+def test_summary_counts_every_distinct_point() -> None:
+    """A chaotic run's Poincaré points are all distinct: the count is the number recorded."""
+    res = gc.simulate(
+        gc.lorenz(), y0=[1.0, 1.0, 1.0], transient_periods=20, periods=150, check=False
+    )
+    s = summarize(res)
+    assert s["recorded_section_points"] == 150
+    assert 120 < s["distinct_section_points"] <= 150

@@ -24,6 +24,8 @@ from gearchaos.gearset.io import (
     to_dict,
     to_toml,
 )
+from gearchaos.gearset.schema import FIELDS
+from gearchaos.gearset.tomltext import float_text
 
 TABLES = [
     "teeth",
@@ -111,19 +113,24 @@ def _floats(
     )
 
 
-positive = _floats(0.0, 1e300, exclude_min=True)
-non_negative = _floats(0.0, 1e300)
-any_real = st.floats(allow_nan=False, allow_infinity=False)
+def _plausible(name: str) -> st.SearchStrategy[float]:
+    """Any float in the plausible range of a field (docs/gearset-rules.md), ends included."""
+    limits = FIELDS[name].limits
+    assert limits is not None and limits.lo is not None and limits.hi is not None
+    return _floats(limits.lo, limits.hi)
 
 
 @st.composite
 def gear_sets(draw: st.DrawFn) -> GearSet:
-    """Valid gear sets: sheng2016 evolved with random valid values for every field."""
+    """Valid gear sets: hindawi2021 evolved with random valid values for every field, over the
+    whole plausible range of each (clearances, errors and eccentricities up to one module)."""
     n = draw(st.integers(1, 12))
     zs = draw(st.integers(1, 400))
     zp = draw(st.integers(1, 400))
     while (2 * (zs + zp)) % n:  # (z_s + z_r)/N = 2(z_s + z_p)/N must be an integer
         zp += 1
+    module = draw(_plausible("geometry.module"))
+    bc = draw(_plausible("clearance.characteristic_length"))
     changes: dict[str, object] = {
         "name": draw(st.text(max_size=20)),
         "description": draw(st.text(max_size=60)),
@@ -131,51 +138,56 @@ def gear_sets(draw: st.DrawFn) -> GearSet:
         "teeth.planet": zp,
         "teeth.ring": zs + 2 * zp,
         "geometry.planets": n,
-        "geometry.module": draw(positive),
+        "geometry.module": module,
         "geometry.pressure_angle_sun": draw(_floats(0.0, 45.0, exclude_min=True, exclude_max=True)),
         "geometry.pressure_angle_ring": draw(
             _floats(0.0, 45.0, exclude_min=True, exclude_max=True)
         ),
         "torque.mode": draw(st.sampled_from(["constant_torque", "constant_power"])),
-        "torque.input": draw(any_real),
-        "torque.reference_omega": draw(positive),
         "backlash.units": draw(st.sampled_from(["dimensionless", "m"])),
         "clearance.units": draw(st.sampled_from(["dimensionless", "m"])),
-        "clearance.characteristic_length": draw(positive),
+        "clearance.characteristic_length": bc,
         "mesh_phasing.model": draw(st.sampled_from(["parker", "in_phase"])),
-        "mesh_phasing.ring_sun": draw(any_real),
     }
-    for name in ["mass.sun", "mass.planet", "inertia.sun", "inertia.planet", "inertia.carrier"]:
-        changes[name] = draw(positive)
-    changes["stiffness.sun_bearing"] = draw(positive)
-    for mesh in ["sun_planet", "planet_ring"]:
-        km = draw(_floats(1e-100, 1e300))
-        changes[f"stiffness.{mesh}_mean"] = km
-        changes[f"stiffness.{mesh}_alternating"] = km * draw(_floats(0.0, 0.5))
-        fractions = draw(st.lists(_floats(-0.1, 0.1), max_size=4))
-        changes[f"stiffness.{mesh}_harmonics"] = [km * f for f in fractions]
     for name in [
+        "mass.sun",
+        "mass.planet",
+        "inertia.sun",
+        "inertia.planet",
+        "inertia.carrier",
+        "stiffness.sun_bearing",
         "damping.sun_planet",
         "damping.planet_ring",
         "damping.sun_bearing",
-        "transmission_error.sun_planet",
-        "transmission_error.planet_ring",
-        "eccentricity.sun",
-        "eccentricity.planet",
-        "eccentricity.ring",
-        "backlash.sun_planet",
-        "backlash.planet_ring",
-        "clearance.sun_bearing",
-    ]:
-        changes[name] = draw(non_negative)
-    for name in [
+        "torque.input",
+        "torque.reference_omega",
         "transmission_error.sun_planet_phase",
         "transmission_error.planet_ring_phase",
         "eccentricity.sun_phase",
         "eccentricity.planet_phase",
         "eccentricity.ring_phase",
+        "mesh_phasing.ring_sun",
     ]:
-        changes[name] = draw(any_real)
+        changes[name] = draw(_plausible(name))
+    for mesh in ["sun_planet", "planet_ring"]:
+        km = draw(_plausible(f"stiffness.{mesh}_mean"))
+        changes[f"stiffness.{mesh}_mean"] = km
+        changes[f"stiffness.{mesh}_alternating"] = km * draw(_floats(0.0, 0.5))
+        fractions = draw(st.lists(_floats(-0.1, 0.1), max_size=4))
+        changes[f"stiffness.{mesh}_harmonics"] = [km * f for f in fractions]
+    # lengths bounded by one module, in metres or in units of b_c
+    for name, units in [
+        ("backlash.sun_planet", "backlash.units"),
+        ("backlash.planet_ring", "backlash.units"),
+        ("clearance.sun_bearing", "clearance.units"),
+        ("transmission_error.sun_planet", None),
+        ("transmission_error.planet_ring", None),
+        ("eccentricity.sun", None),
+        ("eccentricity.planet", None),
+        ("eccentricity.ring", None),
+    ]:
+        scale = bc if units is not None and changes[units] == "dimensionless" else 1.0
+        changes[name] = draw(_floats(0.0, 0.999 * module / scale))
     return evolve(preset("hindawi2021"), changes)
 
 
@@ -247,12 +259,18 @@ def test_strings_are_escaped(base: GearSet, text: str) -> None:
     assert (back.name, back.description) == (text, text + "!")
 
 
-@pytest.mark.parametrize("value", [1e-300, 5e-324, 1.7976931348623157e308, 0.1 + 0.2, 1 / 3])
+@pytest.mark.parametrize(
+    "value", [1e-300, 5e-324, 1.7976931348623157e308, -2.5e-320, 0.1 + 0.2, 1 / 3, 123456789.0]
+)
 def test_awkward_floats_round_trip(base: GearSet, value: float) -> None:
-    gs = evolve(base, {"torque.input": value, "backlash.sun_planet": value})
+    # the writer alone, at any magnitude: the shortest text that reads back to the same double
+    assert tomllib.loads(f"x = {float_text(value)}")["x"] == value
+    if not 0.0 <= value <= 1e9:  # outside the plausible ranges of T_D and b̄_sp
+        return
+    gs = evolve(base, {"torque.input": value, "backlash.sun_planet": min(value, 100.0)})
     back = from_toml_string(to_toml(gs))
     assert back.torque.input == value
-    assert back.backlash.sun_planet == value
+    assert back.backlash.sun_planet == min(value, 100.0)
 
 
 def test_to_dict_layout(base: GearSet) -> None:

@@ -17,6 +17,7 @@ from gearchaos.paper.landmarks import (
     recipe_for,
     score,
 )
+from gearchaos.sweep import SweepSpec
 
 ROOT = Path(__file__).resolve().parents[2]
 FIG4 = {
@@ -183,7 +184,8 @@ def test_missing_panel_or_axis_is_not_evaluated(marks):
 def test_stored_fixed_values_must_agree(marks):
     omega = np.linspace(0.01, 4.0, 50)
     ds = _sweep(omega, ["1T"] * omega.size)
-    ds.attrs["sweep_toml"] = '[fixed]\n"backlash.sun_planet" = 4.0\n'
+    spec = SweepSpec.build({"omega": omega}, fixed={"backlash.sun_planet": 4.0})
+    ds.attrs["sweep_toml"] = spec.to_toml()  # what a store made with that value records
     res = evaluate(marks["fig4a-1T-low"], ds)
     assert res.verdict == "not evaluated"
     assert "backlash.sun_planet = 4" in res.evidence

@@ -29,6 +29,7 @@ def test_reproduce_all_quick_writes_every_figure_and_the_report(tmp_path: Path) 
     for fig in FIGS:
         assert (out / f"{fig}-quick.png").is_file(), fig
         assert f"src='{fig}-quick.png'" in page  # relative path: the page is self-contained
+        assert f"<a href='{fig}-quick.png'" in page  # a click opens it at full resolution
         assert f"id='{fig}'" in page
     assert "id='conclusions'" in page
     for cid in range(1, 9):
@@ -73,3 +74,26 @@ def test_html_escapes_text(tmp_path: Path) -> None:
     assert "<script>x" not in page
     assert "&lt;script&gt;" in page and "a &lt; b &amp; c" in page
     assert "<code>preset sheng2016</code>" in page  # the default gear set is named
+
+
+def test_regime_table_columns_in_fixed_order_with_zero_written_out() -> None:
+    import json
+    import re
+
+    import xarray as xr
+
+    from gearchaos.paper.report import _regime_table
+
+    table = {
+        "xi = 0.03": {"chaos": 0.5, "2T": 0.25, "unresolved": 0.25},
+        "xi = 0.07": {"1T": 0.75, "QP": 0.25},
+    }
+    ds = xr.Dataset(attrs={"regime_table": json.dumps(table)})
+    html = _regime_table(ds)
+    head = re.findall(r"<th>([^<]*)</th>", html.split("</tr>")[0])
+    assert head == ["panel", "1T", "2T", "QP", "chaos", "unresolved"]
+    rows = re.findall(r"<tr><th>([^<]*)</th>(.*?)</tr>", html)
+    cells = {panel: re.findall(r"<td>([^<]*)</td>", body) for panel, body in rows}
+    assert cells["xi = 0.03"] == ["0 %", "25 %", "0 %", "50 %", "25 %"]
+    assert cells["xi = 0.07"] == ["75 %", "0 %", "25 %", "0 %", "0 %"]
+    assert "—" not in html

@@ -17,8 +17,14 @@ from matplotlib.figure import Figure
 import gearchaos as gc
 from gearchaos.analysis.derived import gearset_info
 from gearchaos.errors import ParameterError
-from gearchaos.plot import bifurcation, bifurcation_figure, distinct_map, sweep_figure
-from gearchaos.plot.bifurcation import axis_label, distinct_counts
+from gearchaos.plot import (
+    axis_label,
+    bifurcation,
+    bifurcation_figure,
+    distinct_counts,
+    distinct_map,
+    sweep_figure,
+)
 from gearchaos.sweep import SweepSpec
 
 SECTIONS = 24  # divisible by 1, 2, 3, 4, 6, 8: every period below repeats whole
@@ -107,7 +113,10 @@ def test_axis_labels_use_the_paper_symbols() -> None:
     assert axis_label("backlash.planet_ring") == r"$\bar b_{rp}$"
     assert axis_label("clearance.sun_bearing") == r"$\bar b_s$"
     assert axis_label("torque.input") == r"$T_D$ [N m]"
-    assert axis_label("mass.sun") == "mass.sun"  # fallback: the dotted name
+    # every gear-set field has a symbol and unit in the registry (gearset/schema.py) ...
+    assert axis_label("mass.sun") == r"$m_s$ [kg]"
+    # ... and a name outside it labels itself
+    assert axis_label("not.a_parameter") == "not.a_parameter"
 
 
 # --------------------------------------------------------------------------- bifurcation
@@ -156,10 +165,32 @@ def test_clearance_lines_from_attrs_and_from_the_swept_backlash() -> None:
 
     b = np.array([1.0, 4.0, 7.0])
     ds = sweep_dataset(np.array([1, 1, 2]), {"backlash.sun_planet": b})
-    ax = bifurcation(ds, clearance_lines=True)
+    ax = bifurcation(ds, clearance_lines=True, relative=False)
     assert ax.get_xlabel() == r"$\bar b_{sp}$"
     ys = sorted(tuple(line.get_ydata()) for line in gid_lines(ax, "clearance"))
     assert ys == [tuple(-b), tuple(b)]  # ±b̄ follows the swept backlash
+
+
+def test_swept_own_clearance_draws_the_deflection_beyond_it() -> None:
+    """Sweeping b̄_sp, X̄_sp grows with b̄ (a thin band along the diagonal); by default the
+    diagram shows X̄ − b̄ with the flank edges at 0 and −2b̄."""
+    b = np.array([1.0, 4.0, 7.0])
+    ds = sweep_dataset(np.array([1, 1, 2]), {"backlash.sun_planet": b})
+    ds["delta_sp"] = ds["delta_sp"] + xr.DataArray(b, dims="backlash.sun_planet")
+    ax = bifurcation(ds, clearance_lines=True)
+    assert ax.get_ylabel() == r"$\bar{X}_{sp1} - \bar b_{sp}$"
+    absolute = bifurcation(ds, relative=False)
+    y_rel = np.sort(ax.collections[0].get_offsets()[:, 1])
+    pts = absolute.collections[0].get_offsets()
+    x_abs = np.asarray(pts[:, 0])
+    y_expected = np.sort(np.asarray(pts[:, 1]) - np.interp(x_abs, b, b))
+    np.testing.assert_allclose(y_rel, y_expected, atol=1e-12)
+    ys = [np.asarray(line.get_ydata(), dtype=float) for line in gid_lines(ax, "clearance")]
+    assert any(np.all(y == 0.0) for y in ys)  # drive-flank edge X̄ = b̄
+    assert any(y.shape == b.shape and np.allclose(y, -2.0 * b) for y in ys)  # back flank
+    # the y axis follows the relative values, not the diagonal
+    lo, hi = ax.get_ylim()
+    assert hi - lo < 0.5 * (b[-1] - b[0])
 
 
 def test_resonance_lines_at_harmonics_meeting_natural_frequencies() -> None:
@@ -301,3 +332,20 @@ def test_linear_regime_sweep_gives_one_dot_per_omega() -> None:
     assert sorted(float(line.get_ydata()[0]) for line in gid_lines(ax, "clearance")) == [-1, 1]
     # default variable of a reference-system store: its first observed one
     assert bifurcation(ds).get_ylabel() == "$x$"
+
+
+def test_axes_follow_an_attractor_beside_the_backlash() -> None:
+    """An attractor spanning X̄ ∈ [2.8, 3.25] beside b̄_sp = 3: the y limits lie within 10 % of
+    the data range; +b̄ (inside) is drawn, −b̄ (far outside) is an edge note, not a limit."""
+    from gearchaos.plot.units import CLEARANCE_NOTE_GID
+
+    ds = sweep_dataset(np.zeros(5, int), {"omega": np.linspace(1.0, 2.0, 5)})
+    v = ds["delta_sp"].values
+    ds["delta_sp"] = (ds["delta_sp"].dims, 2.8 + 0.45 * (v - v.min()) / np.ptp(v))
+    ax = bifurcation(ds, clearance_lines=True)
+    lo, hi = ax.get_ylim()
+    assert lo <= 2.8 and hi >= 3.25
+    assert lo >= 2.8 - 0.045 and hi <= 3.25 + 0.045
+    notes = [t.get_text() for t in ax.texts if t.get_gid() == CLEARANCE_NOTE_GID]
+    assert len(notes) == 1 and "−" in notes[0] and "3" in notes[0]
+    assert sorted(float(line.get_ydata()[0]) for line in gid_lines(ax, "clearance")) == [-3, 3]

@@ -98,7 +98,9 @@ def test_runner_labels_every_value_of_a_reference_system() -> None:
     # backlash oscillator held in contact by its mean load (x ≈ b + F_m, |x - b - F_m| < F_m):
     # a linear oscillator, 1T, both exponents -zeta
     system = gc.backlash_oscillator(0.6, zeta=0.1, b=1.0, f_mean=2.0, f_alt=0.3, omega_power=0)
-    fig, rows = run_gallery(system, "omega", [0.5, 0.8], transient=30, periods=40, progress=False)
+    fig, rows = run_gallery(
+        system, "omega", [0.5, 0.8], transient_periods=30, periods=40, progress=False
+    )
     assert len(map_axes(fig)) == 2
     assert [list(r) for r in rows] == [list(ROW_KEYS)] * 2
     assert [r["value"] for r in rows] == [0.5, 0.8]

@@ -164,3 +164,25 @@ def test_periodic_poincare_point_is_not_blown_up(oscillator: gc.SimulationResult
     lo, hi = ax.get_ylim()
     assert hi - lo > 0.05 * abs(oscillator.section("x_dot")[0])
     assert ax.yaxis.get_major_formatter().get_useOffset() is False
+
+
+def test_spectrum_labels_mesh_harmonics_in_hertz(planetary: gc.SimulationResult) -> None:
+    """The h-th mesh harmonic is labelled h f_m in Hz with f_m = Ω ω_n/2π, ω_n = √(k_m,sp/m_e)
+    from the gear set's own numbers (MODEL.md §7)."""
+    import re
+
+    from gearchaos.plot.timeseries import HARMONIC_GID
+
+    gs = planetary.system.model.gearset
+    alpha = math.radians(gs.geometry.pressure_angle_sun)
+    r_bs = 0.5 * gs.geometry.module * gs.teeth.sun * math.cos(alpha)
+    r_bp = 0.5 * gs.geometry.module * gs.teeth.planet * math.cos(alpha)
+    m_s, m_p = gs.inertia.sun / r_bs**2, gs.inertia.planet / r_bp**2
+    omega_n = math.sqrt(gs.stiffness.sun_planet_mean * (m_s + m_p) / (m_s * m_p))
+    f_m = 0.5 * omega_n / (2.0 * math.pi)  # Ω = 0.5
+    ax = gc.plot.spectrum(planetary, max_harmonic=5.0)
+    labels = [t.get_text() for t in ax.texts if t.get_gid() == HARMONIC_GID]
+    assert len(labels) == 5
+    for h, text in enumerate(labels, start=1):
+        hz = float(re.search(r"= (\d+) Hz", text).group(1))
+        assert hz == pytest.approx(h * f_m, abs=0.5)

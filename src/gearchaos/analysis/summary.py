@@ -89,7 +89,10 @@ def summarize(
     model = system.model
     planetary = hasattr(model, "n_planets")
     x, xd = section_points(result)
-    n = count_distinct(np.column_stack([x, xd]), tol=tol, max_count=max_count)
+    pts = np.column_stack([x, xd])
+    n_recorded = int(np.sum(np.all(np.isfinite(pts), axis=1)))
+    # the true count, up to the number of recorded points: never a cap that reads as data
+    n = count_distinct(pts, tol=tol, max_count=max(n_recorded, 1))
     mc = classify_motion(
         np.column_stack([x, xd]),
         lle=lle,
@@ -122,6 +125,7 @@ def summarize(
         "steps_accepted": int(result.steps_accepted),
         "steps_rejected": int(result.steps_rejected),
     }
+    out["recorded_section_points"] = n_recorded
     out["lle"] = _num(mc.lle) if mc.lle is not None else None
     out["k01"] = _num(mc.k01) if mc.k01 is not None else None
     out["indicators_agree"] = bool(mc.agree)
@@ -186,8 +190,9 @@ def format_summary(summary: dict[str, Any], *, title: str | None = None) -> Any:
     for key, label in labels.items():
         if key in summary:
             value = summary[key]
-            if key == "distinct_section_points" and motion_name(int(value)) == "many":
-                value = f"> {int(value) - 1} (many)"
+            recorded = summary.get("recorded_section_points")
+            if key == "distinct_section_points" and recorded:
+                value = f"{int(value)} of {int(recorded)}"
             table.add_row(escape(label), escape(_fmt(value)))
     style = {"none": "green", "single_sided": "yellow", "double_sided": "red"}
     for c in summary.get("contact", []):

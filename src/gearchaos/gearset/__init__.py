@@ -1,39 +1,18 @@
-"""Physical layer: frozen gear-set records, TOML I/O, validation and presets."""
+"""Physical layer: frozen gear-set records, TOML I/O, validation and presets.
 
+The records of the tables (:class:`Teeth` … :class:`MeshPhasing`) are those of
+:mod:`.tables`; :class:`GearSet` holds one of each (:mod:`.records`).
+"""
+
+from . import tables
 from .io import from_toml, from_toml_string, template_toml, to_toml
 from .presets import list_presets, preset
-from .records import (
-    UNITS,
-    Backlash,
-    Clearance,
-    Damping,
-    Eccentricity,
-    GearSet,
-    Geometry,
-    Inertia,
-    Mass,
-    MeshPhasing,
-    Stiffness,
-    Teeth,
-    Torque,
-    TransmissionError,
-)
+from .records import UNITS, GearSet
+from .tables import *  # noqa: F403 - the record classes, listed in tables.__all__
 
 __all__ = [
     "UNITS",
-    "Backlash",
-    "Clearance",
-    "Damping",
-    "Eccentricity",
     "GearSet",
-    "Geometry",
-    "Inertia",
-    "Mass",
-    "MeshPhasing",
-    "Stiffness",
-    "Teeth",
-    "Torque",
-    "TransmissionError",
     "from_toml",
     "from_toml_string",
     "list_presets",
@@ -41,3 +20,4 @@ __all__ = [
     "template_toml",
     "to_toml",
 ]
+__all__ += tables.__all__

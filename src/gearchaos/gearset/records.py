@@ -2,7 +2,9 @@
 
 Every field is addressed by a stable dotted name (``teeth.sun``, ``backlash.sun_planet``,
 ``damping.sun_bearing`` ...) that is the same in Python, TOML, the CLI, sweep stores and plot
-labels. Units live in one table, :data:`UNITS`, not in the field names.
+labels. Units live in the parameter registry (:mod:`gearchaos.gearset.schema`; :data:`UNITS`),
+not in the field names. The records of the tables (:class:`Teeth` …) are defined in
+:mod:`gearchaos.gearset.tables` and importable from here.
 
 Angles are stored in degrees (as gear designers quote them); everything else is SI. Clearances
 may be stored dimensionless (relative to ``clearance.characteristic_length`` b_c, as the seed
@@ -19,161 +21,38 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from pathlib import Path
+from types import MappingProxyType
+from typing import Final
 
-__all__ = [
-    "UNITS",
-    "Backlash",
-    "Clearance",
-    "Damping",
-    "Eccentricity",
-    "GearSet",
-    "Geometry",
-    "Inertia",
-    "Mass",
-    "MeshPhasing",
-    "Stiffness",
-    "Teeth",
-    "Torque",
-    "TransmissionError",
-]
+from .._files import read_text_file
+from ..errors import ParameterError
+from .mapping import apply_changes, check_changes, records_from_data, to_dict
+from .schema import UNITS
+from .tables import (
+    RECORD_CLASSES,
+    Backlash,
+    Clearance,
+    Damping,
+    Eccentricity,
+    Geometry,
+    Inertia,
+    Mass,
+    MeshPhasing,
+    Stiffness,
+    Teeth,
+    Torque,
+    TransmissionError,
+)
+from .tomltext import MAX_FILE_BYTES, parse, to_toml
+from .validation import validate
 
-
-@dataclass(frozen=True)
-class Teeth:
-    """Tooth numbers z_s (sun), z_p (planet), z_r (ring, internal)."""
-
-    sun: int
-    planet: int
-    ring: int
-
-
-@dataclass(frozen=True)
-class Geometry:
-    """Planets N, module m [m], pressure angles α_s (sun–planet), α_r (ring–planet) [deg]."""
-
-    planets: int
-    module: float
-    pressure_angle_sun: float = 20.0
-    pressure_angle_ring: float = 20.0
+__all__ = ["MAX_FILE_BYTES", "UNITS", "GearSet"]
 
 
-@dataclass(frozen=True)
-class Mass:
-    """Translational masses [kg]: the sun's m_s (moves in x, y) and each planet's m_p
-    (rides on the carrier)."""
-
-    sun: float
-    planet: float
-
-
-@dataclass(frozen=True)
-class Inertia:
-    """Polar moments of inertia [kg m²] J_s, J_p (each planet) and J_c (carrier)."""
-
-    sun: float
-    planet: float
-    carrier: float
-
-
-@dataclass(frozen=True)
-class Stiffness:
-    """Mesh and support stiffness [N/m].
-
-    k_sp(t) = k_m,sp + k_a,sp cos(ωt + φ) + Σ_h k_h cos(h(ωt + φ)), h = 2, 3, …
-    (``sun_planet_harmonics`` lists k_2, k_3, …); likewise for the planet–ring mesh.
-    """
-
-    sun_planet_mean: float
-    sun_planet_alternating: float
-    planet_ring_mean: float
-    planet_ring_alternating: float
-    sun_bearing: float
-    sun_planet_harmonics: tuple[float, ...] = ()
-    planet_ring_harmonics: tuple[float, ...] = ()
-
-
-@dataclass(frozen=True)
-class Damping:
-    """Viscous damping ratios ξ_sp, ξ_rp, ξ_s (MODEL.md §4)."""
-
-    sun_planet: float
-    planet_ring: float
-    sun_bearing: float
-
-
-@dataclass(frozen=True)
-class Torque:
-    """Input torque T_D on the sun [N m] and load mode.
-
-    ``constant_torque``: T_D fixed. ``constant_power``: T_D is the torque at the dimensionless
-    mesh frequency Ω = ``reference_omega`` and scales as T_D Ω_ref/Ω. The output torque on the
-    carrier is always the loss-free balance (:attr:`GearSet.output_torque`).
-    """
-
-    input: float
-    mode: str = "constant_torque"
-    reference_omega: float = 1.0
-
-
-@dataclass(frozen=True)
-class TransmissionError:
-    """Static transmission-error amplitudes A_sp, A_rp [m] and their phase offsets [deg]
-    relative to the mesh-stiffness phase of the same mesh."""
-
-    sun_planet: float = 0.0
-    planet_ring: float = 0.0
-    sun_planet_phase: float = 0.0
-    planet_ring_phase: float = 0.0
-
-
-@dataclass(frozen=True)
-class Eccentricity:
-    """Geometric eccentricities E_s, E_p, E_r [m] and phases β_s, β_p, β_r [deg] (MODEL.md §3)."""
-
-    sun: float = 0.0
-    planet: float = 0.0
-    ring: float = 0.0
-    sun_phase: float = 0.0
-    planet_phase: float = 0.0
-    ring_phase: float = 0.0
-
-
-@dataclass(frozen=True)
-class Backlash:
-    """Half backlashes b_sp, b_rp of the sun–planet and planet–ring meshes (total 2b).
-
-    ``units`` is ``"dimensionless"`` (values are b̄ = b/b_c, as in the seed) or ``"m"``.
-    """
-
-    sun_planet: float
-    planet_ring: float
-    units: str = "dimensionless"
-
-
-@dataclass(frozen=True)
-class Clearance:
-    """Sun bearing half clearance b_s and the characteristic length b_c [m].
-
-    ``units`` applies to ``sun_bearing`` only (``"dimensionless"`` or ``"m"``);
-    ``characteristic_length`` is always in metres.
-    """
-
-    sun_bearing: float
-    characteristic_length: float
-    units: str = "dimensionless"
-
-
-@dataclass(frozen=True)
-class MeshPhasing:
-    """Mesh phasing model: ``parker`` (Parker & Lin 2004) or ``in_phase`` (all φ = 0).
-
-    ``ring_sun`` is γ_rs, the ring-mesh phase of planet 1 relative to its sun mesh, as a
-    fraction of one mesh cycle (used by ``parker`` only).
-    """
-
-    model: str = "parker"
-    ring_sun: float = 0.0
+_NO_CHANGES: Final[Mapping[str, object]] = MappingProxyType({})
 
 
 def _frac(x: float) -> float:
@@ -204,8 +83,6 @@ class GearSet:
     description: str = ""
 
     def __post_init__(self) -> None:
-        from .validation import validate
-
         validate(self)
 
     # ------------------------------------------------------------------ geometry
@@ -384,89 +261,75 @@ class GearSet:
         return any(v != 0.0 for v in (e.sun, e.planet, e.ring))
 
     # ------------------------------------------------------------------ copies and I/O
-    def evolve(self, changes: dict[str, object] | None = None, /, **kwargs: object) -> GearSet:
-        """A validated copy with some fields changed.
+    def evolve(self, changes: Mapping[str, object] = _NO_CHANGES, /, **kwargs: object) -> GearSet:
+        """A validated copy with some parameters changed.
 
-        Fields are addressed by dotted name: ``gs.evolve({"backlash.sun_planet": 4.0})`` or,
-        as keywords, with ``__`` for the dot: ``gs.evolve(backlash__sun_planet=4.0)``.
-        The alias ``xi`` sets all three damping ratios.
+        Parameters
+        ----------
+        changes : mapping of str to object, optional
+            New values by dotted name (``{"backlash.sun_planet": 4.0}``), ``"name"``,
+            ``"description"``, a table name (``"backlash"``) with a record instance or a
+            mapping of some of its fields, or the alias ``"xi"`` that sets
+            ``damping.sun_planet``, ``damping.planet_ring`` and ``damping.sun_bearing`` at once
+            (a dotted damping name in the same call overrides the alias for that ratio).
+            Integers are accepted for float fields and sequences for the harmonics; they are
+            converted to float and tuple. Leave it out for an unchanged copy: anything but a
+            mapping, ``None`` included, is refused (a ``None`` where changes were meant is a
+            bug, not a request for no change).
+        **kwargs
+            More changes, with ``__`` for the dot: ``gs.evolve(backlash__sun_planet=4.0)``;
+            they override ``changes``.
+
+        Returns
+        -------
+        GearSet
+            The new gear set, validated as a whole (so a change of ``teeth.planet`` must come
+            with a consistent ``teeth.ring``).
+
+        Raises
+        ------
+        ParameterError
+            If ``changes`` is not a mapping (the message names ``changes``), for an unknown
+            name (suggesting the closest valid one) or an invalid resulting set.
         """
-        from .io import evolve
-
-        merged: dict[str, object] = dict(changes or {})
+        merged: dict[object, object] = dict(check_changes(changes))
         merged.update({k.replace("__", "."): v for k, v in kwargs.items()})
-        return evolve(self, merged)
+        tables, meta = apply_changes(self, merged)
+        records = {table: cls(**tables[table]) for table, cls in RECORD_CLASSES.items()}
+        return GearSet(**records, **meta)  # type: ignore[arg-type]
 
     @classmethod
-    def from_toml(cls, path: str | os.PathLike[str]) -> GearSet:
-        """Read a gear set from a TOML file (see ``gearchaos init-gearset`` for a template)."""
-        from .io import from_toml
-
-        return from_toml(path)
+    def from_dict(cls, data: Mapping[str, object]) -> GearSet:
+        """Build a gear set from a nested mapping in TOML layout (the inverse of
+        :meth:`to_dict`); see :func:`gearchaos.gearset.io.from_dict`."""
+        records, meta = records_from_data(data)
+        return GearSet(**records, **meta)  # type: ignore[arg-type]
 
     @classmethod
     def from_toml_string(cls, text: str) -> GearSet:
-        """Parse a gear set from TOML text."""
-        from .io import from_toml_string
+        """Parse a gear set from TOML text (``ParameterError`` for invalid TOML or values)."""
+        return cls.from_dict(parse(text))
 
-        return from_toml_string(text)
+    @classmethod
+    def from_toml(cls, path: str | os.PathLike[str]) -> GearSet:
+        """Read a gear set from a TOML file (see ``gearchaos init-gearset`` for a template).
+
+        Only a regular UTF-8 file of at most :data:`MAX_FILE_BYTES` bytes is read (see
+        :func:`gearchaos.gearset.io.from_toml` for the errors): a directory, FIFO, device,
+        link loop or huge file is refused with a ``StoreError``, a missing file with a
+        ``FileNotFoundError`` (that is also a ``StoreError``), invalid contents with a
+        ``ParameterError`` whose message starts with the path.
+        """
+        text = read_text_file(path, what="gear-set file", max_bytes=MAX_FILE_BYTES)
+        try:
+            return cls.from_toml_string(text)
+        except ParameterError as exc:
+            raise ParameterError(f"{Path(path)}: {exc}") from exc
 
     def to_toml(self) -> str:
         """TOML text that :meth:`from_toml_string` reads back to an equal gear set."""
-        from .io import to_toml
-
         return to_toml(self)
 
     def to_dict(self) -> dict[str, object]:
         """Nested plain dictionary (TOML layout)."""
-        from .io import to_dict
-
         return to_dict(self)
-
-
-#: Units of every dotted field (degrees for angles; clearances follow their ``units`` field).
-UNITS: dict[str, str] = {
-    "teeth.sun": "1",
-    "teeth.planet": "1",
-    "teeth.ring": "1",
-    "geometry.planets": "1",
-    "geometry.module": "m",
-    "geometry.pressure_angle_sun": "deg",
-    "geometry.pressure_angle_ring": "deg",
-    "mass.sun": "kg",
-    "mass.planet": "kg",
-    "inertia.sun": "kg m^2",
-    "inertia.planet": "kg m^2",
-    "inertia.carrier": "kg m^2",
-    "stiffness.sun_planet_mean": "N/m",
-    "stiffness.sun_planet_alternating": "N/m",
-    "stiffness.planet_ring_mean": "N/m",
-    "stiffness.planet_ring_alternating": "N/m",
-    "stiffness.sun_bearing": "N/m",
-    "stiffness.sun_planet_harmonics": "N/m",
-    "stiffness.planet_ring_harmonics": "N/m",
-    "damping.sun_planet": "1",
-    "damping.planet_ring": "1",
-    "damping.sun_bearing": "1",
-    "torque.input": "N m",
-    "torque.mode": "",
-    "torque.reference_omega": "1",
-    "transmission_error.sun_planet": "m",
-    "transmission_error.planet_ring": "m",
-    "transmission_error.sun_planet_phase": "deg",
-    "transmission_error.planet_ring_phase": "deg",
-    "eccentricity.sun": "m",
-    "eccentricity.planet": "m",
-    "eccentricity.ring": "m",
-    "eccentricity.sun_phase": "deg",
-    "eccentricity.planet_phase": "deg",
-    "eccentricity.ring_phase": "deg",
-    "backlash.sun_planet": "b_c or m (backlash.units)",
-    "backlash.planet_ring": "b_c or m (backlash.units)",
-    "backlash.units": "",
-    "clearance.sun_bearing": "b_c or m (clearance.units)",
-    "clearance.characteristic_length": "m",
-    "clearance.units": "",
-    "mesh_phasing.model": "",
-    "mesh_phasing.ring_sun": "mesh cycles",
-}

@@ -2,18 +2,22 @@
 
 For each gear-set field (``teeth.sun`` … ``mesh_phasing.ring_sun``) :data:`FIELDS` holds a
 :class:`Field`: its kind (``int``, ``float``, ``str`` or ``floats``), unit, plain and TeX
-symbol, meaning, allowed choices and range rule. The operating point ``omega`` (Ω = ω/ω_n) and
-the alias ``xi`` (the three damping ratios) are described in :data:`EXTRA`. :data:`CLEARANCES`
-says which clearance belongs to which observable. Validation, TOML I/O, the command line's
-``--set`` parsing, plot labels and the paper's tables all read this module; it imports nothing
-from the package.
+symbol, meaning, allowed choices, its rule (the sign or interval the model needs) and its
+plausible range (``limits``: where a value stops describing a gear set; docs/gearset-rules.md).
+The operating point ``omega`` (Ω = ω/ω_n) and the alias ``xi`` (the three damping ratios) are
+described in :data:`EXTRA`. :data:`CLEARANCES` says which clearance belongs to which
+observable, :data:`MODULE_BOUNDED` which lengths may not exceed one module. Validation, TOML
+I/O, the command line's ``--set`` parsing, plot labels and the paper's tables all read this
+module; it imports only its types (:mod:`~gearchaos.gearset.fieldtypes`).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import replace
 from types import MappingProxyType
 from typing import Final
+
+from .fieldtypes import ANGLE, AT_LEAST_ONE, NON_NEGATIVE, POSITIVE, Field, Rule
 
 __all__ = [
     "ALIASES",
@@ -21,7 +25,9 @@ __all__ = [
     "CLEARANCES",
     "EXTRA",
     "FIELDS",
+    "MAX_HARMONICS",
     "META",
+    "MODULE_BOUNDED",
     "OMEGA",
     "TABLES",
     "UNITS",
@@ -29,100 +35,73 @@ __all__ = [
     "Field",
     "Rule",
     "describe",
+    "display_symbol",
     "symbol",
     "tex",
 ]
 
+# Plausible ranges (docs/gearset-rules.md): from below MEMS gears to beyond mill drives, chosen
+# so that every derived quantity (radii, equivalent masses, ω_n, damping coefficients, the
+# dimensionless groups of MODEL.md §7) stays finite and positive.
+_TEETH: Final = Rule(1, 10_000)
+_PLANETS: Final = Rule(1, 100)
+_MODULE: Final = Rule(1e-6, 1.0)
+_MASS: Final = Rule(1e-12, 1e6)
+_INERTIA: Final = Rule(1e-24, 1e6)
+_STIFFNESS: Final = Rule(1e-3, 1e13)
+_STIFFNESS_ALT: Final = Rule(0.0, 1e13)
+_HARMONIC: Final = Rule(-1e13, 1e13)
+_DAMPING: Final = Rule(0.0, 10.0)
+_TORQUE: Final = Rule(-1e9, 1e9)
+_OMEGA: Final = Rule(1e-6, 1e6)
+_LENGTH_SCALE: Final = Rule(1e-9, 1.0)
+_PHASE: Final = Rule(-1e6, 1e6)
 
-@dataclass(frozen=True)
-class Rule:
-    """A range: ``lo`` < or ≤ value < or ≤ ``hi`` (``None``: unbounded on that side)."""
-
-    lo: float | None = None
-    hi: float | None = None
-    lo_open: bool = False
-    hi_open: bool = False
-
-    def holds(self, x: float) -> bool:
-        if self.lo is not None and (x < self.lo or (self.lo_open and x == self.lo)):
-            return False
-        return not (self.hi is not None and (x > self.hi or (self.hi_open and x == self.hi)))
-
-    def text(self) -> str:
-        """``> 0``, ``>= 0`` or ``in (0, 45)``."""
-        if self.hi is None:
-            return f"{'>' if self.lo_open else '>='} {self.lo:g}"
-        if self.lo is None:
-            return f"{'<' if self.hi_open else '<='} {self.hi:g}"
-        return (
-            f"in {'(' if self.lo_open else '['}{self.lo:g}, {self.hi:g}"
-            f"{')' if self.hi_open else ']'}"
-        )
-
-
-POSITIVE: Final = Rule(lo=0.0, lo_open=True)
-NON_NEGATIVE: Final = Rule(lo=0.0)
-AT_LEAST_ONE: Final = Rule(lo=1.0)
-ANGLE: Final = Rule(lo=0.0, hi=45.0, lo_open=True, hi_open=True)
-
-
-@dataclass(frozen=True)
-class Field:
-    """One addressable parameter.
-
-    Attributes
-    ----------
-    name
-        Dotted name (``backlash.sun_planet``), the same in Python, TOML, the CLI and stores.
-    kind
-        ``int``, ``float``, ``str`` or ``floats`` (a tuple of floats).
-    unit
-        Unit as written in TOML comments (``m``, ``N/m``, ``deg``, ``1`` for dimensionless).
-    symbol
-        Plain (Unicode) symbol of MODEL.md, e.g. ``b_sp``; empty for switches.
-    tex
-        Matplotlib mathtext symbol without ``$``, e.g. ``\\bar b_{sp}``.
-    meaning
-        One line for templates and documentation.
-    rule
-        Range of a number (``None``: any finite value).
-    choices
-        Allowed values of a string field.
-    """
-
-    name: str
-    kind: str
-    unit: str
-    symbol: str
-    tex: str
-    meaning: str
-    rule: Rule | None = None
-    choices: tuple[str, ...] = ()
-
-    @property
-    def table(self) -> str:
-        return self.name.split(".", 1)[0]
-
-    @property
-    def key(self) -> str:
-        return self.name.split(".", 1)[-1]
-
-    @property
-    def unit_label(self) -> str:
-        """``[N/m]`` for dimensional units, empty for dimensionless ones and switches."""
-        if self.unit in ("", "1") or " or " in self.unit:
-            return ""
-        return f"[{self.unit.replace('m^2', 'm²')}]"
+#: Most higher harmonics a mesh stiffness may list (``stiffness.*_harmonics``).
+MAX_HARMONICS: Final = 64
 
 
 _F = Field
 _CLEAR_SP = "b_c or m (backlash.units)"
 _CLEAR_S = "b_c or m (clearance.units)"
 
+_LIMITS: Final = {
+    **dict.fromkeys(("teeth.sun", "teeth.planet", "teeth.ring"), _TEETH),
+    "geometry.planets": _PLANETS,
+    "geometry.module": _MODULE,
+    **dict.fromkeys(("mass.sun", "mass.planet"), _MASS),
+    **dict.fromkeys(("inertia.sun", "inertia.planet", "inertia.carrier"), _INERTIA),
+    **dict.fromkeys(
+        ("stiffness.sun_planet_mean", "stiffness.planet_ring_mean", "stiffness.sun_bearing"),
+        _STIFFNESS,
+    ),
+    **dict.fromkeys(
+        ("stiffness.sun_planet_alternating", "stiffness.planet_ring_alternating"), _STIFFNESS_ALT
+    ),
+    **dict.fromkeys(
+        ("stiffness.sun_planet_harmonics", "stiffness.planet_ring_harmonics"), _HARMONIC
+    ),
+    **dict.fromkeys(("damping.sun_planet", "damping.planet_ring", "damping.sun_bearing"), _DAMPING),
+    "torque.input": _TORQUE,
+    "torque.reference_omega": _OMEGA,
+    "clearance.characteristic_length": _LENGTH_SCALE,
+    **dict.fromkeys(
+        (
+            "transmission_error.sun_planet_phase",
+            "transmission_error.planet_ring_phase",
+            "eccentricity.sun_phase",
+            "eccentricity.planet_phase",
+            "eccentricity.ring_phase",
+            "mesh_phasing.ring_sun",
+        ),
+        _PHASE,
+    ),
+}
+
 #: Every gear-set field by dotted name, table by table in record order.
 FIELDS: Final = MappingProxyType(
     {
-        f.name: f
+        f.name: replace(f, limits=_LIMITS.get(f.name))
         for f in (
             _F("teeth.sun", "int", "1", "z_s", "z_s", "number of sun teeth", POSITIVE),
             _F(
@@ -512,6 +491,7 @@ EXTRA: Final = MappingProxyType(
             r"\Omega",
             "dimensionless mesh frequency Ω = ω/ω_n",
             POSITIVE,
+            limits=_OMEGA,
         ),
         XI: Field(
             XI,
@@ -530,6 +510,21 @@ CHOICES: Final = MappingProxyType({n: f.choices for n, f in FIELDS.items() if f.
 
 #: Units of every dotted field (degrees for angles; clearances follow their ``units`` field).
 UNITS: Final = MappingProxyType({n: f.unit for n, f in FIELDS.items()})
+
+#: Lengths that may not exceed one module m (the addendum of a standard tooth), each with the
+#: field giving its units (``None``: always metres).
+MODULE_BOUNDED: Final = MappingProxyType(
+    {
+        "backlash.sun_planet": "backlash.units",
+        "backlash.planet_ring": "backlash.units",
+        "clearance.sun_bearing": "clearance.units",
+        "transmission_error.sun_planet": None,
+        "transmission_error.planet_ring": None,
+        "eccentricity.sun": None,
+        "eccentricity.planet": None,
+        "eccentricity.ring": None,
+    }
+)
 
 #: Which clearance acts on which observable: observable -> (clearance field, its units field,
 #: the model's clearance key).
@@ -558,3 +553,11 @@ def tex(name: str) -> str | None:
     """Mathtext symbol (without ``$``) of a parameter, or ``None`` for unknown names."""
     f = describe(name)
     return None if f is None else f.tex
+
+
+def display_symbol(name: str) -> str:
+    """Plain symbol for tables and captions: ``Ω``, ``ξ``, ``b̄_sp`` (the clearances are shown
+    dimensionless, as the seed quotes them), ``T_D``; the name itself when it has none."""
+    if any(name == parameter for parameter, _, _ in CLEARANCES.values()):
+        return "b̄_" + FIELDS[name].symbol.split("_", 1)[1]
+    return symbol(name)

@@ -1,4 +1,4 @@
-"""Validation of :class:`~gearchaos.gearset.records.GearSet` records.
+"""Validation of gear sets against the rules of the parameter registry.
 
 :func:`validate` runs from ``GearSet.__post_init__``, so every gear set that exists has passed
 it. Each violation raises :class:`~gearchaos.errors.ParameterError` with a message that names
@@ -6,16 +6,14 @@ the dotted parameter, the rule and the offending value, e.g.::
 
     backlash.sun_planet must be >= 0: got -3.0
     teeth.ring must equal teeth.sun + 2*teeth.planet (34 + 2*31 = 96): got 95
+    geometry.module must lie in the plausible range [1e-06, 1] m: got 1e+308
 
-The checks run in a fixed order and the first violation is reported:
-
-1. every nested field holds the right record class; ``name`` and ``description`` are strings;
-2. per field, in the order of :data:`FIELD_KINDS`: type (integer, number, string or tuple of
-   numbers; ``bool`` is never a number), finiteness, then the field's own rule (sign, open
-   interval or allowed choices);
-3. relations between fields: standard tooth numbers z_r = z_s + 2 z_p, equal planet spacing
-   ((z_s + z_r)/N an integer, MODEL.md §1) and positive mesh stiffness
-   (k_a + Σ|k_h| < k_m for each mesh, so that k(t) > 0 whatever the phases, MODEL.md §3).
+The rules themselves (kinds, signs, choices, plausible ranges, which lengths are bounded by the
+module) are data of :mod:`gearchaos.gearset.schema`; this module applies them. It knows the
+records of the tables (:mod:`gearchaos.gearset.tables`) but not the ``GearSet`` class, which
+calls it: a gear set is anything with the twelve table attributes, ``name`` and
+``description`` and the derived properties of :class:`~gearchaos.gearset.records.GearSet`.
+The edges of a valid gear set are explained in ``docs/gearset-rules.md``.
 
 :func:`warn_if_eccentric` is a separate, non-fatal check for analyses that sample the response at
 the mesh-period Poincaré section.
@@ -25,107 +23,51 @@ from __future__ import annotations
 
 import math
 import numbers
-import typing
 import unicodedata
 import warnings
-from dataclasses import fields
-from typing import Final
+from collections.abc import Callable
+from types import MappingProxyType
+from typing import Any, Final
 
 from ..errors import ParameterError
-from .records import GearSet
+from .fieldtypes import Field, Rule
+from .schema import CHOICES, FIELDS, MAX_HARMONICS, META, MODULE_BOUNDED
+from .tables import RECORD_CLASSES
 
 __all__ = [
     "CHOICES",
     "FIELD_KINDS",
     "POINCARE_ANALYSES",
     "RECORD_CLASSES",
+    "show",
     "validate",
     "warn_if_eccentric",
 ]
 
-
-def _record_classes() -> dict[str, type]:
-    hints = typing.get_type_hints(GearSet)
-    return {f.name: hints[f.name] for f in fields(GearSet) if f.name not in ("name", "description")}
-
-
-#: The nested records of a gear set: GearSet field (= TOML table) name -> record class.
-RECORD_CLASSES: Final[dict[str, type]] = _record_classes()
-
-
-def _kind(tp: object) -> str:
-    if tp is int:
-        return "int"
-    if tp is float:
-        return "float"
-    if tp is str:
-        return "str"
-    if tp == tuple[float, ...]:
-        return "floats"
-    raise TypeError(f"unsupported record field type {tp!r}")  # pragma: no cover
-
-
-def _field_kinds() -> dict[str, str]:
-    kinds: dict[str, str] = {}
-    for table, cls in RECORD_CLASSES.items():
-        hints = typing.get_type_hints(cls)
-        for f in fields(cls):
-            kinds[f"{table}.{f.name}"] = _kind(hints[f.name])
-    return kinds
-
-
 #: Kind of every dotted field: ``"int"``, ``"float"``, ``"str"`` or ``"floats"`` (tuple of floats).
-FIELD_KINDS: Final[dict[str, str]] = _field_kinds()
+FIELD_KINDS: Final = MappingProxyType({name: f.kind for name, f in FIELDS.items()})
 
-#: Allowed values of the string fields.
-CHOICES: Final[dict[str, tuple[str, ...]]] = {
-    "torque.mode": ("constant_torque", "constant_power"),
-    "backlash.units": ("dimensionless", "m"),
-    "clearance.units": ("dimensionless", "m"),
-    "mesh_phasing.model": ("parker", "in_phase"),
-}
+_MAX_SHOWN = 120  # characters of a value's repr in a message
 
-# Sign rules of scalar fields; a float field not listed may take any finite value.
-_POSITIVE: Final = frozenset(
-    {
-        "teeth.sun",
-        "teeth.planet",
-        "teeth.ring",
-        "geometry.module",
-        "mass.sun",
-        "mass.planet",
-        "inertia.sun",
-        "inertia.planet",
-        "inertia.carrier",
-        "stiffness.sun_planet_mean",
-        "stiffness.planet_ring_mean",
-        "stiffness.sun_bearing",
-        "torque.reference_omega",
-        "clearance.characteristic_length",
-    }
-)
-_AT_LEAST_ONE: Final = frozenset({"geometry.planets"})
-_NON_NEGATIVE: Final = frozenset(
-    {
-        "stiffness.sun_planet_alternating",
-        "stiffness.planet_ring_alternating",
-        "damping.sun_planet",
-        "damping.planet_ring",
-        "damping.sun_bearing",
-        "transmission_error.sun_planet",
-        "transmission_error.planet_ring",
-        "eccentricity.sun",
-        "eccentricity.planet",
-        "eccentricity.ring",
-        "backlash.sun_planet",
-        "backlash.planet_ring",
-        "clearance.sun_bearing",
-    }
-)
-_OPEN_INTERVAL: Final[dict[str, tuple[float, float]]] = {
-    "geometry.pressure_angle_sun": (0.0, 45.0),
-    "geometry.pressure_angle_ring": (0.0, 45.0),
-}
+
+def show(value: object) -> str:
+    """``repr(value)``, shortened for messages: never longer than about 120 characters, never
+    an exception (huge integers, failing ``__repr__``)."""
+    if isinstance(value, numbers.Integral) and not isinstance(value, bool):
+        bits = int(value).bit_length()
+        if bits > 256:  # more than 77 digits; beyond 4300 digits repr() itself fails
+            return f"<an integer of about {int(bits * math.log10(2)) + 1} digits>"
+    try:
+        text = repr(value)
+    except Exception:  # a message must not fail on a hostile object
+        text = object.__repr__(value)
+    if len(text) > _MAX_SHOWN:
+        text = f"{text[: _MAX_SHOWN - 20]}…{text[-15:]} ({len(text)} characters)"
+    return text
+
+
+def _got(value: object) -> str:
+    return f"got {show(value)} ({type(value).__name__})"
 
 
 def _is_int(value: object) -> bool:
@@ -136,20 +78,16 @@ def _is_number(value: object) -> bool:
     return isinstance(value, numbers.Real) and not isinstance(value, bool)
 
 
-def _got(value: object) -> str:
-    return f"got {value!r} ({type(value).__name__})"
-
-
 def _check_number(name: str, value: object) -> float:
     """Type and finiteness of one real number; returns it as a float."""
     if not _is_number(value):
         raise ParameterError(f"{name} must be a number: {_got(value)}")
     try:
         x = float(value)  # type: ignore[arg-type]
-    except OverflowError:
-        raise ParameterError(f"{name} must be finite: got {value!r}") from None
+    except (OverflowError, ValueError, TypeError):
+        raise ParameterError(f"{name} must be finite: got {show(value)}") from None
     if not math.isfinite(x):
-        raise ParameterError(f"{name} must be finite: got {value!r}")
+        raise ParameterError(f"{name} must be finite: got {show(value)}")
     return x
 
 
@@ -160,47 +98,68 @@ def _check_text(name: str, value: object) -> str:
         value.encode("utf-8")
     except UnicodeEncodeError:
         raise ParameterError(
-            f"{name} must be valid Unicode text (no lone surrogates): got {value!r}"
+            f"{name} must be valid Unicode text (no lone surrogates): got {show(value)}"
         ) from None
     return value
 
 
-def _check_field(name: str, kind: str, value: object) -> None:
+def _unit_words(unit: str) -> str:
+    if unit in ("", "1"):
+        return ""
+    return " degrees" if unit == "deg" else f" {unit}"
+
+
+def _check_range(name: str, f: Field, x: float, value: object) -> None:
+    """The field's rule (sign or interval), then its plausible range."""
+    rule = f.rule
+    if rule is not None and not rule.holds(x):
+        if rule.lo is not None and rule.hi is not None:
+            kind = "open interval" if rule.lo_open and rule.hi_open else "interval"
+            raise ParameterError(
+                f"{name} must lie in the {kind} {rule.text()[3:]}{_unit_words(f.unit)}: "
+                f"got {show(value)}"
+            )
+        raise ParameterError(f"{name} must be {rule.text()}: got {show(value)}")
+    _check_limits(name, f.limits, f.unit, x, value)
+
+
+def _check_limits(name: str, limits: Rule | None, unit: str, x: float, value: object) -> None:
+    if limits is not None and not limits.holds(x):
+        raise ParameterError(
+            f"{name} must lie in the plausible range {limits.text()[3:]}{_unit_words(unit)}: "
+            f"got {show(value)}"
+        )
+
+
+def _check_field(f: Field, value: object) -> None:
+    name, kind = f.name, f.kind
     if kind == "int":
         if not _is_int(value):
             raise ParameterError(f"{name} must be an integer: {_got(value)}")
-        n = int(value)  # type: ignore[call-overload]
-        if name in _POSITIVE and n <= 0:
-            raise ParameterError(f"{name} must be > 0: got {value!r}")
-        if name in _AT_LEAST_ONE and n < 1:
-            raise ParameterError(f"{name} must be >= 1: got {value!r}")
+        # compared as an exact integer: a huge one never becomes a float
+        _check_range(name, f, int(value), value)  # type: ignore[call-overload]
     elif kind == "float":
-        x = _check_number(name, value)
-        if name in _POSITIVE and not x > 0.0:
-            raise ParameterError(f"{name} must be > 0: got {value!r}")
-        if name in _NON_NEGATIVE and not x >= 0.0:
-            raise ParameterError(f"{name} must be >= 0: got {value!r}")
-        if name in _OPEN_INTERVAL:
-            lo, hi = _OPEN_INTERVAL[name]
-            if not lo < x < hi:
-                raise ParameterError(
-                    f"{name} must lie in the open interval ({lo:g}, {hi:g}) degrees: got {value!r}"
-                )
+        _check_range(name, f, _check_number(name, value), value)
     elif kind == "str":
         text = _check_text(name, value)
         if name in CHOICES and text not in CHOICES[name]:
             allowed = ", ".join(repr(c) for c in CHOICES[name])
-            raise ParameterError(f"{name} must be one of {allowed}: got {value!r}")
+            raise ParameterError(f"{name} must be one of {allowed}: got {show(value)}")
     elif kind == "floats":
         if not isinstance(value, tuple):
             raise ParameterError(f"{name} must be a tuple of numbers: {_got(value)}")
+        if len(value) > MAX_HARMONICS:
+            raise ParameterError(
+                f"{name} must list at most {MAX_HARMONICS} harmonics: got {len(value)}"
+            )
         for i, item in enumerate(value):
-            _check_number(f"{name}[{i}]", item)
-    else:  # pragma: no cover - FIELD_KINDS only holds the kinds above
+            x = _check_number(f"{name}[{i}]", item)
+            _check_limits(f"{name}[{i}]", f.limits, f.unit, x, item)
+    else:  # pragma: no cover - the registry only holds the kinds above
         raise AssertionError(kind)
 
 
-def _check_stiffness_positive(gs: GearSet, mesh: str) -> None:
+def _check_stiffness_positive(gs: Any, mesh: str) -> None:
     s = gs.stiffness
     km = float(getattr(s, f"{mesh}_mean"))
     ka = float(getattr(s, f"{mesh}_alternating"))
@@ -221,7 +180,107 @@ def _check_stiffness_positive(gs: GearSet, mesh: str) -> None:
     )
 
 
-def validate(gs: GearSet) -> None:
+def _value(gs: Any, dotted: str) -> Any:
+    table, attr = dotted.split(".", 1)
+    return getattr(getattr(gs, table), attr)
+
+
+def _check_within_module(gs: Any) -> None:
+    """Clearances, transmission errors and eccentricities, in metres, are at most one module."""
+    module = float(gs.geometry.module)
+    bc = float(gs.clearance.characteristic_length)
+    for dotted, units_field in MODULE_BOUNDED.items():
+        value = float(_value(gs, dotted))
+        if units_field is not None and _value(gs, units_field) == "dimensionless":
+            metres = value * bc
+            shown = f"{value!r} × b_c = {value!r} × {bc!r} m = {metres!r} m"
+        else:
+            metres, shown = value, f"{value!r} m"
+        if metres > module:
+            raise ParameterError(
+                f"{dotted} must be <= geometry.module = {module!r} m (one module, the addendum "
+                "of a standard tooth: a larger clearance, transmission error or eccentricity "
+                f"would disengage the teeth): got {shown}"
+            )
+
+
+def _derived(gs: Any) -> list[tuple[str, Callable[[], float], bool]]:
+    """(symbol = formula, value, must be positive) of every derived quantity (MODEL.md §1, §4,
+    §7); the values are computed lazily so that one failing formula is reported by name."""
+    st, tq = gs.stiffness, gs.torque
+
+    def me() -> float:
+        return float(gs.equivalent_mass_mesh)
+
+    def bar(x: float) -> float:
+        return x / gs.clearance.characteristic_length
+
+    return [
+        ("r_s = m z_s / 2", lambda: gs.radius_sun, True),
+        ("r_p = m z_p / 2", lambda: gs.radius_planet, True),
+        ("r_r = m z_r / 2", lambda: gs.radius_ring, True),
+        ("r_bs = r_s cos α_s", lambda: gs.base_radius_sun, True),
+        ("r_bp = r_p cos α_s", lambda: gs.base_radius_planet, True),
+        ("m_s* = J_s / r_bs²", lambda: gs.equivalent_mass_sun, True),
+        ("m_p* = J_p / r_bp²", lambda: gs.equivalent_mass_planet, True),
+        ("m_c* = J_c / r_c² + N m_p", lambda: gs.equivalent_mass_carrier, True),
+        ("m_e = m_s* m_p* / (m_s* + m_p*)", me, True),
+        ("ω_n = √(k_m,sp / m_e)", lambda: gs.omega_n, True),
+        ("c_sp = 2 ξ_sp √(k_m,sp m_e)", lambda: gs.damping_sun_planet, False),
+        ("c_rp = 2 ξ_rp √(k_m,rp m_p*)", lambda: gs.damping_planet_ring, False),
+        ("c_s = 2 ξ_s √(k_s m_s)", lambda: gs.damping_sun_bearing, False),
+        ("T_L = T_D r_c (cos α_s + cos α_r) / r_bs", lambda: gs.output_torque, False),
+        ("μ_s = m_s / m_e", lambda: gs.mass.sun / me(), True),
+        ("μ_s* = m_s* / m_e", lambda: gs.equivalent_mass_sun / me(), True),
+        ("μ_p* = m_p* / m_e", lambda: gs.equivalent_mass_planet / me(), True),
+        ("μ_c* = m_c* / m_e", lambda: gs.equivalent_mass_carrier / me(), True),
+        ("κ_b = k_s / k_m,sp", lambda: st.sun_bearing / st.sun_planet_mean, True),
+        ("k_m,rp / k_m,sp", lambda: st.planet_ring_mean / st.sun_planet_mean, True),
+        (
+            "T̄_D = T_D / (r_bs k_m,sp b_c)",
+            lambda: bar(tq.input / (gs.base_radius_sun * st.sun_planet_mean)),
+            False,
+        ),
+        (
+            "T̄_L = T_L / (r_c k_m,sp b_c)",
+            lambda: bar(gs.output_torque / (gs.radius_carrier * st.sun_planet_mean)),
+            False,
+        ),
+        ("b̄_sp, b̄_rp", lambda: max(gs.backlash_bar()), False),
+        ("b̄_s", lambda: gs.sun_bearing_clearance_bar(), False),
+        ("Ā_sp = A_sp / b_c", lambda: bar(gs.transmission_error.sun_planet), False),
+        ("Ā_rp = A_rp / b_c", lambda: bar(gs.transmission_error.planet_ring), False),
+        ("Ē = max(E_s, E_p, E_r) / b_c", lambda: bar(max(_eccentricities(gs))), False),
+        ("φ_sp, φ_rp (mesh phases)", lambda: _largest_phase(gs), False),
+    ]
+
+
+def _eccentricities(gs: Any) -> tuple[float, float, float]:
+    e = gs.eccentricity
+    return e.sun, e.planet, e.ring
+
+
+def _largest_phase(gs: Any) -> float:
+    sp, rp = gs.mesh_phases()
+    return max((abs(p) for p in (*sp, *rp)), default=0.0)
+
+
+def _check_derived(gs: Any) -> None:
+    """Every derived quantity is finite, and positive where the model divides by it."""
+    for label, compute, positive in _derived(gs):
+        try:
+            x = float(compute())
+        except (ArithmeticError, ValueError):
+            x = math.nan
+        if not math.isfinite(x) or (positive and not x > 0.0):
+            rule = "finite and > 0" if positive else "finite"
+            raise ParameterError(
+                f"derived quantity {label} must be {rule}: got {x!r}; the gear set's values "
+                "are outside what the model can represent (docs/gearset-rules.md)"
+            )
+
+
+def validate(gs: Any) -> None:
     """Check every field of a gear set and the relations between them.
 
     Parameters
@@ -231,27 +290,53 @@ def validate(gs: GearSet) -> None:
 
     Raises
     ------
+    TypeError
+        If ``gs`` has not the attributes of a gear set.
     ParameterError
         At the first violated rule, with a message naming the dotted parameter, the rule and
-        the value. The rules are (symbols of MODEL.md):
+        the value. The checks run in this order (symbols of MODEL.md; the plausible ranges and
+        their reasons are in ``docs/gearset-rules.md``):
 
-        - records: each nested field is its record class; ``name``, ``description`` strings;
-        - integers (``bool`` and integral floats such as ``34.0`` are rejected):
-          z_s, z_p, z_r > 0, N >= 1;
-        - every float field is a finite real number (``bool`` rejected, ``int`` accepted);
-        - > 0: module m, masses m_s, m_p, inertias J_s, J_p, J_c, mean mesh stiffnesses
-          k_m,sp and k_m,rp, sun bearing stiffness k_s, b_c, ``torque.reference_omega``;
-        - >= 0: alternating stiffnesses k_a, damping ratios ξ, transmission-error amplitudes
-          A, eccentricities E, half clearances b_sp, b_rp, b_s;
-        - 0 < α_s, α_r < 45 degrees;
-        - ``torque.mode`` in {constant_torque, constant_power}; ``backlash.units`` and
-          ``clearance.units`` in {dimensionless, m}; ``mesh_phasing.model`` in {parker, in_phase};
-        - harmonics are tuples of finite numbers of any sign;
-        - z_r = z_s + 2 z_p (standard gears);
-        - (z_s + z_r)/N is an integer (equally spaced planets);
-        - k_a + Σ_h |k_h| < k_m for each mesh, so the mesh stiffness stays positive.
+        1. records: each nested field is its record class; ``name``, ``description`` strings
+           of valid Unicode;
+        2. per field, in registry order: type (integer, number, string or tuple of numbers;
+           ``bool`` is never a number, integral floats such as ``34.0`` are not integers,
+           ``int`` is accepted for floats), finiteness, the rule the model needs, then the
+           plausible range:
+
+           - z_s, z_p, z_r integers > 0 and <= 10000; N integer >= 1 and <= 100 (one planet
+             is allowed: the model holds for any N, e.g. a single-planet test rig);
+           - module m > 0, in [1e-6, 1] m (below MEMS gears to ten times the largest
+             mill-drive modules);
+           - 0 < α_s, α_r < 45 degrees;
+           - masses m_s, m_p > 0, in [1e-12, 1e6] kg; inertias J_s, J_p, J_c > 0, in
+             [1e-24, 1e6] kg m²;
+           - k_m,sp, k_m,rp, k_s > 0, in [1e-3, 1e13] N/m; k_a >= 0 and <= 1e13 N/m;
+             harmonics: at most 64 finite numbers of any sign, each |k_h| <= 1e13 N/m;
+           - damping ratios ξ >= 0 and <= 10;
+           - T_D any sign, |T_D| <= 1e9 N m; ``torque.reference_omega`` Ω_ref > 0, in
+             [1e-6, 1e6];
+           - b_c > 0, in [1e-9, 1] m; half clearances b_sp, b_rp, b_s, transmission-error
+             amplitudes A and eccentricities E >= 0;
+           - phases (degrees) and γ_rs (mesh cycles) of any sign, |value| <= 1e6;
+           - ``torque.mode`` in {constant_torque, constant_power}; ``backlash.units`` and
+             ``clearance.units`` in {dimensionless, m}; ``mesh_phasing.model`` in
+             {parker, in_phase};
+        3. relations: z_r = z_s + 2 z_p (standard gears); (z_s + z_r)/N an integer (equally
+           spaced planets); k_a + Σ_h |k_h| < k_m for each mesh (positive mesh stiffness);
+           b_sp, b_rp, b_s, A_sp, A_rp, E_s, E_p, E_r, converted to metres (× b_c when their
+           ``units`` is ``dimensionless``), at most one module m — the addendum of a standard
+           tooth: a larger clearance or error disengages the teeth;
+        4. every derived quantity — radii, equivalent masses, m_e, ω_n, damping coefficients,
+           T_L and the dimensionless groups μ, κ, T̄_D, T̄_L, b̄, Ā, Ē, mesh phases — is finite,
+           and positive where the model divides by it. The ranges above guarantee this; the
+           check guards against a rule relaxed later.
+
+        Not checked: that neighbouring planets clear each other ((z_s + z_p) sin(π/N) >
+        z_p + 2): the lumped model has no tip circles, and the modal theory holds for any N
+        (the calibration's search space enforces it, ``paper/calibrate.py``).
     """
-    if not isinstance(gs, GearSet):
+    if not all(hasattr(gs, t) for t in (*RECORD_CLASSES, *META)):
         raise TypeError(f"validate() expects a GearSet: got {type(gs).__name__}")
     for table, cls in RECORD_CLASSES.items():
         record = getattr(gs, table)
@@ -260,9 +345,8 @@ def validate(gs: GearSet) -> None:
     _check_text("name", gs.name)
     _check_text("description", gs.description)
 
-    for dotted, kind in FIELD_KINDS.items():
-        table, attr = dotted.split(".", 1)
-        _check_field(dotted, kind, getattr(getattr(gs, table), attr))
+    for f in FIELDS.values():
+        _check_field(f, _value(gs, f.name))
 
     z = gs.teeth
     if z.ring != z.sun + 2 * z.planet:
@@ -279,6 +363,8 @@ def validate(gs: GearSet) -> None:
         )
     _check_stiffness_positive(gs, "sun_planet")
     _check_stiffness_positive(gs, "planet_ring")
+    _check_within_module(gs)
+    _check_derived(gs)
 
 
 #: Analyses that sample the response at the mesh-period section t_k = kT (case-insensitive;
@@ -293,7 +379,7 @@ def _normalise_analysis(analysis: str) -> str:
     return text.strip().lower().replace("-", "_").replace(" ", "_")
 
 
-def warn_if_eccentric(gs: GearSet, analysis: str) -> bool:
+def warn_if_eccentric(gs: Any, analysis: str) -> bool:
     """Warn when a Poincaré-section analysis is asked of a gear set with eccentricities.
 
     With any eccentricity E_s, E_p or E_r non-zero the transmission errors contain the
@@ -315,7 +401,14 @@ def warn_if_eccentric(gs: GearSet, analysis: str) -> bool:
     -------
     bool
         Whether a :class:`UserWarning` was issued.
+
+    Raises
+    ------
+    ParameterError
+        If ``analysis`` is not a string.
     """
+    if not isinstance(analysis, str):
+        raise ParameterError(f"analysis must be a string: {_got(analysis)}")
     key = _normalise_analysis(analysis)
     if not gs.has_eccentricity:
         return False

@@ -19,9 +19,9 @@ import numpy as np
 from .._numba import call_literal
 from ..errors import ParameterError, Status
 from ..model.system import System
-from .settings import SolverSettings
+from .settings import SampleTimes, SolverSettings
 
-__all__ = ["ChainOutput", "ChainRun", "run_chains"]
+__all__ = ["ChainOutput", "ChainRun", "SampleArrays", "run_chains"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -93,18 +93,53 @@ class ChainRun:
                 P[c, j] = s.params
                 SW[c, j] = s.switch_widths
                 T[c, j] = s.period
+        t_start = np.full((C, L), float(t0))
+        times = settings.sample_times(T, t0=t_start)
+        return cls.from_arrays(
+            ref,
+            P,
+            SW,
+            t_start,
+            times,
+            settings,
+            y0=y0,
+            n_tangent=n_tangent,
+            continuation=continuation,
+            first_step=first_step,
+            max_step=max_step,
+        )
+
+    @classmethod
+    def from_arrays(
+        cls,
+        ref: System,
+        P: np.ndarray,
+        SW: np.ndarray,
+        t0: np.ndarray,
+        times: SampleTimes,
+        settings: SolverSettings,
+        *,
+        y0: np.ndarray | None = None,
+        n_tangent: int = 0,
+        continuation: bool = False,
+        first_step: float | None = None,
+        max_step: float = np.inf,
+    ) -> ChainRun:
+        """A run from packed parameters ``P`` and switch widths ``SW`` (C, L, …) of systems
+        like ``ref``, start times ``t0`` and sample times (C, L): the one place a run is laid
+        out, for callers that pack their own points (shooting, a hot path)."""
+        C = P.shape[0]
         n = ref.n_state
         k = int(n_tangent)
         Y0 = np.zeros((C, n * (1 + k)))
         if y0 is not None:
             Y0[:, :n] = y0
-        times = settings.sample_times(T, t0=np.full((C, L), float(t0)))
         return cls(
             kind=ref.kind,
             Y0=Y0,
             P=P,
             SW=SW,
-            t0=np.full((C, L), float(t0)),
+            t0=t0,
             t_rec=times.t_rec,
             dt=times.dt,
             t_end=times.t_end,
@@ -141,16 +176,11 @@ class ChainRun:
 
 
 @dataclass(frozen=True, eq=False)
-class ChainOutput:
-    """Raw outputs of :func:`run_chains`, chain and point first.
-
-    ``tau`` (C, L, s) sample times (NaN where not reached); ``states`` (C, L, s, n_full);
-    ``observables`` (C, L, s, n_obs); ``obs_min``/``obs_max`` (C, L, n_track) extrema of the
-    tracked observables over the recorded window; ``final_state`` (C, L, n_full) with the
-    tangent vectors; ``info`` (C, L, 4): accepted steps, rejected steps, time reached, next
-    step size; ``status`` (C, L) :class:`~gearchaos.errors.Status` codes; ``log_sums``
-    (C, L, k) accumulated log stretch factors of the tangent vectors.
-    """
+class SampleArrays:
+    """What an integration records, for one run or many: sample times ``tau`` (NaN where not
+    reached), ``states`` and ``observables`` at them, the extrema ``obs_min``/``obs_max`` of the
+    tracked observables over the recorded window, and the ``final_state``. Leading axes: none
+    (a :class:`~gearchaos.integrate.Trajectory`), points (a batch) or chains × points."""
 
     tau: np.ndarray
     states: np.ndarray
@@ -158,6 +188,20 @@ class ChainOutput:
     obs_min: np.ndarray
     obs_max: np.ndarray
     final_state: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class ChainOutput(SampleArrays):
+    """Raw outputs of :func:`run_chains`, chain and point first.
+
+    The :class:`SampleArrays` with shapes ``tau`` (C, L, s), ``states`` (C, L, s, n_full),
+    ``observables`` (C, L, s, n_obs), ``obs_min``/``obs_max`` (C, L, n_track), ``final_state``
+    (C, L, n_full) with the tangent vectors; then ``info`` (C, L, 4): accepted steps, rejected
+    steps, time reached, next step size; ``status`` (C, L)
+    :class:`~gearchaos.errors.Status` codes; ``log_sums`` (C, L, k) accumulated log stretch
+    factors of the tangent vectors.
+    """
+
     info: np.ndarray
     status: np.ndarray
     log_sums: np.ndarray

@@ -17,28 +17,23 @@ import numpy as np
 
 from ..errors import ParameterError, Status
 from ..model.system import System
-from ._chains import ChainRun, run_chains
+from ._chains import ChainRun, SampleArrays, run_chains
 from .settings import SolverSettings
 
 __all__ = ["BatchResult", "integrate_batch"]
 
 
 @dataclass(frozen=True, eq=False)
-class BatchResult:
+class BatchResult(SampleArrays):
     """Outputs of :func:`integrate_batch`, point index first.
 
-    ``tau`` (m, s), ``states`` (m, s, n_state), ``observables`` (m, s, n_obs),
-    ``obs_min``/``obs_max`` (m, n_track), ``final_state`` (m, n_state), ``status`` (m,) int codes
+    The :class:`~gearchaos.integrate._chains.SampleArrays` with shapes ``tau`` (m, s),
+    ``states`` (m, s, n_state), ``observables`` (m, s, n_obs), ``obs_min``/``obs_max``
+    (m, n_track), ``final_state`` (m, n_state); then the ``systems``, ``status`` (m,) int codes
     (:class:`~gearchaos.errors.Status`), ``steps_accepted``/``steps_rejected`` (m,).
     """
 
     systems: tuple[System, ...]
-    tau: np.ndarray
-    states: np.ndarray
-    observables: np.ndarray
-    obs_min: np.ndarray
-    obs_max: np.ndarray
-    final_state: np.ndarray
     status: np.ndarray
     steps_accepted: np.ndarray
     steps_rejected: np.ndarray

@@ -65,6 +65,8 @@ class SolverSettings:
         Step attempts allowed before the integration gives up (``Status.MAX_STEPS``); ``None``
         allows 100 000 + 50 000 per simulated period.
 
+    Notes
+    -----
     Every value is checked on construction (:meth:`check`); an invalid one raises
     :class:`~gearchaos.errors.ParameterError` naming the setting, the rule and the value.
     """

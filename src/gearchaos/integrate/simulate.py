@@ -23,27 +23,13 @@ from .result import SimulationResult
 from .settings import SolverSettings
 from .trajectory import Trajectory
 
-__all__ = ["Trajectory", "integrate", "simulate"]
+__all__ = ["Trajectory", "integrate", "run_simulation", "simulate"]
 
 _DEFAULT = SolverSettings()
 
 
 def _initial_state(system: System, y0: Any) -> np.ndarray | None:
-    if y0 is None:
-        return None
-    try:
-        y = np.array(y0, dtype=np.float64).reshape(-1)
-    except (TypeError, ValueError):
-        raise ParameterError(
-            f"y0 must be {system.n_state} numbers ({', '.join(system.state_names)}): got {y0!r}"
-        ) from None
-    if y.size != system.n_state:
-        raise ParameterError(
-            f"y0 must have {system.n_state} entries ({', '.join(system.state_names)}): got {y.size}"
-        )
-    if not np.all(np.isfinite(y)):
-        raise ParameterError(f"y0 must be finite: got {y!r}")
-    return y
+    return None if y0 is None else system.check_state(y0, "y0")
 
 
 def integrate(
@@ -179,14 +165,17 @@ def simulate(
     )
     raise_on_failure = check_bool("check", check)
     system = resolve(system_or_gearset, {} if omega is None else {"omega": omega})
-    gs = getattr(system.model, "gearset", None)
-    if gs is not None and gs.has_eccentricity:
-        from ..gearset.validation import warn_if_eccentric
+    return run_simulation(system, settings, y0=y0, check=raise_on_failure)
 
-        warn_if_eccentric(gs, "Poincaré section")
+
+def run_simulation(
+    system: System, settings: SolverSettings, *, y0: Any = None, check: bool = True
+) -> SimulationResult:
+    """:func:`simulate` of a resolved system with given settings (the library's own door)."""
+    system.warn_for("Poincaré section")
     traj = integrate(system, settings, y0=y0)
     result = SimulationResult.from_trajectory(traj)
-    if raise_on_failure and not traj.ok:
+    if check and not traj.ok:
         err = IntegrationError(
             f"simulation at omega={system.omega:g} stopped at tau={traj.tau_reached:.6g} "
             f"after {traj.steps_accepted + traj.steps_rejected} step attempts: "
@@ -195,5 +184,5 @@ def simulate(
         err.result = result  # type: ignore[attr-defined]
         raise err
     if not traj.ok:
-        warnings.warn(f"{traj.status.name}: {traj.status.message}", RuntimeWarning, stacklevel=2)
+        warnings.warn(f"{traj.status.name}: {traj.status.message}", RuntimeWarning, stacklevel=3)
     return result

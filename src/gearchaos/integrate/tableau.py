@@ -125,6 +125,7 @@ class ButcherTableau:
         assert sum(self.error_weights, Fr(0)) == 0, "Σ(b − b̂) must vanish"
 
 
+#: The Dormand–Prince 5(4) pair (Dormand & Prince 1980), checked on import.
 DOPRI5 = ButcherTableau(
     name="Dormand–Prince 5(4)",
     c=(Fr(0), Fr(1, 5), Fr(3, 10), Fr(4, 5), Fr(8, 9), Fr(1), Fr(1)),

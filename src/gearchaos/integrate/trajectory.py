@@ -8,13 +8,14 @@ import numpy as np
 
 from ..errors import Status
 from ..model.system import System
+from ._chains import SampleArrays
 from .settings import SolverSettings
 
 __all__ = ["Trajectory"]
 
 
 @dataclass(frozen=True, eq=False)
-class Trajectory:
+class Trajectory(SampleArrays):
     """Samples of one integration of a :class:`System`.
 
     Attributes
@@ -23,18 +24,15 @@ class Trajectory:
     states : (m, n_state) states at ``tau``.
     observables : (m, n_obs) observables (``system.obs_names``) at ``tau``.
     obs_min, obs_max : (n_track,) extrema of the tracked observables over the recorded window.
+    final_state : (n_state,) the state at the end.
+    system : the integrated system.
+    status : how the integration ended.
     solver : the :class:`~gearchaos.integrate.settings.SolverSettings` of the run.
     t0, y0 : start time and initial state (``None``: the zero state).
     tau_reached : where the integration stopped (the end time when it succeeded).
     """
 
     system: System
-    tau: np.ndarray
-    states: np.ndarray
-    observables: np.ndarray
-    obs_min: np.ndarray
-    obs_max: np.ndarray
-    final_state: np.ndarray
     status: Status
     steps_accepted: int
     steps_rejected: int

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from ..gearset import GearSet
+from ..gearset.validation import warn_if_eccentric
 from . import layout as L
 from .system import System
 
@@ -171,6 +172,36 @@ def nondimensionalise(gs: GearSet) -> tuple[PlanetaryParameters, Scales]:
     return par, Scales(length=bc, omega_n=wn, mass=me, stiffness=k)
 
 
+# Header slots of the packed vector filled straight from PlanetaryParameters (slot, field).
+_HEADER = {
+    L.P_CS: "damping_sun_bearing",
+    L.P_KB: "kappa_b",
+    L.P_BS: "b_s",
+    L.P_CSP: "damping_sun_planet",
+    L.P_CRP: "damping_planet_ring",
+    L.P_BSP: "b_sp",
+    L.P_BRP: "b_rp",
+    L.P_EPS_SP: "eps_sp",
+    L.P_KRP_M: "kappa_rp_mean",
+    L.P_KRP_A: "kappa_rp_alt",
+    L.P_ASP: "te_sp",
+    L.P_ARP: "te_rp",
+    L.P_ES: "ecc_sun",
+    L.P_EP: "ecc_planet",
+    L.P_ER: "ecc_ring",
+    L.P_ZS: "teeth_sun",
+    L.P_ZP: "teeth_planet",
+    L.P_ZR: "teeth_ring",
+}
+# Slots holding reciprocals of equivalent masses (slot, field).
+_INVERSES = {
+    L.P_INV_MU_S: "mu_s",
+    L.P_INV_MUS: "mu_s_star",
+    L.P_INV_MUP: "mu_p_star",
+    L.P_INV_MUC: "mu_c_star",
+}
+
+
 def pack_planetary(par: PlanetaryParameters, omega: float) -> np.ndarray:
     """Packed parameter vector for :func:`~gearchaos.model.kernels.planetary_rhs` at Ω."""
     N = par.n_planets
@@ -179,32 +210,14 @@ def pack_planetary(par: PlanetaryParameters, omega: float) -> np.ndarray:
     td, tl = par.loads(omega)
     p[L.P_N] = N
     p[L.P_OMEGA] = omega
-    p[L.P_INV_MU_S] = 1.0 / par.mu_s
-    p[L.P_INV_MUS] = 1.0 / par.mu_s_star
-    p[L.P_INV_MUP] = 1.0 / par.mu_p_star
-    p[L.P_INV_MUC] = 1.0 / par.mu_c_star
-    p[L.P_CS] = par.damping_sun_bearing
-    p[L.P_KB] = par.kappa_b
-    p[L.P_BS] = par.b_s
-    p[L.P_CSP] = par.damping_sun_planet
-    p[L.P_CRP] = par.damping_planet_ring
-    p[L.P_BSP] = par.b_sp
-    p[L.P_BRP] = par.b_rp
-    p[L.P_EPS_SP] = par.eps_sp
-    p[L.P_KRP_M] = par.kappa_rp_mean
-    p[L.P_KRP_A] = par.kappa_rp_alt
+    for slot, name in _INVERSES.items():
+        p[slot] = 1.0 / getattr(par, name)
+    for slot, name in _HEADER.items():
+        p[slot] = getattr(par, name)
     p[L.P_TD] = td
     p[L.P_TL] = tl
     p[L.P_COS_AS] = math.cos(par.alpha_s)
     p[L.P_COS_AR] = math.cos(par.alpha_r)
-    p[L.P_ASP] = par.te_sp
-    p[L.P_ARP] = par.te_rp
-    p[L.P_ES] = par.ecc_sun
-    p[L.P_EP] = par.ecc_planet
-    p[L.P_ER] = par.ecc_ring
-    p[L.P_ZS] = par.teeth_sun
-    p[L.P_ZP] = par.teeth_planet
-    p[L.P_ZR] = par.teeth_ring
     p[L.P_ECC] = 1.0 if (par.ecc_sun or par.ecc_planet or par.ecc_ring) else 0.0
     p[L.P_NH_SP] = nh_sp
     p[L.P_NH_RP] = nh_rp
@@ -313,6 +326,12 @@ class PlanetaryModel:
 
     def pack(self, omega: float) -> np.ndarray:
         return pack_planetary(self.parameters, omega)
+
+    def warn_for(self, analysis: str) -> None:
+        """Warn when a Poincaré-section analysis meets eccentricities (see
+        :func:`~gearchaos.gearset.validation.warn_if_eccentric`)."""
+        if self.gearset is not None and self.gearset.has_eccentricity:
+            warn_if_eccentric(self.gearset, analysis)
 
     def with_parameters(self, **changes: Any) -> PlanetaryModel:
         """A copy with some dimensionless parameters changed (the gear set is dropped)."""

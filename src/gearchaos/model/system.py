@@ -113,33 +113,20 @@ class System:
         object.__setattr__(self, "params", p)
 
     # -- delegated layout -------------------------------------------------------------
-    @property
-    def kind(self) -> int:
-        return int(self.model.kind)
-
-    @property
-    def name(self) -> str:
-        return str(self.model.name)
-
-    @property
-    def n_state(self) -> int:
-        return int(self.model.n_state)
-
-    @property
-    def state_names(self) -> tuple[str, ...]:
-        return tuple(self.model.state_names)
-
-    @property
-    def obs_names(self) -> tuple[str, ...]:
-        return tuple(self.model.obs_names)
-
-    @property
-    def n_obs(self) -> int:
-        return len(self.model.obs_names)
-
-    @property
-    def n_track(self) -> int:
-        return int(self.model.n_track)
+    kind = property(lambda self: int(self.model.kind), doc="Kind of the compiled model.")
+    name = property(lambda self: str(self.model.name), doc="Name of the model.")
+    n_state = property(lambda self: int(self.model.n_state), doc="Length of the state.")
+    state_names = property(
+        lambda self: tuple(self.model.state_names), doc="Names of the state components."
+    )
+    obs_names = property(
+        lambda self: tuple(self.model.obs_names), doc="Names of the observables, in order."
+    )
+    n_obs = property(lambda self: len(self.model.obs_names), doc="Number of observables.")
+    n_track = property(
+        lambda self: int(self.model.n_track),
+        doc="Number of leading observables whose extrema are tracked (the dead-zone arguments).",
+    )
 
     def observable(self, name: str, planets: Sequence[int] | None = None) -> Observable:
         """Where a variable lives in the kernel's outputs, by name.
@@ -185,6 +172,41 @@ class System:
             cols = [cols[int(p) - 1] for p in planets]
         return Observable(name, source, np.array(cols), True)
 
+    def tracked_groups(self) -> list[tuple[str, np.ndarray, bool]]:
+        """The tracked observables grouped as sweeps and orbits store them: per-planet groups
+        (``delta_sp`` → its columns, True) and scalars (``x_s`` → one column, False)."""
+        names = self.obs_names[: self.n_track]
+        out: list[tuple[str, np.ndarray, bool]] = []
+        seen: set[str] = set()
+        for k, nm in enumerate(names):
+            head, _, tail = nm.rpartition("_")
+            if tail.isdigit():
+                if head not in seen:
+                    seen.add(head)
+                    idx = [j for j, m in enumerate(names) if m.rpartition("_")[0] == head]
+                    out.append((head, np.array(idx), True))
+            else:
+                out.append((nm, np.array([k]), False))
+        return out
+
+    def check_state(self, value: Any, what: str = "y0") -> np.ndarray:
+        """``value`` as a state of this system: ``n_state`` finite numbers, else a
+        :class:`~gearchaos.errors.ParameterError` naming ``what`` and the components."""
+        from ..errors import ParameterError
+
+        names = ", ".join(self.state_names)
+        try:
+            y = np.array(value, dtype=np.float64).reshape(-1)
+        except (TypeError, ValueError):
+            raise ParameterError(
+                f"{what} must be {self.n_state} numbers ({names}): got {value!r}"
+            ) from None
+        if y.size != self.n_state:
+            raise ParameterError(f"{what} must have {self.n_state} entries ({names}): got {y.size}")
+        if not np.all(np.isfinite(y)):
+            raise ParameterError(f"{what} must be finite: got {y!r}")
+        return y
+
     @property
     def switch_widths(self) -> np.ndarray:
         """Half clearances b_k of the dead zones acting on the tracked observables.
@@ -202,30 +224,35 @@ class System:
         """Forcing period T = 2π/Ω in units of τ."""
         return 2.0 * math.pi / self.omega
 
+    def warn_for(self, analysis: str) -> None:
+        """Let the model warn when ``analysis`` is questionable for it (a planetary model with
+        eccentricities has no 1T-periodic section, MODEL.md §3)."""
+        hook = getattr(self.model, "warn_for", None)
+        if hook is not None:
+            hook(analysis)
+
     def at(self, omega: float) -> System:
         """The same model at another forcing frequency."""
         return System(self.model, omega)
 
-    def observe(self, tau: np.ndarray, states: np.ndarray) -> np.ndarray:
-        """Observables (``obs_names``) at the given times and states, shape (m, n_obs)."""
+    def evaluate(self, tau: Any, states: Any) -> tuple[np.ndarray, np.ndarray]:
+        """(observables (m, n_obs), derivatives f(τ, y) (m, n_state)) at m times and states,
+        with the compiled right-hand side."""
         from .._numba import call_literal
         from .kernels import observe_many
 
         tau = np.ascontiguousarray(tau, dtype=np.float64).reshape(-1)
         states = np.ascontiguousarray(states, dtype=np.float64).reshape(tau.size, self.n_state)
-        obs, _ = call_literal(observe_many, self.kind, tau, states, self.params, self.n_obs)
-        return np.asarray(obs)
+        obs, d = call_literal(observe_many, self.kind, tau, states, self.params, self.n_obs)
+        return np.asarray(obs), np.asarray(d)
+
+    def observe(self, tau: np.ndarray, states: np.ndarray) -> np.ndarray:
+        """Observables (``obs_names``) at the given times and states, shape (m, n_obs)."""
+        return self.evaluate(tau, states)[0]
 
     def derivative(self, tau: float, state: np.ndarray) -> np.ndarray:
         """The right-hand side f(τ, y) evaluated once (for tests and users)."""
-        from .._numba import call_literal
-        from .kernels import observe_many
-
-        y = np.ascontiguousarray(state, dtype=np.float64).reshape(1, self.n_state)
-        _, d = call_literal(
-            observe_many, self.kind, np.array([float(tau)]), y, self.params, self.n_obs
-        )
-        return np.asarray(d[0])
+        return self.evaluate([float(tau)], state)[1][0]
 
     def __repr__(self) -> str:
         return f"System({self.name}, omega={self.omega:g}, n_state={self.n_state})"

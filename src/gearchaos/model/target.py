@@ -19,7 +19,7 @@ from typing import Any
 from .._checks import check_real
 from ..errors import ParameterError
 from ..gearset import GearSet
-from ..gearset.schema import ALIASES, FIELDS
+from ..gearset.schema import ALIASES, EXTRA, FIELDS
 from .planetary import PlanetaryModel
 from .system import System
 
@@ -30,6 +30,7 @@ __all__ = [
     "model_for",
     "parameter_names",
     "resolve",
+    "scale_attrs",
     "split_omega",
 ]
 
@@ -73,13 +74,23 @@ def check_names(target: Any, names: Any) -> None:
             raise ParameterError(f"unknown parameter {name!r}{hint}")
 
 
+def check_omega(value: Any) -> float:
+    """Ω as a float: a finite number > 0 inside its plausible range (the registry's)."""
+    omega = check_real(OMEGA, value, lo=0.0, lo_open=True)
+    limits = EXTRA[OMEGA].limits
+    if limits is not None and not limits.holds(omega):
+        raise ParameterError(
+            f"omega must lie in the plausible range {limits.text()[3:]}: got {value!r}"
+        )
+    return omega
+
+
 def split_omega(values: Mapping[str, Any]) -> tuple[float | None, dict[str, Any]]:
-    """(Ω or None, the other values); Ω is checked to be a finite number > 0."""
+    """(Ω or None, the other values); Ω is checked by :func:`check_omega`."""
     rest = dict(values)
     if OMEGA not in rest:
         return None, rest
-    omega = check_real(OMEGA, rest.pop(OMEGA), lo=0.0, lo_open=True)
-    return omega, rest
+    return check_omega(rest.pop(OMEGA)), rest
 
 
 def model_for(target: Any, changes: Mapping[str, Any]) -> Any:
@@ -117,7 +128,7 @@ def resolve(
     omega, changes = split_omega(values or {})
     if omega is None:
         if default_omega is not None:
-            omega = check_real(OMEGA, default_omega, lo=0.0, lo_open=True)
+            omega = check_omega(default_omega)
         elif isinstance(target, System):
             omega = target.omega
         else:
@@ -129,3 +140,16 @@ def resolve(
     if isinstance(target, System) and not changes:
         return target if omega == target.omega else target.at(omega)
     return System(model_for(target, changes), omega)
+
+
+def scale_attrs(model: Any) -> dict[str, float]:
+    """A model's scales and clearances as store attributes: ``omega_n_rad_s`` (ω_n),
+    ``characteristic_length_m`` (b_c) where the model has physical scales, and
+    ``clearance_<name>`` for each of its clearances."""
+    a: dict[str, float] = {}
+    if hasattr(model, "scales"):
+        a["omega_n_rad_s"] = float(model.scales.omega_n)
+        a["characteristic_length_m"] = float(model.scales.length)
+    for k, v in getattr(model, "clearances", {}).items():
+        a[f"clearance_{k}"] = float(v)
+    return a

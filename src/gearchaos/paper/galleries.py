@@ -28,7 +28,6 @@ given value can differ from the seed's.
 from __future__ import annotations
 
 import csv
-import dataclasses
 import json
 import math
 import os
@@ -40,6 +39,9 @@ from types import MappingProxyType
 from typing import Any
 
 from ..errors import ParameterError
+from ..gearset.schema import display_symbol, tex
+from ..integrate.settings import SolverSettings
+from .recipes import load_figures, lookup_figure
 
 __all__ = [
     "GALLERIES",
@@ -56,6 +58,8 @@ __all__ = [
 PRESET = "sheng2016"
 #: (transient, recorded) mesh periods of the full galleries (the seed discards 100).
 FULL_PERIODS = (100, 500)
+#: Solver settings of :func:`run_gallery` when none are given: 100 transient, 300 recorded.
+GALLERY_SETTINGS = SolverSettings(transient_periods=100, periods=300)
 #: (transient, recorded) mesh periods of ``quick`` galleries (the 0–1 test needs ≥ 100 points).
 QUICK_PERIODS = (50, 100)
 #: Keys of every row of :func:`run_gallery` (and columns of the recipes' CSV), in order.
@@ -70,43 +74,8 @@ ROW_KEYS = (
     "motion_note",
 )
 
-# dotted name -> (unicode symbol, mathtext symbol) for captions
-_SYMBOLS: dict[str, tuple[str, str]] = {
-    "omega": ("Ω", r"\Omega"),
-    "xi": ("ξ", r"\xi"),
-    "backlash.sun_planet": ("b̄_sp", r"\bar{b}_{sp}"),
-    "backlash.planet_ring": ("b̄_rp", r"\bar{b}_{rp}"),
-    "clearance.sun_bearing": ("b̄_s", r"\bar{b}_{s}"),
-}
-
 
 # --------------------------------------------------------------------------- runner
-def _point(target: Any, vals: Mapping[str, Any]) -> tuple[Any, float | None]:
-    """(what :func:`gearchaos.simulate` takes, Ω) of one point: a gear set with the changes
-    applied, or a reference system with its model fields replaced."""
-    from ..gearset import GearSet
-    from ..model.system import System
-
-    changes = dict(vals)
-    omega = changes.pop("omega", None)
-    if isinstance(target, GearSet):
-        if omega is None:
-            raise ParameterError(
-                "omega must be varied or fixed (e.g. fixed={'omega': 1.5} or --set omega=1.5)"
-            )
-        return (target.evolve(changes) if changes else target), float(omega)
-    if isinstance(target, System):
-        model = target.model
-        if changes:
-            try:
-                model = dataclasses.replace(model, **changes)
-            except TypeError:
-                names = ", ".join(sorted(changes))
-                raise ParameterError(f"unknown parameter of {target.name}: got {names}") from None
-        return System(model, float(omega) if omega is not None else target.omega), None
-    raise ParameterError(f"target must be a GearSet or a System: got {type(target).__name__}")
-
-
 def _finite(v: Any) -> float | None:
     if v is None:
         return None
@@ -135,14 +104,12 @@ def run_gallery(
     values: Sequence[float],
     *,
     fixed: Mapping[str, Any] | None = None,
-    transient: float = 100,
-    periods: int = 300,
     with_: Iterable[str] | str | None = (),
     progress: bool = True,
-    rtol: float = 1e-8,
-    atol: float = 1e-10,
     planet: int = 1,
     title: str | None = None,
+    settings: Any = None,
+    **solver: Any,
 ) -> tuple[Any, list[dict[str, Any]]]:
     """Simulate, measure and label every value of a parameter path and draw the gallery.
 
@@ -157,16 +124,17 @@ def run_gallery(
     fixed
         Other parameters by dotted name, ``omega`` included when it is not varied (required for
         a gear set).
-    transient, periods
-        Mesh periods discarded, then recorded (one Poincaré point each) — for the simulation
-        and for the Lyapunov exponent alike.
     with_
         ``"phase"`` and/or ``"spectrum"`` rows under each map; the simulations then record 64
         samples per period (else one, the section points only).
     progress
         A progress bar on stderr.
-    rtol, atol, planet, title
-        Tolerances; planet of X̄_sp; figure title (default: the gallery's own).
+    planet, title
+        Planet of X̄_sp; figure title (default: the gallery's own).
+    settings, **solver
+        :class:`~gearchaos.integrate.settings.SolverSettings` (default: 100 transient and 300
+        recorded periods) and/or its fields by name (``transient_periods``, ``periods``,
+        ``rtol``, ``atol``) — for the simulation and the Lyapunov exponent alike.
 
     Returns
     -------
@@ -179,58 +147,36 @@ def run_gallery(
     Raises
     ------
     ParameterError
-        An unknown or invalid parameter name or value (checked for every value before anything
-        runs), ``param`` also in ``fixed``, no Ω, or invalid ``with_``.
+        An unknown or invalid parameter name, value or setting (checked for every value before
+        anything runs), ``param`` also in ``fixed``, no Ω, or invalid ``with_``.
     """
-    from ..analysis.lyapunov import lyapunov_spectrum
-    from ..analysis.summary import summarize
-    from ..integrate import simulate
-    from ..plot.bifurcation import axis_symbol
+    from ..analysis.point import analyse_point
+    from ..model.target import resolve
+    from ..plot import axis_symbol
     from ..plot.gallery import parse_extras, poincare_gallery
 
+    extras = parse_extras(with_)
+    base = SolverSettings.build(settings or GALLERY_SETTINGS, **solver)
+    settings = base.replace(samples_per_period=64 if extras else 1)
     fixed = dict(fixed or {})
     if param in fixed:
         raise ParameterError(f"{param} is both varied and fixed; choose one")
     vals = [float(v) for v in values]
     if not vals:
         raise ParameterError(f"{param} needs at least one value: got none")
-    extras = parse_extras(with_)
-    # build every point first: a bad name or value fails before anything runs
-    points = [_point(gs, {**fixed, param: v}) for v in vals]
-    spp = 64 if extras else 1
+    # resolve every point first: a bad name or value fails before anything runs
+    systems = [resolve(gs, {**fixed, param: v}) for v in vals]
     results: list[Any] = []
     summaries: list[dict[str, Any]] = []
     rows: list[dict[str, Any]] = []
-    sym = _SYMBOLS.get(param, (param, param))[0]
+    sym = display_symbol(param)
     with _progress(progress, len(vals)) as bar:
         task = bar.add_task("Poincaré gallery", total=len(vals))
-        for v, (target, omega) in zip(vals, points, strict=True):
+        for v, system in zip(vals, systems, strict=True):
             bar.update(task, description=f"{sym} = {v:g}")
-            res = simulate(
-                target,
-                omega=omega,
-                transient_periods=transient,
-                periods=periods,
-                samples_per_period=spp,
-                rtol=rtol,
-                atol=atol,
-                check=False,
-            )
-            lle = None
-            if res.status.ok:
-                lr = lyapunov_spectrum(
-                    res.system,
-                    n_exponents=1,
-                    transient_periods=transient,
-                    periods=periods,
-                    rtol=rtol,
-                    atol=atol,
-                )
-                lle = _finite(lr.largest) if lr.status.ok else None
-            summary = summarize(res, lle=lle)
-            if not res.status.ok:
-                summary["motion"] = "failed"
-            results.append(res)
+            point = analyse_point(system, None, settings)
+            summary = point.summary
+            results.append(point.result)
             summaries.append(summary)
             rows.append(
                 {
@@ -251,7 +197,10 @@ def run_gallery(
         title += f" at different {axis_symbol(param)}"
         if given:
             title += "\nat " + ", ".join(given)
-        title += f"\n{transient:g} transient + {periods} recorded periods, zero initial state"
+        title += (
+            f"\n{settings.transient_periods:g} transient + {settings.periods} recorded periods, "
+            "zero initial state"
+        )
     fig = poincare_gallery(
         results, summaries, param=param, values=vals, with_=extras, planet=planet, title=title
     )
@@ -306,92 +255,28 @@ class Gallery:
     def title(self, quick: bool = False) -> str:
         """Figure title in mathtext, built from the recipe's own numbers."""
         number = self.name.removeprefix("fig")
-        given = ", ".join(f"${_SYMBOLS[k][1]} = {_fmt(v)}$" for k, v in self.fixed.items())
+        given = ", ".join(f"${tex(k)} = {_fmt(v)}$" for k, v in self.fixed.items())
         tr, rec = QUICK_PERIODS if quick else (self.transient_periods, self.periods)
         text = (
             f"Fig. {number}: Poincaré maps of $\\bar{{X}}_{{sp1}}$ versus "
-            f"$\\bar{{X}}'_{{sp1}}$ at {given} and different ${_SYMBOLS[self.param][1]}$\n"
+            f"$\\bar{{X}}'_{{sp1}}$ at {given} and different ${tex(self.param)}$\n"
             f"{tr} transient + {rec} recorded mesh periods, zero initial state"
         )
         return text + (" (quick)" if quick else "")
 
 
-_FIG10_VALUES = (1.0, 1.9, 3.7, 4.41, 4.79, 4.84, 4.91, 5.39, 5.47, 5.55, 5.93, 6.0, 7.5, 9.0)
-
-
 def _galleries() -> dict[str, Gallery]:
-    stand_in = (
-        "The default gear set stands in for the seed's lost Table 1, so the motion at a value "
-        "can differ from the seed's panels."
-    )
     items = [
         Gallery(
-            name="fig5",
-            caption=(
-                "Poincaré maps of X̄_sp1 versus X̄'_sp1 at given ξ = 0.03, b̄_sp = 3, b̄_rp = 3.5, "
-                "b̄_s = 2 and different Ω values"
-            ),
-            param="omega",
-            values=(1.2, 1.35, 1.5, 1.69, 1.696, 1.875, 1.926, 2.02, 2.45, 2.62, 3.03, 3.58),
-            named=(1.35, 1.69, 1.696, 1.875, 1.926, 2.02, 2.45, 2.62, 3.03, 3.58),
-            fixed={
-                "xi": 0.03,
-                "backlash.sun_planet": 3.0,
-                "backlash.planet_ring": 3.5,
-                "clearance.sun_bearing": 2.0,
-            },
-            notes=(
-                "Named in the text of Sec. 3.1: 1.35 (end of 1T), 1.69 and 1.696 (QP → 1T), "
-                "1.875 (2T), 1.926 (Hopf), 2.02 (1T, entry to chaos), 2.45 and 2.62 (chaotic "
-                "window), 3.03 (2T), 3.58 (back to 1T). Added: 1.2 (inside the 1T range "
-                "0 ≤ Ω ≤ 1.35) and 1.5 (inside 1.36 ≤ Ω ≤ 2.45, the Ω of the other figures). "
-                + stand_in
-            ),
-        ),
-        Gallery(
-            name="fig7",
-            caption=(
-                "Poincaré maps of X̄_sp1 versus X̄'_sp1 at given Ω = 1.5, ξ = 0.05, b̄_rp = 3.5, "
-                "b̄_s = 2 and different b̄_sp values"
-            ),
-            param="backlash.sun_planet",
-            values=(1.0, 1.5, 2.0, 2.4, 2.81, 2.85, 3.3, 3.8, 4.3, 4.83, 5.4, 6.0),
-            named=(1.0, 2.81, 2.85, 4.83, 6.0),
-            fixed={
-                "omega": 1.5,
-                "xi": 0.05,
-                "backlash.planet_ring": 3.5,
-                "clearance.sun_bearing": 2.0,
-            },
-            notes=(
-                "Named in the text of Sec. 3.2: the range 1 ≤ b̄_sp ≤ 6, 2.81 (Hopf) and the "
-                "period-doubling range 2.85 ≤ b̄_sp ≤ 4.83. The other values fill the range "
-                "(1T → QP → 3T → 1T below 2.81, 2T/4T/8T/16T inside the doubling range, chaos "
-                "above it, in the seed). " + stand_in
-            ),
-        ),
-        Gallery(
-            name="fig10",
-            caption=(
-                "Poincaré maps of X̄_sp1 versus X̄'_sp1 at given ξ = 0.05, Ω = 1.5, b̄_sp = 3, "
-                "b̄_s = 2 and different b̄_rp values"
-            ),
-            param="backlash.planet_ring",
-            values=_FIG10_VALUES,
-            named=(1.0, 1.9, 3.7, 4.41, 4.79, 4.84, 4.91, 5.39, 5.47, 5.55, 5.93, 6.0, 9.0),
-            fixed={
-                "omega": 1.5,
-                "xi": 0.05,
-                "backlash.sun_planet": 3.0,
-                "clearance.sun_bearing": 2.0,
-            },
-            notes=(
-                "Named in the text of Sec. 3.3: the range 1 ≤ b̄_rp ≤ 9, 1.9 (end of 1T), 3.7 "
-                "and 4.41 (chaos), 4.79 (6T), 4.84 (3T), 4.91 (QP), 5.39 (chaos), 5.47 (8T), "
-                "5.55 (4T), 5.93 and 6 (chaos/Hopf switching). Added: 7.5 (the final "
-                "period-doubling route, panels (u)–(x)). " + stand_in
-            ),
-        ),
+            name=d["name"],
+            caption=d["caption"],
+            param=d["param"],
+            values=tuple(d["values"]),
+            named=tuple(d["named"]),
+            fixed=d["fixed"],
+            notes=d["notes"],
+        )
+        for d in load_figures()["gallery"]
     ]
     return {g.name: g for g in items}
 
@@ -402,15 +287,7 @@ GALLERIES: dict[str, Gallery] = _galleries()
 
 def get_gallery(name: str) -> Gallery:
     """The gallery called ``name`` (``fig5``, ``Fig5`` and ``5`` alike)."""
-    key = str(name).strip().lower()
-    if key.isdigit():
-        key = "fig" + key
-    try:
-        return GALLERIES[key]
-    except KeyError:
-        raise ParameterError(
-            f"gallery must be one of {', '.join(GALLERIES)}: got {name!r}"
-        ) from None
+    return lookup_figure(GALLERIES, name, "gallery")
 
 
 def _write_json(path: Path, obj: Any) -> None:
@@ -449,7 +326,7 @@ def reproduce_gallery(
     dict
         ``{"figure", "json", "table" (the CSV), "points", "failed", "seconds", "rows"}``.
     """
-    from .. import __version__
+    from .._version import __version__
     from ..gearset import preset
     from ..plot import savefig
 
@@ -465,7 +342,7 @@ def reproduce_gallery(
         g.param,
         g.values,
         fixed=dict(g.fixed),
-        transient=tr,
+        transient_periods=tr,
         periods=rec,
         progress=progress,
         title=g.title(quick),

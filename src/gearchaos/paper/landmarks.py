@@ -48,7 +48,10 @@ from typing import Any, Literal
 
 import numpy as np
 
+from .._files import read_text_file
 from ..errors import ParameterError
+from ..gearset.mapping import flatten
+from ..sweep.result import SweepResult
 
 __all__ = [
     "AXES",
@@ -157,17 +160,6 @@ class LandmarkResult:
 
 
 # ------------------------------------------------------------------------------ loading
-def _flatten(d: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
-    out: dict[str, Any] = {}
-    for k, v in d.items():
-        name = f"{prefix}{k}"
-        if isinstance(v, Mapping):
-            out.update(_flatten(v, name + "."))
-        else:
-            out[name] = v
-    return out
-
-
 def _number(where: str, key: str, v: Any) -> float:
     if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
         raise ParameterError(f"{where}: {key} must be a finite number: got {v!r}")
@@ -188,7 +180,7 @@ def _labels(where: str, key: str, v: Any) -> tuple[str, ...]:
 def _params(where: str, key: str, v: Any) -> dict[str, float]:
     if not isinstance(v, Mapping):
         raise ParameterError(f"{where}: {key} must be a table of parameters: got {v!r}")
-    flat = _flatten(v)
+    flat = flatten(v)
     for name in flat:
         if name not in AXES:
             raise ParameterError(f"{where}: {key}.{name} is not one of {', '.join(AXES)}")
@@ -281,6 +273,10 @@ def _landmark(i: int, d: Mapping[str, Any]) -> Landmark:
     return mark
 
 
+#: Largest landmarks file read (the packaged one has about 30 kB).
+MAX_LANDMARKS_BYTES = 4 * 2**20
+
+
 def load_landmarks(path: str | Path | None = None) -> list[Landmark]:
     """Read and validate the landmarks (default: the packaged ``landmarks.toml``).
 
@@ -294,11 +290,11 @@ def load_landmarks(path: str | Path | None = None) -> list[Landmark]:
         text = resources.files(__package__).joinpath("landmarks.toml").read_text("utf-8")
         source = "landmarks.toml (packaged)"
     else:
-        text = Path(path).read_text("utf-8")
+        text = read_text_file(path, what="landmarks file", max_bytes=MAX_LANDMARKS_BYTES)
         source = str(path)
     try:
         data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
+    except (tomllib.TOMLDecodeError, RecursionError, ValueError) as exc:
         raise ParameterError(f"{source}: not valid TOML: {exc}") from None
     rows = data.get("landmark")
     if not isinstance(rows, list) or not rows:
@@ -415,14 +411,11 @@ def _panel(mark: Landmark, ds: Any, planet: int) -> tuple[np.ndarray, np.ndarray
 
 
 def _stored_fixed(ds: Any) -> dict[str, Any]:
-    text = getattr(ds, "attrs", {}).get("sweep_toml")
-    if not isinstance(text, str):
+    """The sweep's numeric fixed values by dotted name (none for a dataset without a spec)."""
+    if not getattr(ds, "attrs", {}).get("sweep_toml"):
         return {}
-    try:
-        fixed = tomllib.loads(text).get("fixed", {})
-    except tomllib.TOMLDecodeError:
-        return {}
-    return {k: v for k, v in _flatten(fixed).items() if isinstance(v, int | float)}
+    fixed = SweepResult.of(ds).fixed
+    return {k: v for k, v in fixed.items() if isinstance(v, int | float)}
 
 
 def _counts(labels: np.ndarray) -> str:

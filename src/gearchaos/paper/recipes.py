@@ -34,15 +34,17 @@ from __future__ import annotations
 import math
 import os
 import time
+import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
 from ..errors import ParameterError
+from ..gearset.schema import tex
 
 __all__ = ["PRESET", "QUICK_PERIODS", "RECIPES", "FamilyAxis", "Recipe", "VaryAxis", "reproduce"]
 
@@ -55,14 +57,6 @@ QUICK_PERIODS = (20, 16)
 #: Points per panel of the ``quick`` sweeps.
 QUICK_POINTS = 12
 
-# dotted name -> (unicode symbol, mathtext symbol)
-_SYMBOLS: dict[str, tuple[str, str]] = {
-    "omega": ("Ω", r"\Omega"),
-    "xi": ("ξ", r"\xi"),
-    "backlash.sun_planet": ("b̄_sp", r"\bar{b}_{sp}"),
-    "backlash.planet_ring": ("b̄_rp", r"\bar{b}_{rp}"),
-    "clearance.sun_bearing": ("b̄_s", r"\bar{b}_{s}"),
-}
 _CLEARANCES = ("backlash.sun_planet", "backlash.planet_ring", "clearance.sun_bearing")
 
 
@@ -165,13 +159,13 @@ class Recipe:
     def title(self, quick: bool = False) -> str:
         """Figure title in matplotlib mathtext, built from the recipe's own numbers."""
         number = self.name.removeprefix("fig")
-        given = ", ".join(f"${_SYMBOLS[k][1]} = {_num(v)}$" for k, v in self.fixed.items())
-        fam = _SYMBOLS[self.family.name][1]
+        given = ", ".join(f"${tex(k)} = {_num(v)}$" for k, v in self.fixed.items())
+        fam = tex(self.family.name)
         values = ", ".join(_num(v) for v in self.family.values)
         plural = "s" if len(self.family.values) > 1 else ""
         text = (
             f"Fig. {number}: bifurcation diagram{plural} of $\\bar{{X}}_{{sp1}}$ versus "
-            f"${_SYMBOLS[self.vary.name][1]}$\nat {given}, ${fam} = {values}$"
+            f"${tex(self.vary.name)}$\nat {given}, ${fam} = {values}$"
         )
         if quick:
             text += (
@@ -181,91 +175,32 @@ class Recipe:
         return text
 
 
+def load_figures() -> dict[str, Any]:
+    """The seed's figures as data (``figures.toml`` in this package): ``recipe`` and
+    ``gallery`` entries, each entry's notes with its section's stand-in note appended."""
+    from importlib import resources
+
+    text = resources.files(__package__).joinpath("figures.toml").read_text(encoding="utf-8")
+    data = tomllib.loads(text)
+    for section, entries in (("recipes", "recipe"), ("galleries", "gallery")):
+        stand_in = data[section]["stand_in"]
+        for entry in data[entries]:
+            own = entry.get("notes", "")
+            entry["notes"] = f"{own} {stand_in}" if own else stand_in
+    return data
+
+
 def _recipes() -> dict[str, Recipe]:
-    xis = (0.03, 0.05, 0.07, 0.09)
-    omegas = (1.0, 1.5, 2.0, 2.5)
-    stand_in = (
-        "The default gear set stands in for the seed's lost Table 1, so bifurcation points differ "
-        "from the seed's; protocol, ranges and layout are the seed's."
-    )
     items = [
         Recipe(
-            name="fig4",
-            caption=(
-                "Bifurcation diagrams of X̄_sp1 versus Ω at given b̄_sp = 3, b̄_rp = 3.5, "
-                "b̄_s = 2 and different ξ values (ξ = 0.03, 0.05, 0.07, 0.09)"
-            ),
-            vary=VaryAxis("omega", 0.01, 4.0, 400),
-            family=FamilyAxis("xi", xis),
-            fixed={
-                "backlash.sun_planet": 3.0,
-                "backlash.planet_ring": 3.5,
-                "clearance.sun_bearing": 2.0,
-            },
-            notes=(
-                "The seed's range is 0 ≤ Ω ≤ 4; Ω starts at 0.01 because the mesh period "
-                "2π/Ω is unbounded at Ω = 0 (points near Ω = 0.01 are the costliest: the "
-                "integration time grows as 1/Ω). " + stand_in
-            ),
-        ),
-        Recipe(
-            name="fig6",
-            caption=(
-                "Bifurcation diagrams of X̄_sp1 versus b̄_sp at given Ω = 1.5, b̄_rp = 3.5, "
-                "b̄_s = 2 and different ξ values (ξ = 0.03, 0.05, 0.07, 0.09)"
-            ),
-            vary=VaryAxis("backlash.sun_planet", 1.0, 10.0, 300),
-            family=FamilyAxis("xi", xis),
-            fixed={"omega": 1.5, "backlash.planet_ring": 3.5, "clearance.sun_bearing": 2.0},
-            notes=stand_in,
-        ),
-        Recipe(
-            name="fig8",
-            caption=(
-                "Bifurcation diagrams of X̄_sp1 versus b̄_sp at given ξ = 0.11, b̄_rp = 3.5, "
-                "b̄_s = 2 and different Ω values (Ω = 1, 1.5, 2, 2.5)"
-            ),
-            vary=VaryAxis("backlash.sun_planet", 1.0, 10.0, 300),
-            family=FamilyAxis("omega", omegas),
-            fixed={"xi": 0.11, "backlash.planet_ring": 3.5, "clearance.sun_bearing": 2.0},
-            notes=(
-                "The seed's text does not restate the b̄_sp range of Fig. 8; [1, 10] as in "
-                "Fig. 6 (its discussion reaches b̄_sp = 9.37). " + stand_in
-            ),
-        ),
-        Recipe(
-            name="fig9",
-            caption=(
-                "Bifurcation diagrams of X̄_sp1 versus b̄_rp at given Ω = 1.5, b̄_sp = 3, "
-                "b̄_s = 2 and different ξ values (ξ = 0.03, 0.05, 0.07, 0.09)"
-            ),
-            vary=VaryAxis("backlash.planet_ring", 1.0, 16.0, 300),
-            family=FamilyAxis("xi", xis),
-            fixed={"omega": 1.5, "backlash.sun_planet": 3.0, "clearance.sun_bearing": 2.0},
-            notes=stand_in,
-        ),
-        Recipe(
-            name="fig11",
-            caption=(
-                "Bifurcation diagrams of X̄_sp1 versus b̄_rp at given ξ = 0.11, b̄_sp = 3, "
-                "b̄_s = 2 and different Ω values (Ω = 1, 1.5, 2, 2.5)"
-            ),
-            vary=VaryAxis("backlash.planet_ring", 1.0, 11.0, 300),
-            family=FamilyAxis("omega", omegas),
-            fixed={"xi": 0.11, "backlash.sun_planet": 3.0, "clearance.sun_bearing": 2.0},
-            notes=stand_in,
-        ),
-        Recipe(
-            name="fig12",
-            caption=(
-                "Bifurcation diagram of X̄_sp1 versus b̄_s at given ξ = 0.05, b̄_sp = 3, "
-                "b̄_rp = 3.5 and Ω = 1.5"
-            ),
-            vary=VaryAxis("clearance.sun_bearing", 1.0, 10.0, 300),
-            family=FamilyAxis("omega", (1.5,)),
-            fixed={"xi": 0.05, "backlash.sun_planet": 3.0, "backlash.planet_ring": 3.5},
-            notes="A single panel: Ω = 1.5 is a one-value family. " + stand_in,
-        ),
+            name=d["name"],
+            caption=d["caption"],
+            vary=VaryAxis(**d["vary"]),
+            family=FamilyAxis(d["family"]["name"], tuple(d["family"]["values"])),
+            fixed=d["fixed"],
+            notes=d["notes"],
+        )
+        for d in load_figures()["recipe"]
     ]
     return {r.name: r for r in items}
 
@@ -275,15 +210,23 @@ def _recipes() -> dict[str, Recipe]:
 RECIPES: dict[str, Recipe] = _recipes()
 
 
-def get_recipe(name: str) -> Recipe:
-    """The recipe called ``name`` (``fig4``, ``Fig4`` and ``4`` alike)."""
+T = TypeVar("T")
+
+
+def lookup_figure(table: Mapping[str, T], name: Any, what: str) -> T:
+    """The entry of ``table`` for a figure name (``fig4``, ``Fig4`` and ``4`` alike)."""
     key = str(name).strip().lower()
     if key.isdigit():
         key = "fig" + key
     try:
-        return RECIPES[key]
+        return table[key]
     except KeyError:
-        raise ParameterError(f"figure must be one of {', '.join(RECIPES)}: got {name!r}") from None
+        raise ParameterError(f"{what} must be one of {', '.join(table)}: got {name!r}") from None
+
+
+def get_recipe(name: str) -> Recipe:
+    """The recipe called ``name`` (``fig4``, ``Fig4`` and ``4`` alike)."""
+    return lookup_figure(RECIPES, name, "figure")
 
 
 def reproduce(
@@ -336,10 +279,10 @@ def reproduce(
         ``name`` is not a recipe.
     """
     recipe = get_recipe(name)
-    from .. import bifurcation  # the sweep layer sits below paper/
     from ..gearset import preset
     from ..plot import savefig
     from ..plot.bifurcation import bifurcation_figure
+    from ..sweep import bifurcation
 
     t0 = time.perf_counter()
     out = Path(os.fspath(outdir))

@@ -32,6 +32,8 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from ..sweep.result import SweepResult
+
 __all__ = ["FIGURES", "HONESTY", "build_report", "render_html"]
 
 #: Every figure of the seed, in the paper's order.
@@ -173,21 +175,28 @@ def _landmark_rows(stores: Mapping[str, Any]) -> tuple[list[dict[str, Any]], str
     return rows, ""
 
 
+def _regime_rank(label: str) -> tuple[int, int, str]:
+    """Columns in one fixed order: 1T, 2T, …, QP, chaos, unresolved, failed (then others)."""
+    from ..plot.regimes import REGIME_ORDER
+
+    if label in REGIME_ORDER:
+        return (REGIME_ORDER.index(label), 0, label)
+    head = label[:-1]
+    if label.endswith("T") and head.isdigit():  # a period beyond the named ones: after them
+        return (REGIME_ORDER.index("QP") - 1, int(head), label)
+    return (len(REGIME_ORDER), 0, label)
+
+
 def _regime_table(ds: Any) -> str:
-    raw = ds.attrs.get("regime_table")
-    if not raw:
+    table = SweepResult.of(ds).regime_table()
+    if not table:
         return "<p>No regime table stored.</p>"
-    table = json.loads(raw) if isinstance(raw, str) else dict(raw)
-    kinds: list[str] = []
-    for fr in table.values():
-        for k in fr:
-            if k not in kinds:
-                kinds.append(k)
+    kinds = sorted({k for fr in table.values() for k in fr}, key=_regime_rank)
     head = "".join(f"<th>{_e(k)}</th>" for k in kinds)
     body = []
     for panel, fr in table.items():
         cells = "".join(
-            f"<td>{100 * float(fr[k]):.0f} %</td>" if k in fr else "<td>—</td>" for k in kinds
+            f"<td>{100 * float(fr.get(k, 0.0)):.0f} %</td>" for k in kinds
         )
         body.append(f"<tr><th>{_e(panel)}</th>{cells}</tr>")
     return (
@@ -220,8 +229,8 @@ _CSS = """
 body{font-family:system-ui,sans-serif;max-width:1200px;margin:2em auto;padding:0 1em;color:#1f2328}
 table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #d0d7de;padding:.3em .5em;
 vertical-align:top;text-align:left}.verdict{color:#fff;font-weight:bold;white-space:nowrap}
-.figure{display:flex;gap:1.5em;align-items:flex-start;margin:1em 0 2em}.figure img{max-width:720px;
-width:60%;border:1px solid #d0d7de}.note{color:#57606a;font-size:.9em}pre{background:#f6f8fa;
+.figure{margin:1em 0 2em}.figure img{width:100%;height:auto;border:1px solid #d0d7de;
+cursor:zoom-in}.note{color:#57606a;font-size:.9em}pre{background:#f6f8fa;
 padding:.6em;overflow:auto;font-size:.85em}.regime td,.regime th{font-size:.85em}
 """
 
@@ -239,7 +248,7 @@ def render_html(
     gearset_label: str | None = None,
 ) -> str:
     """The report page (see the module docstring)."""
-    from .. import __version__
+    from .._version import __version__
     from .galleries import GALLERIES
     from .recipes import PRESET, RECIPES
 
@@ -314,7 +323,11 @@ def render_html(
         fig = res.get("figure")
         if fig and Path(fig).exists():
             rel = os.path.relpath(fig, outdir)
-            p.append(f"<img src='{_e(rel)}' alt='{_e(name)}'>")
+            # full width; a click opens the PNG at its own resolution (plain HTML, no server)
+            p.append(
+                f"<a href='{_e(rel)}' title='open the figure at full resolution'>"
+                f"<img src='{_e(rel)}' alt='{_e(name)}'></a>"
+            )
         else:
             p.append(f"<p><strong>missing</strong> {_e(res.get('error', ''))}</p>")
         p.append(

@@ -11,9 +11,11 @@ Every plotting function takes ``ax=None`` (a new figure when not given) and retu
 X̄_sp1 = δ_sp1/b_c, time in mesh periods τΩ/2π.
 """
 
-from .bifurcation import bifurcation, bifurcation_figure, distinct_map, sweep_figure
+from ._common import axis_label, axis_symbol
+from .bifurcation import bifurcation, bifurcation_figure
 from .figure import savefig, summary_figure
 from .gallery import poincare_gallery
+from .maps import distinct_counts, distinct_map, sweep_figure
 from .phase import phase_portrait, poincare_map, sun_orbit
 from .regimes import (
     REGIME_COLOURS,
@@ -27,8 +29,11 @@ from .timeseries import amplitude_spectrum, spectrum, time_history
 __all__ = [
     "REGIME_COLOURS",
     "amplitude_spectrum",
+    "axis_label",
+    "axis_symbol",
     "bifurcation",
     "bifurcation_figure",
+    "distinct_counts",
     "distinct_map",
     "phase_portrait",
     "poincare_gallery",

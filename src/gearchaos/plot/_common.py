@@ -1,4 +1,5 @@
-"""Shared helpers of the plotting layer: variable names, symbols, axes and clearance lines."""
+"""Shared helpers of the plotting layer: symbols and labels (from the parameter registry),
+variables of results, axes, cell edges, clearance and resonance lines."""
 
 from __future__ import annotations
 
@@ -9,6 +10,143 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
+from ..gearset.schema import OMEGA, describe
+
+#: ``gid`` of the vertical lines where a mesh harmonic meets a natural frequency.
+RESONANCE_GID = "resonance"
+
+# symbols of the reference systems' parameters (gearchaos.model.library)
+_REFERENCE_TEX: dict[str, str] = {
+    "zeta": r"\zeta",
+    "eps": r"\varepsilon",
+    "b": "b",
+    "f_mean": "F_m",
+    "f_alt": "F_a",
+}
+# definitions shown after a symbol on axes
+_DEFINITIONS: dict[str, str] = {OMEGA: r"\omega/\omega_n"}
+
+# section variable -> mathtext symbol (%d: planet); derivatives get a prime
+_VAR_SYMBOLS: dict[str, str] = {
+    "delta_sp": r"\bar{X}_{sp%d}",
+    "delta_rp": r"\bar{X}_{rp%d}",
+    "force_sp": r"\bar{F}_{sp%d}",
+    "force_rp": r"\bar{F}_{rp%d}",
+    "p": r"\bar{p}_{%d}",
+    "x_s": r"\bar{x}_s",
+    "y_s": r"\bar{y}_s",
+    "sigma": r"\bar{\sigma}",
+}
+
+
+# --------------------------------------------------------------------------- names and labels
+def _tex(name: str) -> str | None:
+    field = describe(name)
+    if field is not None:
+        return field.tex
+    return _REFERENCE_TEX.get(name)
+
+
+def axis_symbol(name: str) -> str:
+    """Mathtext symbol (with ``$``) of a parameter, e.g. ``$\\xi$``; else the name."""
+    sym = _tex(name)
+    return f"${sym}$" if sym is not None else name
+
+
+def axis_label(name: str) -> str:
+    """Axis label of a parameter from the registry: ``omega`` → ``$\\Omega = \\omega/\\omega_n$``,
+    ``backlash.sun_planet`` → ``$\\bar b_{sp}$``, ``torque.input`` → ``$T_D$ [N m]``; an
+    unknown name labels itself."""
+    sym = _tex(name)
+    if sym is None:
+        return name
+    if name in _DEFINITIONS:
+        return f"${sym} = {_DEFINITIONS[name]}$"
+    field = describe(name)
+    unit = field.unit_label if field is not None else ""
+    return f"${sym}$ {unit}" if unit else f"${sym}$"
+
+
+def var_symbol(var: str, planet: int | None) -> str:
+    """Mathtext symbol (without ``$``) of a section variable: ``delta_sp`` → ``\\bar{X}_{sp1}``,
+    ``delta_sp_dot`` → ``\\bar{X}'_{sp1}``; other names become ``head_{tail}``."""
+    base, prime = (var[:-4], "'") if var.endswith("_dot") else (var, "")
+    if base in _VAR_SYMBOLS:
+        sym = _VAR_SYMBOLS[base]
+        if "%d" in sym:
+            sym = sym % (planet if planet is not None else 1)
+        # prime before the subscript: \bar{X}'_{sp1}
+        head, sep, tail = sym.partition("_")
+        return f"{head}{prime}{sep}{tail}" if sep else sym + prime
+    head, sep, tail = base.partition("_")
+    sym = f"{head}_{{{tail}}}" if sep else head
+    return sym + prime
+
+
+def fmt(v: Any) -> str:
+    """A coordinate value for titles: strings as they are, numbers with ``%g``."""
+    if isinstance(v, str):
+        return v
+    return f"{float(v):g}"
+
+
+def edges(v: np.ndarray) -> np.ndarray:
+    """Cell edges around (possibly non-uniform) centres."""
+    v = np.asarray(v, dtype=np.float64)
+    if v.size == 1:
+        d = 0.5 * abs(v[0]) if v[0] != 0 else 0.5
+        return np.array([v[0] - d, v[0] + d])
+    mid = 0.5 * (v[1:] + v[:-1])
+    return np.concatenate([[v[0] - (mid[0] - v[0])], mid, [v[-1] + (v[-1] - mid[-1])]])
+
+
+def no_offset(*axes: Any) -> None:
+    """Turn off axis offsets (“1e-6 + 3.49”) on the given matplotlib axes."""
+    for axis in axes:
+        formatter = axis.get_major_formatter()
+        if hasattr(formatter, "set_useOffset"):
+            formatter.set_useOffset(False)
+
+
+_HARMONIC_STYLES = {1: "-", 2: "--", 3: ":"}
+
+
+def resonance_lines(ax: Any, gearset: Any, lo: float, hi: float) -> int:
+    """Vertical lines at Ω = ω_k/(h ω_n) inside [lo, hi], where the h-th mesh harmonic meets a
+    natural frequency ω_k of the linear model; returns how many were drawn."""
+    if gearset is None:
+        raise ParameterError(
+            "resonances need the gear set of the sweep (attribute gearset_toml); "
+            "this dataset has none (a reference system?)"
+        )
+    from ..analysis.derived import gearset_info
+
+    found = sorted(
+        gearset_info(gearset)["omega_at_resonances"],
+        key=lambda r: (int(r["harmonic"]), float(r["omega"])),
+    )
+    drawn = 0
+    labelled: set[int] = set()
+    for r in found:
+        om, h = float(r["omega"]), int(r["harmonic"])
+        if not lo <= om <= hi:
+            continue
+        ax.axvline(
+            om,
+            color="tab:green",
+            linestyle=_HARMONIC_STYLES.get(h, "-."),
+            linewidth=0.7,
+            alpha=0.55,
+            zorder=0.5,
+            gid=RESONANCE_GID,
+            label=(
+                rf"${'' if h == 1 else h}\Omega = \omega_k/\omega_n$" if h not in labelled else None
+            ),
+        )
+        labelled.add(h)
+        drawn += 1
+    return drawn
+
 
 #: Line style of clearance markers (±b̄), so tests and users can find them by ``gid``.
 CLEARANCE_GID = "clearance"
@@ -167,6 +305,20 @@ def clearance_lines(ax: Any, info: VarInfo, *, vertical: bool = False) -> None:
             zorder=1,
             **_CLEARANCE_STYLE,
         )
+
+
+def corner_note(ax: Any, text: str) -> Any:
+    """A small grey note in the lower right corner of ``ax`` (points left out, and why)."""
+    return ax.text(
+        0.99,
+        0.01,
+        text,
+        ha="right",
+        va="bottom",
+        fontsize="x-small",
+        color="0.3",
+        transform=ax.transAxes,
+    )
 
 
 def message(ax: Any, text: str) -> Any:

@@ -32,7 +32,8 @@ def _text_lines(result: Any, summary: dict[str, Any]) -> list[str]:
     gs = summary.get("gearset") or result.system.name
     n = summary["distinct_section_points"]
     motion = summary["motion"]
-    points = f"> {n - 1}" if motion == "many" else str(n)
+    recorded = summary.get("recorded_section_points")
+    points = f"{n} of {recorded}" if recorded else str(n)
     lines = [
         f"gear set: {gs}",
         rf"$\Omega = \omega/\omega_n$ = {_fmt(summary['omega'])}",
@@ -137,8 +138,7 @@ def summary_figure(
     try:
         ax = poincare_map(result, planet, ax=axs[0, 2], var=var)
         n_pts = summary["distinct_section_points"]
-        what = "many points" if summary["motion"] == "many" else f"{n_pts} distinct point(s)"
-        ax.set_title(f"Poincaré map ({what})")
+        ax.set_title(f"Poincaré map ({n_pts} distinct of {len(result.section_tau)} points)")
     except ParameterError as e:
         message(axs[0, 2], str(e))
 

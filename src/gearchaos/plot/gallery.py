@@ -19,7 +19,10 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from ._common import is_planetary, message, variable
+from ._common import axis_symbol, is_planetary, message, variable
+from .phase import phase_portrait, poincare_map
+from .regimes import regime_colour, regime_legend_below
+from .timeseries import spectrum
 
 __all__ = ["GALLERY_EXTRAS", "gallery_title", "parse_extras", "poincare_gallery"]
 
@@ -34,8 +37,6 @@ def _minus(text: str) -> str:
 def gallery_title(param: str, value: float, summary: dict[str, Any] | None) -> str:
     """Panel title ``Ω = 1.875 · 2T · λ₁ = −0.012`` (mathtext symbols; the LLE only when
     the summary has one, ``failed`` for a failed integration)."""
-    from .bifurcation import axis_symbol
-
     parts = [f"{axis_symbol(param)} = {_minus(f'{float(value):g}')}"]
     if summary is not None:
         parts.append(str(summary.get("motion", "?")))
@@ -120,10 +121,6 @@ def poincare_gallery(
     from matplotlib.figure import Figure
 
     from ..analysis.summary import summarize
-    from .bifurcation import axis_symbol
-    from .phase import phase_portrait, poincare_map
-    from .regimes import regime_colour, regime_handles
-    from .timeseries import spectrum
 
     results = list(results)
     values = [float(v) for v in values]
@@ -206,14 +203,5 @@ def poincare_gallery(
             f"at different {axis_symbol(param)}"
         )
     fig.suptitle(title, fontsize="medium")
-    handles = regime_handles(labels)
-    fig.legend(
-        handles=handles,
-        loc="outside lower center",
-        ncols=min(len(handles), 8),
-        fontsize="small",
-        frameon=False,
-        title="motion (panel frame colour)",
-        title_fontsize="small",
-    )
+    regime_legend_below(fig, labels, title="motion (panel frame colour)")
     return fig

@@ -13,9 +13,16 @@ from ._common import (
     clearance_lines,
     get_ax,
     is_planetary,
-    readable_limits,
     sample_window,
     variable,
+)
+from .units import (
+    PhysicalScales,
+    clearance_notes,
+    fit_to_data,
+    secondary_axis,
+    section_style,
+    var_quantity,
 )
 
 __all__ = ["phase_portrait", "poincare_map", "sun_orbit"]
@@ -30,12 +37,30 @@ def _with_dot(result: Any, var: str | None, planet: int) -> VarInfo:
     return info
 
 
+def _section_points(ax: Any, xs: np.ndarray, ys: np.ndarray) -> None:
+    """Overlay Poincaré section points, sized and faded by their number (:func:`section_style`)."""
+    style = section_style(xs.size)
+    ax.plot(
+        xs,
+        ys,
+        ".",
+        ms=max(1.0, float(np.sqrt(style["s"]))),
+        alpha=style["alpha"],
+        color="C3",
+        label="section points",
+        zorder=3,
+        rasterized=True,
+    )
+
+
 def phase_portrait(
     result: Any,
     var: str | None = None,
     planet: int = 1,
     ax: Any = None,
     periods: float | None = None,
+    *,
+    physical: bool = True,
 ) -> Any:
     """Plot the phase portrait X̄ against X̄' with the Poincaré section points overlaid.
 
@@ -53,34 +78,47 @@ def phase_portrait(
         Draw only the last ``periods`` recorded periods of the orbit (default: all); the
         section points are always all drawn.
 
+    physical
+        Physical axes opposite the dimensionless ones (µm, mm/s), for gear sets.
+
     Returns
     -------
     matplotlib.axes.Axes
-        Vertical dashed lines mark ±b̄ of variables with a clearance.
+        Limits follow the orbit and the section points; vertical dashed lines mark ±b̄ of
+        variables with a clearance where they fall inside, edge notes where they do not.
     """
     info = _with_dot(result, var, planet)
     assert info.dot is not None
     ax = get_ax(ax)
     x = np.asarray(result.series(info.name))
     xd = np.asarray(result.series(info.dot))
+    xs, xds = np.asarray(result.section(info.name)), np.asarray(result.section(info.dot))
+    data_x, data_y = [xs], [xds]
     if result.samples_per_period > 1:
         sl = sample_window(result, periods)
         ax.plot(x[sl], xd[sl], lw=0.5, color="C0", alpha=0.8, label="orbit")
-    ax.plot(
-        result.section(info.name),
-        result.section(info.dot),
-        ".",
-        ms=4,
-        color="C3",
-        label="section points",
-        zorder=3,
-        rasterized=True,
-    )
+        data_x.append(x[sl])
+        data_y.append(xd[sl])
+    _section_points(ax, xs, xds)
+    _finish(ax, result, info, np.concatenate(data_x), np.concatenate(data_y), physical)
+    return ax
+
+
+def _finish(
+    ax: Any, result: Any, info: VarInfo, x: np.ndarray, y: np.ndarray, physical: bool
+) -> None:
+    """Labels, limits from the data, ±b̄ lines (notes at the edge when outside the data) and
+    the physical axes of an x–x' plane."""
     clearance_lines(ax, info, vertical=True)
     ax.set_xlabel(info.label)
     ax.set_ylabel(info.dot_label)
-    readable_limits(ax, joint=True)
-    return ax
+    fit_to_data(ax, x, y, joint=True)
+    if info.clearance is not None:
+        clearance_notes(ax, "x", (-info.clearance, info.clearance), info.clearance_symbol or "b")
+    if physical:
+        scales = PhysicalScales.of_result(result)
+        secondary_axis(ax, "x", var_quantity(info.name), scales)
+        secondary_axis(ax, "y", var_quantity(info.dot or ""), scales)
 
 
 def poincare_map(
@@ -88,23 +126,27 @@ def poincare_map(
     planet: int = 1,
     ax: Any = None,
     var: str | None = None,
+    *,
+    physical: bool = True,
 ) -> Any:
     """Scatter the Poincaré section points (X̄_spi, X̄'_spi) at τ_k = (2πk + φ)/Ω.
 
     The seed's Poincaré map (MODEL.md §8) with ``var=None`` (X̄_sp of ``planet``); other
-    variables as in :func:`phase_portrait`. The scatter is rasterized, so vector output of
-    many points stays small. Dashed vertical lines mark ±b̄.
+    variables as in :func:`phase_portrait`. The axes follow the points (a small margin), the
+    dot size and transparency follow their number (:func:`~gearchaos.plot.units.section_style`)
+    so the structure of a 10 000-point attractor shows; dashed vertical lines mark ±b̄ where
+    they fall inside the points' range, an edge note where they do not. With ``physical`` the
+    opposite axes show µm and mm/s (gear sets only). The scatter is rasterized, so vector
+    output of many points stays small.
     """
     info = _with_dot(result, var, planet)
     assert info.dot is not None
     ax = get_ax(ax)
     x = np.asarray(result.section(info.name))
     xd = np.asarray(result.section(info.dot))
-    ax.scatter(x, xd, s=6, color="C3", linewidths=0, rasterized=True, zorder=3)
-    clearance_lines(ax, info, vertical=True)
-    ax.set_xlabel(info.label)
-    ax.set_ylabel(info.dot_label)
-    readable_limits(ax, joint=True)
+    n = int(np.sum(np.isfinite(x) & np.isfinite(xd)))
+    ax.scatter(x, xd, color="C3", linewidths=0, rasterized=True, zorder=3, **section_style(n))
+    _finish(ax, result, info, x, xd, physical)
     return ax
 
 
@@ -129,16 +171,8 @@ def sun_orbit(result: Any, ax: Any = None, periods: float | None = None) -> Any:
     if result.samples_per_period > 1:
         sl = sample_window(result, periods)
         ax.plot(x[sl], y[sl], lw=0.5, color="C0", label="orbit")
-    ax.plot(
-        result.section("x_s"),
-        result.section("y_s"),
-        ".",
-        ms=4,
-        color="C3",
-        label="section points",
-        zorder=3,
-        rasterized=True,
-    )
+    xs, ys = np.asarray(result.section("x_s")), np.asarray(result.section("y_s"))
+    _section_points(ax, xs, ys)
     b = xi.clearance
     if b is not None and b > 0:
         ax.add_patch(
@@ -154,7 +188,11 @@ def sun_orbit(result: Any, ax: Any = None, periods: float | None = None) -> Any:
                 label=rf"$|\bar{{x}}_s|, |\bar{{y}}_s| \leq \bar{{b}}_s = {b:g}$",
             )
         )
-    readable_limits(ax, joint=True)
+    data_x = np.concatenate([xs, x[sample_window(result, periods)]])
+    data_y = np.concatenate([ys, y[sample_window(result, periods)]])
+    fit_to_data(ax, data_x, data_y, joint=True)
+    if b is not None and b > 0:
+        clearance_notes(ax, "x", (-b, b), r"\bar{b}_s")
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel(xi.label)
     ax.set_ylabel(yi.label)

@@ -24,7 +24,8 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError, Status
-from ._common import get_ax
+from ..sweep.result import SweepResult
+from ._common import axis_label, edges, get_ax, no_offset, resonance_lines
 
 __all__ = [
     "NOT_RUN",
@@ -37,6 +38,7 @@ __all__ = [
     "regime_colour",
     "regime_handles",
     "regime_legend",
+    "regime_legend_below",
     "regime_map",
 ]
 
@@ -134,6 +136,20 @@ def regime_legend(target: Any, labels: Iterable[Any], **kwargs: Any) -> Any:
     return target.legend(handles=handles, **opts)
 
 
+def regime_legend_below(fig: Any, labels: Iterable[Any], *, title: str = "motion") -> Any:
+    """One legend under all panels of ``fig`` naming exactly the regimes of ``labels``."""
+    handles = regime_handles(labels)
+    return fig.legend(
+        handles=handles,
+        loc="outside lower center",
+        ncols=max(1, min(len(handles), 8)),
+        fontsize="small",
+        frameon=False,
+        title=title,
+        title_fontsize="small",
+    )
+
+
 def regime_categories(ds: Any, *, select: Mapping[str, Any] | None = None) -> Any:
     """Display categories of every point of a sweep dataset (a DataArray of ``motion``'s
     dimensions), after fixing the dimensions in ``select``; points with status 4 (never run,
@@ -145,28 +161,19 @@ def regime_categories(ds: Any, *, select: Mapping[str, Any] | None = None) -> An
         The dataset has no ``motion`` labels (label a store with ``gearchaos classify STORE``
         or :func:`gearchaos.sweep.classify_store`).
     """
-    from .bifurcation import _select
-
-    if "motion" not in ds.data_vars:
+    res = SweepResult.of(ds)
+    if "motion" not in res.ds.data_vars:
         raise ParameterError(
             "the dataset has no motion labels (variable 'motion'); label a store with "
             "`gearchaos classify STORE` or gearchaos.sweep.classify_store(STORE)"
         )
-    sub = _select(ds, select)
+    sub = res.select(select).ds
     motion = sub["motion"]
     cats = np.vectorize(regime_category, otypes=[object])(np.asarray(motion.values, dtype=str))
     cats = np.asarray(cats, dtype=object).reshape(motion.shape)
     if "status" in sub.data_vars and sub["status"].dims == motion.dims:
         cats = np.where(np.asarray(sub["status"].values) == _NOT_RUN_STATUS, NOT_RUN, cats)
     return motion.copy(data=cats)
-
-
-def _swept_dims(sub: Any) -> tuple[tuple[str, ...], str | None, tuple[str, ...]]:
-    """(directions, family, varied) of a sweep dataset, read from its ``motion`` variable."""
-    from .bifurcation import _layout
-
-    lay = _layout(sub, "motion")
-    return lay.directions, lay.family, lay.vary
 
 
 def _runs(cats: list[str]) -> list[tuple[int, int, str]]:
@@ -216,23 +223,14 @@ def regime_band(
         y ticks hidden (or naming the branches), x label the swept parameter, x limits the
         outer cell edges.
     """
-    from .bifurcation import _edges, _fmt, _select, axis_label
-
-    sub = _select(ds, select)
-    cats_da = regime_categories(sub)
-    directions, family, vary = _swept_dims(sub)
-    rest = ([family] if family else []) + list(vary)
-    if len(rest) != 1:
-        if not rest:
-            raise ParameterError("nothing left to draw along: select fixed every swept dimension")
-        raise ParameterError(
-            f"a regime band needs one swept dimension: the dataset has {', '.join(rest)}; fix "
-            f"the others with select, e.g. select={{{rest[0]!r}: {_fmt(sub[rest[0]].values[0])}}}"
-        )
-    x_name = rest[0]
+    res = SweepResult.of(ds).select(select)
+    sub = res.ds
+    cats_da = regime_categories(res)
+    directions = res.layout("motion").directions
+    x_name = res.line_axis("a regime band", "motion")
     x = np.asarray(sub[x_name].values, dtype=np.float64)
     order = np.argsort(x, kind="stable")
-    edges = _edges(x[order])
+    cell = edges(x[order])
     rows: list[tuple[str | None, Any]]
     if directions:
         rows = [(d, cats_da.isel(direction=i)) for i, d in enumerate(directions)]
@@ -246,7 +244,7 @@ def regime_band(
         y0 = n_rows - 1 - r  # first row on top
         spans: dict[str, list[tuple[float, float]]] = {}
         for i, j, cat in _runs(cats):
-            spans.setdefault(cat, []).append((float(edges[i]), float(edges[j] - edges[i])))
+            spans.setdefault(cat, []).append((float(cell[i]), float(cell[j] - cell[i])))
         for cat in _ordered(spans):
             ax.broken_barh(
                 spans[cat],
@@ -259,16 +257,14 @@ def regime_band(
             )
             seen.append(cat)
     ax.set_ylim(0.0, float(n_rows))
-    ax.set_xlim(float(edges[0]), float(edges[-1]))
+    ax.set_xlim(float(cell[0]), float(cell[-1]))
     if directions:
         ax.set_yticks([n_rows - 0.5 - r for r in range(n_rows)], [d for d, _ in rows])
         ax.tick_params(axis="y", labelsize="x-small", length=0)
     else:
         ax.set_yticks([])
     ax.set_xlabel(axis_label(x_name))
-    formatter = ax.xaxis.get_major_formatter()
-    if hasattr(formatter, "set_useOffset"):
-        formatter.set_useOffset(False)
+    no_offset(ax.xaxis)
     if legend:
         regime_legend(ax, seen, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     return ax
@@ -300,23 +296,10 @@ def regime_map(
     """
     from matplotlib.colors import BoundaryNorm, ListedColormap
 
-    from .bifurcation import _edges, _fmt, _resonance_lines, _select, axis_label
-
-    sub = _select(ds, select)
-    cats_da = regime_categories(sub)
-    directions, family, vary = _swept_dims(sub)
-    left = [*(["direction"] if directions else []), *([family] if family else [])]
-    if left:
-        raise ParameterError(
-            f"regime_map draws one 2-D grid: fix {', '.join(left)} with select, e.g. "
-            f"select={{{left[0]!r}: {_fmt(sub[left[0]].values[0])!r}}}"
-        )
-    if len(vary) != 2:
-        raise ParameterError(
-            f"regime_map needs a 2-D sweep: the dataset varies {', '.join(vary) or 'nothing'}"
-            "; use regime_band under a bifurcation diagram for 1-D sweeps"
-        )
-    xname, yname = vary
+    res = SweepResult.of(ds).select(select)
+    sub = res.ds
+    cats_da = regime_categories(res)
+    xname, yname = res.grid_axes("regime_map", "motion")
     cats = np.asarray(cats_da.transpose(yname, xname).values, dtype=object)
     present = _ordered(str(c) for c in cats.ravel())
     index = {c: k for k, c in enumerate(present)}
@@ -329,8 +312,8 @@ def regime_map(
     norm = BoundaryNorm(np.arange(-0.5, len(present) + 0.5, 1.0), cmap.N)
     ax = get_ax(ax)
     ax.pcolormesh(
-        _edges(x[ox]),
-        _edges(y[oy]),
+        edges(x[ox]),
+        edges(y[oy]),
         codes,
         cmap=cmap,
         norm=norm,
@@ -340,11 +323,8 @@ def regime_map(
     ax.set_xlabel(axis_label(xname))
     ax.set_ylabel(axis_label(yname))
     if resonances and xname == "omega" and x.size:
-        _resonance_lines(ax, ds, float(np.min(x)), float(np.max(x)))
-    for axis in (ax.xaxis, ax.yaxis):
-        formatter = axis.get_major_formatter()
-        if hasattr(formatter, "set_useOffset"):
-            formatter.set_useOffset(False)
+        resonance_lines(ax, res.gearset, float(np.min(x)), float(np.max(x)))
+    no_offset(ax.xaxis, ax.yaxis)
     if legend:
         regime_legend(ax, present, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)
     return ax

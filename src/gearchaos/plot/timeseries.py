@@ -13,11 +13,22 @@ from ._common import (
     get_ax,
     is_planetary,
     period_axis_label,
-    readable_limits,
     sample_window,
     to_periods,
     variable,
 )
+from .units import (
+    PhysicalScales,
+    clearance_notes,
+    fit_to_data,
+    linear_axis,
+    secondary_axis,
+    section_style,
+    var_quantity,
+)
+
+#: ``gid`` of the mesh-harmonic labels and sideband lines of a spectrum.
+HARMONIC_GID = "mesh-harmonic"
 
 __all__ = ["amplitude_spectrum", "spectrum", "time_history"]
 
@@ -28,6 +39,8 @@ def time_history(
     planet: int = 1,
     ax: Any = None,
     periods: float | None = None,
+    *,
+    physical: bool = True,
 ) -> Any:
     """Plot a variable against time in mesh (forcing) periods, t/T_m = τΩ/2π.
 
@@ -45,11 +58,15 @@ def time_history(
     periods
         Show only the last ``periods`` recorded periods (default: all).
 
+    physical
+        Physical axes opposite the dimensionless ones (time in ms; µm, mm/s or N), for gear
+        sets.
+
     Returns
     -------
     matplotlib.axes.Axes
-        With dashed lines at ±b̄ for variables with a clearance and dots at the Poincaré
-        section times.
+        Limits follow the data; dashed lines at ±b̄ for variables with a clearance where they
+        fall inside (an edge note where not), dots at the Poincaré section times.
     """
     info = variable(result, var, planet)
     ax = get_ax(ax)
@@ -61,11 +78,13 @@ def time_history(
         ax.plot(t[sl], y[sl], lw=0.8, color="C0", label=f"${info.symbol}$")
     idx = np.arange(result.tau.size)[sl]
     sec = idx[idx % s == 0]
+    style = section_style(sec.size)
     ax.plot(
         t[sec],
         y[sec],
         ".",
-        ms=4 if s > 1 else 3,
+        ms=max(1.0, float(np.sqrt(style["s"]))),
+        alpha=style["alpha"],
         color="C3",
         label="section points",
         zorder=3,
@@ -73,7 +92,15 @@ def time_history(
     clearance_lines(ax, info)
     ax.set_xlabel(period_axis_label(result))
     ax.set_ylabel(info.label)
-    readable_limits(ax)
+    fit_to_data(ax, None, y[sl])
+    if info.clearance is not None:
+        clearance_notes(ax, "y", (-info.clearance, info.clearance), info.clearance_symbol or "b")
+    if physical:
+        scales = PhysicalScales.of_result(result)
+        secondary_axis(ax, "y", var_quantity(info.name), scales)
+        ms = scales.period_ms(result.system.omega)
+        if ms is not None:
+            linear_axis(ax, "x", ms, "t [ms]")
     return ax
 
 
@@ -159,10 +186,36 @@ def spectrum(
         shown = amp[ratio <= hi]
         lo = max(float(np.min(shown[shown > 0])) if np.any(shown > 0) else floor, top * 1e-9)
         ax.set_ylim(lo / 2.0, top * 3.0)
+    scales = PhysicalScales.of_result(result) if is_planetary(result) else PhysicalScales()
+    f_m = float(result.omega) * scales.omega_n / (2.0 * math.pi) if scales.omega_n else None
     for h in range(1, math.floor(hi) + 1):
         ax.axvline(h, color="0.8", lw=0.6, zorder=0)
+        label = f"{h}$f_m$" if f_m is None else f"{h}$f_m$ = {h * f_m:.0f} Hz"
+        ax.text(
+            h,
+            0.98,
+            label,
+            transform=ax.get_xaxis_transform(),
+            rotation=90,
+            ha="right",
+            va="top",
+            fontsize="x-small",
+            color="0.35",
+            gid=HARMONIC_GID,
+        )
+    gs = getattr(getattr(result.system, "model", None), "gearset", None)
+    if gs is not None and gs.has_eccentricity:
+        # eccentricities modulate the meshes at the sun's speed relative to the carrier,
+        # f_s = f_m / z_s: sidebands h f_m ± f_s
+        side = 1.0 / float(gs.teeth.sun)
+        for h in range(1, math.floor(hi) + 1):
+            for r in (h - side, h + side):
+                if 0.0 < r <= hi:
+                    ax.axvline(r, color="0.85", lw=0.5, ls=":", zorder=0, gid=HARMONIC_GID)
     if is_planetary(result):
-        ax.set_xlabel(r"$\omega/\omega_m$ (multiples of the mesh frequency)")
+        ax.set_xlabel(r"$\omega/\omega_m$ (multiples of the mesh frequency $f_m$)")
+        if f_m is not None:
+            linear_axis(ax, "x", f_m, "frequency [Hz]")
     else:
         ax.set_xlabel(r"$\omega/\Omega$ (multiples of the forcing frequency)")
     ax.set_ylabel(f"amplitude of ${info.symbol}$")

@@ -15,24 +15,26 @@ tolerances.
 from __future__ import annotations
 
 import json
-import math
 import os
 from typing import Any
 
 import numpy as np
 
+from .._checks import check_int, check_real
 from ..errors import StoreError
+from .result import SweepResult
+from .store import SweepStore, consolidate, foreign_files_ignored, open_sweep
 
 __all__ = ["classify_dataset", "classify_store"]
 
 LABEL_DTYPE = "<U10"
 
 
-def _section_pair(ds: Any) -> np.ndarray:
-    import tomllib
-
-    spec = tomllib.loads(ds.attrs["sweep_toml"])
-    names = [n for n in spec["observe"] if n in ds.data_vars and "section" in ds[n].dims]
+def _section_pair(res: SweepResult) -> np.ndarray:
+    """(X_k, X'_k) of the first two observed section variables, first observed planet."""
+    ds = res.ds
+    observed = res.spec.observe if res.spec is not None else tuple(ds.data_vars)
+    names = [n for n in observed if n in ds.data_vars and "section" in ds[n].dims]
     if not names:
         raise StoreError("the store holds no section variables to classify")
     cols = []
@@ -44,30 +46,22 @@ def _section_pair(ds: Any) -> np.ndarray:
     return np.stack(cols, axis=-1)
 
 
-def _forcing_period(ds: Any, lead_dims: tuple[str, ...], shape: tuple[int, ...]) -> np.ndarray:
-    if "omega" in lead_dims:
-        om = np.asarray(ds["omega"].values, dtype=float)
-        ax = lead_dims.index("omega")
-        om = om.reshape([-1 if i == ax else 1 for i in range(len(shape))])
-        return np.broadcast_to(2.0 * math.pi / om, shape)
-    omega = float(ds.attrs.get("omega_fixed", float("nan")))
-    return np.full(shape, 2.0 * math.pi / omega)
-
-
-def classify_dataset(ds: Any, *, rtol: float = 1e-3, max_period: int = 64) -> dict[str, Any]:
+def classify_dataset(ds: Any, *, period_rtol: float = 1e-3, max_period: int = 64) -> dict[str, Any]:
     """Labels and indicators for every point of a sweep dataset (nothing written)."""
     from ..analysis.classify import classify_sections, regime_table
 
-    pts = _section_pair(ds)
-    lead_dims = tuple(d for d in ds["status"].dims)
-    shape = tuple(int(ds.sizes[d]) for d in lead_dims)
-    kw: dict[str, Any] = {"details": True, "rtol": rtol, "max_period": max_period}
+    res = SweepResult.of(ds)
+    ds = res.ds
+    pts = _section_pair(res)
+    lead_dims, shape = res.lead_dims, res.shape
+    kw: dict[str, Any] = {"details": True, "rtol": period_rtol, "max_period": max_period}
     if "lle" in ds.data_vars:
         kw["lle"] = np.asarray(ds["lle"].values, dtype=float)
-        kw["run_periods"] = int(ds.attrs["periods"])
-        kw["forcing_period"] = _forcing_period(ds, lead_dims, shape)
+        spec = res.spec
+        kw["run_periods"] = int(spec.solver.periods if spec is not None else ds.attrs["periods"])
+        kw["forcing_period"] = res.forcing_period()
     details = classify_sections(pts, **kw)
-    status = np.asarray(ds["status"].values)
+    status = res.status()
     labels = np.empty(shape, dtype=LABEL_DTYPE)
     period = np.zeros(shape, dtype=np.int16)
     k01 = np.full(shape, np.nan)
@@ -78,7 +72,7 @@ def classify_dataset(ds: Any, *, rtol: float = 1e-3, max_period: int = 64) -> di
         period[idx] = mc.period or 0
         k01[idx] = np.nan if mc.k01 is None else mc.k01
         agree[idx] = bool(mc.agree)
-    fam = _family_dim(ds)
+    fam = res.layout().family
     table: dict[str, Any]
     if fam is not None and fam in lead_dims:
         ax = lead_dims.index(fam)
@@ -88,10 +82,9 @@ def classify_dataset(ds: Any, *, rtol: float = 1e-3, max_period: int = 64) -> di
         }
     else:
         table = {"all": regime_table(labels.ravel())}
-    contact = _contact(ds, lead_dims, shape)
     return {
         "dims": lead_dims,
-        **contact,
+        **_contact(res),
         "motion": labels,
         "period": period,
         "k01": k01,
@@ -101,63 +94,45 @@ def classify_dataset(ds: Any, *, rtol: float = 1e-3, max_period: int = 64) -> di
 
 
 CONTACT_CODES = {"none": 0, "single_sided": 1, "double_sided": 2}
-_BACKLASH_FIELDS = {"sp": "backlash.sun_planet", "rp": "backlash.planet_ring"}
 
 
-def _half_clearance(ds: Any, mesh: str, lead_dims: tuple[str, ...], shape: tuple[int, ...]) -> Any:
-    """b̄ of a mesh at every grid point: swept axis, fixed override or the base gear set."""
-    import tomllib
-
-    from ..gearset import GearSet
-
-    name = _BACKLASH_FIELDS[mesh]
-    if name in lead_dims:
-        b = np.asarray(ds[name].values, dtype=float)
-        ax = lead_dims.index(name)
-        b = b.reshape([-1 if i == ax else 1 for i in range(len(shape))])
-        gs = GearSet.from_toml_string(ds.attrs["gearset_toml"])
-        if gs.backlash.units == "m":
-            b = b / gs.clearance.characteristic_length
-        return np.broadcast_to(b, shape)
-    fixed = tomllib.loads(ds.attrs["sweep_toml"]).get("fixed", {})
-    gs = GearSet.from_toml_string(ds.attrs["gearset_toml"])
-    if name in fixed:
-        gs = gs.evolve({name: fixed[name]})
-    b_sp, b_rp = gs.backlash_bar()
-    return np.full(shape, b_sp if mesh == "sp" else b_rp)
-
-
-def _contact(ds: Any, lead_dims: tuple[str, ...], shape: tuple[int, ...]) -> dict[str, Any]:
+def _contact(res: SweepResult) -> dict[str, Any]:
     """Contact regime codes per mesh (MODEL.md §8) from the stored minimum deflections."""
     out: dict[str, Any] = {}
-    if not ds.attrs.get("gearset_toml") or "delta_sp_min" not in ds.data_vars:
+    ds = res.ds
+    if res.base_gearset is None or "delta_sp_min" not in ds.data_vars:
         return out
     for mesh in ("sp", "rp"):
-        dmin = np.asarray(ds[f"delta_{mesh}_min"].transpose(*lead_dims, "planet_all").values)
-        b = _half_clearance(ds, mesh, lead_dims, shape)[..., None]
+        dmin = np.asarray(ds[f"delta_{mesh}_min"].transpose(*res.lead_dims, "planet_all").values)
+        found = res.clearance(f"delta_{mesh}")
+        assert found is not None  # a gear-set store always has its backlashes
+        b = found[0][..., None]
         code = np.where(dmin > b, 0, np.where(dmin >= -b, 1, 2)).astype(np.int8)
         code[np.isnan(dmin)] = -1
         out[f"contact_{mesh}"] = code
     return out
 
 
-def _family_dim(ds: Any) -> str | None:
-    import tomllib
-
-    fam = tomllib.loads(ds.attrs["sweep_toml"]).get("family")
-    return fam["name"] if fam else None
-
-
 def classify_store(
-    store: str | os.PathLike[str] | Any, *, rtol: float = 1e-3, max_period: int = 64
+    store: str | os.PathLike[str] | Any, *, period_rtol: float = 1e-3, max_period: int = 64
 ) -> dict[str, Any]:
-    """Label every point of a sweep store in place; returns the regime table."""
+    """Label every point of a sweep store in place; returns the regime table.
+
+    ``period_rtol`` is the tolerance of period detection relative to the attractor's size
+    (:func:`~gearchaos.analysis.periodicity.detect_period`), ``max_period`` the longest period
+    recognised as nT.
+    """
     import xarray as xr
     import zarr
 
+    check_real("period_rtol", period_rtol, lo=0.0, hi=1.0, lo_open=True, hi_open=True)
+    check_int("max_period", max_period, lo=1, hi=10_000)
     zstore = os.fspath(store) if isinstance(store, str | os.PathLike) else store
-    ds = xr.open_zarr(zstore, chunks=None, consolidated=False)
-    res = classify_dataset(ds, rtol=rtol, max_period=max_period)
+    if isinstance(zstore, str):
+        open_sweep(zstore)  # a damaged or foreign store is reported, never relabelled
+    with foreign_files_ignored():
+        ds = xr.open_zarr(zstore, chunks=None, consolidated=False)
+    res = classify_dataset(ds, period_rtol=period_rtol, max_period=max_period)
     g = zarr.open_group(zstore, mode="a", use_consolidated=False)
     dims = list(res["dims"])
     for mesh, label in (("sp", "sun–planet"), ("rp", "planet–ring")):
@@ -192,12 +167,16 @@ def classify_store(
             shape=values.shape,
             chunks=values.shape if values.size else "auto",
             dtype=values.dtype,
-            fill_value=fill,
+            # only floats carry a fill value (NaN): xarray would mask a bool False or a
+            # period 0 equal to the fill value as missing (the array is written whole)
+            fill_value=fill if values.dtype.kind == "f" else None,
             attributes={"long_name": doc, "_ARRAY_DIMENSIONS": dims},
             overwrite=True,
         )
         arr[...] = values
     g.attrs["regime_table"] = json.dumps(res["regime_table"])
-    g.attrs["classification_rtol"] = float(rtol)
-    zarr.consolidate_metadata(zstore)
+    g.attrs["classification_rtol"] = float(period_rtol)
+    consolidate(zstore)
+    if isinstance(zstore, str):
+        SweepStore(zstore).refresh_manifest()
     return dict(res["regime_table"])

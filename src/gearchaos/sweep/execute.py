@@ -18,13 +18,14 @@ import contextlib
 import functools
 import multiprocessing
 from collections.abc import Iterator
+from dataclasses import dataclass
 from typing import Any
 
 from .._checks import check_int
 from ..errors import ParameterError
 from ..integrate._chains import run_chains
 
-__all__ = ["InProcess", "executor"]
+__all__ = ["EXECUTION_OPTIONS", "Execution", "InProcess", "executor"]
 
 
 def _init_worker() -> None:  # pragma: no cover - runs in worker processes
@@ -47,47 +48,68 @@ class InProcess:
         return fut
 
 
+#: The keyword names of :class:`Execution`.
+EXECUTION_OPTIONS = ("workers", "scheduler", "dask_local")
+
+
+@dataclass(frozen=True)
+class Execution:
+    """Where the tasks of a sweep run: in-process on all cores (the default), ``workers`` local
+    processes, an existing ``dask.distributed`` cluster at ``scheduler``, or a local Dask
+    cluster of ``dask_local`` workers — at most one of the three."""
+
+    workers: int | None = None
+    scheduler: str | None = None
+    dask_local: int | None = None
+
+    def __post_init__(self) -> None:
+        chosen = [x is not None for x in (self.workers, self.scheduler, self.dask_local)]
+        if sum(chosen) > 1:
+            raise ParameterError("choose at most one of workers, scheduler and dask_local")
+        if self.workers is not None:
+            check_int("workers", self.workers, lo=1, hi=4096)
+        if self.dask_local is not None:
+            check_int("dask_local", self.dask_local, lo=1, hi=4096)
+        if self.scheduler is not None and (
+            not isinstance(self.scheduler, str) or "://" not in self.scheduler
+        ):
+            raise ParameterError(
+                f"scheduler must be an address such as tcp://HOST:8786: got {self.scheduler!r}"
+            )
+
+
 @contextlib.contextmanager
-def executor(
-    workers: int | None = None, scheduler: str | None = None, dask_local: int | None = None
-) -> Iterator[tuple[Any, Any, str]]:
+def executor(execution: Execution | None = None) -> Iterator[tuple[Any, Any, str]]:
     """Yield (executor, task function, description) for the chosen execution mode."""
-    chosen = [x is not None for x in (workers, scheduler, dask_local)]
-    if sum(chosen) > 1:
-        raise ParameterError("choose at most one of workers, scheduler and dask_local")
+    ex_ = execution or Execution()
     single = functools.partial(run_chains, single_thread=True)
-    if workers is not None:
-        n = check_int("workers", workers, lo=1, hi=4096)
+    if ex_.workers is not None:
+        n = int(ex_.workers)
         ctx = multiprocessing.get_context("spawn")
         with cf.ProcessPoolExecutor(max_workers=n, mp_context=ctx, initializer=_init_worker) as ex:
             yield ex, run_chains, f"{n} local processes"
         return
-    if scheduler is not None or dask_local is not None:
+    if ex_.scheduler is not None or ex_.dask_local is not None:
         try:
             from dask.distributed import Client, LocalCluster
         except ImportError as exc:  # pragma: no cover - dask is in [dev] and [dask]
             raise ParameterError(
                 "scheduler/dask_local need dask.distributed: pip install 'gearchaos[dask]'"
             ) from exc
-        if scheduler is not None:
-            if not isinstance(scheduler, str) or "://" not in scheduler:
-                raise ParameterError(
-                    f"scheduler must be an address such as tcp://HOST:8786: got {scheduler!r}"
-                )
+        if ex_.scheduler is not None:
             try:
-                client = Client(scheduler, timeout=30)
+                client = Client(ex_.scheduler, timeout=30)
             except (OSError, TimeoutError, ValueError) as exc:
-                raise ParameterError(f"scheduler {scheduler!r} cannot be reached: {exc}") from None
+                raise ParameterError(
+                    f"scheduler {ex_.scheduler!r} cannot be reached: {exc}"
+                ) from None
             with client:
-                yield client.get_executor(), single, f"dask cluster {scheduler}"
+                yield client.get_executor(), single, f"dask cluster {ex_.scheduler}"
             return
-        n = check_int("dask_local", dask_local, lo=1, hi=4096)
+        n = int(ex_.dask_local)  # type: ignore[arg-type]
         with (
             LocalCluster(
-                n_workers=n,
-                threads_per_worker=1,
-                processes=True,
-                dashboard_address=None,
+                n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None
             ) as cluster,
             Client(cluster) as client,
         ):

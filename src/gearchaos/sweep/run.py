@@ -9,8 +9,10 @@ result as an :class:`xarray.Dataset`.
 from __future__ import annotations
 
 import contextlib
+import math
 import os
 import signal
+import sys
 import threading
 import time
 from collections.abc import Iterator
@@ -21,28 +23,14 @@ import numpy as np
 from .._version import provenance
 from ..errors import ParameterError, Status
 from ..integrate._chains import ChainOutput, ChainRun
-from .execute import InProcess, executor
+from ..model.target import scale_attrs
+from .execute import EXECUTION_OPTIONS, Execution, InProcess, executor
 from .grid import Grid, Task
+from .integrity import StoreLock
 from .spec import DEFAULT_OBSERVE, SweepSpec
 from .store import SweepStore
 
 __all__ = ["bifurcation", "run_sweep"]
-
-def _tracked_groups(system: Any) -> list[tuple[str, np.ndarray, bool]]:
-    """Tracked observables grouped: per-planet groups (delta_sp …) and scalars (x_s …)."""
-    names = system.obs_names[: system.n_track]
-    out: list[tuple[str, np.ndarray, bool]] = []
-    seen: set[str] = set()
-    for k, nm in enumerate(names):
-        head, _, tail = nm.rpartition("_")
-        if tail.isdigit():
-            if head not in seen:
-                seen.add(head)
-                idx = [j for j, m in enumerate(names) if m.rpartition("_")[0] == head]
-                out.append((head, np.array(idx), True))
-        else:
-            out.append((nm, np.array([k]), False))
-    return out
 
 
 class _Layout:
@@ -54,14 +42,14 @@ class _Layout:
         self.lead_dims = grid.dims
         self.lead_shape = grid.shape
         self.observed = [ref.observable(nm, spec.planets) for nm in spec.observe]
-        self.tracked = _tracked_groups(ref)
+        self.tracked = ref.tracked_groups()
         self.n_planets = int(getattr(ref.model, "n_planets", 0))
         self.state_names = ref.state_names
 
     def variables(self) -> tuple[dict[str, Any], dict[str, tuple[int, ...]]]:
         spec = self.grid.spec
         lead, shp, ch = self.lead_dims, self.lead_shape, self.grid.chunks
-        ns, npl = int(spec.periods), len(spec.planets)
+        ns, npl = int(spec.solver.periods), len(spec.planets)
         var: dict[str, Any] = {}
         chunks: dict[str, tuple[int, ...]] = {}
         for ob in self.observed:
@@ -117,7 +105,7 @@ class _Layout:
         spec = self.grid.spec
         bshape = tuple(b.stop - b.start for b in task.block)
         starts = tuple(b.start for b in task.block)
-        ns, npl = int(spec.periods), len(spec.planets)
+        ns, npl = int(spec.solver.periods), len(spec.planets)
         data: dict[str, np.ndarray] = {}
         for ob in self.observed:
             data[ob.name] = np.full((*bshape, ns, *((npl,) if ob.per_planet else ())), np.nan)
@@ -159,7 +147,7 @@ def _coords(grid: Grid, layout: _Layout) -> dict[str, tuple[tuple[str, ...], np.
         c["direction"] = (("direction",), np.array(spec.directions, dtype="U4"))
     for a in spec.axes:
         c[a.name] = ((a.name,), np.array(a.values, dtype=float))
-    c["section"] = (("section",), np.arange(int(spec.periods)))
+    c["section"] = (("section",), np.arange(int(spec.solver.periods)))
     if any(ob.per_planet for ob in layout.observed):
         c["planet"] = (("planet",), np.array(spec.planets, dtype=np.int64))
     if any(per for *_, per in layout.tracked):
@@ -178,10 +166,10 @@ def _attrs(target: Any, grid: Grid) -> dict[str, Any]:
         "gearset_toml": target.to_toml() if isinstance(target, GearSet) else "",
         "model_parameters": "" if isinstance(target, GearSet) else repr(target.model),
         "sweep_toml": spec.to_toml(),
-        "rtol": float(spec.rtol),
-        "atol": float(spec.atol),
-        "transient_periods": float(spec.transient_periods),
-        "periods": int(spec.periods),
+        "rtol": float(spec.solver.rtol),
+        "atol": float(spec.solver.atol),
+        "transient_periods": float(spec.solver.transient_periods),
+        "periods": int(spec.solver.periods),
         "initial_conditions": spec.initial_conditions,
         "direction": spec.direction,
         "dims": list(grid.dims),
@@ -191,11 +179,7 @@ def _attrs(target: Any, grid: Grid) -> dict[str, Any]:
         a["omega_fixed"] = float(ref.omega)
     # clearances and scales of the base gear set with the fixed overrides (not of a grid point)
     model = grid.base_model()
-    if hasattr(model, "scales"):
-        a["omega_n_rad_s"] = float(model.scales.omega_n)
-        a["characteristic_length_m"] = float(model.scales.length)
-    for k, v in getattr(model, "clearances", {}).items():
-        a[f"clearance_{k}"] = float(v)
+    a.update(scale_attrs(model))
     return a
 
 
@@ -222,35 +206,68 @@ def run_sweep(
     *,
     store: str | os.PathLike[str] | None = None,
     overwrite: bool = False,
-    workers: int | None = None,
-    scheduler: str | None = None,
-    dask_local: int | None = None,
+    execution: Execution | None = None,
     progress: bool = True,
     chunk_points: int | None = None,
     classify: bool = True,
 ) -> Any:
-    """Run (or resume) a sweep described by ``spec``; return its :class:`xarray.Dataset`."""
+    """Run (or resume) a sweep described by ``spec`` on ``execution`` (default: in-process on
+    all cores) into ``store``; return its :class:`xarray.Dataset`."""
     grid = Grid(target, spec, chunk_points=chunk_points)
     layout = _Layout(grid)
-    st = SweepStore(store)
+    path = _store_path(store)
+    st = SweepStore(path)
     attrs = _attrs(target, grid)
+    lock = StoreLock(path) if path is not None else contextlib.nullcontext()
+    with lock:
+        return _run_locked(grid, layout, st, attrs, overwrite, execution, progress, classify)
+
+
+def _store_path(store: Any) -> str | None:
+    """The store's path (``None``: in memory); an empty or non-path value is refused."""
+    if store is None:
+        return None
+    if not isinstance(store, str | os.PathLike):
+        raise ParameterError(f"store must be a path such as 'run.zarr' or None: got {store!r}")
+    path = os.fspath(store)
+    if not path.strip():
+        raise ParameterError("store must be a path such as 'run.zarr': got an empty string")
+    if os.path.basename(os.path.normpath(path)) in ("", ".", ".."):
+        raise ParameterError(
+            f"store must name a directory to create, such as 'run.zarr': got {path!r}"
+        )
+    return path
+
+
+def _run_locked(
+    grid: Grid,
+    layout: _Layout,
+    st: SweepStore,
+    attrs: dict[str, Any],
+    overwrite: bool,
+    execution: Execution | None,
+    progress: bool,
+    classify: bool,
+) -> Any:
     identity = {k: attrs[k] for k in ("model", "gearset_toml", "model_parameters", "sweep_toml")}
     if st.exists() and overwrite:
         st.remove()
     if st.exists():
         st.check_same(identity)
         if st.attrs().get("complete"):
+            st.clear_stale_progress()
             return st.open()
-    elif store is not None and os.path.exists(os.fspath(store)):
+    elif st.path is not None and os.path.exists(st.path):
         if overwrite:
             st.remove()
         else:
             raise ParameterError(
-                f"{os.fspath(store)} exists and is not a gearchaos sweep store; "
+                f"{st.path} exists and is not a gearchaos sweep store; "
                 "choose another path or pass overwrite=True (--overwrite)"
             )
     if not st.exists():
         variables, chunks = layout.variables()
+        _check_sizes(grid, variables, st.path)
         st.create(_coords(grid, layout), variables, chunks, attrs)
 
     done = st.done_tasks()
@@ -261,21 +278,50 @@ def run_sweep(
     with (
         _sigterm_as_interrupt(),
         bar,
-        executor(workers, scheduler, dask_local) as (ex, fn, desc),
+        executor(execution) as (ex, fn, desc),
     ):
         bar.describe(desc)
         if isinstance(ex, InProcess):
             _run_in_process(todo, grid, layout, st, fn, bar)
         else:
-            _run_pool(todo, grid, layout, st, ex, fn, bar, workers or dask_local or 8)
-    # every task is written: drop the markers before classification consolidates the metadata
-    st.clear_progress()
+            ex_ = execution or Execution()
+            _run_pool(todo, grid, layout, st, ex, fn, bar, ex_.workers or ex_.dask_local or 8)
+    # every task is written (its marker says so): label the points, then finish the store
     if classify:
         from .classify import classify_store
 
         classify_store(st.zarr_store)
     st.finish()
     return st.open()
+
+
+def _check_sizes(grid: Grid, variables: dict[str, Any], path: str | None) -> None:
+    """Refuse, before anything is written, a sweep whose task outputs do not fit in memory or
+    whose store (uncompressed, the worst case) does not fit on the disk."""
+    import shutil
+
+    from .._checks import check_memory
+
+    ref = grid.reference
+    per_point = grid.spec.solver.n_samples * (
+        ref.n_state * (1 + int(grid.spec.lyapunov)) + ref.n_obs + 1
+    )
+    largest = int(np.prod(grid.chunks))  # points of the largest task
+    check_memory(f"one task of the sweep ({largest} points)", 8.0 * per_point * largest)
+    total = sum(
+        float(np.prod(shape)) * np.dtype(dtype).itemsize
+        for _, (shape, dtype), _, _ in variables.values()
+    )
+    if path is None:
+        check_memory("the sweep held in memory (store=None)", total)
+        return
+    parent = os.path.dirname(os.path.abspath(path))
+    free = shutil.disk_usage(parent if os.path.isdir(parent) else os.getcwd()).free
+    if total > free:
+        raise ParameterError(
+            f"the sweep store {path} may need up to {total / 2**30:.3g} GiB but the disk has "
+            f"{free / 2**30:.3g} GiB free; record fewer periods or points, or write elsewhere"
+        )
 
 
 def _run_in_process(
@@ -343,7 +389,11 @@ def _run_pool(
 
 
 class _Bar:
-    """Rich progress bar (points done, points/s, ETA) on stderr; silent when disabled."""
+    """Rich progress bar (points done, points/s, ETA) on stderr in a terminal; elsewhere (a
+    log file, a pipe, a batch job) one plain line per 5 % of the points; silent when
+    disabled."""
+
+    STEP = 0.05  # fraction of the points between two plain lines
 
     def __init__(self, enabled: bool, total: int, done: int):
         self.enabled = enabled
@@ -351,10 +401,18 @@ class _Bar:
         self.t0 = time.perf_counter()
         self.started_at = done
         self._p: Any = None
+        self._plain = False
+        self._next_line = 0.0
+        self._what = ""
 
     def __enter__(self) -> _Bar:
         if self.enabled:
             from rich.console import Console
+
+            if not Console(stderr=True).is_terminal:
+                self._plain = True
+                self._next_line = self.done / max(self.total, 1) + self.STEP
+                return self
             from rich.progress import (
                 BarColumn,
                 MofNCompleteColumn,
@@ -385,12 +443,32 @@ class _Bar:
             self._p.__exit__(*exc)
 
     def describe(self, text: str) -> None:
+        self._what = f" ({text})"
         if self._p is not None:
             self._p.update(self._id, description=f"({text})")
+
+    def _line(self) -> str:
+        dt = time.perf_counter() - self.t0
+        new = self.done - self.started_at
+        rate = new / dt if dt > 0 else 0.0
+        left = (self.total - self.done) / rate if rate > 0 else float("nan")
+        eta = time.strftime("%H:%M:%S", time.gmtime(left)) if math.isfinite(left) else "–"
+        pct = 100.0 * self.done / max(self.total, 1)
+        return (
+            f"sweep{self._what}: {self.done} of {self.total} points ({pct:.0f} %) · "
+            f"{rate:.1f} points/s · failed {self.failed} · elapsed "
+            f"{time.strftime('%H:%M:%S', time.gmtime(dt))} · ETA {eta}"
+        )
 
     def advance(self, n: int, failed: int) -> None:
         self.done += n
         self.failed += failed
+        if self._plain and (
+            self.done / max(self.total, 1) >= self._next_line or self.done >= self.total
+        ):
+            print(self._line(), file=sys.stderr, flush=True)
+            while self._next_line <= self.done / max(self.total, 1):
+                self._next_line += self.STEP
         if self._p is not None:
             dt = time.perf_counter() - self.t0
             rate = (self.done - self.started_at) / dt if dt > 0 else 0.0
@@ -416,9 +494,6 @@ def bifurcation(
     fixed: dict[str, Any] | None = None,
     store: str | os.PathLike[str] | None = None,
     overwrite: bool = False,
-    workers: int | None = None,
-    scheduler: str | None = None,
-    dask_local: int | None = None,
     progress: bool = True,
     **options: Any,
 ) -> Any:
@@ -440,10 +515,6 @@ def bifurcation(
         Path of a Zarr store. Written chunk by chunk; an interrupted sweep (Ctrl-C, SIGTERM,
         SIGKILL) resumes when called again with the same arguments; other settings are refused
         unless ``overwrite``. ``None`` keeps the result in memory.
-    workers, scheduler, dask_local
-        Executor: N local processes, a ``dask.distributed`` scheduler address, or a local Dask
-        cluster of N workers. Default: in-process on all cores. Results are bitwise identical
-        whatever the executor.
     progress
         Show a progress bar (points, points/s, ETA) on stderr.
     **options
@@ -465,6 +536,11 @@ def bifurcation(
             Protocol and tolerances (:class:`~gearchaos.integrate.settings.SolverSettings`),
             or ``solver=SolverSettings(...)``.
 
+        and where it runs (:class:`~gearchaos.sweep.execute.Execution`): ``workers`` (N local
+        processes), ``scheduler`` (the address of a ``dask.distributed`` cluster) or
+        ``dask_local`` (a local Dask cluster of N workers); default in-process on all cores.
+        Results are bitwise identical whatever the executor.
+
     Returns
     -------
     xarray.Dataset
@@ -472,16 +548,10 @@ def bifurcation(
         point ``status``, step counts, extrema of every mesh deflection and the final state.
         Attributes carry the gear set, the sweep specification, the solver settings and versions.
     """
+    where = Execution(**{k: options.pop(k) for k in EXECUTION_OPTIONS if k in options})
     if options.get("observe") is None:
         options["observe"] = _default_observe(target)
     spec = SweepSpec.build(vary, family=family, fixed=fixed, **options)
     return run_sweep(
-        target,
-        spec,
-        store=store,
-        overwrite=overwrite,
-        workers=workers,
-        scheduler=scheduler,
-        dask_local=dask_local,
-        progress=progress,
+        target, spec, store=store, overwrite=overwrite, execution=where, progress=progress
     )

@@ -302,23 +302,6 @@ class SweepSpec:
             **own,
         )
 
-    # ------------------------------------------------------------------ settings
-    @property
-    def transient_periods(self) -> float:
-        return self.solver.transient_periods
-
-    @property
-    def periods(self) -> int:
-        return self.solver.periods
-
-    @property
-    def rtol(self) -> float:
-        return self.solver.rtol
-
-    @property
-    def atol(self) -> float:
-        return self.solver.atol
-
     # ------------------------------------------------------------------ grid
     @property
     def axes(self) -> tuple[Axis, ...]:
@@ -366,10 +349,10 @@ class SweepSpec:
         lines = [
             f"initial_conditions = {val(self.initial_conditions)}",
             f"direction = {val(self.direction)}",
-            f"transient_periods = {val(float(self.transient_periods))}",
-            f"periods = {val(self.periods)}",
-            f"rtol = {val(float(self.rtol))}",
-            f"atol = {val(float(self.atol))}",
+            f"transient_periods = {val(float(self.solver.transient_periods))}",
+            f"periods = {val(self.solver.periods)}",
+            f"rtol = {val(float(self.solver.rtol))}",
+            f"atol = {val(float(self.solver.atol))}",
             f"lyapunov = {val(self.lyapunov)}",
             f"observe = {val(list(self.observe))}",
             f"planets = {val(list(self.planets))}",

@@ -14,24 +14,84 @@ Every store carries its provenance: the gear set (``gearset_toml``), the sweep s
 
 from __future__ import annotations
 
+import contextlib
+import json
 import os
 import shutil
+import warnings
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
 
 from ..errors import StoreError
+from ..gearset.mapping import flatten
+from .integrity import (
+    MANIFEST,
+    all_chunks,
+    chunk_keys,
+    digest_chunks,
+    verify_chunks,
+    verify_manifest,
+    write_json_atomic,
+)
 
 __all__ = ["SweepStore", "open_sweep"]
 
 PROGRESS = "_progress"
 
 
-def open_sweep(path: str | os.PathLike[str]) -> Any:
-    """Open a sweep store as an :class:`xarray.Dataset` (lazy, no dask needed)."""
+@contextlib.contextmanager
+def foreign_files_ignored() -> Iterator[None]:
+    """Silence Zarr's warning about the files of a store that are no Zarr nodes (the task
+    markers and the chunk manifest), which it meets when it lists the store."""
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message=".*not recognized as a component")
+        yield
+
+
+def consolidate(store: Any) -> None:
+    """Consolidate a store's metadata."""
+    import zarr
+
+    with foreign_files_ignored():
+        zarr.consolidate_metadata(store)
+
+
+def open_sweep(path: str | os.PathLike[str], *, verify: bool = True) -> Any:
+    """Open a sweep store as an :class:`xarray.Dataset` (lazy, no dask needed).
+
+    A path that is no sweep store (missing, a file, an empty or foreign directory, unreadable
+    metadata) raises :class:`~gearchaos.errors.StoreError`; with ``verify`` (the default) every
+    chunk of a complete store is checked against its manifest first, so a deleted, truncated or
+    overwritten chunk is reported by name instead of being read as data.
+    """
     import xarray as xr
 
-    return xr.open_zarr(os.fspath(path), chunks=None, consolidated=True)
+    if not isinstance(path, str | os.PathLike) or not os.fspath(path):
+        raise StoreError(f"a sweep store path must be a non-empty path: got {path!r}")
+    root = os.fspath(path)
+    if not os.path.exists(root):
+        raise StoreError(f"no sweep store at {root!r} (no such file or directory)")
+    if not os.path.isdir(root):
+        raise StoreError(
+            f"{root!r} is not a readable sweep store: it is a file, not a directory such as "
+            "run.zarr"
+        )
+    if not os.path.exists(os.path.join(root, ".zgroup")):
+        raise StoreError(f"{root!r} is not a readable sweep store (no Zarr group metadata .zgroup)")
+    if verify:
+        verify_manifest(root)
+    consolidated = os.path.exists(os.path.join(root, ".zmetadata"))
+    try:
+        ds = xr.open_zarr(root, chunks=None, consolidated=consolidated)
+    except Exception as exc:  # zarr and xarray raise many types for damaged metadata
+        raise StoreError(
+            f"{root!r} is not a readable sweep store ({type(exc).__name__}: {exc})"
+        ) from None
+    if "status" not in ds.data_vars:
+        raise StoreError(f"{root!r} is not a gearchaos sweep store (no 'status' variable)")
+    return ds
 
 
 class SweepStore:
@@ -136,13 +196,15 @@ class SweepStore:
             )
             if integer:
                 arr[...] = np.full(shape, fill, dtype=dtype)
-        zarr.consolidate_metadata(target)
+        consolidate(target)
         if tmp is not None and self.path is not None:
             os.makedirs(os.path.join(tmp, PROGRESS), exist_ok=True)
             os.rename(tmp, self.path)
 
     # ------------------------------------------------------------------ progress
     def done_tasks(self) -> set[int]:
+        """Tasks whose chunks are written and intact: a marker whose recorded chunks are
+        missing or damaged is dropped, so the task is computed again."""
         if self.path is None:
             return set()
         d = os.path.join(self.path, PROGRESS)
@@ -150,11 +212,17 @@ class SweepStore:
             return set()
         out = set()
         for name in os.listdir(d):
-            if name.endswith(".done"):
-                try:
-                    out.add(int(name[:-5]))
-                except ValueError:
-                    continue
+            if not name.endswith(".done"):
+                continue
+            try:
+                index = int(name[:-5])
+                with open(os.path.join(d, name), encoding="utf-8") as f:
+                    text = f.read()
+                chunks = json.loads(text)["chunks"] if text.strip() else {}
+            except (ValueError, KeyError, TypeError, OSError):
+                continue  # a marker torn by a kill: the task is computed again
+            if not verify_chunks(self.path, chunks):
+                out.add(index)
         return out
 
     def write(self, task_index: int, block: tuple[slice, ...], data: dict[str, np.ndarray]) -> None:
@@ -168,31 +236,55 @@ class SweepStore:
                 arr = g[name]
                 assert isinstance(arr, zarr.Array)
                 self._arrays[name] = arr
+        keys: list[str] = []
         for name, values in data.items():
             arr = self._arrays[name]
             sl = block + (slice(None),) * (arr.ndim - len(block))
             arr[sl] = values
+            keys += chunk_keys(name, arr.shape, arr.chunks, block)
         if self.path is not None:
             d = os.path.join(self.path, PROGRESS)
             os.makedirs(d, exist_ok=True)
-            with open(os.path.join(d, f"{task_index}.done"), "w"):
-                pass
+            # the marker records what was written: a later damage is found on resume
+            write_json_atomic(
+                os.path.join(d, f"{task_index}.done"),
+                {"chunks": digest_chunks(self.path, keys)},
+            )
 
-    def clear_progress(self) -> None:
-        """Remove the task markers (all tasks written). Must precede any metadata
-        consolidation: zarr would list the marker folder as a stray node."""
+    def clear_stale_progress(self) -> None:
+        """Remove task markers left by a kill after a store was completed."""
         if self.path is not None:
             shutil.rmtree(os.path.join(self.path, PROGRESS), ignore_errors=True)
 
+    def refresh_manifest(self) -> None:
+        """Rewrite the chunk manifest of a complete store after a legitimate change (the
+        classifier relabelling its points)."""
+        if self.path is not None and os.path.exists(os.path.join(self.path, MANIFEST)):
+            write_json_atomic(
+                os.path.join(self.path, MANIFEST),
+                {"chunks": digest_chunks(self.path, all_chunks(self.path))},
+            )
+
     def finish(self) -> None:
-        """Mark the store complete (after :meth:`clear_progress`)."""
+        """Mark the store complete: write the chunk manifest, set ``complete``, consolidate the
+        metadata, then remove the task markers. A kill at any moment leaves a store that the
+        next run finishes (markers present: nothing is recomputed) or a complete one."""
         import zarr
 
+        if self.path is not None:
+            write_json_atomic(
+                os.path.join(self.path, MANIFEST),
+                {"chunks": digest_chunks(self.path, all_chunks(self.path))},
+            )
         g = zarr.open_group(self.zarr_store, mode="a", use_consolidated=False)
         g.attrs["complete"] = True
-        zarr.consolidate_metadata(self.zarr_store)
+        consolidate(self.zarr_store)
+        if self.path is not None:
+            shutil.rmtree(os.path.join(self.path, PROGRESS), ignore_errors=True)
 
     def open(self) -> Any:
+        if self.path is not None:
+            return open_sweep(self.path)
         import xarray as xr
 
         return xr.open_zarr(self.zarr_store, chunks=None, consolidated=True)
@@ -206,21 +298,8 @@ def _short(v: Any, limit: int = 80) -> str:
 def _toml_diff(old: str, new: str, what: str) -> str:
     import tomllib
 
-    def flat(d: dict[str, Any], prefix: str = "") -> dict[str, Any]:
-        out: dict[str, Any] = {}
-        for k, v in d.items():
-            key = f"{prefix}{k}"
-            if isinstance(v, dict):
-                out.update(flat(v, key + "."))
-            elif isinstance(v, list) and v and isinstance(v[0], dict):
-                for i, item in enumerate(v):
-                    out.update(flat(item, f"{key}[{i}]."))
-            else:
-                out[key] = v
-        return out
-
     try:
-        a, b = flat(tomllib.loads(old)), flat(tomllib.loads(new))
+        a, b = flatten(tomllib.loads(old)), flatten(tomllib.loads(new))
     except Exception:
         return f"{what} differs (the stored text is not readable TOML)"
     keys = sorted(k for k in set(a) | set(b) if a.get(k) != b.get(k))

@@ -13,7 +13,6 @@ import functools
 from importlib import resources
 
 from ...errors import ParameterError
-from ..io import from_toml_string
 from ..records import GearSet
 
 __all__ = ["list_presets", "preset"]
@@ -34,7 +33,7 @@ def _names() -> list[str]:
 def _load(name: str) -> GearSet:
     text = resources.files(__name__).joinpath(name + _SUFFIX).read_text(encoding="utf-8")
     try:
-        return from_toml_string(text)
+        return GearSet.from_toml_string(text)
     except ParameterError as exc:  # pragma: no cover - the shipped presets are tested
         raise ParameterError(f"preset {name!r}: {exc}") from exc
 

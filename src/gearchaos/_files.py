@@ -1,0 +1,150 @@
+"""Reading an input file safely: only a regular file of bounded size, as UTF-8 text.
+
+A path given by a user may name a directory, a FIFO (whose ``open`` blocks until a writer
+appears), a character device (``/dev/zero`` never ends), a symbolic-link loop, a huge or a
+binary file. :func:`read_text_file` opens it without blocking, checks what the open file is,
+reads at most ``max_bytes`` + 1 bytes and decodes them, so that each of these ends in one clear
+error naming the file and the rule instead of a hang, a ``MemoryError`` or a traceback:
+
+- :class:`MissingFileError` (a :class:`~gearchaos.errors.StoreError` and a
+  :class:`FileNotFoundError`) when nothing is there;
+- :class:`~gearchaos.errors.StoreError` when the path cannot be used as a file (a directory, a
+  FIFO or device, a link loop, no permission, too large);
+- :class:`~gearchaos.errors.ParameterError` when the path is not a path (wrong type, empty,
+  a NUL character) or the contents are not UTF-8 text; the message starts with the path.
+
+A leaf module: it imports nothing from the package but :mod:`gearchaos.errors`.
+"""
+
+from __future__ import annotations
+
+import errno
+import os
+import stat
+from pathlib import Path
+
+from .errors import ParameterError, StoreError
+
+__all__ = ["MissingFileError", "read_text_file"]
+
+_KINDS = (
+    (stat.S_ISDIR, "a directory"),
+    (stat.S_ISFIFO, "a FIFO (named pipe)"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISSOCK, "a socket"),
+)
+
+
+class MissingFileError(StoreError, FileNotFoundError):
+    """No file at the given path (both a :class:`StoreError` and a :class:`FileNotFoundError`)."""
+
+
+def _size(n: int) -> str:
+    """``100 bytes``, ``1048576 bytes (1 MiB)``."""
+    if n < 1024:
+        return f"{n} bytes"
+    if n < 1024**2:
+        return f"{n} bytes ({n / 1024:.4g} KiB)"
+    return f"{n} bytes ({n / 1024**2:.4g} MiB)"
+
+
+def _kind(mode: int) -> str:
+    for test, name in _KINDS:
+        if test(mode):
+            return name
+    return "not a regular file"  # pragma: no cover - every other type is listed above
+
+
+def read_text_file(path: object, *, what: str, max_bytes: int) -> str:
+    """The text of a regular UTF-8 file of at most ``max_bytes`` bytes.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file. A symbolic link is followed (a loop is an error).
+    what : str
+        What the file is, for messages: ``"gear-set file"`` gives
+        ``gear-set file 'x.toml' is a directory, not a regular file``.
+    max_bytes : int
+        Largest accepted size in bytes (≥ 1).
+
+    Returns
+    -------
+    str
+        The decoded text (strict UTF-8; a byte-order mark is kept as U+FEFF).
+
+    Raises
+    ------
+    ParameterError
+        ``path`` is not a ``str`` or path-like, is empty or holds a NUL character; or the
+        contents are not UTF-8 (the message starts with the path).
+    MissingFileError
+        Nothing exists at ``path`` (``"{what} not found: '{path}'"``).
+    StoreError
+        ``path`` is not a regular file (directory, FIFO, device, socket), cannot be opened
+        (permission, symbolic-link loop, a path component that is not a directory) or is
+        larger than ``max_bytes``.
+
+    Notes
+    -----
+    The file is opened with ``O_NONBLOCK`` so that opening a FIFO never waits for a writer,
+    and its type is taken from the open descriptor (``fstat``), so it cannot change between
+    the check and the read. At most ``max_bytes`` + 1 bytes are read whatever size the file
+    claims, which also bounds files that grow or report size 0 (``/proc``).
+    """
+    if not isinstance(path, (str, os.PathLike)):
+        raise ParameterError(f"{what} path must be a str or path-like: got {type(path).__name__}")
+    try:
+        name = os.fspath(path)
+    except TypeError as exc:  # a PathLike whose __fspath__ returns neither str nor bytes
+        raise ParameterError(f"{what} path must be a str or path-like: {exc}") from None
+    if not isinstance(name, str):
+        raise ParameterError(f"{what} path must be text: got {type(name).__name__}")
+    if not name:
+        raise ParameterError(f"{what} path must not be empty: got ''")
+    if "\0" in name:
+        raise ParameterError(f"{what} path must not contain a NUL character: got {name!r}")
+    shown = str(Path(name))
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0)
+    flags |= getattr(os, "O_CLOEXEC", 0)
+    try:
+        fd = os.open(name, flags)
+    except FileNotFoundError:
+        raise MissingFileError(f"{what} not found: '{shown}'") from None
+    except OSError as exc:
+        reason = exc.strerror or str(exc)
+        if exc.errno == errno.ELOOP:
+            reason = "a loop of symbolic links"
+        raise StoreError(f"{what} '{shown}' cannot be opened: {reason}") from None
+    try:
+        mode = os.fstat(fd).st_mode
+        if not stat.S_ISREG(mode):
+            raise StoreError(f"{what} '{shown}' is {_kind(mode)}, not a regular file")
+        size = os.fstat(fd).st_size
+        if size > max_bytes:
+            raise StoreError(
+                f"{what} '{shown}' is {size} bytes, more than the {_size(max_bytes)} allowed"
+            )
+        chunks: list[bytes] = []
+        total = 0
+        while total <= max_bytes:
+            chunk = os.read(fd, max_bytes + 1 - total)
+            if not chunk:
+                break
+            chunks.append(chunk)
+            total += len(chunk)
+        if total > max_bytes:
+            raise StoreError(f"{what} '{shown}' is more than the {_size(max_bytes)} allowed")
+    except OSError as exc:
+        raise StoreError(f"{what} '{shown}' cannot be read: {exc.strerror or exc}") from None
+    finally:
+        os.close(fd)
+    data = b"".join(chunks)
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ParameterError(
+            f"{shown}: not UTF-8 text ({what}): byte 0x{data[exc.start]:02x} at offset "
+            f"{exc.start} cannot be decoded"
+        ) from None

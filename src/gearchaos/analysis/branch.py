@@ -1,0 +1,325 @@
+"""The dataset of a continued branch, and its files (netCDF-4 via h5netcdf, or Zarr).
+
+Layout of :func:`branch_dataset` (keep these names; plots and the CLI read them):
+
+dimensions
+    ``point`` (branch points in arclength order), ``state`` (state names), ``multiplier``
+    (0 … n_state−1, by modulus, descending), ``section`` (0 … n−1), ``planet`` (observed
+    per-planet variables), ``planet_all`` (tracked per-planet extrema), ``contact`` (meshes
+    and bearing axes), ``event``.
+coordinates
+    the parameter by its dotted name (point) and ``arclength`` (point).
+per point
+    ``orbit_state`` (point, state): y* at the section; ``multiplier_re``, ``multiplier_im``,
+    ``multiplier_abs`` (point, multiplier); ``max_multiplier``, ``unstable`` (number of
+    |μ| > 1), ``stable`` (int8), ``residual``, ``iterations`` (map evaluations of the
+    corrector), ``jacobians`` (of them, with tangents), ``newton_steps`` (corrections),
+    ``dparameter_ds`` (dλ/ds of the unit tangent: changes sign at folds), ``minimal_period``
+    (the smallest d | n after which the section points repeat), ``on_grid`` (int8: landed on
+    a value of ``grid``);
+    the observed variables at the n section points (``delta_sp`` (point, section, planet),
+    ``delta_sp_dot`` …, as sweeps store them); extrema over the orbit of the tracked
+    observables (``delta_sp_min`` (point, planet_all) …); ``contact_regime`` (point, contact).
+events
+    ``event_kind``, ``event_value`` (parameter value), ``event_point`` (index of the point
+    before it), ``event_arclength``, ``event_multiplier_re``, ``event_multiplier_im``,
+    ``event_state`` (event, state), ``event_vector`` (event, state), ``event_detail``,
+    ``event_located`` (int8).
+attributes
+    ``parameter``, ``period``, ``range_start``, ``range_stop``, ``vary``, ``fixed`` (JSON of the
+    fixed values), ``stop_reason``, ``start`` (how the branch started), ``tol``, the step
+    settings, the solver settings, the model's provenance (``model``, ``gearset_toml``,
+    ``model_parameters``, scales, clearances) and the versions (``version``, ``numba_version``
+    …), as sweeps carry them.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from .._version import provenance
+from ..errors import ParameterError, StoreError
+from .orbits import (
+    PeriodicOrbit,
+    minimal_period,
+    model_attrs,
+    orbit_contacts,
+)
+
+__all__ = [
+    "branch_dataset",
+    "branch_multipliers",
+    "branch_summary",
+    "check_store",
+    "fixed_json",
+    "open_branch",
+    "save_branch",
+]
+
+
+def _default_observe(system: Any) -> tuple[str, ...]:
+    if hasattr(system.model, "n_planets"):
+        return ("delta_sp", "delta_sp_dot")
+    names, nt = system.obs_names, system.n_track
+    return (names[0], names[nt]) if len(names) > nt else (names[0],)
+
+
+def _start_text(start: Any) -> str:
+    if start is None:
+        return "simulation"
+    if isinstance(start, PeriodicOrbit):
+        return "periodic_orbit"
+    if hasattr(start, "kind") and hasattr(start, "value"):
+        return f"{start.kind} at {start.parameter}={start.value:.10g} (period {start.period})"
+    return "state"
+
+
+def branch_dataset(
+    br: Any,
+    pts: list[Any],
+    events: list[Any],
+    reason: str,
+    rng: tuple[float, float],
+    observe: Any,
+    start: Any,
+) -> Any:
+    """The :class:`xarray.Dataset` of a branch (layout in the module docstring)."""
+    import xarray as xr
+
+    ref = br.system(pts[0].lam)
+    names = list(ref.state_names)
+    m, n = len(names), br.n
+    P = len(pts)
+    obs_names = (observe,) if isinstance(observe, str) else tuple(observe or ())
+    observed = [ref.observable(nm) for nm in (obs_names or _default_observe(ref))]
+    tracked = ref.tracked_groups()
+    levels = br.levels
+    n_planets = int(getattr(ref.model, "n_planets", 0))
+    coords: dict[str, Any] = {
+        br.name: ("point", np.array([p.lam for p in pts])),
+        "arclength": ("point", np.array([p.s for p in pts])),
+        "point": ("point", np.arange(P)),
+        "state": ("state", np.array(names, dtype="U16")),
+        "multiplier": ("multiplier", np.arange(m)),
+        "section": ("section", np.arange(n)),
+    }
+    if any(ob.per_planet for ob in observed):
+        coords["planet"] = ("planet", np.arange(1, n_planets + 1))
+    if any(per for *_, per in tracked):
+        coords["planet_all"] = ("planet_all", np.arange(1, n_planets + 1))
+    if levels:
+        coords["contact"] = ("contact", np.array([lv[0] for lv in levels], dtype="U16"))
+    mu = np.array([p.mu for p in pts])
+    cfg = br.cfg
+    st = br.steps
+    attrs = {
+        "title": f"gearchaos branch of period-{n} orbits of {ref.name}",
+        **model_attrs(ref),
+        "parameter": br.name,
+        "period": int(n),
+        "range_start": float(rng[0]),
+        "range_stop": float(rng[1]),
+        "vary": f"{br.name}={rng[0]:.10g}:{rng[1]:.10g}",
+        "fixed": fixed_json(br.fixed),
+        "stop_reason": reason,
+        "start": _start_text(start),
+        "n_points": int(P),
+        "map_evaluations": int(br.evals),
+        "jacobian_evaluations": int(br.jacobians),
+        "tol": float(br.tol),
+        "step": st.initial,
+        "min_step": st.minimum,
+        "max_step": st.maximum,
+        "max_points": st.max_points,
+        "event_tol": st.event_tol,
+        **cfg.attrs(),
+        **provenance(),
+    }
+    ds = xr.Dataset(coords=coords, attrs=attrs)
+    ds[br.name].attrs["long_name"] = f"continued parameter {br.name}"
+    ds["arclength"].attrs["long_name"] = "pseudo-arclength s (parameter units)"
+    ds["orbit_state"] = (("point", "state"), np.array([p.y for p in pts]))
+    ds["orbit_state"].attrs["long_name"] = "orbit state y* at the section"
+    ds["multiplier_re"] = (("point", "multiplier"), mu.real)
+    ds["multiplier_im"] = (("point", "multiplier"), mu.imag)
+    ds["multiplier_abs"] = (("point", "multiplier"), np.abs(mu))
+    ds["max_multiplier"] = ("point", np.abs(mu).max(axis=1))
+    ds["unstable"] = ("point", (np.abs(mu) > 1.0).sum(axis=1).astype(np.int64))
+    ds["stable"] = ("point", (np.abs(mu).max(axis=1) < 1.0).astype(np.int8))
+    ds["residual"] = ("point", np.array([p.residual for p in pts]))
+    ds["iterations"] = ("point", np.array([p.evals for p in pts], dtype=np.int64))
+    ds["iterations"].attrs["long_name"] = "map evaluations of the corrector"
+    ds["newton_steps"] = ("point", np.array([p.corrections for p in pts], dtype=np.int64))
+    ds["newton_steps"].attrs["long_name"] = "Newton corrections of the corrector"
+    ds["jacobians"] = ("point", np.array([p.jacobians for p in pts], dtype=np.int64))
+    ds["jacobians"].attrs["long_name"] = "map evaluations with tangents (monodromy matrices)"
+    ds["dparameter_ds"] = ("point", np.array([float(p.tangent[-1]) for p in pts]))
+    ds["minimal_period"] = (
+        "point",
+        np.array([minimal_period(p.shot.sections[0], br.tol) for p in pts], dtype=np.int64),
+    )
+    ds["minimal_period"].attrs["long_name"] = (
+        "smallest d | n after which the section points repeat (d < n: a period-d orbit)"
+    )
+    ds["on_grid"] = ("point", np.array([p.landed for p in pts], dtype=np.int8))
+    ds["on_grid"].attrs["long_name"] = "1 where the point was landed on a value of grid"
+    for ob in observed:
+        vals = np.array([ob.take(p.shot.sections[0], p.shot.section_obs[0]) for p in pts])
+        dims = ("point", "section", "planet") if ob.per_planet else ("point", "section")
+        ds[ob.name] = (dims, vals, {"long_name": f"{ob.name} at the section"})
+    for nm, cols, per in tracked:
+        for which in ("min", "max"):
+            arr = np.array([getattr(p.shot, f"obs_{which}")[0][cols] for p in pts])
+            if per:
+                ds[f"{nm}_{which}"] = (("point", "planet_all"), arr)
+            else:
+                ds[f"{nm}_{which}"] = ("point", arr[:, 0])
+            ds[f"{nm}_{which}"].attrs["long_name"] = f"{which} of {nm} over the orbit"
+    if levels:
+        # against the clearances of each point (the continued parameter may be one)
+        reg = [
+            list(orbit_contacts(br.system(p.lam), p.shot.obs_min[0], p.shot.obs_max[0]).values())
+            for p in pts
+        ]
+        ds["contact_regime"] = (("point", "contact"), np.array(reg, dtype="U16"))
+    _put_events(ds, events, m)
+    return ds
+
+
+def _put_events(ds: Any, events: list[Any], m: int) -> None:
+    E = len(events)
+    ds.coords["event"] = ("event", np.arange(E))
+    ds["event_kind"] = ("event", np.array([e.kind for e in events], dtype="U16"))
+    ds["event_value"] = ("event", np.array([e.value for e in events], dtype=float))
+    ds["event_point"] = ("event", np.array([e.point for e in events], dtype=np.int64))
+    ds["event_arclength"] = ("event", np.array([e.arclength for e in events], dtype=float))
+    mu = np.array([e.multiplier for e in events], dtype=complex)
+    ds["event_multiplier_re"] = ("event", mu.real)
+    ds["event_multiplier_im"] = ("event", mu.imag)
+    ds["event_state"] = (("event", "state"), np.array([e.state for e in events]).reshape(E, m))
+    ds["event_vector"] = (("event", "state"), np.array([e.vector for e in events]).reshape(E, m))
+    width = max([len(e.detail) for e in events] + [1])
+    ds["event_detail"] = ("event", np.array([e.detail for e in events], dtype=f"U{width}"))
+    ds["event_located"] = ("event", np.array([e.located for e in events], dtype=np.int8))
+
+
+def fixed_json(values: Mapping[str, Any]) -> str:
+    """The fixed parameter values as JSON (numbers and strings; anything else by repr)."""
+    out = {k: v if isinstance(v, int | float | str) else repr(v) for k, v in values.items()}
+    return json.dumps(out, sort_keys=True)
+
+
+def branch_summary(ds: Any) -> dict[str, Any]:
+    """A JSON-serialisable summary of a branch: ``parameter``, ``period``, ``range``,
+    ``points``, ``stop_reason``, ``segments`` (maximal runs of consecutive points of equal
+    stability: ``from``/``to`` parameter values, ``stable``, ``points``) and ``events``
+    (``kind``, ``value``, ``point``, ``multiplier`` {re, im, abs} or None for grazing,
+    ``detail``, ``located``), in arclength order."""
+    name = str(ds.attrs["parameter"])
+    lam = np.asarray(ds[name].values, dtype=float)
+    stable = np.asarray(ds["stable"].values, dtype=bool)
+    segments = []
+    start = 0
+    for k in range(1, lam.size + 1):
+        if k == lam.size or stable[k] != stable[start]:
+            segments.append(
+                {
+                    "from": float(lam[start]),
+                    "to": float(lam[k - 1]),
+                    "stable": bool(stable[start]),
+                    "points": int(k - start),
+                }
+            )
+            start = k
+    events = []
+    for k in range(ds.sizes.get("event", 0)):
+        re, im = float(ds.event_multiplier_re[k]), float(ds.event_multiplier_im[k])
+        kind = str(ds.event_kind.values[k])
+        events.append(
+            {
+                "kind": kind,
+                "value": float(ds.event_value[k]),
+                "point": int(ds.event_point[k]),
+                "multiplier": None
+                if kind == "grazing"
+                else {"re": re, "im": im, "abs": float(np.hypot(re, im))},
+                "detail": str(ds.event_detail.values[k]),
+                "located": bool(int(ds.event_located[k])),
+            }
+        )
+    return {
+        "parameter": name,
+        "period": int(ds.attrs["period"]),
+        "range": [float(ds.attrs["range_start"]), float(ds.attrs["range_stop"])],
+        "points": int(lam.size),
+        "stop_reason": str(ds.attrs["stop_reason"]),
+        "segments": segments,
+        "events": events,
+    }
+
+
+def branch_multipliers(ds: Any) -> np.ndarray:
+    """The complex multipliers (point, multiplier) of a branch dataset."""
+    return np.asarray(ds["multiplier_re"].values) + 1j * np.asarray(ds["multiplier_im"].values)
+
+
+def check_store(path: str | os.PathLike[str], overwrite: bool = False) -> str:
+    """The kind of a branch file (``zarr`` or ``netcdf``) from its suffix; refuses other
+    suffixes and, unless ``overwrite``, existing paths (before any computation)."""
+    path = os.fspath(path)
+    if path.endswith(".zarr"):
+        kind = "zarr"
+    elif path.endswith((".nc", ".nc4", ".h5")):
+        kind = "netcdf"
+    else:
+        raise ParameterError(f"store must end in .nc or .zarr: got {path!r}")
+    if os.path.exists(path) and not overwrite:
+        raise StoreError(f"{path} exists; choose another path or pass overwrite=True")
+    return kind
+
+
+def save_branch(ds: Any, path: str | os.PathLike[str], *, overwrite: bool = False) -> str:
+    """Write a branch to ``path``: ``*.nc`` as netCDF-4 (h5netcdf), ``*.zarr`` as a Zarr store.
+
+    An existing path is refused unless ``overwrite``; the file appears under its name only
+    when complete.
+    """
+    kind = check_store(path, overwrite)
+    path = os.fspath(path)
+    tmp = path + ".partial"
+    if os.path.isdir(tmp):
+        shutil.rmtree(tmp)
+    elif os.path.exists(tmp):
+        os.remove(tmp)
+    if kind == "zarr":
+        ds.to_zarr(tmp, mode="w", consolidated=True, zarr_format=2)
+    else:
+        ds.to_netcdf(tmp, engine="h5netcdf")
+    if os.path.isdir(path):
+        shutil.rmtree(path)
+    elif os.path.exists(path):
+        os.remove(path)
+    os.replace(tmp, path)
+    return path
+
+
+def open_branch(path: str | os.PathLike[str]) -> Any:
+    """Open a branch written by :func:`save_branch` (loaded into memory)."""
+    import xarray as xr
+
+    path = os.fspath(path)
+    if not os.path.exists(path):
+        raise StoreError(f"{path} does not exist")
+    if path.endswith(".zarr"):
+        ds = xr.open_zarr(path, consolidated=True).load()
+    else:
+        ds = xr.load_dataset(path, engine="h5netcdf")
+    if "parameter" not in ds.attrs or "multiplier_re" not in ds:
+        raise StoreError(f"{path} is not a gearchaos branch (no 'parameter' attribute)")
+    return ds

@@ -1,0 +1,51 @@
+"""Command-line interface: ``gearchaos simulate | info | presets | init-gearset |
+bifurcation | plot | classify | poincare | reproduce | calibrate``.
+
+Every command takes the gear set the same way: ``--preset NAME`` (default ``sheng2016``) or
+``--gearset FILE.toml`` (one of the two), then any number of ``--set NAME=VALUE`` changes by
+the dotted parameter names of :mod:`gearchaos.gearset.schema` (``backlash.sun_planet``,
+``teeth.sun``, the alias ``xi`` for the three damping ratios). ``omega`` (the dimensionless mesh
+frequency Ω = ω/ω_n) is a simulation setting, not a gear-set field, but is given with
+``--set omega=1.5`` as well, so that a command line reads like a point of a sweep.
+
+One module per group of commands (:mod:`.simulate`, :mod:`.gearset`, :mod:`.sweep`,
+:mod:`.gallery`, :mod:`.paper`); what they share — the app, error handling and exit codes,
+``--set`` parsing, options — is in :mod:`._common`, tables for people in :mod:`._render`.
+"""
+
+# isort: off
+# the import order is the order of the commands in `gearchaos --help`
+from . import simulate, gearset, sweep, gallery, orbits, paper, export
+
+# isort: on
+from ._common import (
+    DEFAULT_OMEGA,
+    DEFAULT_PRESET,
+    EXIT_FAILURE,
+    EXIT_INTERRUPTED,
+    EXIT_INVALID,
+    INTERRUPTED_MESSAGE,
+    app,
+    parse_sets,
+)
+from .paper import GALLERY_FIGURES, PAPER_FIGURES
+
+__all__ = [
+    "DEFAULT_OMEGA",
+    "DEFAULT_PRESET",
+    "EXIT_FAILURE",
+    "EXIT_INTERRUPTED",
+    "EXIT_INVALID",
+    "GALLERY_FIGURES",
+    "INTERRUPTED_MESSAGE",
+    "PAPER_FIGURES",
+    "app",
+    "export",
+    "gallery",
+    "gearset",
+    "orbits",
+    "paper",
+    "parse_sets",
+    "simulate",
+    "sweep",
+]

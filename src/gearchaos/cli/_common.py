@@ -1,0 +1,349 @@
+"""What every command shares: the Typer app, consoles, error handling, ``--set`` parsing, the
+gear-set options and the solver options.
+
+Exit codes: 0 success; 2 invalid input (unknown or invalid parameter, conflicting options,
+missing gear-set file, a sweep store made with other settings or damaged) — the message names
+the parameter, the rule and the value and suggests the closest valid name; 1 the integration
+failed or a file could not be written; 130 a sweep interrupted with Ctrl-C (its store keeps
+every finished chunk). Errors are reported on stderr as one line, never as a traceback.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import math
+import warnings
+from collections.abc import Iterator, Mapping, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated, Any, NoReturn
+
+import numpy as np
+import typer
+from rich.console import Console
+from rich.text import Text
+
+from .._version import __version__
+from ..errors import IntegrationError, ParameterError, StoreError
+from ..gearset.parsing import parse_text
+from ..model.target import DEFAULT_OMEGA, OMEGA
+
+if TYPE_CHECKING:
+    from ..gearset import GearSet
+    from ..integrate.settings import SolverSettings
+
+#: Gear set used when neither ``--preset`` nor ``--gearset`` is given.
+DEFAULT_PRESET = "sheng2016"
+
+EXIT_FAILURE = 1
+EXIT_INVALID = 2
+EXIT_INTERRUPTED = 130
+
+INTERRUPTED_MESSAGE = (
+    "interrupted: the store keeps every finished chunk; run the same command again to resume"
+)
+
+app = typer.Typer(
+    name="gearchaos",
+    help=(
+        "Nonlinear dynamics of planetary gear trains with backlash and bearing clearance: "
+        "simulate a gear set at a mesh frequency, sweep any parameter into bifurcation "
+        "diagrams and maps, reproduce the seed paper's figures, inspect linear properties, "
+        "manage gear-set files. Parameters are addressed by dotted names "
+        "(backlash.sun_planet, teeth.sun, xi, ...), the same as in Python and in result files."
+    ),
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+    rich_markup_mode="markdown",
+    context_settings={"help_option_names": ["-h", "--help"]},
+)
+
+
+# --------------------------------------------------------------------------- consoles, errors
+def stdout() -> Console:
+    return Console(highlight=False)
+
+
+def stderr() -> Console:
+    return Console(stderr=True, highlight=False)
+
+
+def fail(message: str, code: int) -> NoReturn:
+    stderr().print(Text("error: ", style="bold red") + Text(message), soft_wrap=True)
+    raise typer.Exit(code)
+
+
+def warn(message: str) -> None:
+    stderr().print(Text("warning: ", style="bold yellow") + Text(message), soft_wrap=True)
+
+
+def wrote(path: Path | str) -> None:
+    """``wrote PATH`` on stdout, never wrapped (paths must stay copyable)."""
+    stdout().print(Text.assemble(("wrote ", "dim"), (str(path), "bold")), soft_wrap=True)
+
+
+@contextlib.contextmanager
+def reported_errors() -> Iterator[None]:
+    """Turn the package's exceptions into one line on stderr and an exit code; say so on
+    stderr before the first compilation of the numerical kernels in this process."""
+    from .._numba import on_first_compile
+
+    on_first_compile(
+        lambda: stderr().print(
+            "compiling numerical kernels (first run only, about a minute; later runs load "
+            "them from the cache)…"
+        )
+    )
+    try:
+        yield
+    except (ParameterError, StoreError) as exc:
+        fail(str(exc), EXIT_INVALID)
+    except FileNotFoundError as exc:
+        fail(str(exc), EXIT_INVALID)
+    except IntegrationError as exc:
+        fail(str(exc), EXIT_FAILURE)
+    except OSError as exc:
+        where = f": '{exc.filename}'" if getattr(exc, "filename", None) else ""
+        fail(f"{exc.strerror or exc}{where}", EXIT_FAILURE)
+
+
+@contextlib.contextmanager
+def interruptible() -> Iterator[None]:
+    """Ctrl-C (and SIGTERM, which the sweep engine turns into it) → one line and exit 130."""
+    try:
+        yield
+    except KeyboardInterrupt:
+        fail(INTERRUPTED_MESSAGE, EXIT_INTERRUPTED)
+
+
+@contextlib.contextmanager
+def warnings_to_stderr() -> Iterator[None]:
+    """Collect the warnings of a computation and print each as one line on stderr."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        yield
+    for w in caught:
+        warn(str(w.message))
+
+
+def jsonable(obj: Any) -> Any:
+    """A JSON-ready copy: numpy scalars and arrays to Python, non-finite floats to null."""
+    if isinstance(obj, Mapping):
+        return {str(k): jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, np.ndarray):
+        return jsonable(obj.tolist())
+    if isinstance(obj, list | tuple):
+        return [jsonable(v) for v in obj]
+    if isinstance(obj, np.generic):
+        return jsonable(obj.item())
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    if isinstance(obj, Path):
+        return str(obj)
+    return obj
+
+
+def print_json(obj: Any) -> None:
+    typer.echo(json.dumps(jsonable(obj), indent=2, ensure_ascii=False, allow_nan=False))
+
+
+# --------------------------------------------------------------------------- --set parsing
+def parse_sets(items: Sequence[str]) -> tuple[float | None, dict[str, object]]:
+    """Split ``--set NAME=VALUE`` options into Ω and gear-set changes.
+
+    Parameters
+    ----------
+    items : sequence of str
+        The option values, e.g. ``["omega=1.5", "xi=0.05", "backlash.sun_planet=3"]``.
+        Values are parsed by the kind of the field: integers for tooth and planet numbers,
+        numbers for physical values, comma-separated numbers (optionally in brackets) for the
+        stiffness harmonics, text for ``torque.mode``, ``*.units``, ``mesh_phasing.model``,
+        ``name`` and ``description``. A name given twice keeps its last value.
+
+    Returns
+    -------
+    omega : float or None
+        The value of ``omega`` if given.
+    changes : dict
+        The other names and their parsed values, for :meth:`GearSet.evolve`, which rejects
+        unknown names with a suggestion.
+
+    Raises
+    ------
+    ParameterError
+        For an item without ``=``, a value that does not parse as its field's kind, or
+        ``omega`` not a finite number > 0.
+    """
+    omega: float | None = None
+    changes: dict[str, object] = {}
+    for item in items:
+        key, sep, raw = item.partition("=")
+        key, raw = key.strip(), raw.strip()
+        if not sep or not key:
+            raise ParameterError(f"--set expects NAME=VALUE (e.g. omega=1.5): got {item!r}")
+        if key == OMEGA:
+            omega = float(parse_text(OMEGA, raw))  # type: ignore[arg-type]
+            if not (math.isfinite(omega) and omega > 0):
+                raise ParameterError(f"omega must be a finite number > 0: got {raw!r}")
+        else:
+            changes[key] = parse_text(key, raw)
+    return omega, changes
+
+
+def load_gearset(
+    preset: str | None, gearset_file: Path | None, changes: Mapping[str, object] | None = None
+) -> GearSet:
+    """The gear set of ``--preset`` / ``--gearset`` (default preset), with ``changes``."""
+    from ..gearset import GearSet
+    from ..gearset import preset as load_preset
+
+    if preset is not None and gearset_file is not None:
+        raise ParameterError(
+            f"--preset and --gearset are mutually exclusive: got --preset {preset} and "
+            f"--gearset {gearset_file}; give one (default: --preset {DEFAULT_PRESET})"
+        )
+    if gearset_file is not None:
+        gs = GearSet.from_toml(gearset_file)
+    else:
+        gs = load_preset(preset if preset is not None else DEFAULT_PRESET)
+    return gs.evolve(dict(changes)) if changes else gs
+
+
+def default_omega_note(quiet: bool, what: str = "swept") -> None:
+    """Tell the user which Ω a command uses when it is neither swept nor set."""
+    if not quiet:
+        stderr().print(
+            Text(
+                f"Ω = {DEFAULT_OMEGA:g} (not {what}; change it with --set omega=...)",
+                style="dim",
+            )
+        )
+
+
+def solver_settings(
+    transient: float, periods: int, rtol: float, atol: float, samples_per_period: int = 1
+) -> SolverSettings:
+    """The :class:`~gearchaos.integrate.settings.SolverSettings` of the solver options;
+    invalid values exit 2 naming the setting."""
+    from ..integrate.settings import SolverSettings
+
+    try:
+        return SolverSettings(
+            transient_periods=transient,
+            periods=periods,
+            samples_per_period=samples_per_period,
+            rtol=rtol,
+            atol=atol,
+        )
+    except ParameterError as exc:
+        setting = str(exc).split(" ", 1)[0]
+        option = _OPTIONS.get(setting)
+        raise ParameterError(f"{option}: {exc}" if option else str(exc)) from None
+
+
+#: The command-line option of each solver setting.
+_OPTIONS = {
+    "transient_periods": "--transient",
+    "periods": "--periods",
+    "samples_per_period": "--samples-per-period",
+    "rtol": "--rtol",
+    "atol": "--atol",
+}
+
+
+# --------------------------------------------------------------------------- shared options
+PresetOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--preset",
+        "-p",
+        help=f"Built-in gear set (see `gearchaos presets`). Default: {DEFAULT_PRESET}.",
+        show_default=False,
+    ),
+]
+GearsetOpt = Annotated[
+    Path | None,
+    typer.Option(
+        "--gearset",
+        "-g",
+        help="Gear-set TOML file (start from `gearchaos init-gearset`). Excludes --preset.",
+        dir_okay=False,
+        show_default=False,
+    ),
+]
+SetOpt = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--set",
+        "-s",
+        help=(
+            "NAME=VALUE, repeatable: omega=1.5 (the dimensionless mesh frequency Ω), "
+            "xi=0.05 (all damping ratios), or any dotted gear-set parameter such as "
+            "backlash.sun_planet=3, clearance.sun_bearing=2, torque.input=1500."
+        ),
+        show_default=False,
+    ),
+]
+JsonOpt = Annotated[
+    bool, typer.Option("--json", help="Print the result as JSON on stdout, and nothing else.")
+]
+QuietOpt = Annotated[
+    bool, typer.Option("--quiet", "-q", help="No progress bar and no summary (errors only).")
+]
+TransientOpt = Annotated[
+    float, typer.Option("--transient", help="Mesh periods discarded before recording.")
+]
+PeriodsOpt = Annotated[
+    int, typer.Option("--periods", help="Mesh periods recorded (one Poincaré point each).")
+]
+RtolOpt = Annotated[
+    float,
+    typer.Option("--rtol", help="Relative tolerance of the integrator (Dormand–Prince 5(4))."),
+]
+AtolOpt = Annotated[float, typer.Option("--atol", help="Absolute tolerance of the integrator.")]
+WorkersOpt = Annotated[
+    int | None,
+    typer.Option(
+        "--workers",
+        "-w",
+        help="Local worker processes (default: in-process on all cores).",
+        show_default=False,
+    ),
+]
+OverwriteOpt = Annotated[
+    bool,
+    typer.Option("--overwrite", help="Replace an existing store made with other settings."),
+]
+
+
+@app.callback(invoke_without_command=True)
+def main(
+    ctx: typer.Context,
+    version: Annotated[
+        bool, typer.Option("--version", "-V", help="Print the version and exit.")
+    ] = False,
+) -> None:
+    """gearchaos: nonlinear dynamics of planetary gear trains with clearances."""
+    if version:
+        if ctx.invoked_subcommand is not None:
+            fail(
+                f"--version takes no command: got {ctx.invoked_subcommand!r}; run "
+                f"'gearchaos --version' or 'gearchaos {ctx.invoked_subcommand} ...'",
+                EXIT_INVALID,
+            )
+        typer.echo(f"gearchaos {__version__}")
+        raise typer.Exit()
+    if ctx.invoked_subcommand is None:
+        typer.echo(ctx.get_help())
+        raise typer.Exit(EXIT_INVALID)
+
+
+def output_path(raw: str | None, option: str = "--output") -> Path | None:
+    """The path of an output option; an empty one is refused (it would mean the current
+    directory by accident)."""
+    if raw is None:
+        return None
+    if not raw.strip():
+        raise ParameterError(f"{option} must be a path: got an empty string")
+    return Path(raw)

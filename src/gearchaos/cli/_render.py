@@ -1,0 +1,258 @@
+"""Rendering of results for people: rich tables of summaries, gear-set information, regime
+tables and gallery rows. Symbols come from the parameter registry
+(:mod:`gearchaos.gearset.schema`)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+from rich.columns import Columns
+from rich.markup import escape
+from rich.table import Table
+from rich.text import Text
+
+from ..gearset.mapping import flatten
+from ..gearset.schema import display_symbol as symbol
+
+__all__ = [
+    "add_motion_rows",
+    "column_title",
+    "fmt",
+    "gallery_rows_table",
+    "info_renderables",
+    "pairs_table",
+    "regime_table",
+]
+
+
+# Labels of the gearset_info() entries (symbols of MODEL.md); unknown keys get a label
+# made from the key, so new entries show up without a change here.
+_LABELS: dict[str, str] = {
+    "planets": "planets N",
+    "teeth.sun": "sun teeth z_s",
+    "teeth.planet": "planet teeth z_p",
+    "teeth.ring": "ring teeth z_r",
+    "omega_n_rad_s": "ω_n = √(k_m,sp/m_e) [rad/s]",
+    "omega_n_hz": "ω_n/2π [Hz]",
+    "output_torque_N_m": "output torque T_L [N m]",
+    "torque_ratio": "torque ratio T_L/T_D",
+    "load_mode": "load mode",
+    "reference_omega": "Ω_ref (constant power)",
+    "static_mesh_force_N": "static mesh force T_D/(N r_bs) [N]",
+    "mesh_phasing.model": "mesh phasing used by the model",
+    "mesh_phasing.class": "Parker–Lin phasing class of the teeth (if model = parker)",
+    "mesh_phasing.k": "k = z_r mod N (decides the class)",
+    "radii_m.sun": "r_s sun pitch",
+    "radii_m.planet": "r_p planet pitch",
+    "radii_m.ring": "r_r ring pitch",
+    "radii_m.carrier": "r_c = r_s + r_p",
+    "radii_m.base_sun": "r_bs = r_s cos α_s",
+    "radii_m.base_planet": "r_bp = r_p cos α_s",
+    "equivalent_masses_kg.sun": "m_s* = J_s/r_bs²",
+    "equivalent_masses_kg.planet": "m_p* = J_p/r_bp²",
+    "equivalent_masses_kg.carrier": "m_c* = J_c/r_c² + N m_p",
+    "equivalent_masses_kg.mesh": "m_e = m_s* m_p*/(m_s* + m_p*)",
+    "damping_coefficients_N_s_per_m.sun_planet": "c_sp = 2ξ_sp √(k_m,sp m_e)",
+    "damping_coefficients_N_s_per_m.planet_ring": "c_rp = 2ξ_rp √(k_m,rp m_p*)",
+    "damping_coefficients_N_s_per_m.sun_bearing": "c_s = 2ξ_s √(k_s m_s)",
+    "dimensionless.mu_s": "μ_s = m_s/m_e",
+    "dimensionless.mu_s_star": "μ_s* = m_s*/m_e",
+    "dimensionless.mu_p_star": "μ_p* = m_p*/m_e",
+    "dimensionless.mu_c_star": "μ_c* = m_c*/m_e",
+    "dimensionless.eps_sp": "ε_sp = k_a,sp/k_m,sp",
+    "dimensionless.kappa_rp_mean": "κ_rp mean = k_m,rp/k_m,sp",
+    "dimensionless.kappa_rp_alt": "κ_rp alternating = k_a,rp/k_m,sp",
+    "dimensionless.kappa_b": "κ_b = k_s/k_m,sp",
+    "dimensionless.damping_sun_planet": "c̄_sp = c_sp/(m_e ω_n)",
+    "dimensionless.damping_planet_ring": "c̄_rp = c_rp/(m_e ω_n)",
+    "dimensionless.damping_sun_bearing": "c̄_s = c_s/(m_e ω_n)",
+    "dimensionless.b_sp": "b̄_sp",
+    "dimensionless.b_rp": "b̄_rp",
+    "dimensionless.b_s": "b̄_s",
+    "dimensionless.torque_input": "T̄_D",
+    "dimensionless.torque_output": "T̄_L",
+    "dimensionless.te_sp": "Ā_sp",
+    "dimensionless.te_rp": "Ā_rp",
+    "dimensionless.harmonics_sp": "stiffness harmonics sp",
+    "dimensionless.harmonics_rp": "stiffness harmonics rp",
+    "static_deflection.sun_planet_m": "sun–planet F/k_m,sp [m]",
+    "static_deflection.sun_planet_bar": "sun–planet F/(k_m,sp b_c)",
+    "static_deflection.planet_ring_m": "planet–ring F/k_m,rp [m]",
+    "static_deflection.planet_ring_bar": "planet–ring F/(k_m,rp b_c)",
+    "natural_frequencies.hz": "f [Hz]",
+    "natural_frequencies.ratio": "ω/ω_n",
+    "natural_frequencies.kind": "mode class",
+    "natural_frequencies.multiplicity": "multiplicity",
+    "omega_at_resonances.mode_ratio": "mode ω/ω_n",
+    "omega_at_resonances.kind": "mode class",
+    "omega_at_resonances.harmonic": "harmonic h",
+    "omega_at_resonances.omega": "Ω = (ω/ω_n)/h",
+    "operating_point.omega": "Ω = ω/ω_n",
+    "operating_point.mesh_frequency_rad_s": "mesh frequency ω [rad/s]",
+    "operating_point.mesh_frequency_hz": "mesh frequency [Hz]",
+    "operating_point.sun_speed_rpm": "sun speed [rpm]",
+}
+_TITLES: dict[str, str] = {
+    "radii_m": "Radii [m]",
+    "equivalent_masses_kg": "Equivalent masses [kg]",
+    "damping_coefficients_N_s_per_m": "Damping [N s/m]",
+    "dimensionless": "Dimensionless groups (MODEL.md §7)",
+    "static_deflection": "Static mesh deflection",
+    "natural_frequencies": "Natural frequencies (mean stiffness, no clearance)",
+    "omega_at_resonances": "Resonances: mesh harmonic h·Ω meets a mode",
+    "operating_point": "Operating point",
+}
+#: Groups shown as rows of the overview table rather than as tables of their own.
+_OVERVIEW_GROUPS = ("teeth", "mesh_phasing")
+_UNIT_SUFFIXES = (
+    ("_N_s_per_m", "N s/m"),
+    ("_rad_s", "rad/s"),
+    ("_N_m", "N m"),
+    ("_rpm", "rpm"),
+    ("_hz", "Hz"),
+    ("_kg", "kg"),
+    ("_m", "m"),
+    ("_N", "N"),
+)
+
+
+def label(path: str) -> str:
+    """The label of an info entry: from :data:`_LABELS`, else made from the key."""
+    if path in _LABELS:
+        return _LABELS[path]
+    key = path.rsplit(".", 1)[-1]
+    for suffix, unit in _UNIT_SUFFIXES:
+        if key.endswith(suffix) and len(key) > len(suffix):
+            return f"{key[: -len(suffix)].replace('_', ' ')} [{unit}]"
+    return key.replace("_", " ")
+
+
+def fmt(value: Any) -> str:
+    if isinstance(value, bool) or value is None:
+        return "—" if value is None else str(value)
+    if isinstance(value, (float, np.floating)):
+        return f"{float(value):.6g}"
+    if isinstance(value, (list, tuple)):
+        return ", ".join(fmt(v) for v in value) or "—"
+    return str(value)
+
+
+def pairs_table(title: str | None) -> Table:
+    table = Table(title=escape(title) if title else None, title_justify="left", show_header=False)
+    table.add_column("quantity", style="cyan")
+    table.add_column("value", justify="right")
+    return table
+
+
+def info_renderables(data: Mapping[str, Any]) -> list[Any]:
+    """Rich tables of a :func:`gearset_info` dictionary: an overview of the scalars, the
+    groups of numbers side by side, then the mode and resonance lists."""
+    overview = pairs_table(None)
+    groups: list[Table] = []
+    lists: list[Table] = []
+    for key, value in data.items():
+        if key in ("name", "description"):
+            continue
+        if isinstance(value, Mapping):
+            target = overview if key in _OVERVIEW_GROUPS else pairs_table(_TITLES.get(key, key))
+            for path, v in flatten(value, f"{key}.").items():
+                target.add_row(escape(label(path)), escape(fmt(v)))
+            if target is not overview:
+                groups.append(target)
+        elif (
+            isinstance(value, (list, tuple))
+            and value
+            and all(isinstance(v, Mapping) for v in value)
+        ):
+            columns: list[str] = []
+            for row in value:
+                columns.extend(k for k in row if k not in columns)
+            table = Table(title=escape(_TITLES.get(key, key)), title_justify="left")
+            for col in columns:
+                table.add_column(
+                    escape(label(f"{key}.{col}")), justify="left" if col == "kind" else "right"
+                )
+            for row in value:
+                table.add_row(*(escape(fmt(row.get(col))) for col in columns))
+            lists.append(table)
+        else:
+            overview.add_row(escape(label(key)), escape(fmt(value)))
+    out: list[Any] = [overview]
+    if groups:
+        out.append(Columns(groups, padding=(0, 2)))
+    return [*out, *lists]
+
+
+def column_title(key: str) -> str:
+    """``xi=0.03`` → ``ξ = 0.03``; ``all`` → ``all points``."""
+    if key == "all":
+        return "all points"
+    name, sep, value = key.partition("=")
+    if not sep:
+        return key
+    return f"{symbol(name)} = {value}"
+
+
+def regime_table(table: Mapping[str, Mapping[str, float]], *, title: str | None) -> Table:
+    """A rich table of a regime table: one row per regime (with its palette colour), one
+    column per family value, fractions in %."""
+    from ..analysis.classify import sort_labels
+    from ..plot.regimes import regime_colour
+
+    labels = sort_labels(label for column in table.values() for label in column)
+    out = Table(title=escape(title) if title else None, title_justify="left")
+    out.add_column("regime", no_wrap=True)
+    for key in table:
+        out.add_column(escape(column_title(key)), justify="right")
+    for label in labels:
+        cells = []
+        for column in table.values():
+            f = column.get(label)
+            cells.append("—" if f is None else f"{100.0 * f:.1f} %")
+        swatch = Text("■ ", style=regime_colour(label)) + Text(label)
+        out.add_row(swatch, *cells)
+    return out
+
+
+def add_motion_rows(table: Table, summary: Mapping[str, Any]) -> None:
+    """The motion indicators of a summary as rows of its table."""
+    lle = summary.get("lle")
+    k01 = summary.get("k01")
+    table.add_row("largest Lyapunov exponent λ₁", "—" if lle is None else f"{lle:.4g}")
+    table.add_row("0–1 test K", "—" if k01 is None else f"{k01:.3f}")
+    agree = summary.get("indicators_agree")
+    if agree is not None:
+        table.add_row(
+            "indicators agree", Text("yes" if agree else "no", style="" if agree else "bold red")
+        )
+    note = summary.get("motion_note")
+    if note:
+        table.add_row("motion note", escape(str(note)))
+
+
+def gallery_rows_table(rows: Sequence[Mapping[str, Any]], param: str, *, title: str) -> Table:
+    """One row per value: value, motion (in its palette colour), λ₁, K, agree, points."""
+    from ..plot.regimes import regime_colour
+
+    table = Table(title=escape(title), title_justify="left")
+    table.add_column(escape(symbol(param)), justify="right")
+    table.add_column("motion", no_wrap=True)
+    table.add_column("λ₁", justify="right")
+    table.add_column("0–1 K", justify="right")
+    table.add_column("agree", justify="center")
+    table.add_column("distinct points", justify="right")
+    for r in rows:
+        motion = str(r["motion"])
+        lle, k01 = r.get("lle"), r.get("k01")
+        agree = bool(r.get("indicators_agree", True))
+        table.add_row(
+            f"{float(r['value']):g}",
+            Text("■ ", style=regime_colour(motion)) + Text(motion),
+            "—" if lle is None else f"{lle:.3g}",
+            "—" if k01 is None else f"{k01:.3f}",
+            Text("yes" if agree else "no", style="" if agree else "bold red"),
+            str(r.get("distinct_section_points", "—")),
+        )
+    return table

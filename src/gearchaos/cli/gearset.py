@@ -1,0 +1,87 @@
+"""Gear-set commands: ``gearchaos info``, ``presets`` and ``init-gearset``."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.table import Table
+from rich.text import Text
+
+from . import _common as c
+from ._render import info_renderables
+
+
+@c.app.command()
+def info(
+    preset: c.PresetOpt = None,
+    gearset: c.GearsetOpt = None,
+    set_: c.SetOpt = None,
+    json_out: c.JsonOpt = False,
+) -> None:
+    """Linear properties of a gear set: radii, equivalent masses, ω_n, damping coefficients,
+    dimensionless groups, mesh phasing and natural frequencies with their mode classes.
+
+    With **--set omega=...** the operating point (mesh frequency, sun speed) is added.
+    """
+    with c.reported_errors():
+        omega, changes = c.parse_sets(set_ or [])
+        gs = c.load_gearset(preset, gearset, changes)
+        from ..analysis.derived import gearset_info
+
+        data = dict(gearset_info(gs))
+        if omega is not None:
+            data["operating_point"] = {
+                "omega": omega,
+                "mesh_frequency_rad_s": omega * gs.omega_n,
+                "mesh_frequency_hz": omega * gs.omega_n / (2.0 * math.pi),
+                "sun_speed_rpm": gs.sun_speed_rpm(omega),
+            }
+    if json_out:
+        c.print_json(data)
+        return
+    out = c.stdout()
+    out.print(Text.assemble(("gear set ", "dim"), (gs.name, "bold")))
+    if gs.description:
+        out.print(Text(gs.description, style="dim"))
+    out.print()
+    for renderable in info_renderables(data):
+        out.print(renderable)
+
+
+@c.app.command()
+def presets() -> None:
+    """List the built-in gear sets (use one with --preset NAME)."""
+    from ..gearset import list_presets
+
+    table = Table(title="Built-in gear sets", title_justify="left")
+    table.add_column("name", style="bold cyan", no_wrap=True)
+    table.add_column("description")
+    for name, description in list_presets():
+        table.add_row(name, description)
+    c.stdout().print(table)
+
+
+@c.app.command("init-gearset")
+def init_gearset(
+    file: Annotated[
+        Path, typer.Argument(help="TOML file to write.", dir_okay=False, show_default=False)
+    ],
+    force: Annotated[
+        bool, typer.Option("--force", "-f", help="Overwrite an existing file.")
+    ] = False,
+) -> None:
+    """Write a commented gear-set file to start from (the sheng2016 values, every line
+    explained); edit it, then run **gearchaos simulate --gearset FILE**."""
+    from ..gearset import template_toml
+
+    if file.exists() and not force:
+        c.fail(f"{file} already exists; pass --force to overwrite it", c.EXIT_FAILURE)
+    with c.reported_errors():
+        file.write_text(template_toml(), encoding="utf-8")
+    c.wrote(file)
+    c.stdout().print(
+        Text(f"next: gearchaos simulate --gearset {file} --set omega=1.5 -o out/", style="dim")
+    )

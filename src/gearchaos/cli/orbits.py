@@ -1,0 +1,217 @@
+"""Periodic orbits and their branches: ``gearchaos orbit`` and ``gearchaos continue``."""
+
+from __future__ import annotations
+
+import contextlib
+import time
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+from rich.markup import escape
+from rich.table import Table
+from rich.text import Text
+
+from ..errors import ParameterError
+from . import _common as c
+from ._render import pairs_table
+
+PeriodOpt = Annotated[
+    int, typer.Option("--period", "-n", help="Period n of the orbit, in mesh periods.")
+]
+
+GuessOpt = Annotated[
+    float,
+    typer.Option(
+        "--transient",
+        help="Mesh periods simulated from rest for the first guess of the (starting) orbit.",
+    ),
+]
+
+
+def _spinner(text: str, quiet: bool) -> contextlib.AbstractContextManager[Any]:
+    err = c.stderr()
+    return err.status(text) if (not quiet and err.is_terminal) else contextlib.nullcontext()
+
+
+@c.app.command()
+def orbit(
+    preset: c.PresetOpt = None,
+    gearset: c.GearsetOpt = None,
+    set_: c.SetOpt = None,
+    period: PeriodOpt = 1,
+    transient: GuessOpt = 50.0,
+    rtol: c.RtolOpt = 1e-8,
+    atol: c.AtolOpt = 1e-10,
+    json_out: c.JsonOpt = False,
+) -> None:
+    """Find the period-n orbit at one operating point by shooting (Newton on Pⁿ(y) − y = 0,
+    the Jacobian from the variational equations) and print its Floquet multipliers, stability
+    and contact regimes.
+
+    The multipliers μ are the eigenvalues of the monodromy matrix; the orbit is stable when
+    every |μ| < 1. **--json** prints exactly {period, converged, residual, stable,
+    multipliers: [{re, im, abs}], x_sp1: [...], contact: [...]}.
+
+    Example: **gearchaos orbit --set omega=1.5 --period 1**
+    """
+    from ..analysis.orbits import periodic_orbit
+
+    with c.reported_errors():
+        omega, changes = c.parse_sets(set_ or [])
+        gs = c.load_gearset(preset, gearset, changes)
+        omega = c.DEFAULT_OMEGA if omega is None else omega
+        settings = c.solver_settings(transient, 1, rtol, atol)
+        if period < 1 or period > 64:
+            raise ParameterError(f"--period must be an integer in [1, 64]: got {period}")
+        with _spinner(f"shooting the period-{period} orbit at Ω = {omega:g}…", json_out):
+            with c.warnings_to_stderr():
+                orb = periodic_orbit(gs, period=period, omega=omega, settings=settings)
+        summary = orb.summary()
+    if json_out:
+        keys = ("period", "converged", "residual", "stable", "multipliers", "x_sp1", "contact")
+        c.print_json({k: summary[k] for k in keys})
+        return
+    out = c.stdout()
+    table = pairs_table(f"period-{period} orbit of {gs.name} at Ω = {omega:g}")
+    table.add_row(
+        "converged",
+        Text("yes" if orb.converged else "no", style="" if orb.converged else "bold red"),
+    )
+    table.add_row("residual ‖Pⁿ(y) − y‖", f"{orb.residual:.3g}")
+    table.add_row("stable (all |μ| < 1)", "yes" if orb.stable else "no")
+    table.add_row("largest |μ|", f"{orb.max_multiplier:.6g}")
+    table.add_row("minimal period", str(orb.minimal_period))
+    xs = summary["x_sp1"]
+    table.add_row("X̄_sp1 at the section", escape(", ".join(f"{x:.6g}" for x in xs)))
+    for item in summary["contact"]:
+        table.add_row(f"contact {item['contact']}", escape(str(item["regime"])))
+    out.print(table)
+    mult = Table(title="Floquet multipliers μ (by modulus)", title_justify="left")
+    for col in ("re", "im", "|μ|"):
+        mult.add_column(col, justify="right")
+    for m in summary["multipliers"]:
+        mult.add_row(f"{m['re']:.6g}", f"{m['im']:.6g}", f"{m['abs']:.6g}")
+    out.print(mult)
+    if not orb.converged:
+        out.print(Text(f"not converged: {orb.message}", style="bold red"))
+
+
+@c.app.command("continue")
+def continue_(
+    output: Annotated[
+        str,
+        typer.Option(
+            "--output",
+            "-o",
+            help="Branch file: BRANCH.nc (netCDF) or BRANCH.zarr.",
+            show_default=False,
+        ),
+    ],
+    vary: Annotated[
+        str | None,
+        typer.Option(
+            "--vary",
+            "-v",
+            help="NAME=START:STOP: the continued parameter and its range, e.g. omega=0.2:4 or "
+            "backlash.sun_planet=1:6 (the branch starts at START).",
+            show_default=False,
+        ),
+    ] = None,
+    preset: c.PresetOpt = None,
+    gearset: c.GearsetOpt = None,
+    set_: c.SetOpt = None,
+    period: PeriodOpt = 1,
+    transient: GuessOpt = 50.0,
+    rtol: c.RtolOpt = 1e-8,
+    atol: c.AtolOpt = 1e-10,
+    max_points: Annotated[
+        int, typer.Option("--max-points", help="Most points of the branch.")
+    ] = 2000,
+    overwrite: c.OverwriteOpt = False,
+    quiet: c.QuietOpt = False,
+    json_out: c.JsonOpt = False,
+) -> None:
+    """Continue a branch of period-n orbits in one parameter (pseudo-arclength, so folds are
+    passed) and locate its events: folds (μ through +1), period doublings (μ through −1),
+    Neimark–Sacker bifurcations (a complex pair through the unit circle, the seed's "Hopf")
+    and grazings (a contact regime changes along the orbit).
+
+    Writes the branch (parameter, section state, X̄ values, multipliers, stability per point;
+    the events table) and prints its stable and unstable segments and events. Overlay it on a
+    sweep with **gearchaos plot STORE --branch BRANCH.nc**.
+
+    Example: **gearchaos continue --vary omega=0.2:4 --set xi=0.03 -o branch.nc**
+    """
+    from ..analysis.arclength import continuation
+    from ..analysis.branch import branch_summary
+
+    with c.reported_errors():
+        if not vary or "=" not in vary:
+            raise ParameterError(
+                f"--vary is required: NAME=START:STOP, e.g. --vary omega=0.2:4: got {vary!r}"
+            )
+        path = c.output_path(output)
+        assert path is not None
+        if path.suffix.lower() not in (".nc", ".zarr"):
+            raise ParameterError(f"--output must end in .nc or .zarr: got {output!r}")
+        omega, changes = c.parse_sets(set_ or [])
+        gs = c.load_gearset(preset, gearset)
+        name = vary.partition("=")[0].strip()
+        values: dict[str, Any] = dict(changes)
+        if name in values:
+            raise ParameterError(f"{name} is both continued and set with --set; choose one")
+        if name != "omega":
+            if omega is None:
+                omega = c.DEFAULT_OMEGA
+                c.default_omega_note(quiet or json_out, "continued")
+            values["omega"] = omega
+        elif omega is not None:
+            raise ParameterError("omega is both continued and set with --set; choose one")
+        settings = c.solver_settings(transient, 1, rtol, atol)
+        t0 = time.perf_counter()
+        with _spinner(f"continuing the period-{period} branch in {name}…", quiet or json_out):
+            with c.warnings_to_stderr():
+                ds = continuation(
+                    gs,
+                    vary,
+                    period=period,
+                    settings=settings,
+                    params=values,
+                    max_points=max_points,
+                    store=path,
+                    overwrite=overwrite,
+                )
+        summary = branch_summary(ds)
+        summary["seconds"] = time.perf_counter() - t0
+        summary["branch"] = str(path)
+    if json_out:
+        c.print_json(summary)
+        return
+    if quiet:
+        return
+    out = c.stdout()
+    table = pairs_table(f"period-{period} branch of {gs.name} in {name}")
+    table.add_row("points", str(summary["points"]))
+    table.add_row("stopped", escape(str(summary["stop_reason"])))
+    table.add_row("seconds", f"{summary['seconds']:.3g}")
+    for seg in summary["segments"]:
+        what = "stable" if seg["stable"] else "unstable"
+        table.add_row(
+            escape(f"{what} {seg['from']:.6g} … {seg['to']:.6g}"), f"{seg['points']} points"
+        )
+    out.print(table)
+    events = Table(title="events along the branch", title_justify="left")
+    for col in ("kind", name, "multiplier", "detail"):
+        events.add_column(escape(col))
+    for e in summary["events"]:
+        mu = e.get("multiplier")
+        mu_text = "—" if mu is None else f"{mu['re']:.4g}{mu['im']:+.4g}i (|μ| {mu['abs']:.4g})"
+        events.add_row(
+            escape(e["kind"]),
+            f"{e['value']:.6g}",
+            escape(mu_text),
+            escape(str(e.get("detail", ""))),
+        )
+    out.print(events)
+    c.wrote(Path(path))

@@ -1,0 +1,298 @@
+"""Commands of the seed paper: ``gearchaos reproduce`` and ``gearchaos calibrate``."""
+
+from __future__ import annotations
+
+import difflib
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+from rich.markup import escape
+from rich.text import Text
+
+from ..errors import ParameterError
+from . import _common as c
+from ._render import fmt, gallery_rows_table, pairs_table
+
+#: Figures of the seed paper that ``gearchaos reproduce`` knows: bifurcation diagrams
+#: (:mod:`gearchaos.paper.recipes`) and Poincaré galleries (:data:`GALLERY_FIGURES`).
+PAPER_FIGURES = ("fig4", "fig5", "fig6", "fig7", "fig8", "fig9", "fig10", "fig11", "fig12")
+#: The Poincaré galleries among them (:mod:`gearchaos.paper.galleries`).
+GALLERY_FIGURES = ("fig5", "fig7", "fig10")
+
+
+@c.app.command()
+def reproduce(
+    figure: Annotated[
+        str | None,
+        typer.Argument(
+            help=f"Figure of the seed paper: {', '.join(PAPER_FIGURES)} (or --all).",
+            show_default=False,
+        ),
+    ] = None,
+    all_figures: Annotated[
+        bool,
+        typer.Option(
+            "--all",
+            help=(
+                "Run every figure, check the paper's conclusions and landmarks and write "
+                "OUTPUT/index.html (the reproduction report)."
+            ),
+        ),
+    ] = False,
+    output: Annotated[
+        Path | None,
+        typer.Option(
+            "--output",
+            "-o",
+            help=(
+                "Directory for FIG.png and the sweep store FIG.zarr (galleries: FIG.json and "
+                "FIG.csv); created if missing. Required with --all (the report)."
+            ),
+            file_okay=False,
+            show_default=False,
+        ),
+    ] = None,
+    quick: Annotated[
+        bool, typer.Option("--quick", help="A coarse version (fewer points and periods), for CI.")
+    ] = False,
+    workers: c.WorkersOpt = None,
+    overwrite: c.OverwriteOpt = False,
+    preset: c.PresetOpt = None,
+    gearset: c.GearsetOpt = None,
+    quiet: c.QuietOpt = False,
+    json_out: c.JsonOpt = False,
+) -> None:
+    """Run the exact sweep of one of the seed paper's bifurcation figures with the default gear
+    set (or --preset / --gearset) and draw it in the paper's layout (resumable like
+    `gearchaos bifurcation`), or draw one of its Poincaré galleries.
+
+    Bifurcation diagrams — fig4: Ω sweep, ξ = 0.03, 0.05, 0.07, 0.09; fig6: b̄_sp at Ω = 1.5 for
+    four ξ; fig8: b̄_sp at ξ = 0.11 for Ω = 1, 1.5, 2, 2.5; fig9: b̄_rp at Ω = 1.5 for four ξ;
+    fig11: b̄_rp at ξ = 0.11 for four Ω; fig12: b̄_s at ξ = 0.05, Ω = 1.5.
+
+    Poincaré galleries (FIG.png, FIG.json and FIG.csv with value, motion, λ₁, K, distinct
+    points) — fig5: Ω path at ξ = 0.03; fig7: b̄_sp ∈ [1, 6] at Ω = 1.5, ξ = 0.05; fig10:
+    b̄_rp ∈ [1, 9] at Ω = 1.5, ξ = 0.05, at the values the seed's text names.
+
+    --all runs every figure into OUTPUT, checks the conclusions of the seed's Section 4 and its
+    landmarks against the runs and writes the report OUTPUT/index.html (resumable; 4–8 minutes
+    on 2 cores, --quick about a minute).
+
+    Example: **gearchaos reproduce fig4 -o paper/ --quick**;
+    **gearchaos reproduce --all -o report/**
+    """
+    gs = None
+    label = None
+    if preset is not None or gearset is not None:
+        with c.reported_errors():
+            gs = c.load_gearset(preset, gearset)
+        label = f"preset {preset}" if preset is not None else f"file {gearset} ({gs.name})"
+    if all_figures:
+        if figure is not None:
+            c.fail("give either FIG or --all, not both", c.EXIT_INVALID)
+        if output is None:
+            c.fail(
+                "--all writes a report of many files: give its directory with -o, e.g. -o report/",
+                c.EXIT_INVALID,
+            )
+        with c.reported_errors(), c.interruptible():
+            from ..paper.report import build_report
+
+            index = build_report(
+                output,
+                quick=quick,
+                progress=not (quiet or json_out),
+                workers=workers,
+                gearset=gs,
+                gearset_label=label,
+            )
+        if json_out:
+            c.print_json({"report": str(index)})
+        elif not quiet:
+            c.stdout().print(escape(str(index)), soft_wrap=True)
+        return
+    if figure is None:
+        c.fail("give a figure (FIG) or --all", c.EXIT_INVALID)
+    output = Path(".") if output is None else output
+    with c.reported_errors(), c.interruptible():
+        name = figure.strip().lower()
+        if name not in PAPER_FIGURES:
+            close = difflib.get_close_matches(name, PAPER_FIGURES, n=1)
+            hint = f"; did you mean {close[0]!r}?" if close else ""
+            raise ParameterError(
+                f"FIG must be one of {', '.join(PAPER_FIGURES)}: got {figure!r}{hint}"
+            )
+        if name in GALLERY_FIGURES:
+            if workers is not None and not (quiet or json_out):
+                c.stderr().print(
+                    Text(
+                        f"--workers does not apply to {name} (a gallery runs its "
+                        f"{name} values one after the other)",
+                        style="dim",
+                    )
+                )
+            import matplotlib
+
+            matplotlib.use("Agg")
+            from ..paper.galleries import reproduce_gallery
+
+            output.mkdir(parents=True, exist_ok=True)
+            result = dict(
+                reproduce_gallery(
+                    name, output, quick=quick, progress=not (quiet or json_out), gearset=gs
+                )
+            )
+        else:
+            from ..paper.recipes import reproduce as run_recipe
+
+            output.mkdir(parents=True, exist_ok=True)
+            result = dict(
+                run_recipe(
+                    name,
+                    output,
+                    quick=quick,
+                    progress=not quiet,
+                    workers=workers,
+                    overwrite=overwrite,
+                    gearset=gs,
+                )
+            )
+    if json_out:
+        c.print_json(result)
+        return
+    if quiet:
+        return
+    rows = result.pop("rows", None)
+    if rows is not None:
+        from ..paper.galleries import get_gallery
+
+        c.stdout().print(
+            gallery_rows_table(rows, get_gallery(name).param, title=f"Poincaré gallery {name}")
+        )
+    table = pairs_table(f"gearchaos reproduce {name}" + (" (quick)" if quick else ""))
+    for key in ("figure", "store", "points", "failed", "seconds"):
+        if key in result:
+            value = result[key]
+            text = f"{value:.3g}" if key == "seconds" and isinstance(value, float) else str(value)
+            table.add_row(key, escape(text))
+    for key, value in result.items():
+        if key not in ("figure", "store", "points", "failed", "seconds"):
+            table.add_row(escape(str(key)), escape(fmt(value)))
+    c.stdout().print(table)
+
+
+@c.app.command()
+def calibrate(
+    landmarks: Annotated[
+        Path | None,
+        typer.Option(
+            "--landmarks",
+            help="Landmarks file (default: the packaged paper/landmarks.toml).",
+            dir_okay=False,
+            show_default=False,
+        ),
+    ] = None,
+    out: Annotated[
+        Path,
+        typer.Option(
+            "--out",
+            help=(
+                "JSON-lines file, one line per evaluated candidate; re-used on restart. "
+                "best.toml is written beside it."
+            ),
+            dir_okay=False,
+        ),
+    ] = Path("calibration.jsonl"),
+    budget_minutes: Annotated[
+        float, typer.Option("--budget-minutes", help="Stop evaluating after this many minutes.")
+    ] = 110.0,
+    max_candidates: Annotated[
+        int | None,
+        typer.Option(
+            "--max-candidates",
+            help="Stop when the candidate sequence (resumed ones included) reaches N.",
+            show_default=False,
+        ),
+    ] = None,
+    seed: Annotated[int, typer.Option("--seed", help="Seed of the candidate sequence.")] = 0,
+    quick: Annotated[
+        bool, typer.Option("--quick", help="3 candidates on tiny sweeps, for CI.")
+    ] = False,
+    quiet: c.QuietOpt = False,
+    json_out: c.JsonOpt = False,
+) -> None:
+    """Search the quantities of the seed's lost Table 1 (N and tooth numbers, input torque,
+    transmission-error amplitude, stiffness ratios, mass ratios, b_c, load mode) for the gear set
+    whose coarse sweeps reproduce the most landmarks of the seed's text. Resumable: candidates
+    already in --out are not evaluated again. See docs/reproduction.md.
+
+    Example: **gearchaos calibrate --landmarks paper/landmarks.toml --budget-minutes 110**
+    """
+    from ..paper.calibrate import calibrate as run_calibration
+
+    show = not (quiet or json_out)
+    err = c.stderr()
+
+    def on_record(rec: Mapping[str, Any], now: bool) -> None:
+        if show:
+            what = f"{rec['seconds']:.0f} s" if now else "resumed"
+            err.print(
+                Text(
+                    f"candidate {rec['index']} ({rec['origin']}): score {rec['score']:.2f} "
+                    f"[{what}]",
+                    style="dim",
+                )
+            )
+
+    with c.reported_errors():
+        from ..paper.landmarks import load_landmarks
+
+        marks = load_landmarks(landmarks)  # a bad file is refused before anything runs
+        if out.parent and not out.parent.exists():
+            out.parent.mkdir(parents=True, exist_ok=True)
+        result = run_calibration(
+            marks,
+            out,
+            budget_minutes=budget_minutes,
+            max_candidates=max_candidates,
+            seed=seed,
+            quick=quick,
+            on_record=on_record,
+        )
+    summary = {
+        "out": str(out),
+        "best_toml": str(result.best_toml) if result.best_toml else None,
+        "evaluated": result.evaluated,
+        "resumed": result.reused,
+        "stopped": result.stopped,
+        "plausible": result.plausible,
+        "problems": result.problems,
+        "best": result.best,
+        "top": result.top(3),
+    }
+    if json_out:
+        c.print_json(summary)
+    elif not quiet:
+        table = pairs_table("gearchaos calibrate: best candidate" + (" (quick)" if quick else ""))
+        best = result.best or {}
+        table.add_row("score", escape(fmt(best.get("score"))))
+        for key, value in (best.get("variables") or {}).items():
+            table.add_row(escape(str(key)), escape(fmt(value)))
+        table.add_row("evaluated / resumed", f"{result.evaluated} / {result.reused}")
+        table.add_row("stopped", escape(result.stopped))
+        table.add_row("best.toml", escape(str(result.best_toml)))
+        verdict = (
+            "yes: inside every range, no validation warnings"
+            if result.plausible
+            else "no: " + "; ".join(result.problems)
+        )
+        table.add_row("physically plausible", escape(verdict))
+        c.stdout().print(table)
+    if result.stopped == "interrupted":
+        c.fail(
+            f"interrupted: every finished candidate is in {out}; run the same command again "
+            "to resume",
+            c.EXIT_INTERRUPTED,
+        )

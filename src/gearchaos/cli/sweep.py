@@ -1,0 +1,410 @@
+"""Sweep commands: ``gearchaos bifurcation``, ``plot`` and ``classify``."""
+
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+from rich.markup import escape
+from rich.text import Text
+
+from ..errors import ParameterError
+from ..gearset.parsing import parse_int
+from . import _common as c
+from ._render import pairs_table, regime_table
+
+
+def _parse_planets(raw: str | None) -> tuple[int, ...]:
+    if raw is None:
+        return (1,)
+    items = [item.strip() for item in raw.split(",") if item.strip()]
+    if not items:
+        raise ParameterError(f"--planets must be planet numbers such as 1,2: got {raw!r}")
+    planets = tuple(parse_int("--planets", item) for item in items)
+    if any(p < 1 for p in planets):
+        raise ParameterError(f"--planets must be planet numbers >= 1: got {raw!r}")
+    return planets
+
+
+def _axis_name(item: str) -> str:
+    return item.partition("=")[0].strip()
+
+
+def open_store(path: Path) -> Any:
+    """A sweep store as a :class:`~gearchaos.sweep.SweepResult`; a missing, unreadable or
+    foreign one is invalid input (exit 2)."""
+    if not path.exists():
+        raise ParameterError(f"store not found: {str(path)!r}")
+    from ..errors import StoreError
+    from ..sweep import SweepResult
+
+    try:
+        res = SweepResult.open(path)
+    except StoreError:
+        raise
+    except Exception as exc:  # zarr raises several types for a directory that is no store
+        raise ParameterError(f"{str(path)!r} is not a readable sweep store: {exc}") from None
+    if "status" not in res.ds.data_vars:
+        raise ParameterError(f"{str(path)!r} is not a gearchaos sweep store (no 'status')")
+    return res
+
+
+StoreArg = Annotated[
+    Path,
+    typer.Argument(help="Sweep store written by `gearchaos bifurcation`.", show_default=False),
+]
+
+@c.app.command()
+def bifurcation(
+    output: Annotated[
+        Path,
+        typer.Option(
+            "--output",
+            "-o",
+            help=(
+                "Zarr store to write (a directory, e.g. run.zarr). Written chunk by chunk; run "
+                "the same command again after an interruption to resume."
+            ),
+            show_default=False,
+        ),
+    ],
+    vary: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--vary",
+            "-v",
+            help=(
+                "NAME=VALUES, once (bifurcation diagram) or twice (2-D map): VALUES is "
+                "start:stop:count, log:start:stop:count or a,b,c; NAME is omega, xi or a "
+                "dotted gear-set parameter, e.g. omega=0.05:4:800, backlash.planet_ring=1:16:300."
+            ),
+            show_default=False,
+        ),
+    ] = None,
+    family: Annotated[
+        str | None,
+        typer.Option(
+            "--family",
+            "-f",
+            help="NAME=VALUES: one diagram per value, e.g. xi=0.03,0.05,0.07,0.09.",
+            show_default=False,
+        ),
+    ] = None,
+    preset: c.PresetOpt = None,
+    gearset: c.GearsetOpt = None,
+    set_: c.SetOpt = None,
+    observe: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--observe",
+            help=(
+                "Variable stored at every section point, repeatable: delta_sp, delta_sp_dot, "
+                "delta_rp, delta_rp_dot, x_s, y_s, ... Default: delta_sp and delta_sp_dot."
+            ),
+            show_default=False,
+        ),
+    ] = None,
+    planets: Annotated[
+        str | None,
+        typer.Option(
+            "--planets", help="Observed planets, comma-separated (default 1).", show_default=False
+        ),
+    ] = None,
+    ic: Annotated[
+        str,
+        typer.Option(
+            "--ic",
+            help=(
+                "Initial conditions: fresh (zero state at every point, the seed's protocol) or "
+                "continuation (each point starts from the previous point's final state)."
+            ),
+        ),
+    ] = "fresh",
+    direction: Annotated[
+        str,
+        typer.Option(
+            "--direction",
+            help="up, down or both (continuation only; both overlays the branches).",
+        ),
+    ] = "up",
+    transient: c.TransientOpt = 100.0,
+    periods: Annotated[
+        int,
+        typer.Option("--periods", help="Mesh periods recorded at every point (section points)."),
+    ] = 100,
+    rtol: c.RtolOpt = 1e-8,
+    atol: c.AtolOpt = 1e-10,
+    workers: c.WorkersOpt = None,
+    scheduler: Annotated[
+        str | None,
+        typer.Option(
+            "--scheduler",
+            help="Address of a running dask.distributed scheduler, e.g. tcp://HOST:8786.",
+            show_default=False,
+        ),
+    ] = None,
+    dask_local: Annotated[
+        int | None,
+        typer.Option(
+            "--dask-local",
+            help="Start a local Dask cluster with N workers on this machine.",
+            show_default=False,
+        ),
+    ] = None,
+    overwrite: c.OverwriteOpt = False,
+    lyapunov: Annotated[
+        bool,
+        typer.Option(
+            "--lyapunov",
+            help=(
+                "Also store the largest Lyapunov exponent lle of every point; the motion "
+                "labels then tell quasi-periodic from chaotic motion by it."
+            ),
+        ),
+    ] = False,
+    quiet: c.QuietOpt = False,
+    json_out: c.JsonOpt = False,
+) -> None:
+    """Sweep one or two parameters and store the Poincaré section values of every point.
+
+    Every grid point is one simulation with the seed's protocol (MODEL.md §8): TRANSIENT mesh
+    periods discarded, PERIODS recorded with one section point each. The store (Zarr, opened
+    by xarray.open_zarr or gearchaos.open_sweep) holds the section values, status and step
+    counts per point and the full gear set and settings, and labels every point (motion 1T …
+    nT, QP, chaos, unresolved, failed; the regime table is printed at the end). Ω is a
+    parameter like any other: sweep it with **--vary omega=...**, or fix it with
+    **--set omega=...**; when it is neither swept nor set, Ω = **1.5**. Draw the result with
+    **gearchaos plot STORE -o fig.png**.
+
+    Example (the seed's Fig. 4): **gearchaos bifurcation --vary omega=0.05:4:800
+    --family xi=0.03,0.05,0.07,0.09 -o fig4.zarr**
+    """
+    from ..model.target import DEFAULT_OMEGA
+
+    with c.reported_errors(), c.interruptible():
+        if not vary:
+            raise ParameterError(
+                "--vary is required: give NAME=VALUES once (e.g. --vary omega=0.1:4:800) "
+                "or twice for a 2-D map"
+            )
+        if len(vary) > 2:
+            raise ParameterError(
+                f"--vary may be given once or twice (two make a 2-D map): got {len(vary)}"
+            )
+        if ic not in ("fresh", "continuation"):
+            raise ParameterError(f"--ic must be fresh or continuation: got {ic!r}")
+        if direction not in ("up", "down", "both"):
+            raise ParameterError(f"--direction must be up, down or both: got {direction!r}")
+        if direction != "up" and ic != "continuation":
+            raise ParameterError(
+                f"--direction {direction} needs --ic continuation "
+                "(fresh starts do not depend on the sweep direction)"
+            )
+        settings = c.solver_settings(transient, periods, rtol, atol)
+        omega, changes = c.parse_sets(set_ or [])
+        gs = c.load_gearset(preset, gearset)
+        swept = {_axis_name(v) for v in vary} | ({_axis_name(family)} if family else set())
+        fixed: dict[str, Any] = dict(changes)
+        for name in swept & set(fixed):
+            raise ParameterError(f"{name} is both swept and set with --set; choose one")
+        if "omega" not in swept:
+            if omega is None:
+                omega = DEFAULT_OMEGA
+                c.default_omega_note(quiet or json_out)
+            fixed["omega"] = omega
+        elif omega is not None:
+            raise ParameterError("omega is both swept and set with --set; choose one")
+
+        from .. import sweep
+
+        t0 = time.perf_counter()
+        ds = sweep.bifurcation(
+            gs,
+            list(vary),
+            family=family,
+            fixed=fixed,
+            observe=tuple(observe) if observe else None,
+            planets=_parse_planets(planets),
+            initial_conditions=ic,
+            direction=direction,
+            lyapunov=lyapunov,
+            solver=settings,
+            store=output,
+            overwrite=overwrite,
+            workers=workers,
+            scheduler=scheduler,
+            dask_local=dask_local,
+            progress=not quiet,
+        )
+        seconds = time.perf_counter() - t0
+        res = sweep.SweepResult.of(ds)
+        points, failed = int(res.status().size), res.n_failed
+
+    result = {"store": str(output), "points": points, "failed": failed, "seconds": seconds}
+    if json_out:
+        c.print_json(result)
+        return
+    if quiet:
+        return
+    table = pairs_table(f"gearchaos bifurcation of {gs.name}")
+    table.add_row("grid", escape(" × ".join(f"{d} ({res.ds.sizes[d]})" for d in res.lead_dims)))
+    table.add_row("points", str(points))
+    table.add_row("failed", Text(str(failed), style="bold red" if failed else ""))
+    table.add_row("seconds", f"{seconds:.3g}")
+    if seconds > 0:
+        table.add_row("points/s", f"{points / seconds:.3g}")
+    table.add_row("store", escape(str(output)))
+    out = c.stdout()
+    out.print(table)
+    out.print(
+        Text(
+            f"{transient:g} transient + {periods} recorded mesh periods, {ic} initial "
+            f"conditions, rtol {rtol:g}, atol {atol:g}"
+            + (", largest Lyapunov exponents" if lyapunov else ""),
+            style="dim",
+        )
+    )
+    regimes = res.regime_table()
+    if regimes:
+        out.print(regime_table(regimes, title="motion regimes (fraction of the swept points)"))
+    out.print(Text(f"next: gearchaos plot {output} -o {output.stem}.png", style="dim"))
+
+
+@c.app.command()
+def plot(
+    store: StoreArg,
+    output: Annotated[
+        Path,
+        typer.Option("--output", "-o", help="Figure file: .png, .pdf or .svg.", show_default=False),
+    ],
+    var: Annotated[
+        str,
+        typer.Option(
+            "--var", help="Section variable: delta_sp (X̄_sp), delta_sp_dot, delta_rp, x_s, ..."
+        ),
+    ] = "delta_sp",
+    planet: Annotated[int, typer.Option("--planet", help="Planet of per-planet variables.")] = 1,
+    clearance: Annotated[
+        bool,
+        typer.Option("--clearance-lines", help="Dashed lines at ±b̄ of the variable's clearance."),
+    ] = False,
+    resonances: Annotated[
+        bool,
+        typer.Option(
+            "--resonances",
+            help="Vertical lines where the 1st–3rd mesh harmonic meets a natural frequency "
+            "(Ω sweeps).",
+        ),
+    ] = False,
+    branch: Annotated[
+        list[Path] | None,
+        typer.Option(
+            "--branch",
+            help="Branch file of `gearchaos continue`, repeatable: drawn over the diagrams of its "
+            "parameter (stable solid, unstable dashed, events marked and named).",
+            show_default=False,
+        ),
+    ] = None,
+) -> None:
+    """Draw a sweep store: bifurcation diagrams (one panel per family value, with a band of
+    motion labels under each) for a 1-D sweep, maps coloured by motion label (1T, 2T, …, QP,
+    chaos) for a 2-D sweep.
+
+    Example: **gearchaos plot fig4.zarr -o fig4.png --clearance-lines**
+    """
+    from ..plot.figure import SAVE_FORMATS
+
+    with c.reported_errors():
+        if output.suffix.lower() not in SAVE_FORMATS:
+            raise ParameterError(
+                f"--output must end in one of {', '.join(SAVE_FORMATS)}: got {str(output)!r}"
+            )
+        res = open_store(store)
+        import matplotlib
+
+        matplotlib.use("Agg")
+        from ..analysis.branch import open_branch
+        from ..plot import savefig, sweep_figure
+
+        branches = [open_branch(b) for b in branch or []]
+        fig = sweep_figure(
+            res,
+            var=var,
+            planet=planet,
+            clearance_lines=clearance,
+            resonances=resonances,
+            branches=branches,
+        )
+        if output.parent != Path(""):
+            output.parent.mkdir(parents=True, exist_ok=True)
+        savefig(fig, output)
+    c.wrote(output)
+
+
+@c.app.command()
+def classify(
+    store: StoreArg,
+    period_rtol: Annotated[
+        float | None,
+        typer.Option(
+            "--period-rtol",
+            help=(
+                "Tolerance of period detection, relative to the attractor's size: section "
+                "points closer than this repeat. [default: 1e-3]"
+            ),
+            show_default=False,
+        ),
+    ] = None,
+    rtol: Annotated[
+        float | None,
+        typer.Option("--rtol", hidden=True, help="Deprecated name of --period-rtol."),
+    ] = None,
+    max_period: Annotated[
+        int, typer.Option("--max-period", help="Longest period n recognised as nT.")
+    ] = 64,
+    json_out: c.JsonOpt = False,
+) -> None:
+    """(Re)label every point of a sweep store without re-simulating: 1T … nT (period of the
+    stored section sequence), QP or chaos (by the stored largest Lyapunov exponent when the
+    sweep ran with --lyapunov, confirmed by the 0–1 test and the spectrum), unresolved, failed.
+
+    Rewrites the store's motion, period, k01 and indicators_agree variables and its
+    regime_table attribute, and prints the regime table: the fraction of the swept points in
+    each regime, per family value. **--json** prints that table as a dictionary
+    (family value → regime → fraction).
+
+    Example: **gearchaos classify fig4.zarr --period-rtol 1e-4**
+    """
+    with c.reported_errors():
+        option, tol = "--period-rtol", period_rtol
+        if rtol is not None:
+            if period_rtol is not None:
+                raise ParameterError("give --period-rtol only (--rtol is its deprecated name)")
+            c.warn(
+                "classify --rtol is deprecated: it is the period tolerance, not the "
+                "integrator's rtol; use --period-rtol"
+            )
+            option, tol = "--rtol", rtol
+        tol = 1e-3 if tol is None else tol
+        if not (math.isfinite(tol) and 0.0 < tol < 1.0):
+            raise ParameterError(f"{option} must be a number in (0, 1): got {tol!r}")
+        if max_period < 1:
+            raise ParameterError(f"--max-period must be an integer >= 1: got {max_period!r}")
+        open_store(store)
+        from ..sweep import classify_store
+
+        table = classify_store(store, period_rtol=tol, max_period=max_period)
+    if json_out:
+        c.print_json(table)
+        return
+    out = c.stdout()
+    out.print(regime_table(table, title=f"motion regimes of {store} (fraction of the points)"))
+    out.print(
+        Text(
+            f"period tolerance {tol:g} of the attractor size, periods up to {max_period}",
+            style="dim",
+        )
+    )

@@ -1,0 +1,257 @@
+"""Maps of 2-D sweeps and the figure of any sweep.
+
+* :func:`distinct_counts` / :func:`distinct_map` — a 2-D sweep coloured by the number of
+  distinct section points of every grid point (1T, 2T, …, many);
+* :func:`sweep_figure` — whichever figure fits the dataset: bifurcation diagrams for a 1-D
+  sweep (:func:`~gearchaos.plot.bifurcation.bifurcation_figure`), one regime map
+  (:func:`~gearchaos.plot.regimes.regime_map`) or distinct-point map per family value and
+  direction for a 2-D sweep.
+"""
+
+from __future__ import annotations
+
+import string
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError, Status
+from ..sweep.result import SweepResult
+from ._common import (
+    axis_label,
+    axis_symbol,
+    corner_note,
+    edges,
+    fmt,
+    get_ax,
+    no_offset,
+    resonance_lines,
+    var_symbol,
+)
+from .bifurcation import _planet_sel, bifurcation_figure, panel_grid, resolve_var, suptitle
+from .regimes import regime_categories, regime_legend, regime_map
+
+__all__ = ["distinct_counts", "distinct_map", "sweep_figure"]
+
+_FAILED_COLOUR = "0.7"
+_MANY_COLOUR = "0.1"
+_NOT_RUN = int(Status.NOT_RUN)
+
+
+def distinct_counts(
+    ds: Any,
+    *,
+    var: str | None = "delta_sp",
+    planet: int = 1,
+    max_count: int = 16,
+    tol: float = 1e-3,
+) -> Any:
+    """Number of distinct section points of every sweep point (a DataArray over the leading
+    dimensions): n for an nT-periodic response, ``max_count + 1`` for "many", 0 for a failed
+    point (non-zero status or no finite section value), −1 for a point not run yet (an
+    interrupted store).
+
+    Counts the pairs (X̄_k, X̄'_k) when the dataset holds ``<var>_dot`` (else X̄_k alone) with
+    :func:`gearchaos.analysis.poincare.count_distinct` and its relative tolerance ``tol``.
+    A period is recognised only when the record shows it at least twice: n > 1 distinct points
+    among fewer than 2n recorded ones count as "many" (with 10 recorded periods, 10 distinct
+    points may be 10T or chaos — record more periods to tell).
+    """
+    import xarray as xr
+
+    from ..analysis.poincare import count_distinct
+
+    res = SweepResult.of(ds)
+    ds = res.ds
+    var = resolve_var(ds, var)
+    if not (isinstance(max_count, int | np.integer) and max_count >= 1):
+        raise ParameterError(f"max_count must be an integer >= 1: got {max_count!r}")
+    lead = tuple(d for d in res.lead_dims if d in ds[var].dims)
+    cols = [_planet_sel(ds[var], planet).transpose(*lead, "section")]
+    dot = f"{var}_dot"
+    if dot in ds.data_vars and "section" in ds[dot].dims:
+        cols.append(_planet_sel(ds[dot], planet).transpose(*lead, "section"))
+    pts = np.stack([np.asarray(c.values, dtype=np.float64) for c in cols], axis=-1)
+    shape = pts.shape[:-2]
+    flat = pts.reshape(-1, pts.shape[-2], pts.shape[-1])
+    status = (
+        np.asarray(ds["status"].transpose(*lead).values).ravel()
+        if "status" in ds.data_vars
+        else np.zeros(flat.shape[0], dtype=np.int64)
+    )
+    counts = np.where(status == _NOT_RUN, -1, 0).astype(np.int64)
+    many = int(max_count) + 1
+    for i in np.flatnonzero(status == 0):
+        n = count_distinct(flat[i], tol=tol, max_count=int(max_count))
+        n_finite = int(np.sum(np.all(np.isfinite(flat[i]), axis=1)))
+        # an nT orbit is recognised only when the record shows it at least twice
+        counts[i] = many if n > 1 and 2 * n > n_finite else n
+    coords = {d: ds[d] for d in lead if d in ds.coords}
+    return xr.DataArray(
+        counts.reshape(shape),
+        dims=lead,
+        coords=coords,
+        name="distinct_points",
+        attrs={"max_count": int(max_count), "tol": float(tol), "var": var},
+    )
+
+
+def _category_colours(max_count: int) -> list[Any]:
+    from matplotlib import colormaps
+
+    tab = [tuple(c) for c in colormaps["tab20"](np.arange(20))]
+    # the tab20 pairs, strong colours first, greys (indices 14, 15) left out
+    order = [0, 2, 4, 6, 8, 10, 12, 16, 18, 1, 3, 5, 7, 9, 11, 13, 17, 19]
+    palette = [tab[i] for i in order]
+    if max_count > len(palette):
+        extra = colormaps["viridis"](np.linspace(0, 1, max_count - len(palette)))
+        palette += [tuple(c) for c in extra]
+    return [_FAILED_COLOUR, *palette[:max_count], _MANY_COLOUR]
+
+
+def distinct_map(
+    ds: Any,
+    ax: Any = None,
+    *,
+    var: str | None = "delta_sp",
+    planet: int = 1,
+    max_count: int = 16,
+    select: Mapping[str, Any] | None = None,
+    resonances: bool = False,
+    colorbar: bool = True,
+) -> Any:
+    """Map of a 2-D sweep coloured by the number of distinct section points.
+
+    Every grid point is one cell coloured by the count of :func:`distinct_counts`: the
+    categories 1, 2, … , ``max_count`` (1T, 2T, … periodic motion), "many" (quasi-periodic
+    or chaotic, more than ``max_count`` points) and "failed" (grey: non-zero status). The
+    first varied parameter is on x, the second on y; a family or direction dimension must be
+    fixed with ``select``. A labelled colour bar names the categories; with ``resonances``
+    and Ω on x, vertical lines mark where a mesh harmonic meets a natural frequency.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    from matplotlib.colors import BoundaryNorm, ListedColormap
+
+    res = SweepResult.of(ds).select(select)
+    sub = res.ds
+    var = resolve_var(sub, var)
+    xname, yname = res.grid_axes("distinct_map", var)
+    counts = distinct_counts(res, var=var, planet=planet, max_count=max_count)
+    c = np.ma.masked_less(np.asarray(counts.transpose(yname, xname).values), 0)
+    x = np.asarray(sub[xname].values, dtype=np.float64)
+    y = np.asarray(sub[yname].values, dtype=np.float64)
+    colours = _category_colours(int(max_count))
+    cmap = ListedColormap(colours)
+    norm = BoundaryNorm(np.arange(-0.5, max_count + 2.0, 1.0), cmap.N)
+    ax = get_ax(ax)
+    mesh = ax.pcolormesh(edges(x), edges(y), c, cmap=cmap, norm=norm, rasterized=True)
+    ax.set_xlabel(axis_label(xname))
+    ax.set_ylabel(axis_label(yname))
+    if resonances and xname == "omega" and x.size:
+        resonance_lines(ax, res.gearset, float(np.min(x)), float(np.max(x)))
+    n_missing = int(np.ma.count_masked(c))
+    if n_missing:
+        corner_note(ax, f"{n_missing} of {c.size} points not run yet (blank)")
+    if colorbar:
+        fig = ax.figure
+        cb = fig.colorbar(mesh, ax=ax, ticks=np.arange(0, max_count + 2))
+        labels = ["failed", *(f"{n}T" for n in range(1, max_count + 1)), "many"]
+        cb.ax.set_yticklabels(labels, fontsize="x-small")
+        sym = var_symbol(var, planet if "planet" in sub[var].dims else None)
+        cb.set_label(f"distinct section points of ${sym}$")
+    no_offset(ax.xaxis, ax.yaxis)
+    return ax
+
+
+# --------------------------------------------------------------------------- sweep_figure
+def sweep_figure(
+    ds: Any,
+    *,
+    var: str | None = "delta_sp",
+    planet: int = 1,
+    clearance_lines: bool = False,
+    resonances: bool = False,
+    max_count: int = 16,
+    regimes: bool | None = None,
+    figsize: tuple[float, float] | None = None,
+    branches: Sequence[Any] = (),
+) -> Any:
+    """The figure of a sweep: :func:`bifurcation_figure` for a 1-D sweep, one map per family
+    value (and per direction) for a 2-D sweep.
+
+    With ``regimes`` (default: when the dataset has ``motion`` labels) 1-D sweeps get regime
+    bands under their panels and 2-D sweeps are drawn as regime maps
+    (:func:`~gearchaos.plot.regimes.regime_map`, one categorical legend for the figure);
+    without, 2-D sweeps are :func:`distinct_map` s. ``clearance_lines`` applies to bifurcation
+    diagrams only; ``max_count`` to distinct-point maps only; ``branches`` (continued branches
+    of periodic orbits, drawn over the diagrams of their parameter) to 1-D sweeps only.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from matplotlib.figure import Figure
+
+    res = SweepResult.of(ds)
+    ds = res.ds
+    var = resolve_var(ds, var)
+    lay = res.layout(var)
+    if len(lay.vary) == 1:
+        return bifurcation_figure(
+            res,
+            var=var,
+            planet=planet,
+            clearance_lines=clearance_lines,
+            resonances=resonances,
+            regimes=regimes,
+            figsize=figsize,
+            branches=branches,
+        )
+    if regimes is None:
+        regimes = "motion" in ds.data_vars
+    selects: list[dict[str, Any]] = [{}]
+    if lay.directions:
+        selects = [{"direction": d} for d in lay.directions]
+    if lay.family:
+        selects = [{**s, lay.family: v} for s in selects for v in np.asarray(ds[lay.family].values)]
+    nrows, ncols = panel_grid(len(selects))
+    if figsize is None:
+        figsize = (6.5 * ncols, 4.5 * nrows + 0.8)
+    fig = Figure(figsize=figsize, layout="constrained")
+    axs = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False)).ravel()
+    for k, sel in enumerate(selects):
+        if regimes:
+            ax = regime_map(res, axs[k], select=sel or None, legend=False, resonances=resonances)
+        else:
+            ax = distinct_map(
+                res,
+                axs[k],
+                var=var,
+                planet=planet,
+                max_count=max_count,
+                select=sel or None,
+                resonances=resonances,
+            )
+        if sel:
+            parts = [
+                f"{axis_symbol(d)} = {fmt(v)}" if d != "direction" else str(v)
+                for d, v in sel.items()
+            ]
+            prefix = f"({string.ascii_lowercase[k % 26]}) " if len(selects) > 1 else ""
+            ax.set_title(prefix + ", ".join(parts), loc="left")
+    for ax in axs[len(selects) :]:
+        ax.set_visible(False)
+    if regimes:
+        regime_legend(
+            fig,
+            np.asarray(regime_categories(res).values, dtype=object).ravel(),
+            loc="outside right upper",
+        )
+        fig.suptitle(suptitle(res, "motion regimes"), fontsize="medium")
+    else:
+        fig.suptitle(suptitle(res, "distinct Poincaré points"), fontsize="medium")
+    return fig

@@ -1,0 +1,248 @@
+"""Physical units beside the dimensionless ones, and axes that follow the data.
+
+Every dimensionless quantity of the model has a physical counterpart fixed by the gear set
+(MODEL.md §7): lengths x = b_c x̄, velocities ẋ = b_c ω_n x̄', forces F = k_m,sp b_c F̄, time
+t = τ/ω_n, the mesh frequency f_m = Ω ω_n/2π and the sun speed n_s = 60 f_m (z_s + z_r)/(z_s z_r).
+:class:`PhysicalScales` holds these factors (from a simulation or a sweep store) and
+:func:`secondary_axis` adds the physical axis opposite the dimensionless one. :func:`fit_to_data`
+sets limits from the data alone (clearance lines never widen them), :func:`clearance_notes`
+marks the clearances that fall outside, and :func:`section_style` sizes Poincaré points so that
+structure shows for a hundred and for ten thousand points.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+__all__ = [
+    "CLEARANCE_NOTE_GID",
+    "PhysicalScales",
+    "clearance_notes",
+    "fit_to_data",
+    "linear_axis",
+    "notes_clear_of",
+    "secondary_axis",
+    "section_style",
+    "var_quantity",
+]
+
+#: ``gid`` of the edge notes of clearances outside the data range.
+CLEARANCE_NOTE_GID = "clearance-note"
+#: Margin around the data range, as a fraction of it.
+MARGIN = 0.05
+
+
+@dataclass(frozen=True)
+class PhysicalScales:
+    """Factors from dimensionless to physical values (``None`` where not defined)."""
+
+    length_m: float | None = None  # b_c
+    omega_n: float | None = None  # rad/s
+    force_n: float | None = None  # k_m,sp b_c
+    rpm_per_omega: float | None = None  # sun speed [rpm] per unit Ω
+
+    @classmethod
+    def of_model(cls, model: Any) -> PhysicalScales:
+        """The scales of a planetary model (none for reference systems)."""
+        sc = getattr(model, "scales", None)
+        if sc is None:
+            return cls()
+        gs = getattr(model, "gearset", None)
+        rpm = gs.sun_speed_rpm(1.0) if gs is not None else None
+        return cls(float(sc.length), float(sc.omega_n), float(sc.force), rpm)
+
+    @classmethod
+    def of_result(cls, result: Any) -> PhysicalScales:
+        return cls.of_model(result.system.model)
+
+    @classmethod
+    def of_sweep(cls, res: Any) -> PhysicalScales:
+        """From a :class:`~gearchaos.sweep.SweepResult`: its gear set with the fixed values."""
+        gs = res.gearset
+        if gs is None:
+            return cls()
+        from ..model.planetary import PlanetaryModel
+
+        return cls.of_model(PlanetaryModel.from_gearset(gs))
+
+    def factor(self, quantity: str) -> tuple[float, str] | None:
+        """(factor, axis label) of a quantity: ``length`` (µm), ``velocity`` (mm/s),
+        ``force`` (N), ``omega`` (sun speed, rpm), ``mesh_hz`` (Hz per Ω), ``time``
+        (ms per mesh period of Ω = 1 — use :meth:`period_ms` for a given Ω)."""
+        if quantity == "length" and self.length_m:
+            return self.length_m * 1e6, "[µm]"
+        if quantity == "velocity" and self.length_m and self.omega_n:
+            return self.length_m * self.omega_n * 1e3, "[mm/s]"
+        if quantity == "force" and self.force_n:
+            return self.force_n, "[N]"
+        if quantity == "omega" and self.rpm_per_omega:
+            return self.rpm_per_omega, "sun speed [rpm]"
+        if quantity == "mesh_hz" and self.omega_n:
+            return self.omega_n / (2.0 * math.pi), "[Hz]"
+        return None
+
+    def period_ms(self, omega: float) -> float | None:
+        """One forcing (mesh) period at Ω in milliseconds: 2π/(Ω ω_n)."""
+        return 2e3 * math.pi / (omega * self.omega_n) if self.omega_n else None
+
+
+def var_quantity(var: str) -> str | None:
+    """The physical quantity of a section variable: ``delta_sp`` → ``length``,
+    ``delta_sp_dot`` → ``velocity``, ``force_rp`` → ``force``; ``None`` otherwise."""
+    import re
+
+    var = re.sub(r"_\d+(_dot)?$", lambda m: m.group(1) or "", var)  # delta_sp_1_dot → …_dot
+    var = re.sub(r"_\d+$", "", var)
+    base = var[:-4] if var.endswith("_dot") else var
+    kind = "velocity" if var.endswith("_dot") else "length"
+    if base.startswith("force_"):
+        return None if var.endswith("_dot") else "force"
+    if base in ("delta_sp", "delta_rp", "x_s", "y_s", "p", "sigma"):
+        return kind
+    return None
+
+
+def secondary_axis(
+    ax: Any, axis: str, quantity: str | None, scales: PhysicalScales, *, symbol: str = ""
+) -> Any:
+    """The physical axis opposite a dimensionless one (top for x, right for y), linear in
+    it; nothing when the scales do not define the quantity. Returns the secondary axis."""
+    if quantity is None:
+        return None
+    found = scales.factor(quantity)
+    if found is None:
+        return None
+    return linear_axis(ax, axis, found[0], f"{symbol} {found[1]}".strip())
+
+
+def linear_axis(ax: Any, axis: str, k: float, label: str) -> Any:
+    """A secondary axis (top for x, right for y) showing ``k`` times the primary values."""
+
+    def forward(v: Any) -> Any:
+        return np.asarray(v) * k
+
+    def inverse(v: Any) -> Any:
+        return np.asarray(v) / k
+
+    if axis == "x":
+        sec = ax.secondary_xaxis("top", functions=(forward, inverse))
+        sec.set_xlabel(label, fontsize="small")
+    else:
+        sec = ax.secondary_yaxis("right", functions=(forward, inverse))
+        sec.set_ylabel(label, fontsize="small")
+    sec.tick_params(labelsize="small")
+    return sec
+
+
+def data_range(
+    values: Any, *, margin: float = MARGIN, mag: float | None = None
+) -> tuple[float, float] | None:
+    """[lo, hi] of the finite values widened by ``margin`` of their span. A span below 10⁻³ of
+    the largest magnitude (``mag``, default the values') shows ±5 % of that magnitude around
+    the centre (±1 around zero): a periodic point spread by integration noise stays a point."""
+    v = np.asarray(values, dtype=np.float64).ravel()
+    v = v[np.isfinite(v)]
+    if v.size == 0:
+        return None
+    lo, hi = float(v.min()), float(v.max())
+    m = float(np.max(np.abs(v))) if mag is None else mag
+    if hi - lo <= 1e-3 * m or m == 0.0:
+        centre = 0.5 * (lo + hi)
+        half = 0.05 * m if m > 0 else 1.0
+        return centre - half, centre + half
+    pad = margin * (hi - lo)
+    return lo - pad, hi + pad
+
+
+def fit_to_data(ax: Any, x: Any = None, y: Any = None, *, joint: bool = False) -> None:
+    """Set the limits of ``ax`` from the data (``x``, ``y``; either may be ``None`` to keep an
+    axis as it is), ignoring clearance and reference lines; turn axis offsets off. With
+    ``joint`` the degenerate-span test uses the larger magnitude of both (x–x' planes)."""
+    mag = None
+    if joint and x is not None and y is not None:
+        both = np.concatenate([np.ravel(np.asarray(x, float)), np.ravel(np.asarray(y, float))])
+        both = both[np.isfinite(both)]
+        mag = float(np.max(np.abs(both))) if both.size else None
+    for data, setter, axis in ((x, ax.set_xlim, ax.xaxis), (y, ax.set_ylim, ax.yaxis)):
+        if data is not None and axis.get_scale() == "linear":
+            found = data_range(data, mag=mag)
+            if found is not None:
+                setter(*found)
+        formatter = axis.get_major_formatter()
+        if hasattr(formatter, "set_useOffset"):
+            formatter.set_useOffset(False)
+
+
+def clearance_notes(
+    ax: Any, axis: str, values: Any, symbol: str, text: str | None = None
+) -> list[Any]:
+    """Mark the clearance levels of ``values`` (scalars) that lie outside the limits of
+    ``axis`` with a small note at that edge (``−b̄_sp = −3 ↓``, or ``text`` for every level;
+    levels beyond the same edge share one note); returns the notes."""
+    lo, hi = ax.get_ylim() if axis == "y" else ax.get_xlim()
+    edges: dict[bool, list[str]] = {True: [], False: []}  # below/left → texts
+    for v in sorted({float(v) for v in np.ravel(values) if np.isfinite(v)}):
+        if lo <= v <= hi:
+            continue
+        sign = "−" if v < 0 else "+"
+        edges[v < lo].append(text or f"{sign}${symbol}$ = {v:g}".replace("-", "−"))
+    notes = []
+    for below, texts in edges.items():
+        if not texts:
+            continue
+        text = ", ".join(texts)
+        if axis == "y":
+            xy, ha, va = (
+                ((0.99, 0.01), "right", "bottom") if below else ((0.99, 0.99), "right", "top")
+            )
+            text += " ↓" if below else " ↑"
+        else:
+            xy, ha, va = (
+                ((0.01, 0.5), "left", "center") if below else ((0.99, 0.5), "right", "center")
+            )
+            text = ("← " + text) if below else (text + " →")
+        notes.append(
+            ax.text(
+                *xy,
+                text,
+                transform=ax.transAxes,
+                ha=ha,
+                va=va,
+                fontsize="small",
+                color="0.2",
+                gid=CLEARANCE_NOTE_GID,
+                bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "none", "alpha": 0.8},
+                rotation=90 if axis == "x" else 0,
+            )
+        )
+    return notes
+
+
+def notes_clear_of(ax: Any, legend: Any) -> None:
+    """Move the clearance notes of ``ax`` that the legend covers to the opposite side."""
+    if legend is None:
+        return
+    box = legend.get_window_extent()
+    for note in ax.texts:
+        if note.get_gid() != CLEARANCE_NOTE_GID or not note.get_window_extent().overlaps(box):
+            continue
+        x, y = note.get_position()
+        if note.get_rotation() == 0:  # a note at the top or bottom edge: to the other corner
+            note.set_position((1.0 - x, y))
+            note.set_horizontalalignment("left" if x > 0.5 else "right")
+        else:  # a note at a side edge: up or down
+            note.set_position((x, 0.05 if y >= 0.5 else 0.95))
+            note.set_verticalalignment("bottom" if y >= 0.5 else "top")
+
+
+def section_style(n: int) -> dict[str, float]:
+    """Marker area (points²) and alpha of n Poincaré points: bold dots for a few, fine
+    translucent ones for many, so that a 10 000-point chaotic attractor shows its folds."""
+    n = max(int(n), 1)
+    s = float(np.clip(60.0 / math.sqrt(n), 0.25, 16.0))
+    alpha = float(np.clip((300.0 / n) ** 0.35, 0.3, 1.0))
+    return {"s": s, "alpha": alpha}

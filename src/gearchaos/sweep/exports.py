@@ -1,0 +1,184 @@
+"""Export of results to the formats other tools read: a tidy CSV table and a MATLAB file.
+
+:func:`export` takes a sweep store (``RUN.zarr``), a simulation file (``simulation.nc``) or an
+open :class:`xarray.Dataset` of either kind and writes
+
+* ``csv`` — one row per point and section sample (a tidy table): the swept parameters, the
+  section index (and ``tau`` for a simulation), the planet where a variable is per planet, then
+  one column per variable; per-point variables (``status``, ``motion``, ``lle`` …) repeat on the
+  rows of their point. A header of ``#`` lines carries the provenance (gear set name, settings,
+  versions), which ``pandas.read_csv(..., comment="#")`` skips.
+* ``mat`` — every variable and coordinate as a MATLAB array (``scipy.io.savemat``, format 5),
+  names with ``.`` turned into ``_`` (``backlash.sun_planet`` → ``backlash_sun_planet``), the
+  dimension names of each variable in ``dims_<name>`` and the attributes in the struct
+  ``attrs``; label arrays become cell arrays of strings.
+
+The write is atomic (a temporary file renamed into place).
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError, StoreError
+
+__all__ = ["FORMATS", "export", "open_result", "table"]
+
+#: The formats :func:`export` writes.
+FORMATS = ("csv", "mat")
+
+#: Attributes written into the CSV header (when present).
+_HEADER_ATTRS = (
+    "title",
+    "model",
+    "omega",
+    "transient_periods",
+    "periods",
+    "samples_per_period",
+    "rtol",
+    "atol",
+    "initial_conditions",
+    "status",
+    "version",
+    "numba_version",
+    "numpy_version",
+)
+
+
+def open_result(source: Any) -> Any:
+    """A dataset from a sweep store, a simulation file or a dataset (returned as it is)."""
+    import xarray as xr
+
+    if isinstance(source, xr.Dataset):
+        return source
+    if hasattr(source, "to_dataset"):  # a SimulationResult, or a SweepResult's dataset
+        return source.to_dataset()
+    if hasattr(source, "ds") and isinstance(source.ds, xr.Dataset):
+        return source.ds
+    if not isinstance(source, str | os.PathLike) or not os.fspath(source):
+        raise ParameterError(
+            f"source must be a sweep store, a simulation file or a Dataset: got {source!r}"
+        )
+    path = os.fspath(source)
+    if os.path.isdir(path):
+        from .store import open_sweep
+
+        return open_sweep(path).load()
+    if not os.path.exists(path):
+        raise StoreError(f"no result at {path!r} (no such file or directory)")
+    from ..integrate.result import open_simulation
+
+    try:
+        return open_simulation(path)
+    except Exception as exc:  # h5netcdf / h5py raise many types for a file that is no netCDF
+        raise StoreError(
+            f"{path!r} is neither a sweep store nor a simulation file ({type(exc).__name__})"
+        ) from None
+
+
+def _is_sweep(ds: Any) -> bool:
+    return "status" in ds.data_vars and "section" in ds.dims and "tau" not in ds.coords
+
+
+def table(source: Any) -> Any:
+    """The tidy table of a result as a :class:`pandas.DataFrame` (see the module docstring)."""
+    ds = open_result(source)
+    if "section" not in ds.dims:
+        raise StoreError("the result has no section dimension: nothing to tabulate")
+    lead = [str(d) for d in ds["status"].dims] if _is_sweep(ds) else []
+    keep_dims = {*lead, "section", "planet"}
+    names = [
+        str(n)
+        for n, v in ds.data_vars.items()
+        if set(v.dims) <= keep_dims and (set(v.dims) & ({"section"} | set(lead)))
+    ]
+    if not names:
+        raise StoreError("the result has no variables over its points and sections")
+    sub = ds[names]
+    df = sub.to_dataframe().reset_index()
+    order = [*lead, "section", *(["tau"] if "tau" in df.columns else [])]
+    order += [c for c in ("planet",) if c in df.columns]
+    return df[[*order, *(c for c in df.columns if c not in order)]]
+
+
+def _mat_name(name: str) -> str:
+    out = re.sub(r"[^A-Za-z0-9_]", "_", name)
+    return out if out[:1].isalpha() else f"v_{out}"
+
+
+def _mat_value(values: np.ndarray) -> Any:
+    if values.dtype.kind in "US":
+        return np.array(values.astype(str), dtype=object)
+    if values.dtype.kind == "b":
+        return values.astype(np.uint8)
+    return values
+
+
+def _write_mat(ds: Any, path: str) -> None:
+    from scipy.io import savemat
+
+    data: dict[str, Any] = {}
+    for name in [*ds.coords, *ds.data_vars]:
+        v = ds[name]
+        key = _mat_name(str(name))
+        data[key] = _mat_value(np.asarray(v.values))
+        data[f"dims_{key}"] = np.array([str(d) for d in v.dims], dtype=object)
+    attrs = {}
+    for k, v in ds.attrs.items():
+        if isinstance(v, bool | int | float | str | np.number):
+            attrs[_mat_name(str(k))] = v
+        else:
+            attrs[_mat_name(str(k))] = str(v)
+    data["attrs"] = attrs
+    savemat(path, data, do_compression=True, oned_as="column", appendmat=False)
+
+
+def export(source: Any, path: str | os.PathLike[str], *, to: str | None = None) -> Path:
+    """Write a result as CSV or MATLAB ``.mat`` (see the module docstring); returns the path.
+
+    Parameters
+    ----------
+    source
+        A sweep store path, a simulation file path (``simulation.nc``) or a dataset of either.
+    path
+        The file to write.
+    to
+        ``csv`` or ``mat``; default: from the suffix of ``path``.
+    """
+    if not isinstance(path, str | os.PathLike) or not os.fspath(path).strip():
+        raise ParameterError(f"the output must be a file path: got {path!r}")
+    out = Path(os.fspath(path))
+    fmt = to if to is not None else out.suffix.lower().lstrip(".")
+    if fmt not in FORMATS:
+        raise ParameterError(
+            f"the export format must be one of {', '.join(FORMATS)} (or a path ending in "
+            f".csv or .mat): got {to if to is not None else out.name!r}"
+        )
+    if out.is_dir():
+        raise ParameterError(f"the output must be a file: {str(out)!r} is a directory")
+    ds = open_result(source)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = out.with_name(f".{out.name}.partial-{os.getpid()}")
+    try:
+        if fmt == "csv":
+            df = table(ds)
+            header = [f"# {k} = {ds.attrs[k]}" for k in _HEADER_ATTRS if k in ds.attrs]
+            if ds.attrs.get("gearset_toml"):
+                name = re.search(r'^name = "(.*)"', str(ds.attrs["gearset_toml"]), re.M)
+                if name:
+                    header.insert(0, f"# gearset = {name.group(1)}")
+            with open(tmp, "w", encoding="utf-8", newline="") as f:
+                f.write("\n".join(header) + ("\n" if header else ""))
+                df.to_csv(f, index=False)  # floats as repr: the shortest exact text
+        else:
+            _write_mat(ds, os.fspath(tmp))
+        os.replace(tmp, out)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+    return out

@@ -1,0 +1,109 @@
+"""Export round trip (issue 12): the values read back from CSV and MATLAB files equal the
+store's and the simulation's, bit for bit."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+from scipy.io import loadmat
+from sweep_helpers import SHORT
+from typer.testing import CliRunner
+
+import gearchaos as gc
+from gearchaos.cli import app
+from gearchaos.errors import ParameterError, StoreError
+
+
+@pytest.fixture(scope="module")
+def store(tmp_path_factory: pytest.TempPathFactory, sheng: gc.GearSet) -> Path:
+    path = tmp_path_factory.mktemp("export") / "run.zarr"
+    gc.bifurcation(
+        sheng,
+        "omega=0.6:2.4:4",
+        family={"xi": [0.03, 0.07]},
+        planets=[1, 3],
+        lyapunov=True,
+        store=path,
+        progress=False,
+        **SHORT,
+    )
+    return path
+
+
+@pytest.fixture(scope="module")
+def simulation(tmp_path_factory: pytest.TempPathFactory, sheng: gc.GearSet) -> Path:
+    path = tmp_path_factory.mktemp("export") / "simulation.nc"
+    gc.simulate(sheng, omega=1.3, transient_periods=8, periods=5, samples_per_period=4).save(path)
+    return path
+
+
+def test_csv_of_a_store_reads_back_to_its_values(store: Path, tmp_path: Path) -> None:
+    out = gc.export(store, tmp_path / "run.csv")
+    df = pd.read_csv(out, comment="#")
+    ds = gc.open_sweep(store).load()
+    assert list(df.columns[:4]) == ["xi", "omega", "section", "planet"]
+    assert len(df) == ds.sizes["xi"] * ds.sizes["omega"] * ds.sizes["section"] * 2
+    for _, row in df.sample(25, random_state=0).iterrows():
+        at = {"xi": row["xi"], "omega": row["omega"]}
+        point = ds.sel(at)
+        assert row["delta_sp"] == float(
+            point.delta_sp.sel(section=row["section"], planet=row["planet"])
+        )
+        assert row["delta_sp_dot"] == float(
+            point.delta_sp_dot.sel(section=row["section"], planet=row["planet"])
+        )
+        assert row["motion"] == str(point.motion.values)
+        assert row["status"] == int(point.status.values)
+        lle = float(point.lle.values)
+        assert row["lle"] == lle or (np.isnan(row["lle"]) and np.isnan(lle))
+    assert "# gearset = hindawi2021" in out.read_text().splitlines()[0]
+
+
+def test_mat_of_a_store_holds_every_variable(store: Path, tmp_path: Path) -> None:
+    out = gc.export(store, tmp_path / "run.mat")
+    m = loadmat(out)
+    ds = gc.open_sweep(store).load()
+    for name in ("delta_sp", "status", "lle", "steps_accepted", "final_state"):
+        np.testing.assert_array_equal(m[name], ds[name].values)
+    np.testing.assert_array_equal(m["omega"].ravel(), ds.omega.values)
+    assert [str(x[0]) for x in m["dims_delta_sp"].ravel()] == list(ds.delta_sp.dims)
+    labels = np.array([str(x[0]) for x in m["motion"].ravel()]).reshape(ds.motion.shape)
+    np.testing.assert_array_equal(labels, ds.motion.values)
+    assert str(m["attrs"]["sweep_toml"][0, 0][0]) == ds.attrs["sweep_toml"]
+
+
+def test_simulation_exports_both_ways(simulation: Path, tmp_path: Path) -> None:
+    ds = gc.open_simulation(simulation)
+    df = pd.read_csv(gc.export(simulation, tmp_path / "s.csv"), comment="#")
+    assert len(df) == ds.sizes["section"] * ds.sizes["planet"]
+    first = df[(df.section == 2) & (df.planet == 2)].iloc[0]
+    assert first["tau"] == float(ds.tau[2])
+    assert first["delta_rp"] == float(ds.delta_rp.isel(section=2).sel(planet=2))
+    assert first["x_s"] == float(ds.x_s[2])
+    m = loadmat(gc.export(simulation, tmp_path / "s.mat"))
+    np.testing.assert_array_equal(m["delta_sp_history"], ds.delta_sp_history.values)
+    np.testing.assert_array_equal(m["tau_sample"].ravel(), ds.tau_sample.values)
+
+
+def test_cli_export_and_refusals(store: Path, tmp_path: Path) -> None:
+    runner = CliRunner()
+    result = runner.invoke(
+        app, ["export", str(store), "--to", "csv", "-o", str(tmp_path / "a.txt")]
+    )
+    assert result.exit_code == 0, result.output
+    assert pd.read_csv(tmp_path / "a.txt", comment="#").shape[0] > 0
+    for args, needle in (
+        ([str(store), "-o", str(tmp_path / "a.xlsx")], "csv, mat"),
+        ([str(tmp_path / "none.zarr"), "-o", str(tmp_path / "b.csv")], "no result"),
+        ([str(store), "-o", ""], "--output must be a path"),
+    ):
+        result = runner.invoke(app, ["export", *args])
+        assert result.exit_code == 2, args
+        assert needle in result.stderr and "Traceback" not in result.output
+    with pytest.raises(ParameterError):
+        gc.export(store, tmp_path / "x.parquet")
+    with pytest.raises(StoreError):
+        gc.export(tmp_path / "a.txt", tmp_path / "y.csv")

@@ -1,0 +1,37 @@
+"""The one-line first-run notice: said once per process, before a kernel that numba's disk cache
+does not hold is compiled, never when every kernel loads from the cache."""
+
+from __future__ import annotations
+
+import pytest
+
+import gearchaos as gc
+from gearchaos import _numba
+
+
+def _run() -> None:
+    gc.simulate(gc.preset("sheng2016"), omega=1.5, transient_periods=1, periods=1)
+
+
+@pytest.mark.parametrize("cached", [False, True])
+def test_notice_once_and_only_before_a_compilation(
+    monkeypatch: pytest.MonkeyPatch, cached: bool
+) -> None:
+    calls: list[int] = []
+    monkeypatch.setattr(_numba, "_in_disk_cache", lambda dispatcher: cached)
+    monkeypatch.setattr(_numba, "_ENTRIES", {})  # as in a fresh process
+    _numba.on_first_compile(lambda: calls.append(1))
+    try:
+        _run()
+        _run()
+    finally:
+        _numba.on_first_compile(None)
+    assert calls == ([] if cached else [1])
+
+
+def test_disk_cache_is_read_from_the_dispatcher() -> None:
+    from gearchaos.integrate.dopri import dopri_chains
+
+    _run()  # compiled or loaded: either way the index is on disk now
+    assert _numba._in_disk_cache(dopri_chains) is True
+    assert _numba._in_disk_cache(object()) is True  # cannot be told: no notice
