@@ -113,6 +113,48 @@ def dead_zone(x: float, b: float) -> float:
     return x - min(max(x, -b), b)  # branch-free: the contact state is unpredictable
 
 
+@numba.njit(cache=True, inline="always")
+def _planetary_eccentricity(t, p, obs, N):  # pragma: no cover - compiled
+    """Mesh errors from the sun, planet and ring eccentricities (MODEL.md §3) and their
+    τ-derivatives: obs[4N+4+i], obs[5N+4+i] (sun–planet i), obs[6N+4+i], obs[7N+4+i]
+    (planet–ring i)."""
+    om = p[P_OMEGA]
+    es = p[P_ES]
+    ep = p[P_EP]
+    er = p[P_ER]
+    om_s = om / p[P_ZS]
+    om_p = om / p[P_ZP]
+    om_r = om / p[P_ZR]
+    cs_ = math.cos(om_s * t)
+    ss_ = math.sin(om_s * t)
+    cp_ = math.cos(om_p * t)
+    sp_ = math.sin(om_p * t)
+    cr_ = math.cos(om_r * t)
+    sr_ = math.sin(om_r * t)
+    for i in range(N):
+        ca = p[P_HEADER + B_C_ES * N + i]
+        sa = p[P_HEADER + B_S_ES * N + i]
+        esp = es * (ss_ * ca + cs_ * sa)
+        esp_d = es * om_s * (cs_ * ca - ss_ * sa)
+        ca = p[P_HEADER + B_C_EPS * N + i]
+        sa = p[P_HEADER + B_S_EPS * N + i]
+        esp += ep * (sp_ * ca + cp_ * sa)
+        esp_d += ep * om_p * (cp_ * ca - sp_ * sa)
+        ca = p[P_HEADER + B_C_EPR * N + i]
+        sa = p[P_HEADER + B_S_EPR * N + i]
+        erp = ep * (sp_ * ca + cp_ * sa)
+        erp_d = ep * om_p * (cp_ * ca - sp_ * sa)
+        # sin(−Ω_H τ + θ) = sin θ cos(Ω_H τ) − cos θ sin(Ω_H τ)
+        ca = p[P_HEADER + B_C_ER * N + i]
+        sa = p[P_HEADER + B_S_ER * N + i]
+        erp += er * (sa * cr_ - ca * sr_)
+        erp_d += er * om_r * (-sa * sr_ - ca * cr_)
+        obs[4 * N + 4 + i] = esp
+        obs[5 * N + 4 + i] = esp_d
+        obs[6 * N + 4 + i] = erp
+        obs[7 * N + 4 + i] = erp_d
+
+
 @numba.njit(cache=True, inline="always")  # inlined at the single stage call site
 def planetary_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
     """Minimal relative-coordinate equations of MODEL.md §7.
@@ -150,28 +192,10 @@ def planetary_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
     h0 = P_HEADER + N_BLOCKS * N  # first harmonic amplitude
 
     ecc = p[P_ECC] != 0.0
-    es = p[P_ES]
-    ep = p[P_EP]
-    er = p[P_ER]
-    cs_ = 0.0
-    ss_ = 0.0
-    cp_ = 0.0
-    sp_ = 0.0
-    cr_ = 0.0
-    sr_ = 0.0
-    om_s = 0.0
-    om_p = 0.0
-    om_r = 0.0
     if ecc:
-        om_s = om / p[P_ZS]
-        om_p = om / p[P_ZP]
-        om_r = om / p[P_ZR]
-        cs_ = math.cos(om_s * t)
-        ss_ = math.sin(om_s * t)
-        cp_ = math.cos(om_p * t)
-        sp_ = math.sin(om_p * t)
-        cr_ = math.cos(om_r * t)
-        sr_ = math.sin(om_r * t)
+        # eccentricity errors of every mesh, into the force and stiffness slots of obs (read
+        # below before those are written): a separate pass keeps the common case lean
+        _planetary_eccentricity(t, p, obs, N)
 
     sum_fsp = 0.0
     sum_frp = 0.0
@@ -215,23 +239,10 @@ def planetary_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
         erp = arp * (s1 * cte + c1 * ste)
         erp_d = arp * om * (c1 * cte - s1 * ste)
         if ecc:
-            ca = p[P_HEADER + B_C_ES * N + i]
-            sa = p[P_HEADER + B_S_ES * N + i]
-            esp += es * (ss_ * ca + cs_ * sa)
-            esp_d += es * om_s * (cs_ * ca - ss_ * sa)
-            ca = p[P_HEADER + B_C_EPS * N + i]
-            sa = p[P_HEADER + B_S_EPS * N + i]
-            esp += ep * (sp_ * ca + cp_ * sa)
-            esp_d += ep * om_p * (cp_ * ca - sp_ * sa)
-            ca = p[P_HEADER + B_C_EPR * N + i]
-            sa = p[P_HEADER + B_S_EPR * N + i]
-            erp += ep * (sp_ * ca + cp_ * sa)
-            erp_d += ep * om_p * (cp_ * ca - sp_ * sa)
-            # sin(−Ω_H τ + θ) = sin θ cos(Ω_H τ) − cos θ sin(Ω_H τ)
-            ca = p[P_HEADER + B_C_ER * N + i]
-            sa = p[P_HEADER + B_S_ER * N + i]
-            erp += er * (sa * cr_ - ca * sr_)
-            erp_d += er * om_r * (-sa * sr_ - ca * cr_)
+            esp += obs[4 * N + 4 + i]
+            esp_d += obs[5 * N + 4 + i]
+            erp += obs[6 * N + 4 + i]
+            erp_d += obs[7 * N + 4 + i]
 
         pi_ = y[2 + i]
         pid = y[n + 2 + i]
