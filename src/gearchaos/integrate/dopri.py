@@ -419,15 +419,18 @@ def dopri_run(
             K[0, i] = K[STAGES - 1, i]
         if tracking:
             track(hist[0], obs, hs, n_track, obs_min, obs_max)
+        record = clipped and j < n_samples and not sec_step
         if clipped and sec_step:
             m_next -= 1
             if _settled(y, ring, runs, n_sec, n_base):
+                # settled: the recording starts here, whole periods before the planned start
                 skipped = m_next + 1
                 t_rec = t
                 t_end -= skipped * period
                 settling = False
+                record = True
             n_sec += 1
-        elif clipped and j < n_samples:
+        if record:
             if n_tan > 0:
                 tan_on = _renormalize(kind, t, y, p, obs, K, n_base, n_tan, lsum, tan_on)
             out_t[j] = t

@@ -358,6 +358,8 @@ class SweepSpec:
             f"planets = {val(list(self.planets))}",
             "",
         ]
+        if self.solver.settle != "off":  # written only when used: older stores stay identical
+            lines.insert(6, f"settle = {val(self.solver.settle)}")
         for a in self.vary:
             lines += ["[[vary]]", f"name = {val(a.name)}", f"values = {val(list(a.values))}", ""]
         if self.family is not None:
@@ -400,6 +402,7 @@ class SweepSpec:
                     periods=int(d["periods"]),
                     rtol=d["rtol"],
                     atol=d["atol"],
+                    settle=d.get("settle", "off"),
                 ),
                 lyapunov=bool(d.get("lyapunov", False)),
                 extra=tuple(sorted(d.get("extra", {}).items())),
