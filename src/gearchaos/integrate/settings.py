@@ -182,8 +182,8 @@ class SolverSettings:
         )
 
     def attrs(self) -> dict[str, Any]:
-        """The settings as result attributes (``max_steps`` only when it was given)."""
-        out = {
+        """The settings as result attributes (``settle`` only when it is not "off")."""
+        out: dict[str, Any] = {
             "rtol": self.rtol,
             "atol": self.atol,
             "transient_periods": self.transient_periods,
