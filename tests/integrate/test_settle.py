@@ -90,3 +90,19 @@ def test_settle_must_be_off_or_auto() -> None:
         SolverSettings(settle="yes")
     with pytest.raises(gc.ParameterError, match="settle"):
         gc.simulate(gc.duffing(1.0), settle=True)  # type: ignore[arg-type]
+
+
+def test_the_command_line_refuses_a_bad_settle(tmp_path) -> None:
+    from typer.testing import CliRunner
+
+    from gearchaos.cli import app
+
+    runner = CliRunner()
+    for args in (
+        ["simulate", "--json"],
+        ["bifurcation", "--vary", "omega=1,2", "-o", str(tmp_path / "b.zarr")],
+    ):
+        result = runner.invoke(app, [*args, "--settle", "maybe"])
+        assert result.exit_code == 2, result.output
+        assert "--settle: settle must be one of 'off', 'auto': got 'maybe'" in result.stderr
+    assert list(tmp_path.iterdir()) == []
