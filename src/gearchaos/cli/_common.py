@@ -220,7 +220,12 @@ def default_omega_note(quiet: bool, what: str = "swept") -> None:
 
 
 def solver_settings(
-    transient: float, periods: int, rtol: float, atol: float, samples_per_period: int = 1
+    transient: float,
+    periods: int,
+    rtol: float,
+    atol: float,
+    samples_per_period: int = 1,
+    settle: str = "off",
 ) -> SolverSettings:
     """The :class:`~gearchaos.integrate.settings.SolverSettings` of the solver options;
     invalid values exit 2 naming the setting."""
@@ -233,6 +238,7 @@ def solver_settings(
             samples_per_period=samples_per_period,
             rtol=rtol,
             atol=atol,
+            settle=settle,
         )
     except ParameterError as exc:
         setting = str(exc).split(" ", 1)[0]
@@ -246,6 +252,7 @@ _OPTIONS = {
     "periods": "--periods",
     "samples_per_period": "--samples-per-period",
     "rtol": "--rtol",
+    "settle": "--settle",
     "atol": "--atol",
 }
 
@@ -291,6 +298,16 @@ QuietOpt = Annotated[
 ]
 TransientOpt = Annotated[
     float, typer.Option("--transient", help="Mesh periods discarded before recording.")
+]
+SettleOpt = Annotated[
+    str,
+    typer.Option(
+        "--settle",
+        help=(
+            "off: always --transient periods of transient; auto: end it early once the Poincaré "
+            "sections repeat (period ≤ 64), never later than --transient."
+        ),
+    ),
 ]
 PeriodsOpt = Annotated[
     int, typer.Option("--periods", help="Mesh periods recorded (one Poincaré point each).")

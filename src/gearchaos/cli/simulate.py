@@ -21,6 +21,7 @@ def simulate(
     gearset: c.GearsetOpt = None,
     set_: c.SetOpt = None,
     transient: c.TransientOpt = SIMULATION.transient_periods,
+    settle: c.SettleOpt = "off",
     periods: c.PeriodsOpt = SIMULATION.periods,
     samples_per_period: Annotated[
         int,
@@ -77,7 +78,7 @@ def simulate(
         omega, changes = c.parse_sets(set_ or [])
         gs = c.load_gearset(preset, gearset, changes)
         omega = c.DEFAULT_OMEGA if omega is None else omega
-        settings = c.solver_settings(transient, periods, rtol, atol, samples_per_period)
+        settings = c.solver_settings(transient, periods, rtol, atol, samples_per_period, settle)
         if output is not None:
             output.mkdir(parents=True, exist_ok=True)
         from ..analysis.point import analyse_point

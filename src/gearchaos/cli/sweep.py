@@ -120,6 +120,7 @@ def bifurcation(
         ),
     ] = "up",
     transient: c.TransientOpt = 100.0,
+    settle: c.SettleOpt = "off",
     periods: Annotated[
         int,
         typer.Option("--periods", help="Mesh periods recorded at every point (section points)."),
@@ -203,7 +204,7 @@ def bifurcation(
                 f"--direction {direction} needs --ic continuation "
                 "(fresh starts do not depend on the sweep direction)"
             )
-        settings = c.solver_settings(transient, periods, rtol, atol)
+        settings = c.solver_settings(transient, periods, rtol, atol, settle=settle)
         omega, changes = c.parse_sets(set_ or [])
         gs = c.load_gearset(preset, gearset)
         swept = {_axis_name(v) for v in vary} | ({_axis_name(family)} if family else set())

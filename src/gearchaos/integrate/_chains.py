@@ -31,7 +31,8 @@ class ChainRun:
     Arrays: ``Y0`` (C, n_full) initial states (system state, then ``n_tangent`` tangent
     vectors); ``P`` (C, L, n_par) packed parameters; ``SW`` (C, L, n_track) dead-zone half
     widths; ``t0``, ``t_rec``, ``dt``, ``t_end`` (C, L) start, first sample, sample interval
-    and end times.
+    and end times; ``settle_spp`` the samples per period when the transient may end early
+    (``settle="auto"``), else 0.
     """
 
     kind: int
@@ -53,6 +54,7 @@ class ChainRun:
     continuation: bool = False
     h_init: float = -1.0
     max_step: float = np.inf
+    settle_spp: int = 0
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -154,6 +156,7 @@ class ChainRun:
             continuation=bool(continuation),
             h_init=-1.0 if first_step is None else float(first_step),
             max_step=float(max_step),
+            settle_spp=int(settings.samples_per_period) if settings.settle == "auto" else 0,
         )
 
     @classmethod
@@ -196,8 +199,8 @@ class ChainOutput(SampleArrays):
 
     The :class:`SampleArrays` with shapes ``tau`` (C, L, s), ``states`` (C, L, s, n_full),
     ``observables`` (C, L, s, n_obs), ``obs_min``/``obs_max`` (C, L, n_track), ``final_state``
-    (C, L, n_full) with the tangent vectors; then ``info`` (C, L, 4): accepted steps, rejected
-    steps, time reached, next step size; ``status`` (C, L)
+    (C, L, n_full) with the tangent vectors; then ``info`` (C, L, 5): accepted steps, rejected
+    steps, time reached, next step size, transient periods skipped (``settle``); ``status`` (C, L)
     :class:`~gearchaos.errors.Status` codes; ``log_sums`` (C, L, k) accumulated log stretch
     factors of the tangent vectors.
     """
@@ -254,7 +257,7 @@ def run_chains(run: ChainRun, *, single_thread: bool = False) -> ChainOutput:
         obs_min=np.zeros((C, L, run.n_track)),
         obs_max=np.zeros((C, L, run.n_track)),
         final_state=np.zeros((C, L, n_full)),
-        info=np.zeros((C, L, 4)),
+        info=np.zeros((C, L, 5)),
         status=np.zeros((C, L), dtype=np.int64),
         log_sums=np.zeros((C, L, k)),
     )
@@ -287,5 +290,6 @@ def run_chains(run: ChainRun, *, single_thread: bool = False) -> ChainOutput:
         out.info,
         out.status,
         out.log_sums,
+        int(run.settle_spp),
     )
     return out

@@ -98,13 +98,16 @@ def _hermite_root(v0, v1, d0, d1, level):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def check_step(obs_prev, obs, dt, n_track, sw):  # pragma: no cover - compiled
-    """Switches inside one accepted step, located on the cubic Hermite interpolant.
+def check_step(obs_prev, obs, dt, n_track, sw, win):  # pragma: no cover - compiled
+    """Switches inside one accepted step of length ``dt``.
 
-    Returns ``(theta, where)``: ``theta`` ∈ (LAND, 1 − LAND) the fraction of the step at the
-    first switch that the step misses (the step must be retried to end there), 2.0 if none;
-    ``where`` 0 if no switch was crossed, 1 if the switches crossed lie at the start of the
-    step only, 2 if one lies at its end (landed on).
+    A switch that the end of the step has passed by at most ``win`` (in τ, from the value and
+    derivative at the end: (v₁ − level)/v₁′) is landed on; one that the start of the step was
+    at most ``win`` before ((level − v₀)/v₀′) lies at the start; any other is located on the
+    cubic Hermite interpolant of the step. Returns ``(theta, where)``: ``theta`` the fraction of
+    the step at the first switch of the last kind (the step must be retried to end there), 2.0
+    if none; ``where`` 0 if no switch was crossed, 1 if those crossed lie at the start of the
+    step only, 2 if one lies at its end.
     """
     best = 2.0
     where = 0
@@ -119,13 +122,20 @@ def check_step(obs_prev, obs, dt, n_track, sw):  # pragma: no cover - compiled
         if r0 == r1:
             continue
         level = _first_level(r0, r1, b)
-        x = _hermite_root(v0, v1, obs_prev[n_track + k] * dt, obs[n_track + k] * dt, level)
-        if x <= LAND:
-            if where == 0:
-                where = 1
-        elif x >= 1.0 - LAND:
-            where = 2
-        elif x < best:
+        d0 = obs_prev[n_track + k]
+        d1 = obs[n_track + k]
+        if abs(r1 - r0) == 1:
+            gap = v1 - level
+            if gap * d1 >= 0.0 and abs(gap) <= win * abs(d1):
+                where = 2  # passed at most win ago: landed on
+                continue
+            gap = level - v0
+            if gap * d0 >= 0.0 and abs(gap) <= win * abs(d0):
+                if where == 0:
+                    where = 1  # reached at most win after the start
+                continue
+        x = _hermite_root(v0, v1, d0 * dt, d1 * dt, level)
+        if x < best:
             best = x
     return best, where
 

@@ -10,9 +10,12 @@ stage).
 
 Error control follows Hairer, Nørsett & Wanner (*Solving ODEs I*, §II.4) as in scipy's
 ``RK45``: the scaled RMS norm of h Σ (b_i − b̂_i) k_i with scale atol + rtol·max(|y_n|, |y_{n+1}|),
-step factor 0.9·err^(−1/5) clipped to [0.2, 10] (no growth right after a rejection), and
-Hairer's starting-step heuristic. After a step clipped to land on a sample the pre-clip step size
-is restored, so sampling does not throttle the integration.
+PI step-size control as in Hairer's DOPRI5 code (Gustafsson; HNW II §IV.2): factor
+0.9·err_n^(−α)·err_{n−1}^β, β = 0.04, α = 1/5 − 0.75β, clipped to [0.2, 10] (no growth right after
+a rejection), and Hairer's starting-step heuristic. Contact switches are predicted from the
+points of the current smooth piece and a step is shortened to end just past the next one
+(:mod:`~gearchaos.integrate._switch`). After a step clipped to land on a sample the pre-clip
+step size is restored, so sampling does not throttle the integration.
 
 The stages are written out with the coefficients of :data:`~gearchaos.integrate.tableau.DOPRI5`
 as compile-time constants; the inner stages ask the right-hand side for no observables, the last
@@ -29,7 +32,7 @@ import numba
 import numpy as np
 
 from ..model.kernels import OBS_ALL, OBS_NONE, OBS_TRACK, rhs, tangent
-from ._switch import first_switch, track
+from ._switch import AIM, LAND, check_step, predict_switch, track
 from .tableau import DOPRI5
 
 __all__ = ["dopri_chains", "dopri_run"]
@@ -53,9 +56,20 @@ E1, E3, E4, E5, E6, E7 = (_E[q] for q in (0, 2, 3, 4, 5, 6))
 SAFETY = 0.9
 MIN_FACTOR = 0.2
 MAX_FACTOR = 10.0
-ERR_EXPONENT = -1.0 / 5.0  # −1/(q+1), q = 4 the lower order of the pair
+#: PI step-size control (Gustafsson): h_{n+1} = h_n · SAFETY · err_n^(−α) · err_{n−1}^β with
+#: β = 0.04 and α = 1/5 − 0.75 β, as in Hairer's DOPRI5 code (HNW II §IV.2)
+BETA = 0.04
+ALPHA = 0.2 - 0.75 * BETA
+ERR_OLD_MIN = 1e-4  # lower bound on err_{n−1} (Hairer's facold)
 
-SWITCH_MIN = 1e-6  # switches closer than this fraction to the step start are not re-located
+#: ``settle="auto"``: the transient ends at the first transient section point τ_k at which the
+#: section sequence has repeated with some period n ≤ SETTLE_MAX_PERIOD, every component within
+#: SETTLE_TOL·(1 + |y|) of its value n periods earlier, for the last max(SETTLE_CYCLES·n,
+#: SETTLE_MIN_MATCHES) section points in a row.
+SETTLE_MAX_PERIOD = 64
+SETTLE_CYCLES = 3
+SETTLE_MIN_MATCHES = 8
+SETTLE_TOL = 1e-7
 
 ST_OK = 0
 ST_MAX_STEPS = 1
@@ -124,6 +138,28 @@ def _renormalize(kind, t, y, p, obs, K, n, k, lsum, tan_on):  # pragma: no cover
 
 
 @numba.njit(cache=True)
+def _settled(y, ring, runs, n_sec, n_base):  # pragma: no cover - compiled
+    """Store transient section point number ``n_sec`` (state ``y``) in ``ring``; update the
+    run lengths ``runs[n]`` of consecutive repeats with period n; whether one is long enough."""
+    n_ring = ring.shape[0]
+    row = n_sec % n_ring
+    for i in range(n_base):
+        ring[row, i] = y[i]
+    done = False
+    for per in range(1, min(n_sec, n_ring - 1) + 1):
+        prev = (n_sec - per) % n_ring
+        close = True
+        for i in range(n_base):
+            if abs(y[i] - ring[prev, i]) > SETTLE_TOL * (1.0 + abs(y[i])):
+                close = False
+                break
+        runs[per] = runs[per] + 1 if close else 0
+        if runs[per] >= max(SETTLE_CYCLES * per, SETTLE_MIN_MATCHES):
+            done = True
+    return done
+
+
+@numba.njit(cache=True)
 def dopri_run(
     kind,
     y0,
@@ -150,6 +186,7 @@ def dopri_run(
     y_final,
     info,
     lsum,
+    settle_spp,
 ):  # pragma: no cover - compiled
     """Integrate one system; fill the output arrays; return the status code.
 
@@ -159,8 +196,14 @@ def dopri_run(
     observables (``inf``: smooth); a step that crosses a switch obs_k = ±b_k is discarded and
     retried so that it ends on the switch, so no step straddles a kink of the vector field
     (DOPRI5's error estimate can miss a kink inside a step: 10–100× larger errors).
-    ``info`` (float64, length 4) receives accepted steps, rejected steps (including steps
-    discarded to land on a switch), the final time reached and the next step size.
+    ``info`` (float64, length 5) receives accepted steps, rejected steps (including steps
+    discarded to land on a switch), the final time reached, the next step size and the
+    transient periods skipped by ``settle``.
+
+    Settling (``settle_spp`` > 0, the samples per period, so T = settle_spp·dt_sample): the
+    steps also land on the transient section points τ_rec − mT, and once their sequence repeats
+    (see ``SETTLE_TOL``) at τ_rec − mT, the recording starts there: τ_rec and τ_end move back
+    by mT (whole periods, so the forcing phase of every sample is unchanged).
 
     Lyapunov exponents: with ``k = lsum.size > 0`` the state holds ``n_base`` system
     components followed by k tangent vectors, integrated with the variational equations
@@ -178,7 +221,6 @@ def dopri_run(
     K = np.zeros((STAGES, n))  # tangent components stay zero until the tangents start
     obs = np.empty(n_obs)
     n_tr2 = 2 * n_track
-    obs_prev = np.empty(n_tr2)
     for k in range(n_track):
         obs_min[k] = np.inf
         obs_max[k] = -np.inf
@@ -214,7 +256,13 @@ def dopri_run(
         for k in range(n_track):
             obs_min[k] = obs[k]
             obs_max[k] = obs[k]
-    obs_prev[:] = obs[:n_tr2]
+    # tracked observables at the last three accepted points, newest first, and their times;
+    # n_pts of them lie on the current smooth piece (since the last switch)
+    hist = np.empty((3, n_tr2))
+    t_hist = np.zeros(3)
+    hist[0, :] = obs[:n_tr2]
+    t_hist[0] = t
+    n_pts = 1
     last_rejected = False
     nonfinite = False
     has_switch = False
@@ -222,9 +270,22 @@ def dopri_run(
         if sw[k] < np.inf:
             has_switch = True
     h_event = -1.0
+    err_old = ERR_OLD_MIN
+    # settling: transient section points, the newest SETTLE_MAX_PERIOD + 1 in a ring
+    settling = settle_spp > 0 and n_samples > 0 and t < t_rec
+    period = dt_sample * settle_spp
+    m_next = int((t_rec - t) / period - 1e-9) if settling else 0
+    n_ring = SETTLE_MAX_PERIOD + 1
+    ring = np.empty((n_ring if settling else 0, n_base))
+    runs = np.zeros(SETTLE_MAX_PERIOD + 1, dtype=np.int64)
+    n_sec = 0
+    skipped = 0
 
     while status == ST_OK:
-        if j < n_samples:
+        sec_step = settling and m_next >= 1
+        if sec_step:
+            target = t_rec - m_next * period
+        elif j < n_samples:
             target = t_rec + j * dt_sample
         else:
             target = t_end
@@ -238,16 +299,23 @@ def dopri_run(
             status = ST_NON_FINITE if nonfinite else ST_UNDERFLOW
             break
         clipped = False
-        event_step = False
+        shortened = False
         hs = h
         if h_event > 0.0:
             hs = h_event
-            event_step = True
+            shortened = True
             h_event = -1.0
+        elif has_switch and n_pts >= 2:
+            # a switch predicted within the step (extrapolating the points of the current
+            # smooth piece): shorten the step to end just past it
+            hp = predict_switch(hist, n_pts, t_hist, n_track, sw, min(h, target - t))
+            if hp > LAND * hs and hp > hmin:
+                hs = hp + AIM * hs
+                shortened = True
         if t + hs >= target:
             hs = target - t
             clipped = True
-            event_step = False
+            shortened = False
 
         t_new = target if clipped else t + hs
         # the stages; the last one is evaluated at (t_new, y_new) (FSAL)
@@ -309,56 +377,86 @@ def dopri_run(
             continue
         nonfinite = False
 
-        if err <= 1.0 and has_switch and not event_step:
-            theta = first_switch(obs_prev, obs, hs, n_track, sw)
-            if SWITCH_MIN < theta < 1.0:
-                # a contact switch lies inside the step: retry, ending exactly on it
-                h_event = theta * hs
+        where = 0
+        if has_switch:
+            # a switch within LAND·h of either end of the step counts as landed on (h the
+            # proposal: a shortened step must not make that window shrink)
+            win = LAND * max(h, hs)
+            theta, where = check_step(hist[0], obs, hs, n_track, sw, win)
+            if theta < 1.0 and theta * hs > hmin:
+                # a switch lies inside the step: retry, ending just past it
+                h_event = theta * hs + AIM * max(h, hs)
+                if h_event >= hs:
+                    h_event = theta * hs
                 n_rej += 1
                 continue
 
-        if err <= 1.0:
-            n_acc += 1
-            if err == 0.0:
-                factor = MAX_FACTOR
-            else:
-                factor = min(MAX_FACTOR, SAFETY * err**ERR_EXPONENT)
-            if last_rejected and factor > 1.0:
-                factor = 1.0
-            last_rejected = False
-            h_next = hs * factor
-            if (clipped or event_step) and h_next < h:
-                h_next = h  # restore the proposal made before clipping to a sample or switch
-            h = min(h_next, max_step)
-            t = t_new
-            for i in range(n):
-                y[i] = yt[i]
-                K[0, i] = K[STAGES - 1, i]
-            if tracking:
-                track(obs_prev, obs, hs, n_track, obs_min, obs_max)
-            if clipped and j < n_samples:
-                if n_tan > 0:
-                    tan_on = _renormalize(kind, t, y, p, obs, K, n_base, n_tan, lsum, tan_on)
-                out_t[j] = t
-                out_y[j, :] = y
-                out_obs[j, :] = obs
-                if not tracking:
-                    tracking = True
-                    for k in range(n_track):
-                        obs_min[k] = obs[k]
-                        obs_max[k] = obs[k]
-                j += 1
-            obs_prev[:] = obs[:n_tr2]
-        else:
+        if err > 1.0:
             n_rej += 1
-            h = hs * max(MIN_FACTOR, SAFETY * err**ERR_EXPONENT)
+            h = hs * max(MIN_FACTOR, SAFETY * err**-ALPHA)
             last_rejected = True
+            continue
+
+        n_acc += 1
+        # PI step-size control (Gustafsson; HNW II §IV.2 and Hairer's DOPRI5)
+        if err == 0.0:
+            factor = MAX_FACTOR
+        else:
+            factor = min(MAX_FACTOR, max(MIN_FACTOR, SAFETY * err**-ALPHA * err_old**BETA))
+        if last_rejected and factor > 1.0:
+            factor = 1.0
+        last_rejected = False
+        h_next = hs * factor
+        if clipped or shortened:
+            if h_next < h:
+                h_next = h  # restore the proposal made before clipping to a sample or switch
+        else:
+            err_old = max(err, ERR_OLD_MIN)  # steps cut short say little about the next one
+        h = min(h_next, max_step)
+        t = t_new
+        for i in range(n):
+            y[i] = yt[i]
+            K[0, i] = K[STAGES - 1, i]
+        if tracking:
+            track(hist[0], obs, hs, n_track, obs_min, obs_max)
+        record = clipped and j < n_samples and not sec_step
+        if clipped and sec_step:
+            m_next -= 1
+            if _settled(y, ring, runs, n_sec, n_base):
+                # settled: the recording starts here, whole periods before the planned start
+                skipped = m_next + 1
+                t_rec = t
+                t_end -= skipped * period
+                settling = False
+                record = True
+            n_sec += 1
+        if record:
+            if n_tan > 0:
+                tan_on = _renormalize(kind, t, y, p, obs, K, n_base, n_tan, lsum, tan_on)
+            out_t[j] = t
+            out_y[j, :] = y
+            out_obs[j, :] = obs
+            if not tracking:
+                tracking = True
+                for k in range(n_track):
+                    obs_min[k] = obs[k]
+                    obs_max[k] = obs[k]
+            j += 1
+        # the smooth piece: a switch at the end starts a new one, at the start one of two points
+        n_pts = 1 if where == 2 else (2 if where == 1 else min(n_pts + 1, 3))
+        hist[2, :] = hist[1]
+        hist[1, :] = hist[0]
+        hist[0, :] = obs[:n_tr2]
+        t_hist[2] = t_hist[1]
+        t_hist[1] = t_hist[0]
+        t_hist[0] = t
 
     y_final[:] = y
     info[0] = n_acc
     info[1] = n_rej
     info[2] = t
     info[3] = h
+    info[4] = skipped
     return status
 
 
@@ -391,6 +489,7 @@ def dopri_chains(
     info,
     status,
     LSUM,
+    settle_spp,
 ):  # pragma: no cover - compiled
     """Chains of integrations, ``numba.prange`` over chains, points of a chain in order: the
     one compiled entry point of the integrator (single runs are chains of length one).
@@ -399,9 +498,10 @@ def dopri_chains(
     from ``Y0[c]`` (fresh) or, with ``continuation``, from the final state of point j−1 of the
     same chain (point 0 from ``Y0[c]``); a failed point restarts its successor from ``Y0[c]``.
     ``LSUM[c, j]`` (k ≥ 0 entries) receives the Lyapunov log sums when the state carries k
-    tangent vectors after its ``n_base`` system components. Every point runs
-    :func:`dopri_run` unchanged, so its result does not depend on the chain it runs in, on the
-    other chains or on the number of threads.
+    tangent vectors after its ``n_base`` system components. ``settle_spp`` > 0 (the samples
+    per period) lets every point end its transient early once its section sequence repeats.
+    Every point runs :func:`dopri_run` unchanged, so its result does not depend on the chain
+    it runs in, on the other chains or on the number of threads.
     """
     numba.literally(kind)
     n_chains = P.shape[0]
@@ -435,6 +535,7 @@ def dopri_chains(
                 y_final[c, j],
                 info[c, j],
                 LSUM[c, j],
+                settle_spp,
             )
             status[c, j] = st
             if continuation and st == ST_OK:

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from .._checks import check_int, check_memory, check_real
+from .._checks import check_choice, check_int, check_memory, check_real
 from ..errors import ParameterError
 
 __all__ = ["SIMULATION", "SampleTimes", "SolverSettings"]
@@ -28,6 +28,8 @@ ATOL_MAX = 1.0
 MAX_PERIODS = 10**9
 MAX_SAMPLES_PER_PERIOD = 10**6
 MAX_STEP_BUDGET = 2**62
+#: Values of ``settle``.
+SETTLE_CHOICES = ("off", "auto")
 
 
 @dataclass(frozen=True)
@@ -64,6 +66,14 @@ class SolverSettings:
     max_steps
         Step attempts allowed before the integration gives up (``Status.MAX_STEPS``); ``None``
         allows 100 000 + 50 000 per simulated period.
+    settle
+        ``"off"`` (the seed's protocol): always ``transient_periods`` periods of transient.
+        ``"auto"``: the transient ends at the first section point x_k (τ = τ_rec − mT) after
+        which the section sequence has repeated with a period n ≤ 64,
+        |x_k − x_(k−n)| ≤ 1e-7 (1 + |x_k|) componentwise for max(3n, 8) section points in a
+        row, never later than ``transient_periods``; the periods are then recorded from there
+        (whole periods earlier, so with the same forcing phase). Chaotic and quasi-periodic
+        motions never settle early.
 
     Notes
     -----
@@ -78,6 +88,7 @@ class SolverSettings:
     rtol: float = 1e-8
     atol: float = 1e-10
     max_steps: int | None = None
+    settle: str = "off"
 
     def __post_init__(self) -> None:
         self.check()
@@ -90,8 +101,8 @@ class SolverSettings:
         [1, 1e9]; ``samples_per_period`` an integer in [1, 1e6]; ``section_phase`` a finite
         number; ``rtol`` a number in [1e-14, 0.1] (below 1e-14 the floating-point resolution
         of the time variable is reached); ``atol`` a number in (0, 1] (states are of order one:
-        lengths in units of b_c); ``max_steps`` None or an integer >= 1. Booleans and strings
-        are not numbers.
+        lengths in units of b_c); ``max_steps`` None or an integer >= 1; ``settle`` "off" or
+        "auto". Booleans and strings are not numbers.
         """
         check_real("transient_periods", self.transient_periods, lo=0.0, hi=float(MAX_PERIODS))
         check_int("periods", self.periods, lo=1, hi=MAX_PERIODS)
@@ -101,6 +112,7 @@ class SolverSettings:
         check_real("atol", self.atol, lo=0.0, hi=ATOL_MAX, lo_open=True)
         if self.max_steps is not None:
             check_int("max_steps", self.max_steps, lo=1, hi=MAX_STEP_BUDGET)
+        check_choice("settle", self.settle, SETTLE_CHOICES)
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -174,8 +186,8 @@ class SolverSettings:
         )
 
     def attrs(self) -> dict[str, Any]:
-        """The settings as result attributes (``max_steps`` only when it was given)."""
-        out = {
+        """The settings as result attributes (``settle`` only when it is not "off")."""
+        out: dict[str, Any] = {
             "rtol": self.rtol,
             "atol": self.atol,
             "transient_periods": self.transient_periods,
@@ -183,6 +195,8 @@ class SolverSettings:
             "samples_per_period": self.samples_per_period,
             "section_phase": self.section_phase,
         }
+        if self.settle != "off":
+            out["settle"] = self.settle
         return out
 
 

@@ -122,6 +122,7 @@ def simulate(
     section_phase: float = _DEFAULT.section_phase,
     max_steps: int | None = None,
     check: bool = True,
+    settle: str = _DEFAULT.settle,
 ) -> SimulationResult:
     """Simulate a gear set (or any :class:`System`) with the seed's protocol.
 
@@ -147,6 +148,10 @@ def simulate(
     check
         Raise :class:`~gearchaos.errors.IntegrationError` (carrying ``.result``) when the
         integration fails; with ``check=False`` inspect ``result.status`` instead.
+    settle
+        ``"auto"``: end the transient early once the section sequence repeats (see
+        :class:`~gearchaos.integrate.settings.SolverSettings`); ``"off"`` (default): the full
+        transient.
 
     Returns
     -------
@@ -162,6 +167,7 @@ def simulate(
         rtol=rtol,
         atol=atol,
         max_steps=max_steps,
+        settle=settle,
     )
     raise_on_failure = check_bool("check", check)
     system = resolve(system_or_gearset, {} if omega is None else {"omega": omega})

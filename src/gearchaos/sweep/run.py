@@ -35,6 +35,9 @@ from .store import SweepStore
 
 __all__ = ["bifurcation", "run_sweep"]
 
+#: Per-point variable of a ``settle="auto"`` sweep: transient periods skipped (0: full transient).
+SKIPPED = "transient_skipped"
+
 
 class _Layout:
     """Store variables of a sweep and how to fill them from kernel outputs."""
@@ -82,6 +85,14 @@ class _Layout:
         for nm in ("steps_accepted", "steps_rejected"):
             var[nm] = (lead, (shp, "int64"), -1, {"long_name": nm.replace("_", " ")})
             chunks[nm] = ch
+        if spec.solver.settle != "off":
+            var[SKIPPED] = (
+                lead,
+                (shp, "int64"),
+                -1,
+                {"long_name": "transient periods skipped: settled early (settle='auto') if > 0"},
+            )
+            chunks[SKIPPED] = ch
         if spec.lyapunov:
             var["lle"] = (
                 lead,
@@ -129,6 +140,9 @@ class _Layout:
         data["status"] = np.full(bshape, int(Status.NOT_RUN), dtype=np.int8)
         data["steps_accepted"] = np.full(bshape, -1, dtype=np.int64)
         data["steps_rejected"] = np.full(bshape, -1, dtype=np.int64)
+        settle = spec.solver.settle != "off"
+        if settle:
+            data[SKIPPED] = np.full(bshape, -1, dtype=np.int64)
         n_st = len(self.state_names)
         data["final_state"] = np.full((*bshape, n_st), np.nan)
         if spec.lyapunov:
@@ -159,6 +173,8 @@ class _Layout:
                 data["status"][pos] = out.status[c, j]
                 data["steps_accepted"][pos] = int(out.info[c, j, 0])
                 data["steps_rejected"][pos] = int(out.info[c, j, 1])
+                if settle:
+                    data[SKIPPED][pos] = int(out.info[c, j, 4])
                 data["final_state"][pos] = out.final_state[c, j, :n_st]
                 if spec.lyapunov:
                     data["lle"][pos] = lle[c, j, 0]

@@ -439,6 +439,8 @@ class SweepSpec:
             ),
             "",
         ]
+        if self.solver.settle != "off":  # written only when used: older stores stay identical
+            lines.insert(6, f"settle = {val(self.solver.settle)}")
         for a in self.vary:
             lines += ["[[vary]]", f"name = {val(a.name)}", f"values = {val(list(a.values))}", ""]
         if self.family is not None:
@@ -482,6 +484,7 @@ class SweepSpec:
                     rtol=d["rtol"],
                     atol=d["atol"],
                     samples_per_period=int(d.get("samples_per_period", 1)),
+                    settle=d.get("settle", "off"),
                 ),
                 lyapunov=bool(d.get("lyapunov", False)),
                 orbits=bool(d.get("orbits", False)),
