@@ -57,7 +57,8 @@ def invalid_setting(name: str) -> st.SearchStrategy[Any]:
     """Values that break the documented rule of a solver setting (``SolverSettings.check``):
     transient_periods a number in [0, 1e9]; periods an integer in [1, 1e9];
     samples_per_period an integer in [1, 1e6]; section_phase a finite number; rtol a number in
-    [1e-14, 1]; atol a number in (0, 1]; max_steps an integer in [1, 2^62] (or None)."""
+    [1e-14, 1]; atol a number in (0, 1]; max_steps an integer in [1, 2^62] (or None); settle
+    "off" or "auto"."""
     real = st.one_of(NOT_NUMBERS, NON_FINITE)
     if name == "transient_periods":
         return st.one_of(real, reals_outside(0.0, 1e9))
@@ -71,6 +72,12 @@ def invalid_setting(name: str) -> st.SearchStrategy[Any]:
         return st.one_of(real, reals_outside(1e-14, 1.0), st.just(0.0))
     if name == "atol":
         return st.one_of(real, reals_outside(0.0, 1.0, lo_ok=False))
+    if name == "settle":
+        return st.one_of(
+            NOT_NUMBERS.filter(lambda v: v not in ("off", "auto")),
+            st.text(max_size=6).filter(lambda v: v not in ("off", "auto")),
+            st.sampled_from(["OFF", "Auto", " auto", True, 1]),
+        )
     assert name == "max_steps"
     return st.one_of(not_integers(), ints_outside(1, 2**62))
 
