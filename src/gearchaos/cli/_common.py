@@ -219,6 +219,24 @@ def default_omega_note(quiet: bool, what: str = "swept") -> None:
         )
 
 
+def sweep_fixed(
+    swept: set[str], omega: float | None, changes: Mapping[str, Any], quiet: bool
+) -> dict[str, Any]:
+    """The fixed values of a sweep from ``--set``: refuse a name both swept and set, and fix Ω
+    (the default, with a note, when it is neither swept nor set)."""
+    fixed: dict[str, Any] = dict(changes)
+    for name in sorted(swept & set(fixed)):
+        raise ParameterError(f"{name} is both swept and set with --set; choose one")
+    if OMEGA not in swept:
+        if omega is None:
+            omega = DEFAULT_OMEGA
+            default_omega_note(quiet)
+        fixed[OMEGA] = omega
+    elif omega is not None:
+        raise ParameterError("omega is both swept and set with --set; choose one")
+    return fixed
+
+
 def solver_settings(
     transient: float,
     periods: int,

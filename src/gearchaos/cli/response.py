@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated
 
 import typer
 from rich.markup import escape
@@ -77,7 +77,6 @@ def response(
 
     Example: **gearchaos response --vary omega=0.3:2.5:221 -o response.zarr**
     """
-    from ..model.target import DEFAULT_OMEGA
 
     with c.reported_errors(), c.interruptible():
         if direction not in ("up", "down", "both"):
@@ -85,17 +84,7 @@ def response(
         settings = c.solver_settings(transient, periods, rtol, atol, samples_per_period)
         omega, changes = c.parse_sets(set_ or [])
         gs = c.load_gearset(preset, gearset)
-        swept = vary.split("=", 1)[0].strip()
-        fixed: dict[str, Any] = dict(changes)
-        if swept in fixed:
-            raise ParameterError(f"{swept} is both swept and set with --set; choose one")
-        if swept != "omega":
-            if omega is None:
-                omega = DEFAULT_OMEGA
-                c.default_omega_note(quiet or json_out)
-            fixed["omega"] = omega
-        elif omega is not None:
-            raise ParameterError("omega is both swept and set with --set; choose one")
+        fixed = c.sweep_fixed({vary.split("=", 1)[0].strip()}, omega, changes, quiet or json_out)
 
         from .. import sweep
 

@@ -183,7 +183,6 @@ def bifurcation(
     Example (the seed's Fig. 4): **gearchaos bifurcation --vary omega=0.05:4:800
     --family xi=0.03,0.05,0.07,0.09 -o fig4.zarr**
     """
-    from ..model.target import DEFAULT_OMEGA
 
     with c.reported_errors(), c.interruptible():
         if not vary:
@@ -208,16 +207,7 @@ def bifurcation(
         omega, changes = c.parse_sets(set_ or [])
         gs = c.load_gearset(preset, gearset)
         swept = {_axis_name(v) for v in vary} | ({_axis_name(family)} if family else set())
-        fixed: dict[str, Any] = dict(changes)
-        for name in swept & set(fixed):
-            raise ParameterError(f"{name} is both swept and set with --set; choose one")
-        if "omega" not in swept:
-            if omega is None:
-                omega = DEFAULT_OMEGA
-                c.default_omega_note(quiet or json_out)
-            fixed["omega"] = omega
-        elif omega is not None:
-            raise ParameterError("omega is both swept and set with --set; choose one")
+        fixed = c.sweep_fixed(swept, omega, changes, quiet or json_out)
 
         from .. import sweep
 

@@ -141,27 +141,6 @@ def check_step(obs_prev, obs, dt, n_track, sw, win):  # pragma: no cover - compi
 
 
 @numba.njit(cache=True)
-def first_switch(obs_prev, obs, dt, n_track, sw):  # pragma: no cover - compiled
-    """Fraction θ ∈ (0, 1) of the step at which the first switch is crossed; 2.0 if none."""
-    best = 2.0
-    for k in range(n_track):
-        b = sw[k]
-        if not b < np.inf:
-            continue
-        v0 = obs_prev[k]
-        v1 = obs[k]
-        r0 = _region(v0, b)
-        r1 = _region(v1, b)
-        if r0 == r1:
-            continue
-        level = _first_level(r0, r1, b)
-        x = _hermite_root(v0, v1, obs_prev[n_track + k] * dt, obs[n_track + k] * dt, level)
-        if x < best:
-            best = x
-    return best
-
-
-@numba.njit(cache=True)
 def track(obs_prev, obs, dt, n_track, omin, omax):  # pragma: no cover - compiled
     """Update running extrema over one accepted step (values and Hermite interior extremum)."""
     for k in range(n_track):

@@ -113,6 +113,14 @@ def dead_zone(x: float, b: float) -> float:
     return x - min(max(x, -b), b)  # branch-free: the contact state is unpredictable
 
 
+@numba.njit(cache=True, inline="always")
+def _sinusoid(a, w, s, c, ca, sa):  # pragma: no cover - compiled
+    """e = a sin(wτ + θ) from s = sin wτ, c = cos wτ, ca = cos θ, sa = sin θ, with its first
+    and second τ-derivatives (e'' = −w² e)."""
+    e = a * (s * ca + c * sa)
+    return e, a * w * (c * ca - s * sa), -w * w * e
+
+
 @numba.njit(cache=True, inline="always")  # inlined at the single stage call site
 def planetary_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
     """Minimal relative-coordinate equations of MODEL.md §7.
@@ -214,42 +222,31 @@ def planetary_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
                 tm2, tm1, dm2, dm1 = tm1, tt, dm1, dt_
 
         # --- transmission errors and their τ-derivatives
-        cte = p[P_HEADER + B_CE_SP * N + i]
-        ste = p[P_HEADER + B_SE_SP * N + i]
-        esp = asp * (s1 * cte + c1 * ste)
-        esp_d = asp * om * (c1 * cte - s1 * ste)
-        esp_dd = -om * om * esp  # e'' of every sinusoid is −(its frequency)² times it
-        cte = p[P_HEADER + B_CE_RP * N + i]
-        ste = p[P_HEADER + B_SE_RP * N + i]
-        erp = arp * (s1 * cte + c1 * ste)
-        erp_d = arp * om * (c1 * cte - s1 * ste)
-        erp_dd = -om * om * erp
+        esp, esp_d, esp_dd = _sinusoid(
+            asp, om, s1, c1, p[P_HEADER + B_CE_SP * N + i], p[P_HEADER + B_SE_SP * N + i]
+        )
+        erp, erp_d, erp_dd = _sinusoid(
+            arp, om, s1, c1, p[P_HEADER + B_CE_RP * N + i], p[P_HEADER + B_SE_RP * N + i]
+        )
         if ecc:
-            ca = p[P_HEADER + B_C_ES * N + i]
-            sa = p[P_HEADER + B_S_ES * N + i]
-            e1 = es * (ss_ * ca + cs_ * sa)
-            esp += e1
-            esp_d += es * om_s * (cs_ * ca - ss_ * sa)
-            esp_dd -= om_s * om_s * e1
-            ca = p[P_HEADER + B_C_EPS * N + i]
-            sa = p[P_HEADER + B_S_EPS * N + i]
-            e1 = ep * (sp_ * ca + cp_ * sa)
-            esp += e1
-            esp_d += ep * om_p * (cp_ * ca - sp_ * sa)
-            esp_dd -= om_p * om_p * e1
-            ca = p[P_HEADER + B_C_EPR * N + i]
-            sa = p[P_HEADER + B_S_EPR * N + i]
-            e1 = ep * (sp_ * ca + cp_ * sa)
-            erp += e1
-            erp_d += ep * om_p * (cp_ * ca - sp_ * sa)
-            erp_dd -= om_p * om_p * e1
-            # sin(−Ω_H τ + θ) = sin θ cos(Ω_H τ) − cos θ sin(Ω_H τ)
-            ca = p[P_HEADER + B_C_ER * N + i]
-            sa = p[P_HEADER + B_S_ER * N + i]
-            e1 = er * (sa * cr_ - ca * sr_)
-            erp += e1
-            erp_d += er * om_r * (-sa * sr_ - ca * cr_)
-            erp_dd -= om_r * om_r * e1
+            for a, w, s_, c_, bc, bs, to_sp in (
+                (es, om_s, ss_, cs_, B_C_ES, B_S_ES, True),
+                (ep, om_p, sp_, cp_, B_C_EPS, B_S_EPS, True),
+                (ep, om_p, sp_, cp_, B_C_EPR, B_S_EPR, False),
+                # sin(−Ω_H τ + θ) = sin θ cos(Ω_H τ) + cos θ sin(−Ω_H τ): frequency −Ω_H
+                (er, -om_r, -sr_, cr_, B_C_ER, B_S_ER, False),
+            ):
+                e1, e1_d, e1_dd = _sinusoid(
+                    a, w, s_, c_, p[P_HEADER + bc * N + i], p[P_HEADER + bs * N + i]
+                )
+                if to_sp:
+                    esp += e1
+                    esp_d += e1_d
+                    esp_dd += e1_dd
+                else:
+                    erp += e1
+                    erp_d += e1_d
+                    erp_dd += e1_dd
 
         pi_ = y[2 + i]
         pid = y[n + 2 + i]
