@@ -21,6 +21,7 @@ from .units import (
     clearance_notes,
     fit_to_data,
     secondary_axis,
+    section_points,
     section_style,
     var_quantity,
 )
@@ -39,22 +40,6 @@ def _with_dot(result: Any, var: str | None, planet: int) -> VarInfo:
 
 #: An orbit within this fraction of the bearing clearance b̄_s is round-off around the centre.
 _AT_REST = 1e-9
-
-
-def _section_points(ax: Any, xs: np.ndarray, ys: np.ndarray) -> None:
-    """Overlay Poincaré section points, sized and faded by their number (:func:`section_style`)."""
-    style = section_style(xs.size)
-    ax.plot(
-        xs,
-        ys,
-        ".",
-        ms=max(1.0, float(np.sqrt(style["s"]))),
-        alpha=style["alpha"],
-        color="C3",
-        label="section points",
-        zorder=3,
-        rasterized=True,
-    )
 
 
 def phase_portrait(
@@ -103,7 +88,7 @@ def phase_portrait(
         ax.plot(x[sl], xd[sl], lw=0.5, color="C0", alpha=0.8, label="orbit")
         data_x.append(x[sl])
         data_y.append(xd[sl])
-    _section_points(ax, xs, xds)
+    section_points(ax, xs, xds)
     _finish(ax, result, info, np.concatenate(data_x), np.concatenate(data_y), physical)
     return ax
 
@@ -176,7 +161,7 @@ def sun_orbit(result: Any, ax: Any = None, periods: float | None = None) -> Any:
         sl = sample_window(result, periods)
         ax.plot(x[sl], y[sl], lw=0.5, color="C0", label="orbit")
     xs, ys = np.asarray(result.section("x_s")), np.asarray(result.section("y_s"))
-    _section_points(ax, xs, ys)
+    section_points(ax, xs, ys)
     b = xi.clearance
     if b is not None and b > 0:
         ax.add_patch(

@@ -23,7 +23,7 @@ from .units import (
     fit_to_data,
     linear_axis,
     secondary_axis,
-    section_style,
+    section_points,
     var_quantity,
 )
 
@@ -78,17 +78,7 @@ def time_history(
         ax.plot(t[sl], y[sl], lw=0.8, color="C0", label=f"${info.symbol}$")
     idx = np.arange(result.tau.size)[sl]
     sec = idx[idx % s == 0]
-    style = section_style(sec.size)
-    ax.plot(
-        t[sec],
-        y[sec],
-        ".",
-        ms=max(1.0, float(np.sqrt(style["s"]))),
-        alpha=style["alpha"],
-        color="C3",
-        label="section points",
-        zorder=3,
-    )
+    section_points(ax, t[sec], y[sec])
     clearance_lines(ax, info)
     ax.set_xlabel(period_axis_label(result))
     ax.set_ylabel(info.label)

@@ -26,6 +26,7 @@ __all__ = [
     "linear_axis",
     "notes_clear_of",
     "secondary_axis",
+    "section_points",
     "section_style",
     "var_quantity",
 ]
@@ -246,3 +247,20 @@ def section_style(n: int) -> dict[str, float]:
     s = float(np.clip(60.0 / math.sqrt(n), 0.25, 16.0))
     alpha = float(np.clip((300.0 / n) ** 0.35, 0.3, 1.0))
     return {"s": s, "alpha": alpha}
+
+
+def section_points(ax: Any, xs: np.ndarray, ys: np.ndarray) -> None:
+    """Overlay Poincaré section points, sized and faded by their number (:func:`section_style`;
+    Poincaré maps, phase portraits and time histories alike)."""
+    style = section_style(xs.size)
+    ax.plot(
+        xs,
+        ys,
+        ".",
+        ms=max(1.0, float(np.sqrt(style["s"]))),
+        alpha=style["alpha"],
+        color="C3",
+        label="section points",
+        zorder=3,
+        rasterized=True,
+    )
