@@ -285,7 +285,14 @@ def bifurcation(
         pad = 0.01 * (hi - lo)
         ax.set_xlim(lo - pad, hi + pad)
     # the y axis follows the section values (the clearance lines and branches never widen it)
-    fit_to_data(ax, None, np.concatenate(all_y) if all_y else None)
+    # drawn relative to b̄, the degenerate-span test still uses |X̄| (integration noise scales
+    # with it), so a settled point does not become a magnified cloud of round-off
+    mag = (
+        float(np.nanmax(np.abs(np.concatenate(all_y)) + np.nanmax(b_line)))
+        if (relative and all_y and np.concatenate(all_y).size)
+        else None
+    )
+    fit_to_data(ax, None, np.concatenate(all_y) if all_y else None, mag=mag)
     levels = np.asarray(found[0], dtype=np.float64).ravel() if found is not None else None
     if found is not None and relative:
         edge = rf"drive-flank edge $\bar X = {found[1]}$"
