@@ -21,13 +21,11 @@ quotes).
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
 import datetime
 import json
 import math
 import os
-import signal
 import time
 from collections import Counter
 from collections.abc import Callable, Iterator
@@ -36,6 +34,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from fuzz_helpers import Hung, alarm
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -73,31 +72,13 @@ def _settings(n: int) -> settings:
 
 
 # ----------------------------------------------------------------------------- the harness
-class _Hung(Exception):
-    pass
-
-
-@contextlib.contextmanager
-def _alarm(seconds: float) -> Iterator[None]:
-    def ring(signum: int, frame: object) -> None:
-        raise _Hung(f"no answer after {seconds} s")
-
-    old = signal.signal(signal.SIGALRM, ring)
-    signal.setitimer(signal.ITIMER_REAL, seconds)
-    try:
-        yield
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, old)
-
-
 def refused(entry: str, call: Callable[[], object], *culprits: str) -> BaseException:
     """Run ``call``: it must raise ParameterError/StoreError naming one of ``culprits`` (none
     given: any message) within :data:`CALL_SECONDS`."""
     COUNTS[entry] += 1
     start = time.perf_counter()
     try:
-        with _alarm(HANG_SECONDS):
+        with alarm(HANG_SECONDS):
             call()
     except (ParameterError, StoreError) as exc:
         elapsed = time.perf_counter() - start
@@ -107,7 +88,7 @@ def refused(entry: str, call: Callable[[], object], *culprits: str) -> BaseExcep
         if culprits:
             assert any(c in message for c in culprits), f"{entry}: {culprits} not in {message!r}"
         return exc
-    except _Hung:
+    except Hung:
         pytest.fail(f"{entry}: hung for {HANG_SECONDS} s")
     except BaseException as exc:  # a traceback a user would see
         pytest.fail(f"{entry}: raised {type(exc).__name__}: {exc}")
