@@ -24,6 +24,8 @@ __all__ = [
     "info_renderables",
     "pairs_table",
     "regime_table",
+    "sweep_summary",
+    "sweep_table",
 ]
 
 
@@ -255,4 +257,24 @@ def gallery_rows_table(rows: Sequence[Mapping[str, Any]], param: str, *, title: 
             Text("yes" if agree else "no", style="" if agree else "bold red"),
             str(r.get("distinct_section_points", "—")),
         )
+    return table
+
+
+def sweep_summary(res: Any, output: Any, seconds: float) -> dict[str, Any]:
+    """What a sweep command reports (``--json``): store, points, failed points and seconds."""
+    return {
+        "store": str(output),
+        "points": int(res.status().size),
+        "failed": res.n_failed,
+        "seconds": seconds,
+    }
+
+
+def sweep_table(title: str, res: Any, summary: Mapping[str, Any]) -> Table:
+    """The summary table of a sweep command, headed by its grid, points and failed points."""
+    table = pairs_table(title)
+    table.add_row("grid", escape(" × ".join(f"{d} ({res.ds.sizes[d]})" for d in res.lead_dims)))
+    table.add_row("points", str(summary["points"]))
+    failed = summary["failed"]
+    table.add_row("failed", Text(str(failed), style="bold red" if failed else ""))
     return table

@@ -13,7 +13,7 @@ from rich.text import Text
 from ..errors import ParameterError
 from ..sweep.spec import RESPONSE_SOLVER
 from . import _common as c
-from ._render import pairs_table
+from ._render import sweep_summary, sweep_table
 
 
 @c.app.command()
@@ -102,16 +102,12 @@ def response(
         )
         seconds = time.perf_counter() - t0
         res = sweep.SweepResult.of(ds)
-        points, failed = int(res.status().size), res.n_failed
         lf = {
             m: float(ds[f"load_factor_{m}"].max()) for m in ("sp", "rp") if f"load_factor_{m}" in ds
         }
 
     result = {
-        "store": str(output),
-        "points": points,
-        "failed": failed,
-        "seconds": seconds,
+        **sweep_summary(res, output, seconds),
         **{f"load_factor_{m}_max": v for m, v in lf.items()},
     }
     if json_out:
@@ -119,10 +115,7 @@ def response(
         return
     if quiet:
         return
-    table = pairs_table(f"gearchaos frequency response of {gs.name}")
-    table.add_row("grid", escape(" × ".join(f"{d} ({res.ds.sizes[d]})" for d in res.lead_dims)))
-    table.add_row("points", str(points))
-    table.add_row("failed", Text(str(failed), style="bold red" if failed else ""))
+    table = sweep_table(f"gearchaos frequency response of {gs.name}", res, result)
     for m, v in lf.items():
         table.add_row(f"largest load factor {m}", f"{v:.4g}")
     table.add_row("seconds", f"{seconds:.3g}")

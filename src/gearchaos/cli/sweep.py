@@ -14,7 +14,7 @@ from rich.text import Text
 from ..errors import ParameterError
 from ..gearset.parsing import parse_int
 from . import _common as c
-from ._render import pairs_table, regime_table
+from ._render import regime_table, sweep_summary, sweep_table
 
 
 def _parse_planets(raw: str | None) -> tuple[int, ...]:
@@ -233,14 +233,8 @@ def bifurcation(
         )
         seconds = time.perf_counter() - t0
         res = sweep.SweepResult.of(ds)
-        points, failed = int(res.status().size), res.n_failed
 
-    result: dict[str, Any] = {
-        "store": str(output),
-        "points": points,
-        "failed": failed,
-        "seconds": seconds,
-    }
+    result: dict[str, Any] = sweep_summary(res, output, seconds)
     if orbits:
         import numpy as np
 
@@ -255,13 +249,10 @@ def bifurcation(
         return
     if quiet:
         return
-    table = pairs_table(f"gearchaos bifurcation of {gs.name}")
-    table.add_row("grid", escape(" × ".join(f"{d} ({res.ds.sizes[d]})" for d in res.lead_dims)))
-    table.add_row("points", str(points))
-    table.add_row("failed", Text(str(failed), style="bold red" if failed else ""))
+    table = sweep_table(f"gearchaos bifurcation of {gs.name}", res, result)
     table.add_row("seconds", f"{seconds:.3g}")
     if seconds > 0:
-        table.add_row("points/s", f"{points / seconds:.3g}")
+        table.add_row("points/s", f"{result['points'] / seconds:.3g}")
     table.add_row("store", escape(str(output)))
     out = c.stdout()
     out.print(table)
