@@ -74,7 +74,8 @@ def invalid_setting(name: str) -> st.SearchStrategy[Any]:
         return st.one_of(real, reals_outside(0.0, 1.0, lo_ok=False))
     if name == "settle":
         return st.one_of(
-            NOT_NUMBERS.filter(lambda v: v not in ("off", "auto")),
+            # NOT_NUMBERS holds arrays too, which `in` cannot compare: only strings can match
+            NOT_NUMBERS.filter(lambda v: not isinstance(v, str) or v not in ("off", "auto")),
             st.text(max_size=6).filter(lambda v: v not in ("off", "auto")),
             st.sampled_from(["OFF", "Auto", " auto", True, 1]),
         )
