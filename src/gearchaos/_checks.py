@@ -21,8 +21,10 @@ __all__ = [
     "check_choice",
     "check_int",
     "check_memory",
+    "check_path",
     "check_real",
     "got",
+    "real_array",
 ]
 
 
@@ -93,6 +95,30 @@ def check_int(name: str, value: Any, *, lo: int | None = None, hi: int | None = 
     if hi is not None and n > hi:
         raise ParameterError(f"{name} must be an integer <= {hi}: {got(value)}")
     return n
+
+
+def real_array(value: Any) -> Any:
+    """``value`` as a float64 array when it holds real numbers only (integers or floats of any
+    precision), else ``None``: bools, text, complex numbers and objects are not numbers."""
+    import numpy as np
+
+    try:
+        raw = np.asarray(value)
+        if raw.dtype.kind not in "fiu":
+            return None
+        return raw.astype(np.float64)
+    except (TypeError, ValueError, OverflowError):
+        return None
+
+
+def check_path(value: Any, message: str, error: type[Exception] = ParameterError) -> str:
+    """``value`` as the text of a file-system path, or ``error(message)``: the one rule for
+    every argument that names a file or store — a ``str`` or path-like object whose path is
+    text, not blank and without a NUL character."""
+    text = os.fspath(value) if isinstance(value, str | os.PathLike) else None
+    if not isinstance(text, str) or not text.strip() or "\0" in text:
+        raise error(message)
+    return text
 
 
 def check_bool(name: str, value: Any) -> bool:

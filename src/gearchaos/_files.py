@@ -23,6 +23,7 @@ import os
 import stat
 from pathlib import Path
 
+from ._checks import check_path
 from .errors import ParameterError, StoreError
 
 __all__ = ["MissingFileError", "check_output_file", "check_regular_file", "read_text_file"]
@@ -177,9 +178,7 @@ def check_output_file(path: object, *, what: str) -> str:
     :class:`~gearchaos.errors.ParameterError`, and an existing path that is not a regular file
     (a directory, a FIFO, a device such as ``/dev/null``, a socket) with
     :class:`~gearchaos.errors.StoreError` — a rename would replace it."""
-    text = os.fspath(path) if isinstance(path, str | os.PathLike) else None
-    if not isinstance(text, str) or not text.strip() or "\0" in text:
-        raise ParameterError(f"{what} must be a file path: got {path!r}")
+    text = check_path(path, f"{what} must be a file path: got {path!r}")
     try:
         mode = os.stat(text).st_mode
     except FileNotFoundError:

@@ -43,7 +43,7 @@ from typing import Any
 
 import numpy as np
 
-from .._checks import check_bool
+from .._checks import check_bool, check_path
 from .._files import check_regular_file
 from .._version import provenance
 from ..errors import ParameterError, StoreError
@@ -292,11 +292,7 @@ def branch_multipliers(ds: Any) -> np.ndarray:
 def check_store(path: str | os.PathLike[str], overwrite: bool = False) -> str:
     """The kind of a branch file (``zarr`` or ``netcdf``) from its suffix; refuses other
     suffixes and, unless ``overwrite``, existing paths (before any computation)."""
-    if not isinstance(path, str | os.PathLike) or not os.fspath(path).strip():
-        raise ParameterError(f"store must be a path ending in .nc or .zarr: got {path!r}")
-    path = os.fspath(path)
-    if not isinstance(path, str) or "\0" in path:
-        raise ParameterError(f"store must be a path ending in .nc or .zarr: got {path!r}")
+    path = check_path(path, f"store must be a path ending in .nc or .zarr: got {path!r}")
     check_bool("overwrite", overwrite)
     if path.endswith(".zarr"):
         kind = "zarr"
@@ -355,9 +351,7 @@ def open_branch(path: str | os.PathLike[str]) -> Any:
     """Open a branch written by :func:`save_branch` (loaded into memory)."""
     import xarray as xr
 
-    if not isinstance(path, str | os.PathLike) or not os.fspath(path) or "\0" in str(path):
-        raise ParameterError(f"branch must be a path (BRANCH.nc or BRANCH.zarr): got {path!r}")
-    path = os.fspath(path)
+    path = check_path(path, f"branch must be a path (BRANCH.nc or BRANCH.zarr): got {path!r}")
     if not os.path.lexists(path):
         raise StoreError(f"branch {path} does not exist")
     try:

@@ -380,3 +380,48 @@ def output_path(raw: str | None, option: str = "--output") -> Path | None:
     if not raw.strip():
         raise ParameterError(f"{option} must be a path: got an empty string")
     return Path(raw)
+
+
+def run_sweep(
+    fn: Any,
+    *args: Any,
+    settings: Any,
+    output: Path,
+    overwrite: bool,
+    workers: int | None,
+    quiet: bool,
+    **options: Any,
+) -> tuple[Any, float]:
+    """``fn(*args, **options)`` (a sweep function of :mod:`gearchaos.sweep`) with the options
+    every sweep command shares — solver settings, store, overwrite, workers, a progress bar
+    unless ``quiet`` — timed; returns its :class:`~gearchaos.sweep.SweepResult` and seconds."""
+    import time
+
+    from ..sweep import SweepResult
+
+    t0 = time.perf_counter()
+    ds = fn(
+        *args,
+        solver=settings,
+        store=output,
+        overwrite=overwrite,
+        workers=workers,
+        progress=not quiet,
+        **options,
+    )
+    return SweepResult.of(ds), time.perf_counter() - t0
+
+
+def sweep_report(
+    title: str, res: Any, result: Mapping[str, Any], *, json_out: bool, quiet: bool
+) -> Any:
+    """What a sweep command prints of ``result`` (its summary): the JSON with ``--json``,
+    nothing with ``--quiet`` (both return None), else the summary table to be completed."""
+    from ._render import sweep_table
+
+    if json_out:
+        print_json(result)
+        return None
+    if quiet:
+        return None
+    return sweep_table(title, res, result)

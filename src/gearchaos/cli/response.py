@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import time
 from pathlib import Path
 from typing import Annotated
 
@@ -13,7 +12,7 @@ from rich.text import Text
 from ..errors import ParameterError
 from ..sweep.spec import RESPONSE_SOLVER
 from . import _common as c
-from ._render import sweep_summary, sweep_table
+from ._render import sweep_summary
 
 
 @c.app.command()
@@ -88,20 +87,19 @@ def response(
 
         from .. import sweep
 
-        t0 = time.perf_counter()
-        ds = sweep.response(
+        res, seconds = c.run_sweep(
+            sweep.response,
             gs,
             vary,
-            direction=direction,
-            fixed=fixed,
-            solver=settings,
-            store=output,
+            settings=settings,
+            output=output,
             overwrite=overwrite,
             workers=workers,
-            progress=not quiet,
+            quiet=quiet,
+            direction=direction,
+            fixed=fixed,
         )
-        seconds = time.perf_counter() - t0
-        res = sweep.SweepResult.of(ds)
+        ds = res.ds
         lf = {
             m: float(ds[f"load_factor_{m}"].max()) for m in ("sp", "rp") if f"load_factor_{m}" in ds
         }
@@ -110,12 +108,10 @@ def response(
         **sweep_summary(res, output, seconds),
         **{f"load_factor_{m}_max": v for m, v in lf.items()},
     }
-    if json_out:
-        c.print_json(result)
+    title = f"gearchaos frequency response of {gs.name}"
+    table = c.sweep_report(title, res, result, json_out=json_out, quiet=quiet)
+    if table is None:
         return
-    if quiet:
-        return
-    table = sweep_table(f"gearchaos frequency response of {gs.name}", res, result)
     for m, v in lf.items():
         table.add_row(f"largest load factor {m}", f"{v:.4g}")
     table.add_row("seconds", f"{seconds:.3g}")

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import time
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -14,7 +13,7 @@ from rich.text import Text
 from ..errors import ParameterError
 from ..gearset.parsing import parse_int
 from . import _common as c
-from ._render import regime_table, sweep_summary, sweep_table
+from ._render import regime_table, sweep_summary
 
 
 def _parse_planets(raw: str | None) -> tuple[int, ...]:
@@ -211,10 +210,15 @@ def bifurcation(
 
         from .. import sweep
 
-        t0 = time.perf_counter()
-        ds = sweep.bifurcation(
+        res, seconds = c.run_sweep(
+            sweep.bifurcation,
             gs,
             list(vary),
+            settings=settings,
+            output=output,
+            overwrite=overwrite,
+            workers=workers,
+            quiet=quiet,
             family=family,
             fixed=fixed,
             observe=tuple(observe) if observe else None,
@@ -223,16 +227,9 @@ def bifurcation(
             direction=direction,
             lyapunov=lyapunov,
             orbits=orbits,
-            solver=settings,
-            store=output,
-            overwrite=overwrite,
-            workers=workers,
             scheduler=scheduler,
             dask_local=dask_local,
-            progress=not quiet,
         )
-        seconds = time.perf_counter() - t0
-        res = sweep.SweepResult.of(ds)
 
     result: dict[str, Any] = sweep_summary(res, output, seconds)
     if orbits:
@@ -244,12 +241,10 @@ def bifurcation(
         result["orbits"] = {
             k: int(np.sum(codes == v)) for k, v in ORBIT_STATUS.items() if np.any(codes == v)
         }
-    if json_out:
-        c.print_json(result)
+    title = f"gearchaos bifurcation of {gs.name}"
+    table = c.sweep_report(title, res, result, json_out=json_out, quiet=quiet)
+    if table is None:
         return
-    if quiet:
-        return
-    table = sweep_table(f"gearchaos bifurcation of {gs.name}", res, result)
     table.add_row("seconds", f"{seconds:.3g}")
     if seconds > 0:
         table.add_row("points/s", f"{result['points'] / seconds:.3g}")

@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from .._checks import check_real
+from .._checks import check_real, real_array
 from ..errors import ParameterError
 from . import layout as L
 from .system import System
@@ -215,15 +215,11 @@ def backlash_oscillator(
 
 def _real_array(name: str, value: Any) -> np.ndarray:
     """An array of finite real numbers (no bools, text or complex numbers)."""
-    try:
-        raw = np.asarray(value)
-        if raw.dtype.kind not in "fiu":
-            raise TypeError(raw.dtype)
-        a = raw.astype(np.float64)
-    except (TypeError, ValueError, OverflowError):
+    a = real_array(value)
+    if a is None:
         raise ParameterError(
             f"{name} must be an array of real numbers: got {type(value).__name__}"
-        ) from None
+        )
     if not np.all(np.isfinite(a)):
         raise ParameterError(f"{name} must be finite: got NaN or inf")
     return a

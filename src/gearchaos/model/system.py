@@ -207,18 +207,15 @@ class System:
     def check_state(self, value: Any, what: str = "y0") -> np.ndarray:
         """``value`` as a state of this system: ``n_state`` finite numbers, else a
         :class:`~gearchaos.errors.ParameterError` naming ``what`` and the components."""
+        from .._checks import real_array
         from ..errors import ParameterError
 
         names = ", ".join(self.state_names)
-        try:
-            raw = np.asarray(value)
-            if raw.dtype.kind not in "fiu":  # bools, text, complex numbers, objects
-                raise TypeError(raw.dtype)
-            y = raw.astype(np.float64)
-        except (TypeError, ValueError, OverflowError):
+        y = real_array(value)
+        if y is None:
             raise ParameterError(
                 f"{what} must be {self.n_state} numbers ({names}): got {type(value).__name__}"
-            ) from None
+            )
         if y.ndim != 1 or y.size != self.n_state:
             raise ParameterError(
                 f"{what} must be a vector of {self.n_state} entries ({names}): got shape {y.shape}"

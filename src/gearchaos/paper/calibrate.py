@@ -53,7 +53,7 @@ from typing import Any, TypeVar
 
 import numpy as np
 
-from .._checks import check_bool, check_int, check_real
+from .._checks import check_bool, check_int, check_path, check_real
 from .._files import MissingFileError, read_text_file
 from ..errors import ParameterError, StoreError
 from ..integrate.settings import SolverSettings
@@ -430,8 +430,7 @@ def calibrate(
     check_real("budget_minutes", budget_minutes, lo=0.0, lo_open=True)
     check_int("seed", seed, lo=0)
     quick = check_bool("quick", quick)
-    if not isinstance(out, str | os.PathLike) or not str(os.fspath(out)).strip():
-        raise ParameterError(f"out must be the path of a JSON-lines file: got {out!r}")
+    check_path(out, f"out must be the path of a JSON-lines file: got {out!r}")
     out_path = Path(out)
     if quick:
         max_candidates = 3 if max_candidates is None else min(max_candidates, 3)

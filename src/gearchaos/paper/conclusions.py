@@ -347,48 +347,55 @@ def _gather_routes(
     return onsets, texts, informative
 
 
+def _route_conclusion(
+    number: int,
+    stores: Stores,
+    figures: Sequence[str],
+    branches: Branches | None,
+    judge: Callable[[dict[str, int]], tuple[bool, bool, dict[str, Any], str]],
+) -> Verdict:
+    """A conclusion about the routes to chaos along the sweeps of ``figures``.
+
+    ``judge(route counts)`` gives (claim met in full, met in part, what it measured, the end
+    of the evidence). Without onsets the verdict is "does not hold" when the stores could have
+    shown one and "not evaluated" when not; with onsets "holds", "partly" or "does not hold".
+    """
+    if not any(f in stores for f in figures):
+        return _missing(number, list(figures))
+    onsets, texts, informative = _gather_routes(stores, figures, branches)
+    counts = _route_counts(onsets)
+    full, some, extra, tail = judge(counts)
+    if not onsets:
+        verdict = "does not hold" if informative else "not evaluated"
+    else:
+        verdict = "holds" if full else ("partly" if some else "does not hold")
+    measured = {"route_counts": counts, "onsets": onsets, **extra}
+    return _verdict(number, verdict, "; ".join(texts) + tail, measured)
+
+
 def conclusion_4(
     stores: Stores, figures: Sequence[str] = ("fig4",), branches: Branches | None = None
 ) -> Verdict:
     """Onsets of chaos along Ω: is crisis (a jump of the attractor) among their routes?"""
-    if not any(f in stores for f in figures):
-        return _missing(4, list(figures))
-    onsets, texts, informative = _gather_routes(stores, figures, branches)
-    counts = _route_counts(onsets)
-    measured = {"route_counts": counts, "onsets": onsets}
-    evidence = "; ".join(texts) + f"; routes: {counts or 'none'}"
-    crisis = counts.get("crisis", 0)
-    if not onsets:
-        verdict = "does not hold" if informative else "not evaluated"
-    elif crisis and crisis >= max(counts.values()):
-        verdict = "holds"
-    elif crisis:
-        verdict = "partly"
-    else:
-        verdict = "does not hold"
-    return _verdict(4, verdict, evidence, measured)
+
+    def judge(counts: dict[str, int]) -> tuple[bool, bool, dict[str, Any], str]:
+        crisis = counts.get("crisis", 0)
+        full = bool(crisis) and crisis >= max(counts.values())
+        return full, bool(crisis), {}, f"; routes: {counts or 'none'}"
+
+    return _route_conclusion(4, stores, figures, branches, judge)
 
 
 def conclusion_5(
     stores: Stores, figures: Sequence[str] = ("fig6", "fig8"), branches: Branches | None = None
 ) -> Verdict:
     """Onsets of chaos along b̄_sp: both crisis and period doubling found?"""
-    if not any(f in stores for f in figures):
-        return _missing(5, list(figures))
-    onsets, texts, informative = _gather_routes(stores, figures, branches)
-    counts = _route_counts(onsets)
-    found = [r for r in ("crisis", "period doubling") if counts.get(r)]
-    measured = {"route_counts": counts, "onsets": onsets, "found": found}
-    evidence = "; ".join(texts) + f"; routes: {counts or 'none'}"
-    if not onsets:
-        verdict = "does not hold" if informative else "not evaluated"
-    elif len(found) == 2:
-        verdict = "holds"
-    elif found:
-        verdict = "partly"
-    else:
-        verdict = "does not hold"
-    return _verdict(5, verdict, evidence, measured)
+
+    def judge(counts: dict[str, int]) -> tuple[bool, bool, dict[str, Any], str]:
+        found = [r for r in ("crisis", "period doubling") if counts.get(r)]
+        return len(found) == 2, bool(found), {"found": found}, f"; routes: {counts or 'none'}"
+
+    return _route_conclusion(5, stores, figures, branches, judge)
 
 
 ROUTE_TYPES = ("period doubling", "crisis", "Hopf", "3T channel")
@@ -398,25 +405,13 @@ def conclusion_6(
     stores: Stores, figures: Sequence[str] = ("fig9", "fig11"), branches: Branches | None = None
 ) -> Verdict:
     """Onsets of chaos along b̄_rp: how many of the paper's four route types coexist?"""
-    if not any(f in stores for f in figures):
-        return _missing(6, list(figures))
-    onsets, texts, informative = _gather_routes(stores, figures, branches)
-    counts = _route_counts(onsets)
-    kinds = [r for r in ROUTE_TYPES if counts.get(r)]
-    measured = {"route_counts": counts, "route_types": kinds, "onsets": onsets}
-    evidence = (
-        "; ".join(texts)
-        + f"; {len(kinds)} of the paper's 4 route types found ({', '.join(kinds) or 'none'})"
-    )
-    if not onsets and not informative:
-        verdict = "not evaluated"
-    elif len(kinds) >= 3:
-        verdict = "holds"
-    elif len(kinds) == 2:
-        verdict = "partly"
-    else:
-        verdict = "does not hold"
-    return _verdict(6, verdict, evidence, measured)
+
+    def judge(counts: dict[str, int]) -> tuple[bool, bool, dict[str, Any], str]:
+        kinds = [r for r in ROUTE_TYPES if counts.get(r)]
+        tail = f"; {len(kinds)} of the paper's 4 route types found ({', '.join(kinds) or 'none'})"
+        return len(kinds) >= 3, len(kinds) == 2, {"route_types": kinds}, tail
+
+    return _route_conclusion(6, stores, figures, branches, judge)
 
 
 def conclusion_7(

@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from .._checks import check_path
 from .._files import check_output_file
 from ..errors import ParameterError, StoreError
 
@@ -61,11 +62,9 @@ def open_result(source: Any) -> Any:
         return source.to_dataset()
     if hasattr(source, "ds") and isinstance(source.ds, xr.Dataset):
         return source.ds
-    if not isinstance(source, str | os.PathLike) or not os.fspath(source):
-        raise ParameterError(
-            f"source must be a sweep store, a simulation file or a Dataset: got {source!r}"
-        )
-    path = os.fspath(source)
+    path = check_path(
+        source, f"source must be a sweep store, a simulation file or a Dataset: got {source!r}"
+    )
     if os.path.isdir(path):
         from .store import open_sweep
 

@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from .._checks import check_path
 from ..errors import ParameterError, Status, StoreError
 from ..gearset.schema import CLEARANCES, FIELDS, OMEGA
 from .store import open_sweep
@@ -372,9 +373,7 @@ def open_result(path: str | os.PathLike[str]) -> SweepResult:
     (``store not found: 'RUN.zarr'``), a damaged or foreign store a
     :class:`~gearchaos.errors.StoreError` or a ``ParameterError`` naming the path and why.
     """
-    if not isinstance(path, str | os.PathLike) or not os.fspath(path) or "\0" in str(path):
-        raise ParameterError(f"store must be the path of a sweep store: got {path!r}")
-    root = os.fspath(path)
+    root = check_path(path, f"store must be the path of a sweep store: got {path!r}")
     if not os.path.exists(root):
         raise ParameterError(f"store not found: {root!r}")
     try:

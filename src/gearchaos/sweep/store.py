@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from .._checks import check_path
 from ..errors import StoreError
 from ..gearset.mapping import flatten
 from .integrity import (
@@ -69,9 +70,9 @@ def open_sweep(path: str | os.PathLike[str], *, verify: bool = True) -> Any:
     """
     import xarray as xr
 
-    if not isinstance(path, str | os.PathLike) or not os.fspath(path):
-        raise StoreError(f"a sweep store path must be a non-empty path: got {path!r}")
-    root = os.fspath(path)
+    root = check_path(
+        path, f"a sweep store path must be a non-empty path: got {path!r}", StoreError
+    )
     if not os.path.exists(root):
         raise StoreError(f"no sweep store at {root!r} (no such file or directory)")
     if not os.path.isdir(root):
