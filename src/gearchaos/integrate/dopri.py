@@ -161,34 +161,12 @@ def _settled(y, ring, runs, n_sec, n_base):  # pragma: no cover - compiled
 
 @numba.njit(cache=True)
 def dopri_run(
-    kind,
-    y0,
-    p,
-    t0,
-    t_rec,
-    dt_sample,
-    n_samples,
-    t_end,
-    n_obs,
-    n_track,
-    sw,
-    n_base,
-    rtol,
-    atol,
-    h_init,
-    max_step,
-    max_steps,
-    out_t,
-    out_y,
-    out_obs,
-    obs_min,
-    obs_max,
-    y_final,
-    info,
-    lsum,
-    settle_spp,
+    kind, y0, p, sw, t0, t_rec, dt_sample, t_end, cfg, out, info, lsum
 ):  # pragma: no cover - compiled
-    """Integrate one system; fill the output arrays; return the status code.
+    """Integrate one system; fill the output arrays ``out`` = (out_t, out_y, out_obs,
+    obs_min, obs_max, y_final); return the status code. ``cfg`` = (n_samples, n_obs, n_track,
+    n_base, rtol, atol, h_init, max_step, max_steps, settle_spp): the numbers every point of a
+    run shares, one tuple so that their list is written once (:func:`dopri_chains`).
 
     Samples are taken at τ_j = t_rec + j·dt_sample, j = 0 … n_samples−1 (t_rec ≥ t0), then the
     integration goes on to t_end ≥ τ_last. Extrema of obs[:n_track] are tracked over
@@ -215,6 +193,8 @@ def dopri_run(
     to the tolerance, not bitwise.
     """
     numba.literally(kind)
+    n_samples, n_obs, n_track, n_base, rtol, atol, h_init, max_step, max_steps, settle_spp = cfg
+    out_t, out_y, out_obs, obs_min, obs_max, y_final = out
     n = y0.size
     y = y0.copy()
     yt = np.empty(n)
@@ -506,36 +486,25 @@ def dopri_chains(
     numba.literally(kind)
     n_chains = P.shape[0]
     length = P.shape[1]
+    cfg = (n_samples, n_obs, n_track, n_base, rtol, atol, h_init, max_step, max_steps, settle_spp)
     for c in numba.prange(n_chains):
         y = Y0[c].copy()
         for j in range(length):
+            out = (out_t[c, j], out_y[c, j], out_obs[c, j])
+            ext = (obs_min[c, j], obs_max[c, j], y_final[c, j])
             st = dopri_run(
                 kind,
                 y,
                 P[c, j],
+                SW[c, j],
                 t0[c, j],
                 t_rec[c, j],
                 dt_sample[c, j],
-                n_samples,
                 t_end[c, j],
-                n_obs,
-                n_track,
-                SW[c, j],
-                n_base,
-                rtol,
-                atol,
-                h_init,
-                max_step,
-                max_steps,
-                out_t[c, j],
-                out_y[c, j],
-                out_obs[c, j],
-                obs_min[c, j],
-                obs_max[c, j],
-                y_final[c, j],
+                cfg,
+                out + ext,
                 info[c, j],
                 LSUM[c, j],
-                settle_spp,
             )
             status[c, j] = st
             if continuation and st == ST_OK:
