@@ -21,7 +21,6 @@ __all__ = [
     "check_choice",
     "check_int",
     "check_memory",
-    "check_path",
     "check_real",
     "got",
     "real_array",
@@ -109,16 +108,6 @@ def real_array(value: Any) -> Any:
         return raw.astype(np.float64)
     except (TypeError, ValueError, OverflowError):
         return None
-
-
-def check_path(value: Any, message: str, error: type[Exception] = ParameterError) -> str:
-    """``value`` as the text of a file-system path, or ``error(message)``: the one rule for
-    every argument that names a file or store — a ``str`` or path-like object whose path is
-    text, not blank and without a NUL character."""
-    text = os.fspath(value) if isinstance(value, str | os.PathLike) else None
-    if not isinstance(text, str) or not text.strip() or "\0" in text:
-        raise error(message)
-    return text
 
 
 def check_bool(name: str, value: Any) -> bool:

@@ -23,10 +23,15 @@ import os
 import stat
 from pathlib import Path
 
-from ._checks import check_path
 from .errors import ParameterError, StoreError
 
-__all__ = ["MissingFileError", "check_output_file", "check_regular_file", "read_text_file"]
+__all__ = [
+    "MissingFileError",
+    "check_output_file",
+    "check_path",
+    "check_regular_file",
+    "read_text_file",
+]
 
 _KINDS = (
     (stat.S_ISDIR, "a directory"),
@@ -35,6 +40,16 @@ _KINDS = (
     (stat.S_ISBLK, "a block device"),
     (stat.S_ISSOCK, "a socket"),
 )
+
+
+def check_path(value: object, message: str, error: type[Exception] = ParameterError) -> str:
+    """``value`` as the text of a file-system path, or ``error(message)``: the one rule for
+    every argument that names a file or store — a ``str`` or path-like object whose path is
+    text, not blank and without a NUL character."""
+    text = os.fspath(value) if isinstance(value, str | os.PathLike) else None
+    if not isinstance(text, str) or not text.strip() or "\0" in text:
+        raise error(message)
+    return text
 
 
 class MissingFileError(StoreError, FileNotFoundError):

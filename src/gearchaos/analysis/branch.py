@@ -43,8 +43,8 @@ from typing import Any
 
 import numpy as np
 
-from .._checks import check_bool, check_path
-from .._files import check_regular_file
+from .._checks import check_bool
+from .._files import check_path, check_regular_file
 from .._version import provenance
 from ..errors import ParameterError, StoreError
 from .orbits import (

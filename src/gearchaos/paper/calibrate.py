@@ -53,8 +53,8 @@ from typing import Any, TypeVar
 
 import numpy as np
 
-from .._checks import check_bool, check_int, check_path, check_real
-from .._files import MissingFileError, read_text_file
+from .._checks import check_bool, check_int, check_real
+from .._files import MissingFileError, check_path, read_text_file
 from ..errors import ParameterError, StoreError
 from ..integrate.settings import SolverSettings
 from .search_space import (

@@ -25,8 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from .._checks import check_path
-from .._files import check_output_file
+from .._files import check_output_file, check_path
 from ..errors import ParameterError, StoreError
 
 __all__ = ["FORMATS", "export", "open_result", "table"]

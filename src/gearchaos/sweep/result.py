@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from .._checks import check_path
+from .._files import check_path
 from ..errors import ParameterError, Status, StoreError
 from ..gearset.schema import CLEARANCES, FIELDS, OMEGA
 from .store import open_sweep

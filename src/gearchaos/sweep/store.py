@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from .._checks import check_path
+from .._files import check_path
 from ..errors import StoreError
 from ..gearset.mapping import flatten
 from .integrity import (
