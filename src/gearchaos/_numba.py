@@ -14,7 +14,7 @@ from typing import Any
 from numba import typeof, types
 from numba.core.errors import NumbaIRAssumptionWarning
 
-__all__ = ["call_literal", "on_first_compile"]
+__all__ = ["call_literal", "entry_point", "on_first_compile"]
 
 _ENTRIES: dict[tuple[Any, ...], Any] = {}
 #: Called once per process before the first kernel that is not in numba's on-disk cache.
@@ -41,25 +41,30 @@ def _in_disk_cache(dispatcher: Any) -> bool:
         return True
 
 
-def call_literal(dispatcher: Any, kind: int, *args: Any) -> Any:
-    """``dispatcher(kind, *args)`` with ``kind`` specialised as a compile-time literal."""
+def entry_point(dispatcher: Any, kind: int, *args: Any) -> Any:
+    """The compiled entry point of ``dispatcher`` specialised on the literal ``kind`` for
+    arguments like ``args``: compiled (or loaded from the disk cache) on first use, then
+    looked up; call it as ``entry(kind, *args)``. Safe to call from several threads once
+    resolved (resolve it in one thread first)."""
     kind = int(kind)
     key = (dispatcher, kind, *(typeof(a) for a in args))
     entry = _ENTRIES.get(key)
     if entry is None:
         if _FIRST_COMPILE and not _in_disk_cache(dispatcher):
             _FIRST_COMPILE.pop()()
+        sig = (types.literal(kind), *key[2:])
         with warnings.catch_warnings():
             # numba's IR inliner emits an internal "pedantic" NumbaIRAssumptionWarning for the
             # inlined right-hand side; it is harmless and not actionable for users
             warnings.simplefilter("ignore", NumbaIRAssumptionWarning)
-            result = dispatcher(kind, *args)  # compiles or loads the literal specialisation
-        sig = (types.literal(kind), *key[2:])
-        cres = dispatcher.overloads.get(sig)
-        if cres is not None:
-            _ENTRIES[key] = cres.entry_point
-        return result
-    return entry(kind, *args)
+            entry = dispatcher.compile(sig)  # compiles or loads the literal specialisation
+        _ENTRIES[key] = entry
+    return entry
+
+
+def call_literal(dispatcher: Any, kind: int, *args: Any) -> Any:
+    """``dispatcher(kind, *args)`` with ``kind`` specialised as a compile-time literal."""
+    return entry_point(dispatcher, kind, *args)(int(kind), *args)
 
 
 def guard_cache(dispatchers: list[Any], sources: list[str]) -> None:

@@ -1,10 +1,10 @@
 """The one Python caller of the compiled integrator: :func:`run_chains`.
 
-Single runs, batches and sweep tasks are all *chains*: C independent chains (run in parallel
-by ``numba.prange``) of L points each (run in order, each optionally starting from its
-predecessor's final state). :class:`ChainRun` holds the numbers of such a job — packed
-parameters, switch widths, sample times, tolerances — and nothing else, so it can be shipped
-to another process or a Dask worker; :class:`ChainOutput` holds the kernel's raw outputs.
+Single runs, batches and sweep tasks are all *chains*: C independent chains (run in parallel on
+a pool of threads, :func:`run_threaded`) of L points each (run in order, each optionally
+starting from its predecessor's final state). :class:`ChainRun` holds the numbers of such a
+job — packed parameters, switch widths, sample times, tolerances — and nothing else, so it can
+be shipped to another process or a Dask worker; :class:`ChainOutput` holds the kernel's raw outputs.
 The kernel's argument list is written here and nowhere else.
 """
 
@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from .._numba import call_literal
+from .._numba import entry_point
 from ..errors import ParameterError, Status
 from ..model.system import System
 from .settings import SampleTimes, SolverSettings
@@ -237,14 +237,17 @@ class ChainOutput(SampleArrays):
 def run_chains(run: ChainRun, *, single_thread: bool = False) -> ChainOutput:
     """Run the chains of ``run`` with the compiled Dormand–Prince kernel.
 
-    ``single_thread`` pins numba to one thread (for worker processes that share a machine).
-    Never raises on solver failure: each point carries its own status.
+    The chains are spread over ``numba.get_num_threads()`` threads (blocks of chains taken in
+    turn, so a slow chain does not hold up a fixed share of the others); ``single_thread``
+    pins this process to one thread (for worker processes that share a machine). Each chain
+    runs the same compiled code whatever the threads, so results are bitwise identical. Never
+    raises on solver failure: each point carries its own status.
     """
+    import numba
+
     from .dopri import dopri_chains
 
     if single_thread:
-        import numba
-
         numba.set_num_threads(1)
     C, L = run.shape
     ns, n_full = run.n_samples, run.Y0.shape[1]
@@ -261,35 +264,62 @@ def run_chains(run: ChainRun, *, single_thread: bool = False) -> ChainOutput:
         status=np.zeros((C, L), dtype=np.int64),
         log_sums=np.zeros((C, L, k)),
     )
-    call_literal(
-        dopri_chains,
-        run.kind,
-        np.ascontiguousarray(run.Y0, dtype=np.float64),
-        np.ascontiguousarray(run.P, dtype=np.float64),
-        np.ascontiguousarray(run.SW, dtype=np.float64),
-        np.ascontiguousarray(run.t0, dtype=np.float64),
-        np.ascontiguousarray(run.t_rec, dtype=np.float64),
-        np.ascontiguousarray(run.dt, dtype=np.float64),
-        int(ns),
-        np.ascontiguousarray(run.t_end, dtype=np.float64),
-        int(run.n_obs),
-        int(run.n_track),
-        int(run.n_state),
-        float(run.rtol),
-        float(run.atol),
-        float(run.h_init),
-        float(run.max_step),
-        int(run.max_steps),
-        bool(run.continuation),
-        out.tau,
-        out.states,
-        out.observables,
-        out.obs_min,
-        out.obs_max,
-        out.final_state,
-        out.info,
-        out.status,
-        out.log_sums,
-        int(run.settle_spp),
-    )
+    f64 = np.float64
+    inputs = [np.ascontiguousarray(getattr(run, a), dtype=f64) for a in _CHAIN_INPUTS]
+    outputs = [getattr(out, a) for a in _CHAIN_OUTPUTS]
+    numbers = (
+        int(ns), int(run.n_obs), int(run.n_track), int(run.n_state), float(run.rtol),
+        float(run.atol), float(run.h_init), float(run.max_step), int(run.max_steps),
+        bool(run.continuation), int(run.settle_spp),
+    )  # fmt: skip
+
+    def args(lo: int, hi: int) -> tuple[Any, ...]:
+        """The kernel's arguments for chains lo … hi − 1 (C-contiguous views)."""
+        Y0, P, SW, t0, t_rec, dt, t_end = (x[lo:hi] for x in inputs)
+        ns_, n_obs, n_track, n_state, rtol, atol, h_init, max_step, max_steps, cont, spp = numbers
+        return (
+            Y0, P, SW, t0, t_rec, dt, ns_, t_end, n_obs, n_track, n_state, rtol, atol, h_init,
+            max_step, max_steps, cont, *(x[lo:hi] for x in outputs), spp,
+        )  # fmt: skip
+
+    entry = entry_point(dopri_chains, run.kind, *args(0, C))
+    kind = int(run.kind)
+    run_threaded(lambda lo, hi: entry(kind, *args(lo, hi)), C, numba.get_num_threads())
     return out
+
+
+#: the ChainRun arrays the kernel reads and the ChainOutput arrays it fills, chain axis first,
+#: in the kernel's argument order
+_CHAIN_INPUTS = ("Y0", "P", "SW", "t0", "t_rec", "dt", "t_end")
+_CHAIN_OUTPUTS = (
+    "tau", "states", "observables", "obs_min", "obs_max", "final_state", "info", "status",
+    "log_sums",
+)  # fmt: skip
+_POOLS: dict[tuple[int, int], Any] = {}
+
+
+def run_threaded(call: Any, n: int, threads: int) -> None:
+    """``call(lo, hi)`` over blocks that cover ``range(n)``, on ``threads`` threads that take
+    the blocks in turn (``call`` must release the GIL: a ``nogil`` kernel). A block is about an
+    eighth of a thread's share, so an uneven load still spreads. An interrupt cancels the blocks
+    not yet started; the running ones finish (compiled code cannot be stopped)."""
+    import concurrent.futures as cf
+    import os
+
+    threads = max(1, min(int(threads), n))
+    if threads == 1:
+        call(0, n)
+        return
+    key = (os.getpid(), threads)  # a pool does not survive a fork
+    pool = _POOLS.get(key)
+    if pool is None:
+        pool = _POOLS[key] = cf.ThreadPoolExecutor(threads, thread_name_prefix="gearchaos")
+    size = max(1, n // (8 * threads))
+    futures = [pool.submit(call, lo, min(lo + size, n)) for lo in range(0, n, size)]
+    try:
+        for f in futures:
+            f.result()
+    except BaseException:
+        for f in futures:
+            f.cancel()
+        raise

@@ -2,7 +2,7 @@
 
 :func:`integrate_batch` runs a list of systems of the same kind and layout (e.g. one model at
 many Ω, or many gear sets with the same number of planets) as chains of length one, with
-``numba.prange`` over the points. Each point runs exactly the same code as
+a pool of threads over the points. Each point runs exactly the same code as
 :func:`~gearchaos.integrate.integrate`, so a point's result is bitwise identical whether it runs
 alone, in a batch, or on any number of threads.
 """
@@ -59,7 +59,7 @@ def integrate_batch(
     max_step: float = np.inf,
     **solver: Any,
 ) -> BatchResult:
-    """Integrate many systems of one kind in parallel (``numba.prange`` over points).
+    """Integrate many systems of one kind in parallel (threads over the points).
 
     ``settings`` and ``**solver`` are those of :func:`~gearchaos.integrate.integrate`; ``y0`` is
     ``None`` (zero start everywhere) or an array (m, n_state) of initial states. Never raises on

@@ -31,7 +31,7 @@ import math
 import numba
 import numpy as np
 
-from ..model.kernels import OBS_ALL, OBS_NONE, OBS_TRACK, rhs, tangent
+from ..model.kernels import OBS_ALL, OBS_NONE, OBS_TRACK, rhs, rhs_inline, tangent
 from ._switch import AIM, LAND, check_step, predict_switch, track
 from .tableau import DOPRI5
 
@@ -77,6 +77,14 @@ ST_UNDERFLOW = 2
 ST_NON_FINITE = 3
 
 
+@numba.njit(cache=True, inline="always")
+def _copy(dst, src, n):  # pragma: no cover - compiled
+    """dst[:n] = src[:n], as a loop: a slice assignment drags numba's shape-mismatch error
+    formatting into every kernel (seconds of compile time)."""
+    for i in range(n):
+        dst[i] = src[i]
+
+
 @numba.njit(cache=True)
 def initial_step(kind, t, y, f0, p, rtol, atol, obs, n):  # pragma: no cover - compiled
     """Hairer's starting step (HNW I, §II.4) for the 5(4) pair, from the first n components."""
@@ -90,7 +98,9 @@ def initial_step(kind, t, y, f0, p, rtol, atol, obs, n):  # pragma: no cover - c
     d0 = math.sqrt(d0 / n)
     d1 = math.sqrt(d1 / n)
     h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
-    y1 = y + h0 * f0
+    y1 = np.empty(y.size)
+    for i in range(y.size):
+        y1[i] = y[i] + h0 * f0[i]
     f1 = np.empty(y.size)
     rhs(kind, t + h0, y1, p, f1, obs, OBS_NONE)
     d2 = 0.0
@@ -229,8 +239,8 @@ def dopri_run(
         if n_tan > 0:
             tan_on = _renormalize(kind, t, y, p, obs, K, n_base, n_tan, lsum, tan_on)
         out_t[0] = t
-        out_y[0, :] = y
-        out_obs[0, :] = obs
+        _copy(out_y[0], y, n)
+        _copy(out_obs[0], obs, n_obs)
         j = 1
         tracking = True
         for k in range(n_track):
@@ -240,7 +250,7 @@ def dopri_run(
     # n_pts of them lie on the current smooth piece (since the last switch)
     hist = np.empty((3, n_tr2))
     t_hist = np.zeros(3)
-    hist[0, :] = obs[:n_tr2]
+    _copy(hist[0], obs, n_tr2)
     t_hist[0] = t
     n_pts = 1
     last_rejected = False
@@ -334,7 +344,7 @@ def dopri_run(
                     )  # fmt: skip
                 ts = t_new
             level = last_level if s == STAGES - 1 else (OBS_ALL if tan_on else OBS_NONE)
-            rhs(kind, ts, yt, p, K[s], obs, level)
+            rhs_inline(kind, ts, yt, p, K[s], obs, level)
             if tan_on:
                 tangent(kind, ts, yt, p, obs, K[s], n_base, n_tan)
         # yt is y_{n+1}; the scaled RMS norm of the embedded error estimate, which is NaN
@@ -414,8 +424,8 @@ def dopri_run(
             if n_tan > 0:
                 tan_on = _renormalize(kind, t, y, p, obs, K, n_base, n_tan, lsum, tan_on)
             out_t[j] = t
-            out_y[j, :] = y
-            out_obs[j, :] = obs
+            _copy(out_y[j], y, n)
+            _copy(out_obs[j], obs, n_obs)
             if not tracking:
                 tracking = True
                 for k in range(n_track):
@@ -424,14 +434,14 @@ def dopri_run(
             j += 1
         # the smooth piece: a switch at the end starts a new one, at the start one of two points
         n_pts = 1 if where == 2 else (2 if where == 1 else min(n_pts + 1, 3))
-        hist[2, :] = hist[1]
-        hist[1, :] = hist[0]
-        hist[0, :] = obs[:n_tr2]
+        _copy(hist[2], hist[1], n_tr2)
+        _copy(hist[1], hist[0], n_tr2)
+        _copy(hist[0], obs, n_tr2)
         t_hist[2] = t_hist[1]
         t_hist[1] = t_hist[0]
         t_hist[0] = t
 
-    y_final[:] = y
+    _copy(y_final, y, n)
     info[0] = n_acc
     info[1] = n_rej
     info[2] = t
@@ -440,7 +450,7 @@ def dopri_run(
     return status
 
 
-@numba.njit(cache=True, parallel=True)
+@numba.njit(cache=True, nogil=True)
 def dopri_chains(
     kind,
     Y0,
@@ -471,8 +481,10 @@ def dopri_chains(
     LSUM,
     settle_spp,
 ):  # pragma: no cover - compiled
-    """Chains of integrations, ``numba.prange`` over chains, points of a chain in order: the
-    one compiled entry point of the integrator (single runs are chains of length one).
+    """Chains of integrations, one chain after another, points of a chain in order: the one
+    compiled entry point of the integrator (single runs are chains of length one). It releases
+    the GIL: :func:`~gearchaos.integrate._chains.run_chains` runs blocks of chains on several
+    threads (a ``parallel=True`` kernel would cost seconds more to compile).
 
     Point j of chain c has parameters ``P[c, j]`` and runs from τ = ``t0[c, j]``; it starts
     from ``Y0[c]`` (fresh) or, with ``continuation``, from the final state of point j−1 of the
@@ -487,7 +499,7 @@ def dopri_chains(
     n_chains = P.shape[0]
     length = P.shape[1]
     cfg = (n_samples, n_obs, n_track, n_base, rtol, atol, h_init, max_step, max_steps, settle_spp)
-    for c in numba.prange(n_chains):
+    for c in range(n_chains):
         y = Y0[c].copy()
         for j in range(length):
             out = (out_t[c, j], out_y[c, j], out_obs[c, j])
@@ -508,9 +520,9 @@ def dopri_chains(
             )
             status[c, j] = st
             if continuation and st == ST_OK:
-                y[:] = y_final[c, j]
+                _copy(y, y_final[c, j], y.size)
             else:
-                y[:] = Y0[c]
+                _copy(y, Y0[c], y.size)
 
 
 def _guard() -> None:

@@ -99,7 +99,16 @@ from .layout import (
     P_ZS,
 )
 
-__all__ = ["OBS_ALL", "OBS_NONE", "OBS_TRACK", "dead_zone", "observe_many", "rhs", "tangent"]
+__all__ = [
+    "OBS_ALL",
+    "OBS_NONE",
+    "OBS_TRACK",
+    "dead_zone",
+    "observe_many",
+    "rhs",
+    "rhs_inline",
+    "tangent",
+]
 
 #: observables a right-hand side writes (see the module docstring)
 OBS_NONE = 0
@@ -121,7 +130,66 @@ def _sinusoid(a, w, s, c, ca, sa):  # pragma: no cover - compiled
     return e, a * w * (c * ca - s * sa), -w * w * e
 
 
-@numba.njit(cache=True, inline="always")  # inlined at the single stage call site
+@numba.njit(cache=True)
+def _planetary_general(t, p, i, N, ck, ckr, ksp, dksp, krp, dkrp, esp, esp_d, esp_dd, erp,
+                       erp_d, erp_dd):  # pragma: no cover - compiled  # fmt: skip
+    """The terms of planet i that the default gear sets do not have — stiffness harmonics
+    h ≥ 2 and eccentricities — added to its stiffnesses, transmission errors and their
+    derivatives (in the order of MODEL.md §5). A called function, not inlined: it keeps the
+    right-hand side that the integrator inlines small (compile time) and its common path free
+    of never-taken branches (run time)."""
+    om = p[P_OMEGA]
+    nh_sp = int(p[P_NH_SP])
+    nh_rp = int(p[P_NH_RP])
+    h0 = P_HEADER + N_BLOCKS * N  # first harmonic amplitude
+    if nh_sp > 0:
+        tm2, tm1, dm2, dm1 = 1.0, ck, 0.0, 1.0  # T_0, T_1 and their derivatives
+        for h in range(nh_sp):
+            tt = 2.0 * ck * tm1 - tm2
+            dt_ = 2.0 * tm1 + 2.0 * ck * dm1 - dm2  # Chebyshev T_h' recurrence
+            ksp += p[h0 + h] * tt
+            dksp += p[h0 + h] * dt_
+            tm2, tm1, dm2, dm1 = tm1, tt, dm1, dt_
+    if nh_rp > 0:
+        tm2, tm1, dm2, dm1 = 1.0, ckr, 0.0, 1.0
+        for h in range(nh_rp):
+            tt = 2.0 * ckr * tm1 - tm2
+            dt_ = 2.0 * tm1 + 2.0 * ckr * dm1 - dm2
+            krp += p[h0 + nh_sp + h] * tt
+            dkrp += p[h0 + nh_sp + h] * dt_
+            tm2, tm1, dm2, dm1 = tm1, tt, dm1, dt_
+    if p[P_ECC] != 0.0:
+        om_s = om / p[P_ZS]
+        om_p = om / p[P_ZP]
+        om_r = om / p[P_ZR]
+        cs_ = math.cos(om_s * t)
+        ss_ = math.sin(om_s * t)
+        cp_ = math.cos(om_p * t)
+        sp_ = math.sin(om_p * t)
+        cr_ = math.cos(om_r * t)
+        sr_ = math.sin(om_r * t)
+        for a, w, s_, c_, bc, bs, to_sp in (
+            (p[P_ES], om_s, ss_, cs_, B_C_ES, B_S_ES, True),
+            (p[P_EP], om_p, sp_, cp_, B_C_EPS, B_S_EPS, True),
+            (p[P_EP], om_p, sp_, cp_, B_C_EPR, B_S_EPR, False),
+            # sin(−Ω_H τ + θ) = sin θ cos(Ω_H τ) + cos θ sin(−Ω_H τ): frequency −Ω_H
+            (p[P_ER], -om_r, -sr_, cr_, B_C_ER, B_S_ER, False),
+        ):
+            e1, e1_d, e1_dd = _sinusoid(
+                a, w, s_, c_, p[P_HEADER + bc * N + i], p[P_HEADER + bs * N + i]
+            )
+            if to_sp:
+                esp += e1
+                esp_d += e1_d
+                esp_dd += e1_dd
+            else:
+                erp += e1
+                erp_d += e1_d
+                erp_dd += e1_dd
+    return ksp, dksp, krp, dkrp, esp, esp_d, esp_dd, erp, erp_d, erp_dd
+
+
+@numba.njit(cache=True)
 def planetary_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
     """Minimal relative-coordinate equations of MODEL.md §7.
 
@@ -159,33 +227,7 @@ def planetary_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
     asp = p[P_ASP]
     arp = p[P_ARP]
     inv_mup = p[P_INV_MUP]
-    nh_sp = int(p[P_NH_SP])
-    nh_rp = int(p[P_NH_RP])
-    h0 = P_HEADER + N_BLOCKS * N  # first harmonic amplitude
-
-    ecc = p[P_ECC] != 0.0
-    es = p[P_ES]
-    ep = p[P_EP]
-    er = p[P_ER]
-    cs_ = 0.0
-    ss_ = 0.0
-    cp_ = 0.0
-    sp_ = 0.0
-    cr_ = 0.0
-    sr_ = 0.0
-    om_s = 0.0
-    om_p = 0.0
-    om_r = 0.0
-    if ecc:
-        om_s = om / p[P_ZS]
-        om_p = om / p[P_ZP]
-        om_r = om / p[P_ZR]
-        cs_ = math.cos(om_s * t)
-        ss_ = math.sin(om_s * t)
-        cp_ = math.cos(om_p * t)
-        sp_ = math.sin(om_p * t)
-        cr_ = math.cos(om_r * t)
-        sr_ = math.sin(om_r * t)
+    general = p[P_ECC] != 0.0 or p[P_NH_SP] > 0.0 or p[P_NH_RP] > 0.0
 
     sum_fsp = 0.0
     sum_frp = 0.0
@@ -201,25 +243,9 @@ def planetary_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
         ck = c1 * p[P_HEADER + B_CK_SP * N + i] - s1 * p[P_HEADER + B_SK_SP * N + i]
         ksp = 1.0 + eps_sp * ck
         dksp = eps_sp  # dκ/d(cos θ); times dcos θ/dτ below (tracked level only)
-        if nh_sp > 0:
-            tm2, tm1, dm2, dm1 = 1.0, ck, 0.0, 1.0  # T_0, T_1 and their derivatives
-            for h in range(nh_sp):
-                tt = 2.0 * ck * tm1 - tm2
-                dt_ = 2.0 * tm1 + 2.0 * ck * dm1 - dm2  # Chebyshev T_h' recurrence
-                ksp += p[h0 + h] * tt
-                dksp += p[h0 + h] * dt_
-                tm2, tm1, dm2, dm1 = tm1, tt, dm1, dt_
         ckr = c1 * p[P_HEADER + B_CK_RP * N + i] - s1 * p[P_HEADER + B_SK_RP * N + i]
         krp = krm + kra * ckr
         dkrp = kra
-        if nh_rp > 0:
-            tm2, tm1, dm2, dm1 = 1.0, ckr, 0.0, 1.0  # T_0, T_1 and their derivatives
-            for h in range(nh_rp):
-                tt = 2.0 * ckr * tm1 - tm2
-                dt_ = 2.0 * tm1 + 2.0 * ckr * dm1 - dm2
-                krp += p[h0 + nh_sp + h] * tt
-                dkrp += p[h0 + nh_sp + h] * dt_
-                tm2, tm1, dm2, dm1 = tm1, tt, dm1, dt_
 
         # --- transmission errors and their τ-derivatives
         esp, esp_d, esp_dd = _sinusoid(
@@ -228,25 +254,10 @@ def planetary_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
         erp, erp_d, erp_dd = _sinusoid(
             arp, om, s1, c1, p[P_HEADER + B_CE_RP * N + i], p[P_HEADER + B_SE_RP * N + i]
         )
-        if ecc:
-            for a, w, s_, c_, bc, bs, to_sp in (
-                (es, om_s, ss_, cs_, B_C_ES, B_S_ES, True),
-                (ep, om_p, sp_, cp_, B_C_EPS, B_S_EPS, True),
-                (ep, om_p, sp_, cp_, B_C_EPR, B_S_EPR, False),
-                # sin(−Ω_H τ + θ) = sin θ cos(Ω_H τ) + cos θ sin(−Ω_H τ): frequency −Ω_H
-                (er, -om_r, -sr_, cr_, B_C_ER, B_S_ER, False),
-            ):
-                e1, e1_d, e1_dd = _sinusoid(
-                    a, w, s_, c_, p[P_HEADER + bc * N + i], p[P_HEADER + bs * N + i]
-                )
-                if to_sp:
-                    esp += e1
-                    esp_d += e1_d
-                    esp_dd += e1_dd
-                else:
-                    erp += e1
-                    erp_d += e1_d
-                    erp_dd += e1_dd
+        if general:
+            ksp, dksp, krp, dkrp, esp, esp_d, esp_dd, erp, erp_d, erp_dd = _planetary_general(
+                t, p, i, N, ck, ckr, ksp, dksp, krp, dkrp, esp, esp_d, esp_dd, erp, erp_d, erp_dd
+            )
 
         pi_ = y[2 + i]
         pid = y[n + 2 + i]
@@ -546,6 +557,13 @@ _KERNELS = {
 }
 
 
+#: the same kernels inlined into their caller at the numba-IR level: only the integrator's stage
+#: loop uses them (:func:`rhs_inline`). Inlining costs compile time (a few seconds a call site),
+#: a call costs run time (array arguments are reference-counted across a call, ~40 ns), so the
+#: one hot call site inlines and every other site calls.
+_KERNELS_INLINE = {k: numba.njit(inline="always")(f.py_func) for k, f in _KERNELS.items()}
+
+
 def rhs(kind, t, y, p, dydt, obs, level):
     """Right-hand side of system ``kind`` (see :mod:`gearchaos.model.layout`); ``level`` says
     which observables to write (module docstring).
@@ -557,22 +575,34 @@ def rhs(kind, t, y, p, dydt, obs, level):
     _KERNELS[int(kind)](t, y, p, dydt, obs, level)
 
 
-@overload(rhs, inline="always")
-def _rhs_overload(kind, t, y, p, dydt, obs, level):  # pragma: no cover - compiled
-    if not isinstance(kind, types.IntegerLiteral):
-        raise numba.errors.TypingError(
-            "gearchaos.model.kernels.rhs: 'kind' must be a compile-time literal; "
-            "call numba.literally(kind) in the calling kernel"
-        )
-    k = kind.literal_value
-    if k not in _KERNELS:
-        raise numba.errors.TypingError(f"unknown system kind {k}")
-    fn = _KERNELS[k]
+def rhs_inline(kind, t, y, p, dydt, obs, level):
+    """:func:`rhs` with the kernel's body inlined into the calling kernel (the one hot call
+    site: the integrator's stages)."""
+    _KERNELS[int(kind)](t, y, p, dydt, obs, level)
 
-    def impl(kind, t, y, p, dydt, obs, level):
-        fn(t, y, p, dydt, obs, level)
 
-    return impl
+def _rhs_impl(table, name):
+    def typer(kind, t, y, p, dydt, obs, level):  # pragma: no cover - compiled
+        if not isinstance(kind, types.IntegerLiteral):
+            raise numba.errors.TypingError(
+                f"gearchaos.model.kernels.{name}: 'kind' must be a compile-time literal; "
+                "call numba.literally(kind) in the calling kernel"
+            )
+        k = kind.literal_value
+        if k not in table:
+            raise numba.errors.TypingError(f"unknown system kind {k}")
+        fn = table[k]
+
+        def impl(kind, t, y, p, dydt, obs, level):
+            fn(t, y, p, dydt, obs, level)
+
+        return impl
+
+    return typer
+
+
+overload(rhs, inline="always")(_rhs_impl(_KERNELS, "rhs"))
+overload(rhs_inline, inline="always")(_rhs_impl(_KERNELS_INLINE, "rhs_inline"))
 
 
 @numba.njit(cache=True)

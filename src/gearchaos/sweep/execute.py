@@ -1,6 +1,6 @@
 """Executors: where tasks run. The parent process is always the only writer of the store.
 
-* in-process (default): tasks run here, the compiled kernel's ``numba.prange`` spreads chains
+* in-process (default): tasks run here, the compiled kernel's thread pool spreads chains
   over all cores; small tasks are grouped so every call has enough chains;
 * ``workers=N``: a pool of N local processes (spawn start method), one numba thread each;
 * ``scheduler="tcp://host:port"``: an existing ``dask.distributed`` cluster;
