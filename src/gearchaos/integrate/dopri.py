@@ -217,7 +217,9 @@ def dopri_run(
 
     t = t0
     n_tan = lsum.size
-    tan_on = False
+    # np.bool_/np.int64: a plain literal would make numba compile the helpers that take these
+    # variables twice, once for the literal value and once for the widened type
+    tan_on = np.bool_(False)
     for r in range(n_tan):
         lsum[r] = 0.0
     rhs(kind, t, y, p, K[0], obs, OBS_ALL)
@@ -252,7 +254,7 @@ def dopri_run(
     t_hist = np.zeros(3)
     _copy(hist[0], obs, n_tr2)
     t_hist[0] = t
-    n_pts = 1
+    n_pts = int(np.int64(1))
     last_rejected = False
     nonfinite = False
     has_switch = False
@@ -268,7 +270,7 @@ def dopri_run(
     n_ring = SETTLE_MAX_PERIOD + 1
     ring = np.empty((n_ring if settling else 0, n_base))
     runs = np.zeros(SETTLE_MAX_PERIOD + 1, dtype=np.int64)
-    n_sec = 0
+    n_sec = int(np.int64(0))
     skipped = 0
 
     while status == ST_OK:
@@ -529,11 +531,12 @@ def _guard() -> None:
     import os
 
     from .. import _numba
-    from ..model import kernels, layout
+    from ..model import kernels, layout, reference_kernels
 
     here = os.path.dirname(__file__)
     sources = [
         kernels.__file__,
+        reference_kernels.__file__,
         layout.__file__,
         os.path.join(here, "dopri.py"),
         os.path.join(here, "_switch.py"),

@@ -42,28 +42,11 @@ from .layout import (
     B_SE_SP,
     B_SK_RP,
     B_SK_SP,
-    BO_B,
-    BO_EPS,
-    BO_FA,
-    BO_FM,
-    BO_OMEGA,
-    BO_ZETA,
-    DU_ALPHA,
-    DU_BETA,
-    DU_DELTA,
-    DU_GAMMA,
-    DU_OMEGA,
     KIND_BACKLASH_OSCILLATOR,
     KIND_DUFFING,
     KIND_LINEAR,
     KIND_LORENZ,
     KIND_PLANETARY,
-    LIN_HEADER,
-    LIN_N,
-    LIN_OMEGA,
-    LZ_BETA,
-    LZ_RHO,
-    LZ_SIGMA,
     N_BLOCKS,
     P_ARP,
     P_ASP,
@@ -98,6 +81,18 @@ from .layout import (
     P_ZR,
     P_ZS,
 )
+from .reference_kernels import (
+    backlash_oscillator_rhs,
+    backlash_oscillator_tangent,
+    dead_zone,
+    duffing_rhs,
+    duffing_tangent,
+    engaged,
+    linear_rhs,
+    linear_tangent,
+    lorenz_rhs,
+    lorenz_tangent,
+)
 
 __all__ = [
     "OBS_ALL",
@@ -114,12 +109,6 @@ __all__ = [
 OBS_NONE = 0
 OBS_TRACK = 1
 OBS_ALL = 2
-
-
-@numba.njit(cache=True, inline="always")
-def dead_zone(x: float, b: float) -> float:
-    """f(x; b) = x − b (x > b), 0 (|x| ≤ b), x + b (x < −b): contact law with half clearance b."""
-    return x - min(max(x, -b), b)  # branch-free: the contact state is unpredictable
 
 
 @numba.njit(cache=True, inline="always")
@@ -334,91 +323,12 @@ def planetary_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
                 obs[nt + 3 * N + 2 + i] += crp * (dydt[n + N + 2] - pdd)
 
 
-@numba.njit(cache=True)
-def backlash_oscillator_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
-    """x'' + 2ζx' + (1 + ε cos Ωτ) f(x; b) = F_m + F_a Ω^q cos Ωτ;
-    obs = (x, Fᶜ, x', Fᶜ', stiffness 1 + ε cos Ωτ) with the contact force
-    Fᶜ = (1 + ε cos Ωτ) f(x; b) + 2ζx' while |x| > b and 0 while |x| ≤ b (teeth apart)."""
-    om = p[BO_OMEGA]
-    c = math.cos(om * t)
-    x = y[0]
-    v = y[1]
-    b = p[BO_B]
-    k = 1.0 + p[BO_EPS] * c
-    fz = dead_zone(x, b)
-    damp = 2.0 * p[BO_ZETA] * v
-    dydt[0] = v
-    dydt[1] = p[BO_FM] + p[BO_FA] * c - damp - k * fz
-    obs[0] = x
-    obs[2] = v
-    if x > b or x < -b:
-        obs[1] = k * fz + damp
-        dk = -p[BO_EPS] * om * math.sin(om * t)
-        obs[3] = dk * fz + k * v + 2.0 * p[BO_ZETA] * dydt[1]
-    else:
-        obs[1] = 0.0
-        obs[3] = 0.0
-    obs[4] = k
-
-
-@numba.njit(cache=True)
-def linear_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
-    """y' = A y + f cos Ωτ + g sin Ωτ; obs = (y, y')."""
-    n = int(p[LIN_N])
-    om = p[LIN_OMEGA]
-    c = math.cos(om * t)
-    s = math.sin(om * t)
-    a0 = LIN_HEADER
-    f0 = a0 + n * n
-    g0 = f0 + n
-    for i in range(n):
-        acc = p[f0 + i] * c + p[g0 + i] * s
-        for j in range(n):
-            acc += p[a0 + i * n + j] * y[j]
-        dydt[i] = acc
-        obs[i] = y[i]
-        obs[n + i] = acc
-
-
-@numba.njit(cache=True)
-def duffing_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
-    """x'' + δx' + αx + βx³ = γ cos Ωτ; obs = (x, x')."""
-    x = y[0]
-    v = y[1]
-    dydt[0] = v
-    dydt[1] = (
-        p[DU_GAMMA] * math.cos(p[DU_OMEGA] * t)
-        - p[DU_DELTA] * v
-        - p[DU_ALPHA] * x
-        - p[DU_BETA] * x * x * x
-    )
-    obs[0] = x
-    obs[1] = v
-
-
-@numba.njit(cache=True)
-def lorenz_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
-    """Lorenz (1963): x' = σ(y − x), y' = x(ρ − z) − y, z' = xy − βz;
-    obs = (x, y, z, x', y', z')."""
-    dydt[0] = p[LZ_SIGMA] * (y[1] - y[0])
-    dydt[1] = y[0] * (p[LZ_RHO] - y[2]) - y[1]
-    dydt[2] = y[0] * y[1] - p[LZ_BETA] * y[2]
-    for i in range(3):
-        obs[i] = y[i]
-        obs[3 + i] = dydt[i]
-
-
 # ----------------------------------------------------------------------------- tangents
 # Variational equations V' = J(τ, y) V for Lyapunov exponents. The vector fields are continuous
 # (damping acts inside the clearances, MODEL.md §4), so J is the piecewise Jacobian: the dead
 # zone contributes f'(x; b) = 1 outside the clearance and 0 inside. Each tangent kernel is called
 # right after the right-hand side at the same (τ, y) and reads the deflections and stiffnesses it
 # needs from ``obs``. V holds k tangent vectors in y[n:], row after row.
-
-
-@numba.njit(cache=True, inline="always")
-def _engaged(x: float, b: float) -> float:
-    return 1.0 if (x > b or x < -b) else 0.0
 
 
 @numba.njit(cache=True)
@@ -434,8 +344,8 @@ def planetary_tangent(t, y, p, obs, dydt, n, k):  # pragma: no cover - compiled
     inv_muc = p[P_INV_MUC]
     cas = p[P_COS_AS]
     car = p[P_COS_AR]
-    kb = p[P_KB] * _engaged(obs[2 * N], p[P_BS])
-    kby = p[P_KB] * _engaged(obs[2 * N + 1], p[P_BS])
+    kb = p[P_KB] * engaged(obs[2 * N], p[P_BS])
+    kby = p[P_KB] * engaged(obs[2 * N + 1], p[P_BS])
     cb = p[P_CS]
     inv_ms = p[P_INV_MU_S]
     for r in range(k):
@@ -459,8 +369,8 @@ def planetary_tangent(t, y, p, obs, dydt, n, k):  # pragma: no cover - compiled
             dsp_d = pdv - xdv * si + ydv * ci
             drp = sv - pv
             drp_d = sdv - pdv
-            fsp = obs[10 * N + 4 + i] * _engaged(obs[i], bsp) * dsp + csp * dsp_d
-            frp = obs[11 * N + 4 + i] * _engaged(obs[N + i], brp) * drp + crp * drp_d
+            fsp = obs[10 * N + 4 + i] * engaged(obs[i], bsp) * dsp + csp * dsp_d
+            frp = obs[11 * N + 4 + i] * engaged(obs[N + i], brp) * drp + crp * drp_d
             dydt[o + nd + 2 + i] = (frp - fsp) * inv_mup  # completed below
             sum_fsp += fsp
             sum_frp += frp
@@ -475,49 +385,6 @@ def planetary_tangent(t, y, p, obs, dydt, n, k):  # pragma: no cover - compiled
         for i in range(N):
             dydt[o + nd + 2 + i] += qs - cas * qc
         dydt[o + nd + N + 2] = qs - (cas + car) * qc
-
-
-@numba.njit(cache=True)
-def backlash_oscillator_tangent(t, y, p, obs, dydt, n, k):  # pragma: no cover - compiled
-    kx = obs[4] * _engaged(obs[0], p[BO_B])
-    for r in range(k):
-        o = n + r * n
-        dydt[o] = y[o + 1]
-        dydt[o + 1] = -kx * y[o] - 2.0 * p[BO_ZETA] * y[o + 1]
-
-
-@numba.njit(cache=True)
-def linear_tangent(t, y, p, obs, dydt, n, k):  # pragma: no cover - compiled
-    a0 = LIN_HEADER
-    for r in range(k):
-        o = n + r * n
-        for i in range(n):
-            acc = 0.0
-            for j in range(n):
-                acc += p[a0 + i * n + j] * y[o + j]
-            dydt[o + i] = acc
-
-
-@numba.njit(cache=True)
-def duffing_tangent(t, y, p, obs, dydt, n, k):  # pragma: no cover - compiled
-    kx = p[DU_ALPHA] + 3.0 * p[DU_BETA] * y[0] * y[0]
-    for r in range(k):
-        o = n + r * n
-        dydt[o] = y[o + 1]
-        dydt[o + 1] = -kx * y[o] - p[DU_DELTA] * y[o + 1]
-
-
-@numba.njit(cache=True)
-def lorenz_tangent(t, y, p, obs, dydt, n, k):  # pragma: no cover - compiled
-    s = p[LZ_SIGMA]
-    for r in range(k):
-        o = n + r * n
-        a = y[o]
-        b = y[o + 1]
-        c = y[o + 2]
-        dydt[o] = s * (b - a)
-        dydt[o + 1] = (p[LZ_RHO] - y[2]) * a - b - y[0] * c
-        dydt[o + 2] = y[1] * a + y[0] * b - p[LZ_BETA] * c
 
 
 _TANGENTS = {
