@@ -370,12 +370,8 @@ def _check_sizes(grid: Grid, variables: dict[str, Any], path: str | None) -> Non
         )
 
 
-def _run_in_process(
-    todo: list[Task], grid: Grid, layout: _Layout, st: SweepStore, fn: Any, bar: Any
-) -> None:
-    import numba
-
-    want = 2 * numba.get_num_threads()
+def _groups(todo: list[Task], want: int) -> Iterator[list[Task]]:
+    """Consecutive tasks of equal chain length, grouped until a group has ``want`` chains."""
     i = 0
     while i < len(todo):
         group = [todo[i]]
@@ -386,12 +382,39 @@ def _run_in_process(
             group.append(todo[i])
             chains += len(todo[i].chains)
             i += 1
+        yield group
+
+
+def _run_in_process(
+    todo: list[Task], grid: Grid, layout: _Layout, st: SweepStore, fn: Any, bar: Any
+) -> None:
+    """Run the groups of tasks here, one after another; the next group is integrated (on the
+    kernel's threads, from a driver thread) while this thread writes the previous one to the
+    store, so the writes cost no integration time. An interrupt loses at most the group in
+    flight; everything written stays."""
+    import concurrent.futures as cf
+
+    import numba
+
+    def compute(group: list[Task]) -> tuple[list[Task], list[ChainRun], list[Any]]:
         runs = [grid.task_run(t) for t in group]
         res = fn(ChainRun.concat(runs))
-        parts = res.split([len(t.chains) for t in group])
-        for t, run, part in zip(group, runs, parts, strict=True):
-            st.write(t.index, t.block, layout.extract(t, run, part))
-            bar.advance(t.n_points, int(np.sum(part.status != 0)))
+        return group, runs, res.split([len(t.chains) for t in group])
+
+    groups = _groups(todo, 2 * numba.get_num_threads())
+    driver = cf.ThreadPoolExecutor(1, thread_name_prefix="gearchaos-sweep")
+    try:
+        first = next(groups, None)
+        pending = driver.submit(compute, first) if first is not None else None
+        while pending is not None:
+            group, runs, parts = pending.result()
+            nxt = next(groups, None)
+            pending = driver.submit(compute, nxt) if nxt is not None else None
+            for t, run, part in zip(group, runs, parts, strict=True):
+                st.write(t.index, t.block, layout.extract(t, run, part))
+                bar.advance(t.n_points, int(np.sum(part.status != 0)))
+    finally:
+        driver.shutdown(wait=False, cancel_futures=True)
 
 
 def _run_pool(
