@@ -11,10 +11,18 @@ from __future__ import annotations
 import warnings
 from typing import Any
 
+import numba
 from numba import typeof, types
 from numba.core.errors import NumbaIRAssumptionWarning
 
-__all__ = ["call_literal", "entry_point", "on_first_compile"]
+__all__ = ["call_literal", "entry_point", "njit_noalloc", "on_first_compile"]
+
+#: ``@njit_noalloc``: a cached kernel compiled without numba's reference counting, for kernels
+#: that allocate nothing (right-hand sides, tangents, the integrator's switch helpers). A call
+#: to it then costs no atomic reference-count updates of its array arguments: as fast as the
+#: kernel inlined into its caller, without the seconds of compile time inlining costs.
+_NO_NRT: dict[str, Any] = {"cache": True, "_nrt": False}
+njit_noalloc: Any = numba.njit(**_NO_NRT)
 
 _ENTRIES: dict[tuple[Any, ...], Any] = {}
 #: Called once per process before the first kernel that is not in numba's on-disk cache.

@@ -91,7 +91,7 @@ def reported_errors() -> Iterator[None]:
 
     on_first_compile(
         lambda: stderr().print(
-            "compiling numerical kernels (first run only, about a minute; later runs load "
+            "compiling numerical kernels (first run only, about 15 seconds; later runs load "
             "them from the cache)…"
         )
     )

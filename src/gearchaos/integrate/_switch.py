@@ -25,6 +25,8 @@ import math
 import numba
 import numpy as np
 
+from .._numba import njit_noalloc
+
 __all__ = ["LAND", "check_step", "predict_switch", "track"]
 
 #: A switch within this fraction of a step from either end counts as landed on. The local error
@@ -63,7 +65,7 @@ def _first_level(r0, r1, b):  # pragma: no cover - compiled
     return b if r1 == 2 else -b
 
 
-@numba.njit(cache=True)
+@njit_noalloc
 def _hermite_root(v0, v1, d0, d1, level):  # pragma: no cover - compiled
     """Root s ∈ (0, 1) of the cubic Hermite interpolant minus ``level`` (Illinois iteration),
     given v0 − level and v1 − level of opposite signs."""
@@ -97,7 +99,7 @@ def _hermite_root(v0, v1, d0, d1, level):  # pragma: no cover - compiled
     return x
 
 
-@numba.njit(cache=True)
+@njit_noalloc
 def check_step(obs_prev, obs, dt, n_track, sw, win):  # pragma: no cover - compiled
     """Switches inside one accepted step of length ``dt``.
 
@@ -140,7 +142,7 @@ def check_step(obs_prev, obs, dt, n_track, sw, win):  # pragma: no cover - compi
     return best, where
 
 
-@numba.njit(cache=True)
+@njit_noalloc
 def track(obs_prev, obs, dt, n_track, omin, omax):  # pragma: no cover - compiled
     """Update running extrema over one accepted step (values and Hermite interior extremum)."""
     for k in range(n_track):
@@ -183,7 +185,7 @@ def _newton(u, ub, ua, c0, c1, c2, c3, c4, c5):  # pragma: no cover - compiled
     return (acc * u + c1) * u + c0
 
 
-@numba.njit(cache=True)
+@njit_noalloc
 def predict_switch(hist, n_pts, t_hist, n_track, sw, h):  # pragma: no cover - compiled
     """Time from the current point to the first switch predicted within (0, h], or −1.
 

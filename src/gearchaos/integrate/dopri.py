@@ -31,7 +31,8 @@ import math
 import numba
 import numpy as np
 
-from ..model.kernels import OBS_ALL, OBS_NONE, OBS_TRACK, rhs, rhs_inline, tangent
+from .._numba import njit_noalloc
+from ..model.kernels import OBS_ALL, OBS_NONE, OBS_TRACK, rhs, tangent
 from ._switch import AIM, LAND, check_step, predict_switch, track
 from .tableau import DOPRI5
 
@@ -115,7 +116,7 @@ def initial_step(kind, t, y, f0, p, rtol, atol, obs, n):  # pragma: no cover - c
     return min(100.0 * h0, h1)
 
 
-@numba.njit(cache=True)
+@njit_noalloc
 def _renormalize(kind, t, y, p, obs, K, n, k, lsum, tan_on):  # pragma: no cover - compiled
     """Tangent vectors in y[n:]: set them orthonormal (first call) or re-orthonormalise them by
     modified Gram–Schmidt, adding log stretch factors to ``lsum``; refresh their FSAL stage
@@ -147,7 +148,7 @@ def _renormalize(kind, t, y, p, obs, K, n, k, lsum, tan_on):  # pragma: no cover
     return True
 
 
-@numba.njit(cache=True)
+@njit_noalloc
 def _settled(y, ring, runs, n_sec, n_base):  # pragma: no cover - compiled
     """Store transient section point number ``n_sec`` (state ``y``) in ``ring``; update the
     run lengths ``runs[n]`` of consecutive repeats with period n; whether one is long enough."""
@@ -346,7 +347,7 @@ def dopri_run(
                     )  # fmt: skip
                 ts = t_new
             level = last_level if s == STAGES - 1 else (OBS_ALL if tan_on else OBS_NONE)
-            rhs_inline(kind, ts, yt, p, K[s], obs, level)
+            rhs(kind, ts, yt, p, K[s], obs, level)
             if tan_on:
                 tangent(kind, ts, yt, p, obs, K[s], n_base, n_tan)
         # yt is y_{n+1}; the scaled RMS norm of the embedded error estimate, which is NaN

@@ -12,6 +12,13 @@ exactly at the new point, so observables cost next to nothing.
 One dispatch function (:func:`rhs`) keeps numba's on-disk cache effective: a cached kernel that
 receives a jitted function as an argument cannot be cached, and closures over dispatchers are
 re-compiled in every process.
+
+The kernels are *called*, not inlined into the integrator at the numba-IR level (that cost
+5–8 s of compile time per call site, issue 13), and compiled without numba's reference
+counting (``_nrt=False``: they allocate nothing), so a call costs no atomic reference-count
+updates of its array arguments; a step of the planetary model is then as fast as with the
+kernel inlined. Terms that the default gear sets do not have (stiffness harmonics,
+eccentricities) live in a called helper, off the common path.
 """
 
 from __future__ import annotations
@@ -23,6 +30,7 @@ import numpy as np
 from numba import types
 from numba.extending import overload
 
+from .._numba import njit_noalloc
 from .layout import (
     B_C,
     B_C_EPR,
@@ -101,7 +109,6 @@ __all__ = [
     "dead_zone",
     "observe_many",
     "rhs",
-    "rhs_inline",
     "tangent",
 ]
 
@@ -119,7 +126,7 @@ def _sinusoid(a, w, s, c, ca, sa):  # pragma: no cover - compiled
     return e, a * w * (c * ca - s * sa), -w * w * e
 
 
-@numba.njit(cache=True)
+@njit_noalloc
 def _planetary_general(t, p, i, N, ck, ckr, ksp, dksp, krp, dkrp, esp, esp_d, esp_dd, erp,
                        erp_d, erp_dd):  # pragma: no cover - compiled  # fmt: skip
     """The terms of planet i that the default gear sets do not have — stiffness harmonics
@@ -178,7 +185,7 @@ def _planetary_general(t, p, i, N, ck, ckr, ksp, dksp, krp, dkrp, esp, esp_d, es
     return ksp, dksp, krp, dkrp, esp, esp_d, esp_dd, erp, erp_d, erp_dd
 
 
-@numba.njit(cache=True)
+@njit_noalloc
 def planetary_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
     """Minimal relative-coordinate equations of MODEL.md §7.
 
@@ -331,7 +338,7 @@ def planetary_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
 # needs from ``obs``. V holds k tangent vectors in y[n:], row after row.
 
 
-@numba.njit(cache=True)
+@njit_noalloc
 def planetary_tangent(t, y, p, obs, dydt, n, k):  # pragma: no cover - compiled
     N = int(p[P_N])
     nd = N + 3
@@ -424,13 +431,6 @@ _KERNELS = {
 }
 
 
-#: the same kernels inlined into their caller at the numba-IR level: only the integrator's stage
-#: loop uses them (:func:`rhs_inline`). Inlining costs compile time (a few seconds a call site),
-#: a call costs run time (array arguments are reference-counted across a call, ~40 ns), so the
-#: one hot call site inlines and every other site calls.
-_KERNELS_INLINE = {k: numba.njit(inline="always")(f.py_func) for k, f in _KERNELS.items()}
-
-
 def rhs(kind, t, y, p, dydt, obs, level):
     """Right-hand side of system ``kind`` (see :mod:`gearchaos.model.layout`); ``level`` says
     which observables to write (module docstring).
@@ -442,34 +442,22 @@ def rhs(kind, t, y, p, dydt, obs, level):
     _KERNELS[int(kind)](t, y, p, dydt, obs, level)
 
 
-def rhs_inline(kind, t, y, p, dydt, obs, level):
-    """:func:`rhs` with the kernel's body inlined into the calling kernel (the one hot call
-    site: the integrator's stages)."""
-    _KERNELS[int(kind)](t, y, p, dydt, obs, level)
+@overload(rhs, inline="always")
+def _rhs_overload(kind, t, y, p, dydt, obs, level):  # pragma: no cover - compiled
+    if not isinstance(kind, types.IntegerLiteral):
+        raise numba.errors.TypingError(
+            "gearchaos.model.kernels.rhs: 'kind' must be a compile-time literal; "
+            "call numba.literally(kind) in the calling kernel"
+        )
+    k = kind.literal_value
+    if k not in _KERNELS:
+        raise numba.errors.TypingError(f"unknown system kind {k}")
+    fn = _KERNELS[k]
 
+    def impl(kind, t, y, p, dydt, obs, level):
+        fn(t, y, p, dydt, obs, level)
 
-def _rhs_impl(table, name):
-    def typer(kind, t, y, p, dydt, obs, level):  # pragma: no cover - compiled
-        if not isinstance(kind, types.IntegerLiteral):
-            raise numba.errors.TypingError(
-                f"gearchaos.model.kernels.{name}: 'kind' must be a compile-time literal; "
-                "call numba.literally(kind) in the calling kernel"
-            )
-        k = kind.literal_value
-        if k not in table:
-            raise numba.errors.TypingError(f"unknown system kind {k}")
-        fn = table[k]
-
-        def impl(kind, t, y, p, dydt, obs, level):
-            fn(t, y, p, dydt, obs, level)
-
-        return impl
-
-    return typer
-
-
-overload(rhs, inline="always")(_rhs_impl(_KERNELS, "rhs"))
-overload(rhs_inline, inline="always")(_rhs_impl(_KERNELS_INLINE, "rhs_inline"))
+    return impl
 
 
 @numba.njit(cache=True)

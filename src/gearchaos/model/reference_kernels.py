@@ -8,6 +8,7 @@ import math
 
 import numba
 
+from .._numba import njit_noalloc
 from .layout import (
     BO_B,
     BO_EPS,
@@ -54,7 +55,7 @@ def engaged(x: float, b: float) -> float:
     return 1.0 if (x > b or x < -b) else 0.0
 
 
-@numba.njit(cache=True)
+@njit_noalloc
 def backlash_oscillator_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
     """x'' + 2ζx' + (1 + ε cos Ωτ) f(x; b) = F_m + F_a Ω^q cos Ωτ;
     obs = (x, Fᶜ, x', Fᶜ', stiffness 1 + ε cos Ωτ) with the contact force
@@ -81,7 +82,7 @@ def backlash_oscillator_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - co
     obs[4] = k
 
 
-@numba.njit(cache=True)
+@njit_noalloc
 def linear_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
     """y' = A y + f cos Ωτ + g sin Ωτ; obs = (y, y')."""
     n = int(p[LIN_N])
@@ -100,7 +101,7 @@ def linear_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
         obs[n + i] = acc
 
 
-@numba.njit(cache=True)
+@njit_noalloc
 def duffing_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
     """x'' + δx' + αx + βx³ = γ cos Ωτ; obs = (x, x')."""
     x = y[0]
@@ -116,7 +117,7 @@ def duffing_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
     obs[1] = v
 
 
-@numba.njit(cache=True)
+@njit_noalloc
 def lorenz_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
     """Lorenz (1963): x' = σ(y − x), y' = x(ρ − z) − y, z' = xy − βz;
     obs = (x, y, z, x', y', z')."""
@@ -128,7 +129,7 @@ def lorenz_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
         obs[3 + i] = dydt[i]
 
 
-@numba.njit(cache=True)
+@njit_noalloc
 def backlash_oscillator_tangent(t, y, p, obs, dydt, n, k):  # pragma: no cover - compiled
     kx = obs[4] * engaged(obs[0], p[BO_B])
     for r in range(k):
@@ -137,7 +138,7 @@ def backlash_oscillator_tangent(t, y, p, obs, dydt, n, k):  # pragma: no cover -
         dydt[o + 1] = -kx * y[o] - 2.0 * p[BO_ZETA] * y[o + 1]
 
 
-@numba.njit(cache=True)
+@njit_noalloc
 def linear_tangent(t, y, p, obs, dydt, n, k):  # pragma: no cover - compiled
     a0 = LIN_HEADER
     for r in range(k):
@@ -149,7 +150,7 @@ def linear_tangent(t, y, p, obs, dydt, n, k):  # pragma: no cover - compiled
             dydt[o + i] = acc
 
 
-@numba.njit(cache=True)
+@njit_noalloc
 def duffing_tangent(t, y, p, obs, dydt, n, k):  # pragma: no cover - compiled
     kx = p[DU_ALPHA] + 3.0 * p[DU_BETA] * y[0] * y[0]
     for r in range(k):
@@ -158,7 +159,7 @@ def duffing_tangent(t, y, p, obs, dydt, n, k):  # pragma: no cover - compiled
         dydt[o + 1] = -kx * y[o] - p[DU_DELTA] * y[o + 1]
 
 
-@numba.njit(cache=True)
+@njit_noalloc
 def lorenz_tangent(t, y, p, obs, dydt, n, k):  # pragma: no cover - compiled
     s = p[LZ_SIGMA]
     for r in range(k):
