@@ -1,6 +1,6 @@
 """The thread pool that spreads chains over cores (:func:`run_threaded`): every chain runs exactly
-once, in as many threads as asked for, results do not depend on the threads, and an error stops
-the blocks not yet started."""
+once, in as many threads as asked for, and an error stops the blocks not yet started (results
+that do not depend on the threads: tests/integrate/test_batch.py)."""
 
 from __future__ import annotations
 
@@ -9,8 +9,6 @@ import threading
 import numpy as np
 import pytest
 
-import gearchaos as gc
-from gearchaos.integrate import integrate_batch
 from gearchaos.integrate._chains import run_threaded
 
 
@@ -57,21 +55,3 @@ def test_an_error_cancels_the_blocks_not_started() -> None:
     release.set()
     # block 0, the block the other thread holds, and at most one the first thread took next
     assert len(started) <= 3
-
-
-def test_chains_on_several_threads_equal_one_thread_bitwise() -> None:
-    import numba
-
-    gs = gc.preset("hindawi2021")
-    systems = [gc.planetary_system(gs, om) for om in np.linspace(0.6, 3.0, 7)]
-    kw = dict(transient_periods=3, periods=4, samples_per_period=2)
-    many = integrate_batch(systems, **kw)
-    old = numba.get_num_threads()
-    try:
-        numba.set_num_threads(1)
-        one = integrate_batch(systems, **kw)
-    finally:
-        numba.set_num_threads(old)
-    for name in ("tau", "states", "observables", "obs_min", "obs_max", "final_state"):
-        np.testing.assert_array_equal(getattr(many, name), getattr(one, name))
-    np.testing.assert_array_equal(many.steps_accepted, one.steps_accepted)
