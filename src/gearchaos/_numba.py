@@ -63,7 +63,7 @@ def entry_point(dispatcher: Any, kind: int, *args: Any) -> Any:
         sig = (types.literal(kind), *key[2:])
         with warnings.catch_warnings():
             # numba's IR inliner emits an internal "pedantic" NumbaIRAssumptionWarning for the
-            # inlined right-hand side; it is harmless and not actionable for users
+            # inlined dispatch of the right-hand side; it is harmless and not actionable
             warnings.simplefilter("ignore", NumbaIRAssumptionWarning)
             entry = dispatcher.compile(sig)  # compiles or loads the literal specialisation
         _ENTRIES[key] = entry

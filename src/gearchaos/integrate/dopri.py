@@ -218,8 +218,8 @@ def dopri_run(
 
     t = t0
     n_tan = lsum.size
-    # np.bool_/np.int64: a plain literal would make numba compile the helpers that take these
-    # variables twice, once for the literal value and once for the widened type
+    # np.bool_ (and np.int64 for n_pts, n_sec): a plain literal would make numba compile the
+    # helpers that take these variables twice, once for the literal value and once widened
     tan_on = np.bool_(False)
     for r in range(n_tan):
         lsum[r] = 0.0
@@ -255,7 +255,7 @@ def dopri_run(
     t_hist = np.zeros(3)
     _copy(hist[0], obs, n_tr2)
     t_hist[0] = t
-    n_pts = int(np.int64(1))
+    n_pts = int(np.int64(1))  # not a literal: see tan_on
     last_rejected = False
     nonfinite = False
     has_switch = False
@@ -271,7 +271,7 @@ def dopri_run(
     n_ring = SETTLE_MAX_PERIOD + 1
     ring = np.empty((n_ring if settling else 0, n_base))
     runs = np.zeros(SETTLE_MAX_PERIOD + 1, dtype=np.int64)
-    n_sec = int(np.int64(0))
+    n_sec = int(np.int64(0))  # not a literal: see tan_on
     skipped = 0
 
     while status == ST_OK:

@@ -127,14 +127,32 @@ def _sinusoid(a, w, s, c, ca, sa):  # pragma: no cover - compiled
 
 
 @njit_noalloc
-def _planetary_general(t, p, i, N, ck, ckr, ksp, dksp, krp, dkrp, esp, esp_d, esp_dd, erp,
+def _eccentric_phases(t, p):  # pragma: no cover - compiled
+    """(Ω_s, Ω_p, Ω_r, cos Ω_s τ, sin Ω_s τ, cos Ω_p τ, sin Ω_p τ, cos Ω_r τ, sin Ω_r τ) with
+    Ω_x = Ω/z_x, the rotation frequencies of the eccentricities, once per right-hand side for
+    every planet (zeros without eccentricities)."""
+    if p[P_ECC] == 0.0:
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    om = p[P_OMEGA]
+    om_s = om / p[P_ZS]
+    om_p = om / p[P_ZP]
+    om_r = om / p[P_ZR]
+    return (
+        om_s, om_p, om_r,
+        math.cos(om_s * t), math.sin(om_s * t),
+        math.cos(om_p * t), math.sin(om_p * t),
+        math.cos(om_r * t), math.sin(om_r * t),
+    )  # fmt: skip
+
+
+@njit_noalloc
+def _planetary_general(ph, p, i, N, ck, ckr, ksp, dksp, krp, dkrp, esp, esp_d, esp_dd, erp,
                        erp_d, erp_dd):  # pragma: no cover - compiled  # fmt: skip
     """The terms of planet i that the default gear sets do not have — stiffness harmonics
-    h ≥ 2 and eccentricities — added to its stiffnesses, transmission errors and their
-    derivatives (in the order of MODEL.md §5). A called function, not inlined: it keeps the
-    right-hand side that the integrator inlines small (compile time) and its common path free
-    of never-taken branches (run time)."""
-    om = p[P_OMEGA]
+    h ≥ 2 and eccentricities (phases ``ph`` from :func:`_eccentric_phases`) — added to its
+    stiffnesses, transmission errors and their derivatives (in the order of MODEL.md §5). A
+    called function: it keeps the common path of the right-hand side short (compile time) and
+    free of never-taken branches (run time)."""
     nh_sp = int(p[P_NH_SP])
     nh_rp = int(p[P_NH_RP])
     h0 = P_HEADER + N_BLOCKS * N  # first harmonic amplitude
@@ -155,15 +173,7 @@ def _planetary_general(t, p, i, N, ck, ckr, ksp, dksp, krp, dkrp, esp, esp_d, es
             dkrp += p[h0 + nh_sp + h] * dt_
             tm2, tm1, dm2, dm1 = tm1, tt, dm1, dt_
     if p[P_ECC] != 0.0:
-        om_s = om / p[P_ZS]
-        om_p = om / p[P_ZP]
-        om_r = om / p[P_ZR]
-        cs_ = math.cos(om_s * t)
-        ss_ = math.sin(om_s * t)
-        cp_ = math.cos(om_p * t)
-        sp_ = math.sin(om_p * t)
-        cr_ = math.cos(om_r * t)
-        sr_ = math.sin(om_r * t)
+        om_s, om_p, om_r, cs_, ss_, cp_, sp_, cr_, sr_ = ph
         for a, w, s_, c_, bc, bs, to_sp in (
             (p[P_ES], om_s, ss_, cs_, B_C_ES, B_S_ES, True),
             (p[P_EP], om_p, sp_, cp_, B_C_EPS, B_S_EPS, True),
@@ -224,6 +234,7 @@ def planetary_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
     arp = p[P_ARP]
     inv_mup = p[P_INV_MUP]
     general = p[P_ECC] != 0.0 or p[P_NH_SP] > 0.0 or p[P_NH_RP] > 0.0
+    ph = _eccentric_phases(t, p) if general else (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 
     sum_fsp = 0.0
     sum_frp = 0.0
@@ -252,7 +263,7 @@ def planetary_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
         )
         if general:
             ksp, dksp, krp, dkrp, esp, esp_d, esp_dd, erp, erp_d, erp_dd = _planetary_general(
-                t, p, i, N, ck, ckr, ksp, dksp, krp, dkrp, esp, esp_d, esp_dd, erp, erp_d, erp_dd
+                ph, p, i, N, ck, ckr, ksp, dksp, krp, dkrp, esp, esp_d, esp_dd, erp, erp_d, erp_dd
             )
 
         pi_ = y[2 + i]

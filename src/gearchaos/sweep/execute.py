@@ -1,7 +1,7 @@
 """Executors: where tasks run. The parent process is always the only writer of the store.
 
-* in-process (default): tasks run here, the compiled kernel's thread pool spreads chains
-  over all cores; small tasks are grouped so every call has enough chains;
+* in-process (default): tasks run here, :func:`~gearchaos.integrate.run_chains` spreads
+  chains over all cores on its threads; small tasks are grouped so every call has enough chains;
 * ``workers=N``: a pool of N local processes (spawn start method), one numba thread each;
 * ``scheduler="tcp://host:port"``: an existing ``dask.distributed`` cluster;
 * ``dask_local=N``: a ``dask.distributed.LocalCluster`` with N single-threaded workers.
