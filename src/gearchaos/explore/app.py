@@ -258,6 +258,7 @@ class Explorer(pn.viewable.Viewer):
         self.marker = Span(location=None, dimension="height", line_color="#d62728", line_width=2)
         fig.add_layout(self.marker)
         fig.on_event(events.Tap, self._tapped)
+        fig.on_event(events.DoubleTap, self._tapped)
         fig.xaxis.axis_label_text_font_size = "13px"
         fig.yaxis.axis_label_text_font_size = "13px"
         band = figure(
@@ -279,6 +280,7 @@ class Explorer(pn.viewable.Viewer):
             HoverTool(renderers=[cells], tooltips=[(name, "@x{0.0000}"), ("motion", "@label")])
         )
         band.on_event(events.Tap, self._tapped)
+        band.on_event(events.DoubleTap, self._tapped)
         self._legend(fig, b["label"])
         self.x_range = x_range
         return _stack(fig, band)
@@ -310,6 +312,7 @@ class Explorer(pn.viewable.Viewer):
             "x", "y", source=self.marker_src, size=14, marker="x", color="black", line_width=3
         )
         fig.on_event(events.Tap, self._tapped)
+        fig.on_event(events.DoubleTap, self._tapped)
         self._legend(fig, b["label"])
         self.x_range = fig.x_range
         self.y_range = fig.y_range
@@ -335,6 +338,9 @@ class Explorer(pn.viewable.Viewer):
 
     # ------------------------------------------------------------------ selecting a point
     def _tapped(self, event: Any) -> None:
+        """A click selects the nearest point. Bokeh reports a click that follows another
+        within its double-tap interval as a DoubleTap, not a Tap, so both select: a quick
+        second click on another point must not be dropped."""
         try:
             y = event.y if self.model.is_map else None
             self.select(self.model.nearest(event.x, y))
