@@ -100,8 +100,10 @@ def _hermite_root(v0, v1, d0, d1, level):  # pragma: no cover - compiled
 
 
 @njit_noalloc
-def check_step(obs_prev, obs, dt, n_track, sw, win):  # pragma: no cover - compiled
-    """Switches inside one accepted step of length ``dt``.
+def check_step(hist, obs, dt, n_track, sw, win):  # pragma: no cover - compiled
+    """Switches inside one step of length ``dt`` from the point ``hist[0]`` to ``obs`` (``hist``
+    as in :func:`predict_switch`: a row, not a view, which would cost two atomic reference-count
+    updates per call).
 
     A switch that the end of the step has passed by at most ``win`` (in τ, from the value and
     derivative at the end: (v₁ − level)/v₁′) is landed on; one that the start of the step was
@@ -117,14 +119,14 @@ def check_step(obs_prev, obs, dt, n_track, sw, win):  # pragma: no cover - compi
         b = sw[k]
         if not b < np.inf:
             continue
-        v0 = obs_prev[k]
+        v0 = hist[0, k]
         v1 = obs[k]
         r0 = _region(v0, b)
         r1 = _region(v1, b)
         if r0 == r1:
             continue
         level = _first_level(r0, r1, b)
-        d0 = obs_prev[n_track + k]
+        d0 = hist[0, n_track + k]
         d1 = obs[n_track + k]
         if abs(r1 - r0) == 1:
             gap = v1 - level
@@ -143,16 +145,17 @@ def check_step(obs_prev, obs, dt, n_track, sw, win):  # pragma: no cover - compi
 
 
 @njit_noalloc
-def track(obs_prev, obs, dt, n_track, omin, omax):  # pragma: no cover - compiled
-    """Update running extrema over one accepted step (values and Hermite interior extremum)."""
+def track(hist, obs, dt, n_track, omin, omax):  # pragma: no cover - compiled
+    """Update running extrema over one accepted step from ``hist[0]`` to ``obs`` (values and
+    Hermite interior extremum)."""
     for k in range(n_track):
-        v0 = obs_prev[k]
+        v0 = hist[0, k]
         v1 = obs[k]
         if v1 < omin[k]:
             omin[k] = v1
         if v1 > omax[k]:
             omax[k] = v1
-        d0 = obs_prev[n_track + k] * dt
+        d0 = hist[0, n_track + k] * dt
         d1 = obs[n_track + k] * dt
         if d0 * d1 < 0.0:
             # derivative of the cubic Hermite interpolant: a s² + b s + c on s ∈ [0, 1]

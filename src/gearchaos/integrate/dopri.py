@@ -21,6 +21,12 @@ The stages are written out with the coefficients of :data:`~gearchaos.integrate.
 as compile-time constants; the inner stages ask the right-hand side for no observables, the last
 (FSAL) stage for the tracked ones only, or for all of them on a sample step.
 
+:func:`dopri_run` allocates nothing: its scratch arrays come from :func:`workspace`, once per
+block of chains, so it is compiled without numba's reference counting. With it, every array
+view a step creates (a row of the stage matrix, say) and every array passed to a helper cost an
+atomic increment and decrement: a perf profile put a quarter of a step in ``NRT_incref`` and
+``NRT_decref`` (issue 13).
+
 Kernels never raise: they return a :class:`~gearchaos.errors.Status` code.
 """
 
@@ -86,9 +92,27 @@ def _copy(dst, src, n):  # pragma: no cover - compiled
         dst[i] = src[i]
 
 
-@numba.njit(cache=True)
-def initial_step(kind, t, y, f0, p, rtol, atol, obs, n):  # pragma: no cover - compiled
-    """Hairer's starting step (HNW I, §II.4) for the 5(4) pair, from the first n components."""
+@numba.njit(cache=True, inline="always")
+def _put_row(dst, r, src, n):  # pragma: no cover - compiled
+    """dst[r, :n] = src[:n] without the view dst[r], whose creation and release are two atomic
+    reference-count updates (a quarter of a step's time when done for every stage, issue 13)."""
+    for i in range(n):
+        dst[r, i] = src[i]
+
+
+@numba.njit(cache=True, inline="always")
+def _shift(hist, obs, n):  # pragma: no cover - compiled
+    """Rows of ``hist`` one older (row 2 ← 1 ← 0), row 0 ← obs[:n]."""
+    for i in range(n):
+        hist[2, i] = hist[1, i]
+        hist[1, i] = hist[0, i]
+        hist[0, i] = obs[i]
+
+
+@njit_noalloc
+def initial_step(kind, t, y, f0, p, rtol, atol, obs, n, y1, f1):  # pragma: no cover - compiled
+    """Hairer's starting step (HNW I, §II.4) for the 5(4) pair, from the first n components
+    (``obs``, ``y1``, ``f1``: scratch)."""
     numba.literally(kind)
     d0 = 0.0
     d1 = 0.0
@@ -99,10 +123,8 @@ def initial_step(kind, t, y, f0, p, rtol, atol, obs, n):  # pragma: no cover - c
     d0 = math.sqrt(d0 / n)
     d1 = math.sqrt(d1 / n)
     h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
-    y1 = np.empty(y.size)
     for i in range(y.size):
         y1[i] = y[i] + h0 * f0[i]
-    f1 = np.empty(y.size)
     rhs(kind, t + h0, y1, p, f1, obs, OBS_NONE)
     d2 = 0.0
     for i in range(n):
@@ -117,10 +139,10 @@ def initial_step(kind, t, y, f0, p, rtol, atol, obs, n):  # pragma: no cover - c
 
 
 @njit_noalloc
-def _renormalize(kind, t, y, p, obs, K, n, k, lsum, tan_on):  # pragma: no cover - compiled
+def _renormalize(kind, t, y, p, obs, K, ks, n, k, lsum, tan_on):  # pragma: no cover - compiled
     """Tangent vectors in y[n:]: set them orthonormal (first call) or re-orthonormalise them by
     modified Gram–Schmidt, adding log stretch factors to ``lsum``; refresh their FSAL stage
-    ``K[0]`` (``obs`` holds all observables at (t, y))."""
+    ``K[0, n:]`` through the scratch row ``ks`` (``obs`` holds all observables at (t, y))."""
     numba.literally(kind)
     if not tan_on:
         for r in range(k):
@@ -144,7 +166,9 @@ def _renormalize(kind, t, y, p, obs, K, n, k, lsum, tan_on):  # pragma: no cover
             lsum[r] += math.log(nrm)
             for i in range(n):
                 y[o + i] /= nrm
-    tangent(kind, t, y, p, obs, K[0], n, k)
+    tangent(kind, t, y, p, obs, ks, n, k)
+    for i in range(n, y.size):
+        K[0, i] = ks[i]
     return True
 
 
@@ -171,8 +195,27 @@ def _settled(y, ring, runs, n_sec, n_base):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
+def workspace(n, n_obs, n_track, n_base):  # pragma: no cover - compiled
+    """The scratch arrays of :func:`dopri_run` for states of size n (allocated once per block of
+    chains, reused by every point)."""
+    return (
+        np.empty(n),  # y
+        np.empty(n),  # yt: the stage argument, then y_{n+1}
+        np.zeros(n),  # ks: a stage's derivative, copied into a row of K
+        np.zeros((STAGES, n)),  # K: the stages
+        np.empty(n_obs),  # obs
+        np.empty((3, 2 * n_track)),  # hist: tracked observables of the last accepted points
+        np.zeros(3),  # t_hist: their times
+        np.empty((SETTLE_MAX_PERIOD + 1, n_base)),  # ring: transient section points
+        np.zeros(SETTLE_MAX_PERIOD + 1, dtype=np.int64),  # runs: repeat run lengths
+        np.empty(n),  # f1: scratch of initial_step
+        np.empty(n_obs),  # o1: scratch of initial_step
+    )
+
+
+@njit_noalloc
 def dopri_run(
-    kind, y0, p, sw, t0, t_rec, dt_sample, t_end, cfg, out, info, lsum
+    kind, y0, p, sw, t0, t_rec, dt_sample, t_end, cfg, out, info, lsum, ws
 ):  # pragma: no cover - compiled
     """Integrate one system; fill the output arrays ``out`` = (out_t, out_y, out_obs,
     obs_min, obs_max, y_final); return the status code. ``cfg`` = (n_samples, n_obs, n_track,
@@ -206,11 +249,14 @@ def dopri_run(
     numba.literally(kind)
     n_samples, n_obs, n_track, n_base, rtol, atol, h_init, max_step, max_steps, settle_spp = cfg
     out_t, out_y, out_obs, obs_min, obs_max, y_final = out
+    y, yt, ks, K, obs, hist, t_hist, ring, runs, f1, o1 = ws
     n = y0.size
-    y = y0.copy()
-    yt = np.empty(n)
-    K = np.zeros((STAGES, n))  # tangent components stay zero until the tangents start
-    obs = np.empty(n_obs)
+    _copy(y, y0, n)
+    for s in range(STAGES):
+        for i in range(n):
+            K[s, i] = 0.0  # tangent components stay zero until the tangents start
+    for i in range(n):
+        ks[i] = 0.0  # stages go into ks, then into rows of K: no views (module docstring)
     n_tr2 = 2 * n_track
     for k in range(n_track):
         obs_min[k] = np.inf
@@ -223,7 +269,8 @@ def dopri_run(
     tan_on = np.bool_(False)
     for r in range(n_tan):
         lsum[r] = 0.0
-    rhs(kind, t, y, p, K[0], obs, OBS_ALL)
+    rhs(kind, t, y, p, ks, obs, OBS_ALL)
+    _put_row(K, 0, ks, n)
     n_acc = 0
     n_rej = 0
     status = ST_OK
@@ -232,7 +279,7 @@ def dopri_run(
             status = ST_NON_FINITE
     h = h_init
     if status == ST_OK and h <= 0.0:
-        h = initial_step(kind, t, y, K[0], p, rtol, atol, np.empty(n_obs), n_base)
+        h = initial_step(kind, t, y, ks, p, rtol, atol, o1, n_base, yt, f1)
     if h > max_step:
         h = max_step
 
@@ -240,10 +287,10 @@ def dopri_run(
     tracking = False
     if status == ST_OK and n_samples > 0 and t >= t_rec:
         if n_tan > 0:
-            tan_on = _renormalize(kind, t, y, p, obs, K, n_base, n_tan, lsum, tan_on)
+            tan_on = _renormalize(kind, t, y, p, obs, K, ks, n_base, n_tan, lsum, tan_on)
         out_t[0] = t
-        _copy(out_y[0], y, n)
-        _copy(out_obs[0], obs, n_obs)
+        _put_row(out_y, 0, y, n)
+        _put_row(out_obs, 0, obs, n_obs)
         j = 1
         tracking = True
         for k in range(n_track):
@@ -251,9 +298,9 @@ def dopri_run(
             obs_max[k] = obs[k]
     # tracked observables at the last three accepted points, newest first, and their times;
     # n_pts of them lie on the current smooth piece (since the last switch)
-    hist = np.empty((3, n_tr2))
-    t_hist = np.zeros(3)
-    _copy(hist[0], obs, n_tr2)
+    for r in range(3):
+        t_hist[r] = 0.0
+    _put_row(hist, 0, obs, n_tr2)
     t_hist[0] = t
     n_pts = int(np.int64(1))  # not a literal: see tan_on
     last_rejected = False
@@ -268,9 +315,8 @@ def dopri_run(
     settling = settle_spp > 0 and n_samples > 0 and t < t_rec
     period = dt_sample * settle_spp
     m_next = int((t_rec - t) / period - 1e-9) if settling else 0
-    n_ring = SETTLE_MAX_PERIOD + 1
-    ring = np.empty((n_ring if settling else 0, n_base))
-    runs = np.zeros(SETTLE_MAX_PERIOD + 1, dtype=np.int64)
+    for r in range(SETTLE_MAX_PERIOD + 1):
+        runs[r] = 0
     n_sec = int(np.int64(0))  # not a literal: see tan_on
     skipped = 0
 
@@ -347,9 +393,10 @@ def dopri_run(
                     )  # fmt: skip
                 ts = t_new
             level = last_level if s == STAGES - 1 else (OBS_ALL if tan_on else OBS_NONE)
-            rhs(kind, ts, yt, p, K[s], obs, level)
+            rhs(kind, ts, yt, p, ks, obs, level)
             if tan_on:
-                tangent(kind, ts, yt, p, obs, K[s], n_base, n_tan)
+                tangent(kind, ts, yt, p, obs, ks, n_base, n_tan)
+            _put_row(K, s, ks, n)
         # yt is y_{n+1}; the scaled RMS norm of the embedded error estimate, which is NaN
         # also when y_{n+1} is not finite
         acc = 0.0
@@ -375,7 +422,7 @@ def dopri_run(
             # a switch within LAND·h of either end of the step counts as landed on (h the
             # proposal: a shortened step must not make that window shrink)
             win = LAND * max(h, hs)
-            theta, where = check_step(hist[0], obs, hs, n_track, sw, win)
+            theta, where = check_step(hist, obs, hs, n_track, sw, win)
             if theta < 1.0 and theta * hs > hmin:
                 # a switch lies inside the step: retry, ending just past it
                 h_event = theta * hs + AIM * max(h, hs)
@@ -411,7 +458,7 @@ def dopri_run(
             y[i] = yt[i]
             K[0, i] = K[STAGES - 1, i]
         if tracking:
-            track(hist[0], obs, hs, n_track, obs_min, obs_max)
+            track(hist, obs, hs, n_track, obs_min, obs_max)
         record = clipped and j < n_samples and not sec_step
         if clipped and sec_step:
             m_next -= 1
@@ -425,10 +472,10 @@ def dopri_run(
             n_sec += 1
         if record:
             if n_tan > 0:
-                tan_on = _renormalize(kind, t, y, p, obs, K, n_base, n_tan, lsum, tan_on)
+                tan_on = _renormalize(kind, t, y, p, obs, K, ks, n_base, n_tan, lsum, tan_on)
             out_t[j] = t
-            _copy(out_y[j], y, n)
-            _copy(out_obs[j], obs, n_obs)
+            _put_row(out_y, j, y, n)
+            _put_row(out_obs, j, obs, n_obs)
             if not tracking:
                 tracking = True
                 for k in range(n_track):
@@ -437,9 +484,7 @@ def dopri_run(
             j += 1
         # the smooth piece: a switch at the end starts a new one, at the start one of two points
         n_pts = 1 if where == 2 else (2 if where == 1 else min(n_pts + 1, 3))
-        _copy(hist[2], hist[1], n_tr2)
-        _copy(hist[1], hist[0], n_tr2)
-        _copy(hist[0], obs, n_tr2)
+        _shift(hist, obs, n_tr2)
         t_hist[2] = t_hist[1]
         t_hist[1] = t_hist[0]
         t_hist[0] = t
@@ -502,6 +547,7 @@ def dopri_chains(
     n_chains = P.shape[0]
     length = P.shape[1]
     cfg = (n_samples, n_obs, n_track, n_base, rtol, atol, h_init, max_step, max_steps, settle_spp)
+    ws = workspace(Y0.shape[1], n_obs, n_track, n_base)
     for c in range(n_chains):
         y = Y0[c].copy()
         for j in range(length):
@@ -520,6 +566,7 @@ def dopri_chains(
                 out + ext,
                 info[c, j],
                 LSUM[c, j],
+                ws,
             )
             status[c, j] = st
             if continuation and st == ST_OK:
