@@ -88,6 +88,8 @@ from .layout import (
     P_ZP,
     P_ZR,
     P_ZS,
+    PLANETARY_FIXED_N,
+    planetary_kind,
 )
 from .reference_kernels import (
     backlash_oscillator_rhs,
@@ -195,150 +197,163 @@ def _planetary_general(ph, p, i, N, ck, ckr, ksp, dksp, krp, dkrp, esp, esp_d, e
     return ksp, dksp, krp, dkrp, esp, esp_d, esp_dd, erp, erp_d, erp_dd
 
 
-@njit_noalloc
-def planetary_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
-    """Minimal relative-coordinate equations of MODEL.md §7.
+def _planetary_rhs(n_fixed):
+    """The planetary right-hand side, for any planet count (``n_fixed`` = 0: read from ``p``)
+    or compiled for ``n_fixed`` planets: the loops over the planets then have a fixed trip
+    count and every parameter a fixed offset (no index arithmetic, no register spills; numba
+    caches the variants apart, by the value of ``n_fixed``)."""
 
-    State y = (x̄_s, ȳ_s, p̄_1..p̄_N, σ̄, then their τ-derivatives).
-    obs = (δ̄_sp1..N, δ̄_rp1..N, x̄_s, ȳ_s, F̄ᶜ_sp1..N, F̄ᶜ_rp1..N, then the τ-derivatives of
-    these T = 4N + 2 tracked observables, then F̄_sp1..N, F̄_rp1..N, then the mesh stiffnesses
-    κ_sp1..N, κ_rp1..N). The first 2N + 2 are the arguments of the dead zones (event-located);
-    F̄ᶜ is the *contact* force of a mesh, κ f(δ̄; b̄) + c̄ δ̄' while the teeth touch
-    (|δ̄| > b̄) and exactly 0 while they are apart; F̄ is the force of the equations of motion,
-    κ f(δ̄; b̄) + c̄ δ̄' at all times (damping acts inside the clearance, MODEL.md §4). Their
-    derivatives F̄ᶜ' = κ' f + κ δ̄' + c̄ δ̄'' (engaged) let the integrator refine the contact
-    forces' extrema inside a step; the stiffnesses feed the tangent equations.
-    """
-    N = int(p[P_N])
-    n = N + 3
-    nt = 4 * N + 2  # tracked observables (their derivatives follow them)
-    om = p[P_OMEGA]
-    th = om * t
-    c1 = math.cos(th)
-    s1 = math.sin(th)
-    x = y[0]
-    yy = y[1]
-    sig = y[N + 2]
-    xd = y[n]
-    yd = y[n + 1]
-    sigd = y[n + N + 2]
+    @njit_noalloc
+    def planetary_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
+        """Minimal relative-coordinate equations of MODEL.md §7.
 
-    eps_sp = p[P_EPS_SP]
-    krm = p[P_KRP_M]
-    kra = p[P_KRP_A]
-    csp = p[P_CSP]
-    crp = p[P_CRP]
-    bsp = p[P_BSP]
-    brp = p[P_BRP]
-    asp = p[P_ASP]
-    arp = p[P_ARP]
-    inv_mup = p[P_INV_MUP]
-    general = p[P_ECC] != 0.0 or p[P_NH_SP] > 0.0 or p[P_NH_RP] > 0.0
-    ph = _eccentric_phases(t, p) if general else (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+        State y = (x̄_s, ȳ_s, p̄_1..p̄_N, σ̄, then their τ-derivatives).
+        obs = (δ̄_sp1..N, δ̄_rp1..N, x̄_s, ȳ_s, F̄ᶜ_sp1..N, F̄ᶜ_rp1..N, then the τ-derivatives of
+        these T = 4N + 2 tracked observables, then F̄_sp1..N, F̄_rp1..N, then the mesh stiffnesses
+        κ_sp1..N, κ_rp1..N). The first 2N + 2 are the arguments of the dead zones (event-located);
+        F̄ᶜ is the *contact* force of a mesh, κ f(δ̄; b̄) + c̄ δ̄' while the teeth touch
+        (|δ̄| > b̄) and exactly 0 while they are apart; F̄ is the force of the equations of motion,
+        κ f(δ̄; b̄) + c̄ δ̄' at all times (damping acts inside the clearance, MODEL.md §4). Their
+        derivatives F̄ᶜ' = κ' f + κ δ̄' + c̄ δ̄'' (engaged) let the integrator refine the contact
+        forces' extrema inside a step; the stiffnesses feed the tangent equations.
+        """
+        N = n_fixed if n_fixed > 0 else int(p[P_N])
+        n = N + 3
+        nt = 4 * N + 2  # tracked observables (their derivatives follow them)
+        om = p[P_OMEGA]
+        th = om * t
+        c1 = math.cos(th)
+        s1 = math.sin(th)
+        x = y[0]
+        yy = y[1]
+        sig = y[N + 2]
+        xd = y[n]
+        yd = y[n + 1]
+        sigd = y[n + N + 2]
 
-    sum_fsp = 0.0
-    sum_frp = 0.0
-    sum_fx = 0.0
-    sum_fy = 0.0
-    for i in range(N):
-        si = p[P_HEADER + B_S * N + i]
-        ci = p[P_HEADER + B_C * N + i]
-        s_i = -x * si + yy * ci
-        sd_i = -xd * si + yd * ci
+        eps_sp = p[P_EPS_SP]
+        krm = p[P_KRP_M]
+        kra = p[P_KRP_A]
+        csp = p[P_CSP]
+        crp = p[P_CRP]
+        bsp = p[P_BSP]
+        brp = p[P_BRP]
+        asp = p[P_ASP]
+        arp = p[P_ARP]
+        inv_mup = p[P_INV_MUP]
+        general = p[P_ECC] != 0.0 or p[P_NH_SP] > 0.0 or p[P_NH_RP] > 0.0
+        ph = _eccentric_phases(t, p) if general else (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 
-        # --- time-varying stiffness, angle addition from one sin/cos pair of Ωτ
-        ck = c1 * p[P_HEADER + B_CK_SP * N + i] - s1 * p[P_HEADER + B_SK_SP * N + i]
-        ksp = 1.0 + eps_sp * ck
-        dksp = eps_sp  # dκ/d(cos θ); times dcos θ/dτ below (tracked level only)
-        ckr = c1 * p[P_HEADER + B_CK_RP * N + i] - s1 * p[P_HEADER + B_SK_RP * N + i]
-        krp = krm + kra * ckr
-        dkrp = kra
-
-        # --- transmission errors and their τ-derivatives
-        esp, esp_d, esp_dd = _sinusoid(
-            asp, om, s1, c1, p[P_HEADER + B_CE_SP * N + i], p[P_HEADER + B_SE_SP * N + i]
-        )
-        erp, erp_d, erp_dd = _sinusoid(
-            arp, om, s1, c1, p[P_HEADER + B_CE_RP * N + i], p[P_HEADER + B_SE_RP * N + i]
-        )
-        if general:
-            ksp, dksp, krp, dkrp, esp, esp_d, esp_dd, erp, erp_d, erp_dd = _planetary_general(
-                ph, p, i, N, ck, ckr, ksp, dksp, krp, dkrp, esp, esp_d, esp_dd, erp, erp_d, erp_dd
-            )
-
-        pi_ = y[2 + i]
-        pid = y[n + 2 + i]
-        dsp = pi_ + s_i - esp
-        dsp_d = pid + sd_i - esp_d
-        drp = sig - pi_ - erp
-        drp_d = sigd - pid - erp_d
-        fzsp = dead_zone(dsp, bsp)
-        fzrp = dead_zone(drp, brp)
-        fsp = ksp * fzsp + csp * dsp_d
-        frp = krp * fzrp + crp * drp_d
-        dydt[n + 2 + i] = (frp - fsp) * inv_mup  # completed below
-
-        if level >= OBS_TRACK:
-            obs[i] = dsp
-            obs[N + i] = drp
-            obs[nt + i] = dsp_d
-            obs[nt + N + i] = drp_d
-            # contact forces: zero while the teeth are apart; their derivatives without the
-            # c̄ δ̄'' term, which needs the accelerations (added after the loop)
-            on = dsp > bsp or dsp < -bsp
-            sk = s1 * p[P_HEADER + B_CK_SP * N + i] + c1 * p[P_HEADER + B_SK_SP * N + i]
-            obs[2 * N + 2 + i] = fsp if on else 0.0
-            dfc = -om * sk * dksp * fzsp + ksp * dsp_d - csp * esp_dd
-            obs[nt + 2 * N + 2 + i] = dfc if on else 0.0
-            on = drp > brp or drp < -brp
-            sk = s1 * p[P_HEADER + B_CK_RP * N + i] + c1 * p[P_HEADER + B_SK_RP * N + i]
-            obs[3 * N + 2 + i] = frp if on else 0.0
-            dfc = -om * sk * dkrp * fzrp + krp * drp_d - crp * erp_dd
-            obs[nt + 3 * N + 2 + i] = dfc if on else 0.0
-            if level >= OBS_ALL:
-                obs[2 * nt + i] = fsp
-                obs[2 * nt + N + i] = frp
-                obs[2 * nt + 2 * N + i] = ksp
-                obs[2 * nt + 3 * N + i] = krp
-        sum_fsp += fsp
-        sum_frp += frp
-        sum_fx += fsp * si
-        sum_fy -= fsp * ci
-
-    inv_mus = p[P_INV_MUS]
-    inv_muc = p[P_INV_MUC]
-    cas = p[P_COS_AS]
-    car = p[P_COS_AR]
-    qs = (p[P_TD] - sum_fsp) * inv_mus
-    qc = (cas * sum_fsp + car * sum_frp - p[P_TL]) * inv_muc
-
-    kb = p[P_KB]
-    bs = p[P_BS]
-    cb = p[P_CS]
-    inv_ms = p[P_INV_MU_S]
-    for j in range(n):
-        dydt[j] = y[n + j]
-    dydt[n] = (sum_fx - cb * xd - kb * dead_zone(x, bs)) * inv_ms
-    dydt[n + 1] = (sum_fy - cb * yd - kb * dead_zone(yy, bs)) * inv_ms
-    qcp = cas * qc
-    for i in range(N):
-        dydt[n + 2 + i] = qs + dydt[n + 2 + i] - qcp
-    dydt[n + N + 2] = qs - (cas + car) * qc
-    if level >= OBS_TRACK:
-        obs[2 * N] = x
-        obs[2 * N + 1] = yy
-        obs[nt + 2 * N] = xd
-        obs[nt + 2 * N + 1] = yd
-        # the c̄ δ̄'' terms of the contact-force derivatives: δ̄_sp'' = p̄_i'' + s_i'' − e_sp'',
-        # δ̄_rp'' = σ̄'' − p̄_i'' − e_rp'' (the e'' parts were added in the loop)
+        sum_fsp = 0.0
+        sum_frp = 0.0
+        sum_fx = 0.0
+        sum_fy = 0.0
         for i in range(N):
-            pdd = dydt[n + 2 + i]
-            if obs[i] > bsp or obs[i] < -bsp:
-                si = p[P_HEADER + B_S * N + i]
-                ci = p[P_HEADER + B_C * N + i]
-                obs[nt + 2 * N + 2 + i] += csp * (pdd - dydt[n] * si + dydt[n + 1] * ci)
-            if obs[N + i] > brp or obs[N + i] < -brp:
-                obs[nt + 3 * N + 2 + i] += crp * (dydt[n + N + 2] - pdd)
+            si = p[P_HEADER + B_S * N + i]
+            ci = p[P_HEADER + B_C * N + i]
+            s_i = -x * si + yy * ci
+            sd_i = -xd * si + yd * ci
+
+            # --- time-varying stiffness, angle addition from one sin/cos pair of Ωτ
+            ck = c1 * p[P_HEADER + B_CK_SP * N + i] - s1 * p[P_HEADER + B_SK_SP * N + i]
+            ksp = 1.0 + eps_sp * ck
+            dksp = eps_sp  # dκ/d(cos θ); times dcos θ/dτ below (tracked level only)
+            ckr = c1 * p[P_HEADER + B_CK_RP * N + i] - s1 * p[P_HEADER + B_SK_RP * N + i]
+            krp = krm + kra * ckr
+            dkrp = kra
+
+            # --- transmission errors and their τ-derivatives
+            esp, esp_d, esp_dd = _sinusoid(
+                asp, om, s1, c1, p[P_HEADER + B_CE_SP * N + i], p[P_HEADER + B_SE_SP * N + i]
+            )
+            erp, erp_d, erp_dd = _sinusoid(
+                arp, om, s1, c1, p[P_HEADER + B_CE_RP * N + i], p[P_HEADER + B_SE_RP * N + i]
+            )
+            if general:
+                g = _planetary_general(
+                    ph, p, i, N, ck, ckr, ksp, dksp, krp, dkrp, esp, esp_d, esp_dd, erp, erp_d,
+                    erp_dd
+                )  # fmt: skip
+                ksp, dksp, krp, dkrp, esp, esp_d, esp_dd, erp, erp_d, erp_dd = g
+
+            pi_ = y[2 + i]
+            pid = y[n + 2 + i]
+            dsp = pi_ + s_i - esp
+            dsp_d = pid + sd_i - esp_d
+            drp = sig - pi_ - erp
+            drp_d = sigd - pid - erp_d
+            fzsp = dead_zone(dsp, bsp)
+            fzrp = dead_zone(drp, brp)
+            fsp = ksp * fzsp + csp * dsp_d
+            frp = krp * fzrp + crp * drp_d
+            dydt[n + 2 + i] = (frp - fsp) * inv_mup  # completed below
+
+            if level >= OBS_TRACK:
+                obs[i] = dsp
+                obs[N + i] = drp
+                obs[nt + i] = dsp_d
+                obs[nt + N + i] = drp_d
+                # contact forces: zero while the teeth are apart; their derivatives without the
+                # c̄ δ̄'' term, which needs the accelerations (added after the loop)
+                on = dsp > bsp or dsp < -bsp
+                sk = s1 * p[P_HEADER + B_CK_SP * N + i] + c1 * p[P_HEADER + B_SK_SP * N + i]
+                obs[2 * N + 2 + i] = fsp if on else 0.0
+                dfc = -om * sk * dksp * fzsp + ksp * dsp_d - csp * esp_dd
+                obs[nt + 2 * N + 2 + i] = dfc if on else 0.0
+                on = drp > brp or drp < -brp
+                sk = s1 * p[P_HEADER + B_CK_RP * N + i] + c1 * p[P_HEADER + B_SK_RP * N + i]
+                obs[3 * N + 2 + i] = frp if on else 0.0
+                dfc = -om * sk * dkrp * fzrp + krp * drp_d - crp * erp_dd
+                obs[nt + 3 * N + 2 + i] = dfc if on else 0.0
+                if level >= OBS_ALL:
+                    obs[2 * nt + i] = fsp
+                    obs[2 * nt + N + i] = frp
+                    obs[2 * nt + 2 * N + i] = ksp
+                    obs[2 * nt + 3 * N + i] = krp
+            sum_fsp += fsp
+            sum_frp += frp
+            sum_fx += fsp * si
+            sum_fy -= fsp * ci
+
+        inv_mus = p[P_INV_MUS]
+        inv_muc = p[P_INV_MUC]
+        cas = p[P_COS_AS]
+        car = p[P_COS_AR]
+        qs = (p[P_TD] - sum_fsp) * inv_mus
+        qc = (cas * sum_fsp + car * sum_frp - p[P_TL]) * inv_muc
+
+        kb = p[P_KB]
+        bs = p[P_BS]
+        cb = p[P_CS]
+        inv_ms = p[P_INV_MU_S]
+        for j in range(n):
+            dydt[j] = y[n + j]
+        dydt[n] = (sum_fx - cb * xd - kb * dead_zone(x, bs)) * inv_ms
+        dydt[n + 1] = (sum_fy - cb * yd - kb * dead_zone(yy, bs)) * inv_ms
+        qcp = cas * qc
+        for i in range(N):
+            dydt[n + 2 + i] = qs + dydt[n + 2 + i] - qcp
+        dydt[n + N + 2] = qs - (cas + car) * qc
+        if level >= OBS_TRACK:
+            obs[2 * N] = x
+            obs[2 * N + 1] = yy
+            obs[nt + 2 * N] = xd
+            obs[nt + 2 * N + 1] = yd
+            # the c̄ δ̄'' terms of the contact-force derivatives: δ̄_sp'' = p̄_i'' + s_i'' − e_sp'',
+            # δ̄_rp'' = σ̄'' − p̄_i'' − e_rp'' (the e'' parts were added in the loop)
+            for i in range(N):
+                pdd = dydt[n + 2 + i]
+                if obs[i] > bsp or obs[i] < -bsp:
+                    si = p[P_HEADER + B_S * N + i]
+                    ci = p[P_HEADER + B_C * N + i]
+                    obs[nt + 2 * N + 2 + i] += csp * (pdd - dydt[n] * si + dydt[n + 1] * ci)
+                if obs[N + i] > brp or obs[N + i] < -brp:
+                    obs[nt + 3 * N + 2 + i] += crp * (dydt[n + N + 2] - pdd)
+
+    return planetary_rhs
+
+
+planetary_rhs = _planetary_rhs(0)
 
 
 # ----------------------------------------------------------------------------- tangents
@@ -406,6 +421,7 @@ def planetary_tangent(t, y, p, obs, dydt, n, k):  # pragma: no cover - compiled
 
 
 _TANGENTS = {
+    **{planetary_kind(n): planetary_tangent for n in PLANETARY_FIXED_N},
     KIND_PLANETARY: planetary_tangent,
     KIND_BACKLASH_OSCILLATOR: backlash_oscillator_tangent,
     KIND_LINEAR: linear_tangent,
@@ -434,6 +450,7 @@ def _tangent_overload(kind, t, y, p, obs, dydt, n, k):  # pragma: no cover - com
 
 
 _KERNELS = {
+    **{planetary_kind(n): _planetary_rhs(n) for n in PLANETARY_FIXED_N},
     KIND_PLANETARY: planetary_rhs,
     KIND_BACKLASH_OSCILLATOR: backlash_oscillator_rhs,
     KIND_LINEAR: linear_rhs,

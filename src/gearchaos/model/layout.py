@@ -13,6 +13,19 @@ KIND_BACKLASH_OSCILLATOR = 1
 KIND_LINEAR = 2
 KIND_DUFFING = 3
 KIND_LORENZ = 4
+#: Planet counts whose planetary right-hand side is compiled for that count, as kind
+#: KIND_PLANETARY_FIXED + N (fixed loop trip counts and parameter offsets: a step about 11 %
+#: cheaper, issue 13); other counts use the general KIND_PLANETARY kernel. Each kind is compiled
+#: (once, on first use, into numba's disk cache) only when a gear set with that count runs.
+PLANETARY_FIXED_N = (3, 4, 5, 6)
+KIND_PLANETARY_FIXED = 100
+
+
+def planetary_kind(n_planets: int) -> int:
+    """The kernel kind of a planetary model with ``n_planets`` planets."""
+    n = int(n_planets)
+    return KIND_PLANETARY_FIXED + n if n in PLANETARY_FIXED_N else KIND_PLANETARY
+
 
 # ---------- planetary (kind 0)
 P_N = 0  # number of planets N

@@ -264,8 +264,12 @@ class PlanetaryModel:
     parameters: PlanetaryParameters
     scales: Scales
     gearset: GearSet | None = None
-    kind: int = L.KIND_PLANETARY
     name: str = "planetary"
+
+    @property
+    def kind(self) -> int:
+        """Kind of the compiled kernel: the one for this planet count where there is one."""
+        return L.planetary_kind(self.parameters.n_planets)
 
     @classmethod
     def from_gearset(cls, gs: GearSet) -> PlanetaryModel:

@@ -59,8 +59,10 @@ class Observable:
 class Model(Protocol):
     """What a dimensionless model provides to build a :class:`System`."""
 
-    kind: int
     name: str
+
+    @property
+    def kind(self) -> int: ...
 
     @property
     def n_state(self) -> int: ...
