@@ -188,6 +188,20 @@ def _newton(u, ub, ua, c0, c1, c2, c3, c4, c5):  # pragma: no cover - compiled
     return (acc * u + c1) * u + c0
 
 
+@numba.njit(cache=True, inline="always")
+def _newton_d(u, ub, ua, c0, c1, c2, c3, c4, c5):  # pragma: no cover - compiled
+    """:func:`_newton` and its derivative in u."""
+    a = c5 * (u - ua) + c4
+    w = u - ub
+    b = a * w + c3
+    db = c5 * w + a
+    q = b * w + c2
+    dq = db * w + b
+    r = q * u + c1
+    dr = dq * u + q
+    return r * u + c0, dr * u + r
+
+
 @njit_noalloc
 def predict_switch(hist, n_pts, t_hist, n_track, sw, h):  # pragma: no cover - compiled
     """Time from the current point to the first switch predicted within (0, h], or −1.
@@ -196,10 +210,16 @@ def predict_switch(hist, n_pts, t_hist, n_track, sw, h):  # pragma: no cover - c
     newest first (rows 0, 1, 2) at times ``t_hist``; only the ``n_pts`` ≥ 2 newest are used
     (those since the last switch). Observables far from every level are skipped by a cheap
     bound; for the others the Hermite interpolant through the points is extrapolated to
-    τ_n + h and, if it changes contact region, its root is found by bisection.
+    τ_n + h and, if it changes contact region, its root is found by Newton's method kept
+    inside the bracket (bisection where a Newton step would leave it): 3–5 evaluations where
+    plain bisection to the same 1e-9 h took 30, which had made the prediction a quarter of a
+    step's time (issue 13).
     """
     u1 = t_hist[1] - t_hist[0]  # < 0
     u2 = t_hist[2] - t_hist[0]
+    r1 = 1.0 / u1
+    r2 = 1.0 / u2 if n_pts >= 3 else 0.0
+    r21 = 1.0 / (u2 - u1) if n_pts >= 3 else 0.0
     best = -1.0
     for k in range(n_track):
         b = sw[k]
@@ -212,28 +232,28 @@ def predict_switch(hist, n_pts, t_hist, n_track, sw, h):  # pragma: no cover - c
         gap = min(abs(v0 - b), abs(v0 + b))
         # a crossing within h needs |Δv| ≥ gap; |v'| is bounded generously by the two last
         # derivatives and their trend
-        reach = h * (abs(d0) + abs(d0 - d1) * (1.0 + h / -u1))
+        reach = h * (abs(d0) + abs(d0 - d1) * (1.0 - h * r1))
         if gap > 2.0 * reach:
             continue
         v1 = hist[1, k]
         # confluent divided differences, nodes 0, 0, u1, u1 (, u2, u2)
-        s01 = (v1 - v0) / u1
-        c2 = (s01 - d0) / u1
-        f12 = (d1 - s01) / u1
-        c3 = (f12 - c2) / u1
+        s01 = (v1 - v0) * r1
+        c2 = (s01 - d0) * r1
+        f12 = (d1 - s01) * r1
+        c3 = (f12 - c2) * r1
         c4 = 0.0
         c5 = 0.0
         if n_pts >= 3:
             v2 = hist[2, k]
             d2 = hist[2, n_track + k]
-            s12 = (v2 - v1) / (u2 - u1)
-            g2 = (s12 - d1) / (u2 - u1)
-            g3 = (d2 - s12) / (u2 - u1)
-            f23 = (g2 - f12) / u2
-            f34 = (g3 - g2) / (u2 - u1)
-            e3 = (f34 - f23) / (u2 - 0.0)
-            c4 = (f23 - c3) / u2
-            c5 = (e3 - c4) / u2
+            s12 = (v2 - v1) * r21
+            g2 = (s12 - d1) * r21
+            g3 = (d2 - s12) * r21
+            f23 = (g2 - f12) * r2
+            f34 = (g3 - g2) * r21
+            e3 = (f34 - f23) * r2
+            c4 = (f23 - c3) * r2
+            c5 = (e3 - c4) * r2
         ve = _newton(h, u1, u2, v0, d0, c2, c3, c4, c5)
         re = _region(ve, b)
         if re == r0:
@@ -242,16 +262,29 @@ def predict_switch(hist, n_pts, t_hist, n_track, sw, h):  # pragma: no cover - c
         lo = 0.0
         hi = h
         f_lo = v0 - level
+        f_hi = ve - level
+        x = lo + f_lo * (lo - hi) / (f_hi - f_lo) if f_hi != f_lo else 0.5 * h  # regula falsi
+        if not lo < x < hi:
+            x = 0.5 * (lo + hi)
         for _ in range(60):
-            mid = 0.5 * (lo + hi)
-            fm = _newton(mid, u1, u2, v0, d0, c2, c3, c4, c5) - level
-            if (fm > 0.0) == (f_lo > 0.0):
-                lo = mid
-                f_lo = fm
+            fx, dfx = _newton_d(x, u1, u2, v0, d0, c2, c3, c4, c5)
+            fx -= level
+            if fx == 0.0:
+                break
+            if (fx > 0.0) == (f_lo > 0.0):
+                lo = x
+                f_lo = fx
             else:
-                hi = mid
+                hi = x
+            step = fx / dfx if dfx != 0.0 else np.inf
+            if abs(step) <= 1e-9 * h:
+                x -= step  # converged (a step this small may touch the bracket's end)
+                break
+            x -= step
+            if not lo < x < hi:
+                x = 0.5 * (lo + hi)  # Newton left the bracket: bisect
             if hi - lo <= 1e-9 * h:
                 break
-        if best < 0.0 or hi < best:
-            best = hi
+        if best < 0.0 or x < best:
+            best = x
     return best
