@@ -68,6 +68,7 @@ MAX_FACTOR = 10.0
 BETA = 0.04
 ALPHA = 0.2 - 0.75 * BETA
 ERR_OLD_MIN = 1e-4  # lower bound on err_{n−1} (Hairer's facold)
+LOG_ERR_OLD_MIN = math.log(ERR_OLD_MIN)
 
 #: ``settle="auto"``: the transient ends at the first transient section point τ_k at which the
 #: section sequence has repeated with some period n ≤ SETTLE_MAX_PERIOD, every component within
@@ -310,7 +311,7 @@ def dopri_run(
         if sw[k] < np.inf:
             has_switch = True
     h_event = -1.0
-    err_old = ERR_OLD_MIN
+    log_err_old = LOG_ERR_OLD_MIN  # log err_{n−1}: one log and one exp a step, no pow
     # settling: transient section points, the newest SETTLE_MAX_PERIOD + 1 in a ring
     settling = settle_spp > 0 and n_samples > 0 and t < t_rec
     period = dt_sample * settle_spp
@@ -393,10 +394,9 @@ def dopri_run(
                     )  # fmt: skip
                 ts = t_new
             level = last_level if s == STAGES - 1 else (OBS_ALL if tan_on else OBS_NONE)
-            rhs(kind, ts, yt, p, ks, obs, level)
+            rhs(kind, ts, yt, p, K[s], obs, level)  # a view: free without reference counts
             if tan_on:
-                tangent(kind, ts, yt, p, obs, ks, n_base, n_tan)
-            _put_row(K, s, ks, n)
+                tangent(kind, ts, yt, p, obs, K[s], n_base, n_tan)
         # yt is y_{n+1}; the scaled RMS norm of the embedded error estimate, which is NaN
         # also when y_{n+1} is not finite
         acc = 0.0
@@ -433,16 +433,18 @@ def dopri_run(
 
         if err > 1.0:
             n_rej += 1
-            h = hs * max(MIN_FACTOR, SAFETY * err**-ALPHA)
+            h = hs * max(MIN_FACTOR, SAFETY * math.exp(-ALPHA * math.log(err)))
             last_rejected = True
             continue
 
         n_acc += 1
         # PI step-size control (Gustafsson; HNW II §IV.2 and Hairer's DOPRI5)
+        log_err = math.log(err) if err > 0.0 else LOG_ERR_OLD_MIN
         if err == 0.0:
             factor = MAX_FACTOR
         else:
-            factor = min(MAX_FACTOR, max(MIN_FACTOR, SAFETY * err**-ALPHA * err_old**BETA))
+            factor = SAFETY * math.exp(BETA * log_err_old - ALPHA * log_err)
+            factor = min(MAX_FACTOR, max(MIN_FACTOR, factor))
         if last_rejected and factor > 1.0:
             factor = 1.0
         last_rejected = False
@@ -451,7 +453,7 @@ def dopri_run(
             if h_next < h:
                 h_next = h  # restore the proposal made before clipping to a sample or switch
         else:
-            err_old = max(err, ERR_OLD_MIN)  # steps cut short say little about the next one
+            log_err_old = max(log_err, LOG_ERR_OLD_MIN)  # steps cut short say little
         h = min(h_next, max_step)
         t = t_new
         for i in range(n):
