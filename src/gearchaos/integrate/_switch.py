@@ -102,8 +102,7 @@ def _hermite_root(v0, v1, d0, d1, level):  # pragma: no cover - compiled
 @njit_noalloc
 def check_step(hist, obs, dt, n_track, sw, win):  # pragma: no cover - compiled
     """Switches inside one step of length ``dt`` from the point ``hist[0]`` to ``obs`` (``hist``
-    as in :func:`predict_switch`: a row, not a view, which would cost two atomic reference-count
-    updates per call).
+    as in :func:`predict_switch`).
 
     A switch that the end of the step has passed by at most ``win`` (in τ, from the value and
     derivative at the end: (v₁ − level)/v₁′) is landed on; one that the start of the step was

@@ -95,8 +95,7 @@ def _copy(dst, src, n):  # pragma: no cover - compiled
 
 @numba.njit(cache=True, inline="always")
 def _put_row(dst, r, src, n):  # pragma: no cover - compiled
-    """dst[r, :n] = src[:n] without the view dst[r], whose creation and release are two atomic
-    reference-count updates (a quarter of a step's time when done for every stage, issue 13)."""
+    """dst[r, :n] = src[:n]."""
     for i in range(n):
         dst[r, i] = src[i]
 
@@ -140,10 +139,10 @@ def initial_step(kind, t, y, f0, p, rtol, atol, obs, n, y1, f1):  # pragma: no c
 
 
 @njit_noalloc
-def _renormalize(kind, t, y, p, obs, K, ks, n, k, lsum, tan_on):  # pragma: no cover - compiled
+def _renormalize(kind, t, y, p, obs, K, n, k, lsum, tan_on):  # pragma: no cover - compiled
     """Tangent vectors in y[n:]: set them orthonormal (first call) or re-orthonormalise them by
     modified Gram–Schmidt, adding log stretch factors to ``lsum``; refresh their FSAL stage
-    ``K[0, n:]`` through the scratch row ``ks`` (``obs`` holds all observables at (t, y))."""
+    ``K[0]`` (``obs`` holds all observables at (t, y))."""
     numba.literally(kind)
     if not tan_on:
         for r in range(k):
@@ -167,9 +166,7 @@ def _renormalize(kind, t, y, p, obs, K, ks, n, k, lsum, tan_on):  # pragma: no c
             lsum[r] += math.log(nrm)
             for i in range(n):
                 y[o + i] /= nrm
-    tangent(kind, t, y, p, obs, ks, n, k)
-    for i in range(n, y.size):
-        K[0, i] = ks[i]
+    tangent(kind, t, y, p, obs, K[0], n, k)
     return True
 
 
@@ -202,7 +199,6 @@ def workspace(n, n_obs, n_track, n_base):  # pragma: no cover - compiled
     return (
         np.empty(n),  # y
         np.empty(n),  # yt: the stage argument, then y_{n+1}
-        np.zeros(n),  # ks: a stage's derivative, copied into a row of K
         np.zeros((STAGES, n)),  # K: the stages
         np.empty(n_obs),  # obs
         np.empty((3, 2 * n_track)),  # hist: tracked observables of the last accepted points
@@ -250,14 +246,12 @@ def dopri_run(
     numba.literally(kind)
     n_samples, n_obs, n_track, n_base, rtol, atol, h_init, max_step, max_steps, settle_spp = cfg
     out_t, out_y, out_obs, obs_min, obs_max, y_final = out
-    y, yt, ks, K, obs, hist, t_hist, ring, runs, f1, o1 = ws
+    y, yt, K, obs, hist, t_hist, ring, runs, f1, o1 = ws
     n = y0.size
     _copy(y, y0, n)
     for s in range(STAGES):
         for i in range(n):
             K[s, i] = 0.0  # tangent components stay zero until the tangents start
-    for i in range(n):
-        ks[i] = 0.0  # stages go into ks, then into rows of K: no views (module docstring)
     n_tr2 = 2 * n_track
     for k in range(n_track):
         obs_min[k] = np.inf
@@ -270,8 +264,7 @@ def dopri_run(
     tan_on = np.bool_(False)
     for r in range(n_tan):
         lsum[r] = 0.0
-    rhs(kind, t, y, p, ks, obs, OBS_ALL)
-    _put_row(K, 0, ks, n)
+    rhs(kind, t, y, p, K[0], obs, OBS_ALL)
     n_acc = 0
     n_rej = 0
     status = ST_OK
@@ -280,7 +273,7 @@ def dopri_run(
             status = ST_NON_FINITE
     h = h_init
     if status == ST_OK and h <= 0.0:
-        h = initial_step(kind, t, y, ks, p, rtol, atol, o1, n_base, yt, f1)
+        h = initial_step(kind, t, y, K[0], p, rtol, atol, o1, n_base, yt, f1)
     if h > max_step:
         h = max_step
 
@@ -288,7 +281,7 @@ def dopri_run(
     tracking = False
     if status == ST_OK and n_samples > 0 and t >= t_rec:
         if n_tan > 0:
-            tan_on = _renormalize(kind, t, y, p, obs, K, ks, n_base, n_tan, lsum, tan_on)
+            tan_on = _renormalize(kind, t, y, p, obs, K, n_base, n_tan, lsum, tan_on)
         out_t[0] = t
         _put_row(out_y, 0, y, n)
         _put_row(out_obs, 0, obs, n_obs)
@@ -394,7 +387,7 @@ def dopri_run(
                     )  # fmt: skip
                 ts = t_new
             level = last_level if s == STAGES - 1 else (OBS_ALL if tan_on else OBS_NONE)
-            rhs(kind, ts, yt, p, K[s], obs, level)  # a view: free without reference counts
+            rhs(kind, ts, yt, p, K[s], obs, level)
             if tan_on:
                 tangent(kind, ts, yt, p, obs, K[s], n_base, n_tan)
         # yt is y_{n+1}; the scaled RMS norm of the embedded error estimate, which is NaN
@@ -474,7 +467,7 @@ def dopri_run(
             n_sec += 1
         if record:
             if n_tan > 0:
-                tan_on = _renormalize(kind, t, y, p, obs, K, ks, n_base, n_tan, lsum, tan_on)
+                tan_on = _renormalize(kind, t, y, p, obs, K, n_base, n_tan, lsum, tan_on)
             out_t[j] = t
             _put_row(out_y, j, y, n)
             _put_row(out_obs, j, obs, n_obs)
