@@ -435,3 +435,15 @@ def test_an_axis_both_swept_and_fixed_or_family_is_refused() -> None:
         lambda: gc.bifurcation(BASE, "omega=1:2:2", family="omega=1,2", progress=False),
         "omega",
     )
+
+
+@pytest.mark.parametrize(
+    "text", ["log:1:inf:1", "log:inf:2:3", "0:inf:1", "-inf:1:5", "nan:1:2", "log:1:nan:4"]
+)
+def test_ranges_with_a_non_finite_bound_are_refused(text: str) -> None:
+    """Found by the fuzz suite: ``log:1:inf:1`` was accepted (one value, 1.0), and linspace
+    was asked for infinite ranges (numpy's RuntimeWarnings) before the values were refused."""
+    from gearchaos.sweep.spec import parse_values
+
+    with pytest.raises(gc.ParameterError, match="omega: the start and stop of a range must be"):
+        parse_values("omega", text)

@@ -22,6 +22,7 @@ be checked against the command that would resume it.
 from __future__ import annotations
 
 import difflib
+import math
 import numbers
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -63,6 +64,13 @@ def _count(name: str, raw: str, text: str) -> int:
     return n
 
 
+def _finite_bounds(name: str, lo: float, hi: float, text: str) -> None:
+    """A range's bounds must be finite, whatever the count (``log:1:inf:1`` is one value, 1,
+    but no meaningful spec)."""
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        raise ParameterError(f"{name}: the start and stop of a range must be finite: got {text!r}")
+
+
 def parse_values(name: str, text: str | float | Sequence[float] | np.ndarray) -> tuple[float, ...]:
     """Values of an axis from ``start:stop:count``, ``log:start:stop:count``, ``a,b,c``, a
     number or a one-dimensional sequence. Errors name the axis, the rule and the value."""
@@ -74,6 +82,7 @@ def parse_values(name: str, text: str | float | Sequence[float] | np.ndarray) ->
                 if len(parts) != 3:
                     raise _syntax(name, text)
                 lo, hi, cnt = float(parts[0]), float(parts[1]), _count(name, parts[2], text)
+                _finite_bounds(name, lo, hi, text)
                 if not (lo > 0 and hi > 0):
                     raise ParameterError(f"{name}: log spacing needs positive bounds: got {text!r}")
                 vals = np.geomspace(lo, hi, cnt)
@@ -82,6 +91,7 @@ def parse_values(name: str, text: str | float | Sequence[float] | np.ndarray) ->
                 if len(parts) != 3:
                     raise _syntax(name, text)
                 a, b = float(parts[0]), float(parts[1])
+                _finite_bounds(name, a, b, text)
                 vals = np.linspace(a, b, _count(name, parts[2], text))
             else:
                 items = t.split(",")
