@@ -128,6 +128,13 @@ def _sinusoid(a, w, s, c, ca, sa):  # pragma: no cover - compiled
     return e, a * w * (c * ca - s * sa), -w * w * e
 
 
+@numba.njit(cache=True, inline="always")
+def _planet_direction(p, N, i):  # pragma: no cover - compiled
+    """(s_i, c_i): the sine and cosine of planet i's sun–planet line of action (the sun's
+    translation enters the mesh deflection as −x s_i + y c_i)."""
+    return p[P_HEADER + B_S * N + i], p[P_HEADER + B_C * N + i]
+
+
 @njit_noalloc
 def _eccentric_phases(t, p):  # pragma: no cover - compiled
     """(Ω_s, Ω_p, Ω_r, cos Ω_s τ, sin Ω_s τ, cos Ω_p τ, sin Ω_p τ, cos Ω_r τ, sin Ω_r τ) with
@@ -249,8 +256,7 @@ def _planetary_rhs(n_fixed):
         sum_fx = 0.0
         sum_fy = 0.0
         for i in range(N):
-            si = p[P_HEADER + B_S * N + i]
-            ci = p[P_HEADER + B_C * N + i]
+            si, ci = _planet_direction(p, N, i)
             s_i = -x * si + yy * ci
             sd_i = -xd * si + yd * ci
 
@@ -344,8 +350,7 @@ def _planetary_rhs(n_fixed):
             for i in range(N):
                 pdd = dydt[n + 2 + i]
                 if obs[i] > bsp or obs[i] < -bsp:
-                    si = p[P_HEADER + B_S * N + i]
-                    ci = p[P_HEADER + B_C * N + i]
+                    si, ci = _planet_direction(p, N, i)
                     obs[nt + 2 * N + 2 + i] += csp * (pdd - dydt[n] * si + dydt[n + 1] * ci)
                 if obs[N + i] > brp or obs[N + i] < -brp:
                     obs[nt + 3 * N + 2 + i] += crp * (dydt[n + N + 2] - pdd)
@@ -394,8 +399,7 @@ def planetary_tangent(t, y, p, obs, dydt, n, k):  # pragma: no cover - compiled
         sum_fx = 0.0
         sum_fy = 0.0
         for i in range(N):
-            si = p[P_HEADER + B_S * N + i]
-            ci = p[P_HEADER + B_C * N + i]
+            si, ci = _planet_direction(p, N, i)
             pv = y[o + 2 + i]
             pdv = y[o + nd + 2 + i]
             dsp = pv - xv * si + yv * ci
