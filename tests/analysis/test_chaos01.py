@@ -89,3 +89,22 @@ def test_validation() -> None:
         chaos01(logistic(200), n_c=0)
     with pytest.raises(ParameterError, match="shape"):
         chaos01(np.zeros((100, 2, 2)))
+
+
+@pytest.mark.parametrize("series", ["logistic", "periodic", "henon"])
+def test_direct_sums_and_fft_autocorrelation_agree(series: str) -> None:
+    """The two evaluations of M_c (compiled direct sums for short series, FFT autocorrelation
+    for long ones) are different algorithms for the same numbers."""
+    from gearchaos.analysis.chaos01 import _k_values_direct, _k_values_fft
+
+    k = np.arange(600)
+    phi = {
+        "logistic": logistic(600)[:, None],
+        "periodic": (0.4 + np.cos(2 * math.pi * k / 3))[:, None],
+        "henon": henon(600),
+    }[series]
+    c = np.random.default_rng(2).uniform(math.pi / 5, 4 * math.pi / 5, 30)
+    for ncut in (10, 60):
+        np.testing.assert_allclose(
+            _k_values_direct(phi, c, ncut), _k_values_fft(phi, c, ncut), rtol=0, atol=1e-9
+        )
