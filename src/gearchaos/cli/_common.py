@@ -91,8 +91,8 @@ def reported_errors() -> Iterator[None]:
 
     on_first_compile(
         lambda: stderr().print(
-            "compiling numerical kernels (first run only, about 15 seconds; later runs load "
-            "them from the cache)…"
+            "compiling numerical kernels (once per planet count and analysis, about 15 "
+            "seconds; later runs load them from the cache)…"
         )
     )
     try:
