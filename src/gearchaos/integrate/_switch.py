@@ -178,18 +178,8 @@ def track(hist, obs, dt, n_track, omin, omax):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, inline="always")
-def _newton(u, ub, ua, c0, c1, c2, c3, c4, c5):  # pragma: no cover - compiled
-    """Newton form on the nodes (0, 0, ub, ub, ua, ua) evaluated at u."""
-    w = u - ua
-    acc = c5 * w + c4
-    w = u - ub
-    acc = (acc * w + c3) * w + c2
-    return (acc * u + c1) * u + c0
-
-
-@numba.njit(cache=True, inline="always")
 def _newton_d(u, ub, ua, c0, c1, c2, c3, c4, c5):  # pragma: no cover - compiled
-    """:func:`_newton` and its derivative in u."""
+    """The Newton form on the nodes (0, 0, ub, ub, ua, ua) at u, and its derivative in u."""
     a = c5 * (u - ua) + c4
     w = u - ub
     b = a * w + c3
@@ -253,7 +243,7 @@ def predict_switch(hist, n_pts, t_hist, n_track, sw, h):  # pragma: no cover - c
             e3 = (f34 - f23) * r2
             c4 = (f23 - c3) * r2
             c5 = (e3 - c4) * r2
-        ve = _newton(h, u1, u2, v0, d0, c2, c3, c4, c5)
+        ve = _newton_d(h, u1, u2, v0, d0, c2, c3, c4, c5)[0]
         re = _region(ve, b)
         if re == r0:
             continue

@@ -94,13 +94,6 @@ def _copy(dst, src, n):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, inline="always")
-def _put_row(dst, r, src, n):  # pragma: no cover - compiled
-    """dst[r, :n] = src[:n]."""
-    for i in range(n):
-        dst[r, i] = src[i]
-
-
-@numba.njit(cache=True, inline="always")
 def _shift(hist, obs, n):  # pragma: no cover - compiled
     """Rows of ``hist`` one older (row 2 ← 1 ← 0), row 0 ← obs[:n]."""
     for i in range(n):
@@ -283,8 +276,8 @@ def dopri_run(
         if n_tan > 0:
             tan_on = _renormalize(kind, t, y, p, obs, K, n_base, n_tan, lsum, tan_on)
         out_t[0] = t
-        _put_row(out_y, 0, y, n)
-        _put_row(out_obs, 0, obs, n_obs)
+        _copy(out_y[0], y, n)
+        _copy(out_obs[0], obs, n_obs)
         j = 1
         tracking = True
         for k in range(n_track):
@@ -294,7 +287,7 @@ def dopri_run(
     # n_pts of them lie on the current smooth piece (since the last switch)
     for r in range(3):
         t_hist[r] = 0.0
-    _put_row(hist, 0, obs, n_tr2)
+    _copy(hist[0], obs, n_tr2)
     t_hist[0] = t
     n_pts = int(np.int64(1))  # not a literal: see tan_on
     last_rejected = False
@@ -432,10 +425,11 @@ def dopri_run(
 
         n_acc += 1
         # PI step-size control (Gustafsson; HNW II §IV.2 and Hairer's DOPRI5)
-        log_err = math.log(err) if err > 0.0 else LOG_ERR_OLD_MIN
         if err == 0.0:
+            log_err = LOG_ERR_OLD_MIN
             factor = MAX_FACTOR
         else:
+            log_err = math.log(err)
             factor = SAFETY * math.exp(BETA * log_err_old - ALPHA * log_err)
             factor = min(MAX_FACTOR, max(MIN_FACTOR, factor))
         if last_rejected and factor > 1.0:
@@ -469,8 +463,8 @@ def dopri_run(
             if n_tan > 0:
                 tan_on = _renormalize(kind, t, y, p, obs, K, n_base, n_tan, lsum, tan_on)
             out_t[j] = t
-            _put_row(out_y, j, y, n)
-            _put_row(out_obs, j, obs, n_obs)
+            _copy(out_y[j], y, n)
+            _copy(out_obs[j], obs, n_obs)
             if not tracking:
                 tracking = True
                 for k in range(n_track):

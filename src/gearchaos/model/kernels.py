@@ -98,6 +98,7 @@ from .reference_kernels import (
     duffing_rhs,
     duffing_tangent,
     engaged,
+    in_contact,
     linear_rhs,
     linear_tangent,
     lorenz_rhs,
@@ -154,6 +155,20 @@ def _eccentric_phases(t, p):  # pragma: no cover - compiled
     )  # fmt: skip
 
 
+@numba.njit(cache=True, inline="always")
+def _chebyshev_harmonics(p, first, count, x, k, dk):  # pragma: no cover - compiled
+    """k + Σ_h a_h T_h(x) and dk + Σ_h a_h T_h'(x), h = 2 … count + 1, with the amplitudes
+    a_h = p[first …] (Chebyshev recurrences for T_h and T_h')."""
+    tm2, tm1, dm2, dm1 = 1.0, x, 0.0, 1.0  # T_0, T_1 and their derivatives
+    for h in range(count):
+        tt = 2.0 * x * tm1 - tm2
+        dt_ = 2.0 * tm1 + 2.0 * x * dm1 - dm2
+        k += p[first + h] * tt
+        dk += p[first + h] * dt_
+        tm2, tm1, dm2, dm1 = tm1, tt, dm1, dt_
+    return k, dk
+
+
 @njit_noalloc
 def _planetary_general(ph, p, i, N, ck, ckr, ksp, dksp, krp, dkrp, esp, esp_d, esp_dd, erp,
                        erp_d, erp_dd):  # pragma: no cover - compiled  # fmt: skip
@@ -165,22 +180,8 @@ def _planetary_general(ph, p, i, N, ck, ckr, ksp, dksp, krp, dkrp, esp, esp_d, e
     nh_sp = int(p[P_NH_SP])
     nh_rp = int(p[P_NH_RP])
     h0 = P_HEADER + N_BLOCKS * N  # first harmonic amplitude
-    if nh_sp > 0:
-        tm2, tm1, dm2, dm1 = 1.0, ck, 0.0, 1.0  # T_0, T_1 and their derivatives
-        for h in range(nh_sp):
-            tt = 2.0 * ck * tm1 - tm2
-            dt_ = 2.0 * tm1 + 2.0 * ck * dm1 - dm2  # Chebyshev T_h' recurrence
-            ksp += p[h0 + h] * tt
-            dksp += p[h0 + h] * dt_
-            tm2, tm1, dm2, dm1 = tm1, tt, dm1, dt_
-    if nh_rp > 0:
-        tm2, tm1, dm2, dm1 = 1.0, ckr, 0.0, 1.0
-        for h in range(nh_rp):
-            tt = 2.0 * ckr * tm1 - tm2
-            dt_ = 2.0 * tm1 + 2.0 * ckr * dm1 - dm2
-            krp += p[h0 + nh_sp + h] * tt
-            dkrp += p[h0 + nh_sp + h] * dt_
-            tm2, tm1, dm2, dm1 = tm1, tt, dm1, dt_
+    ksp, dksp = _chebyshev_harmonics(p, h0, nh_sp, ck, ksp, dksp)
+    krp, dkrp = _chebyshev_harmonics(p, h0 + nh_sp, nh_rp, ckr, krp, dkrp)
     if p[P_ECC] != 0.0:
         om_s, om_p, om_r, cs_, ss_, cp_, sp_, cr_, sr_ = ph
         for a, w, s_, c_, bc, bs, to_sp in (
@@ -301,12 +302,12 @@ def _planetary_rhs(n_fixed):
                 obs[nt + N + i] = drp_d
                 # contact forces: zero while the teeth are apart; their derivatives without the
                 # c̄ δ̄'' term, which needs the accelerations (added after the loop)
-                on = dsp > bsp or dsp < -bsp
+                on = in_contact(dsp, bsp)
                 sk = s1 * p[P_HEADER + B_CK_SP * N + i] + c1 * p[P_HEADER + B_SK_SP * N + i]
                 obs[2 * N + 2 + i] = fsp if on else 0.0
                 dfc = -om * sk * dksp * fzsp + ksp * dsp_d - csp * esp_dd
                 obs[nt + 2 * N + 2 + i] = dfc if on else 0.0
-                on = drp > brp or drp < -brp
+                on = in_contact(drp, brp)
                 sk = s1 * p[P_HEADER + B_CK_RP * N + i] + c1 * p[P_HEADER + B_SK_RP * N + i]
                 obs[3 * N + 2 + i] = frp if on else 0.0
                 dfc = -om * sk * dkrp * fzrp + krp * drp_d - crp * erp_dd
@@ -349,10 +350,10 @@ def _planetary_rhs(n_fixed):
             # δ̄_rp'' = σ̄'' − p̄_i'' − e_rp'' (the e'' parts were added in the loop)
             for i in range(N):
                 pdd = dydt[n + 2 + i]
-                if obs[i] > bsp or obs[i] < -bsp:
+                if in_contact(obs[i], bsp):
                     si, ci = _planet_direction(p, N, i)
                     obs[nt + 2 * N + 2 + i] += csp * (pdd - dydt[n] * si + dydt[n + 1] * ci)
-                if obs[N + i] > brp or obs[N + i] < -brp:
+                if in_contact(obs[N + i], brp):
                     obs[nt + 3 * N + 2 + i] += crp * (dydt[n + N + 2] - pdd)
 
     return planetary_rhs

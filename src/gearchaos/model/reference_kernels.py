@@ -36,6 +36,7 @@ __all__ = [
     "duffing_rhs",
     "duffing_tangent",
     "engaged",
+    "in_contact",
     "linear_rhs",
     "linear_tangent",
     "lorenz_rhs",
@@ -50,9 +51,15 @@ def dead_zone(x: float, b: float) -> float:
 
 
 @numba.njit(cache=True, inline="always")
+def in_contact(x: float, b: float) -> bool:
+    """Whether x lies outside the clearance [−b, b] (teeth in contact)."""
+    return x > b or x < -b
+
+
+@numba.njit(cache=True, inline="always")
 def engaged(x: float, b: float) -> float:
     """f'(x; b): 1 outside the clearance (teeth in contact), 0 inside."""
-    return 1.0 if (x > b or x < -b) else 0.0
+    return 1.0 if in_contact(x, b) else 0.0
 
 
 @njit_noalloc
@@ -72,7 +79,7 @@ def backlash_oscillator_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - co
     dydt[1] = p[BO_FM] + p[BO_FA] * c - damp - k * fz
     obs[0] = x
     obs[2] = v
-    if x > b or x < -b:
+    if in_contact(x, b):
         obs[1] = k * fz + damp
         dk = -p[BO_EPS] * om * math.sin(om * t)
         obs[3] = dk * fz + k * v + 2.0 * p[BO_ZETA] * dydt[1]
