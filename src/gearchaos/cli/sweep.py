@@ -45,6 +45,7 @@ StoreArg = Annotated[
     typer.Argument(help="Sweep store written by `gearchaos bifurcation`.", show_default=False),
 ]
 
+
 @c.app.command()
 def bifurcation(
     output: Annotated[

@@ -27,6 +27,7 @@ __all__ = [
     "TransmissionError",
 ]
 
+
 @dataclass(frozen=True)
 class Teeth:
     """Tooth numbers z_s (sun), z_p (planet), z_r (ring, internal)."""

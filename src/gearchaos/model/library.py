@@ -217,9 +217,7 @@ def _real_array(name: str, value: Any) -> np.ndarray:
     """An array of finite real numbers (no bools, text or complex numbers)."""
     a = real_array(value)
     if a is None:
-        raise ParameterError(
-            f"{name} must be an array of real numbers: got {type(value).__name__}"
-        )
+        raise ParameterError(f"{name} must be an array of real numbers: got {type(value).__name__}")
     if not np.all(np.isfinite(a)):
         raise ParameterError(f"{name} must be finite: got NaN or inf")
     return a
