@@ -81,10 +81,10 @@ def tsit5_tableau() -> Any:
 
 
 def pi_loop(f: Any, t0: float, y0: np.ndarray, t1: float, tab: Any) -> tuple[np.ndarray, int]:
-    """The package's step control (dopri.py) around one embedded pair, in Python: returns
-    y(t1) and the number of step attempts."""
-    beta = 0.04
-    alpha = 0.2 - 0.75 * beta
+    """The package's step control (its constants from dopri.py) around one embedded pair, in
+    Python: returns y(t1) and the number of step attempts."""
+    from gearchaos.integrate import dopri as D
+
     a = tab.a_matrix()
     c = np.array([float(x) for x in tab.c])
     e = np.array([float(x) for x in tab.error_weights])
@@ -92,7 +92,7 @@ def pi_loop(f: Any, t0: float, y0: np.ndarray, t1: float, tab: Any) -> tuple[np.
     t, y, h = t0, y0.copy(), 0.01
     k = np.zeros((s, y.size))
     k[0] = f(t, y)
-    attempts, err_old, last_rejected = 0, 1e-4, False
+    attempts, err_old, last_rejected = 0, D.ERR_OLD_MIN, False
     while t < t1:
         hs = min(h, t1 - t)
         for i in range(1, s):
@@ -102,14 +102,17 @@ def pi_loop(f: Any, t0: float, y0: np.ndarray, t1: float, tab: Any) -> tuple[np.
         err = float(np.sqrt(np.mean((hs * (e @ k) / sc) ** 2)))
         attempts += 1
         if err > 1.0:
-            h = hs * max(0.2, 0.9 * err**-alpha)
+            h = hs * max(D.MIN_FACTOR, D.SAFETY * err**-D.ALPHA)
             last_rejected = True
             continue
-        fac = 10.0 if err == 0.0 else min(10.0, max(0.2, 0.9 * err**-alpha * err_old**beta))
+        fac = D.MAX_FACTOR
+        if err > 0.0:
+            fac = D.SAFETY * err**-D.ALPHA * err_old**D.BETA
+            fac = min(D.MAX_FACTOR, max(D.MIN_FACTOR, fac))
         if last_rejected:
             fac = min(fac, 1.0)
         last_rejected = False
-        err_old = max(err, 1e-4)
+        err_old = max(err, D.ERR_OLD_MIN)
         t, y, h = t + hs, y_new, hs * fac
         k[0] = k[s - 1]
     return y, attempts
