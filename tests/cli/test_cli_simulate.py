@@ -177,9 +177,9 @@ def test_integration_failure_exits_1(runner: CliRunner, monkeypatch) -> None:
     def fail(*args: object, **kwargs: object) -> None:
         raise IntegrationError("simulation at omega=1.5 stopped at tau=3: NON_FINITE: diverged")
 
-    # the CLI simulates through gearchaos.analysis.point.analyse_point, which runs the
+    # the CLI simulates through gearchaos.dynamics.point.analyse_point, which runs the
     # integration with run_simulation
-    monkeypatch.setattr(importlib.import_module("gearchaos.analysis.point"), "run_simulation", fail)
+    monkeypatch.setattr(importlib.import_module("gearchaos.dynamics.point"), "run_simulation", fail)
     result = runner.invoke(app, ["simulate", "--json"])
     assert result.exit_code == 1
     assert "NON_FINITE" in result.stderr

@@ -36,7 +36,7 @@ from hypothesis import strategies as st
 
 import gearchaos as gc
 from gearchaos.analysis.lyapunov import lyapunov_spectrum, max_lyapunov
-from gearchaos.analysis.point import analyse_point
+from gearchaos.dynamics.point import analyse_point
 from gearchaos.integrate import integrate, integrate_batch
 from gearchaos.integrate.settings import SolverSettings
 from gearchaos.paper.galleries import MAX_GALLERY_VALUES, run_gallery

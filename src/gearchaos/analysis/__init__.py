@@ -31,7 +31,6 @@ from .orbit_batch import periodic_orbits
 from .orbits import PeriodicOrbit, periodic_orbit
 from .periodicity import detect_period, period_label
 from .poincare import count_distinct, section_points
-from .point import PointAnalysis, analyse_point
 from .summary import format_summary, summarize
 
 __all__ = [
@@ -40,8 +39,6 @@ __all__ = [
     "LyapunovResult",
     "MotionClass",
     "PeriodicOrbit",
-    "PointAnalysis",
-    "analyse_point",
     "attractors",
     "branch_multipliers",
     "branch_summary",

@@ -16,6 +16,8 @@ for 1/s.
 
 from __future__ import annotations
 
+import math
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
@@ -27,7 +29,67 @@ from ..integrate.settings import MAX_SAMPLES_PER_PERIOD, SolverSettings
 from ..integrate.simulate import integrate
 from ..model.system import System
 
-__all__ = ["LyapunovResult", "lyapunov_spectrum", "max_lyapunov"]
+__all__ = [
+    "LYAPUNOV_BLOCKS",
+    "LyapunovResult",
+    "exponent_estimate",
+    "lyapunov_spectrum",
+    "max_lyapunov",
+    "random_tangents",
+]
+
+#: Blocks the record is cut into for the standard error of λ₁ (batch means).
+LYAPUNOV_BLOCKS = 10
+#: Seed of the default random initial tangent vectors.
+TANGENT_SEED = 0
+
+
+def random_tangents(n: int, k: int = 1, *, seed: int = TANGENT_SEED, points: int = 1) -> np.ndarray:
+    """``points`` × k × n standard normal tangent vectors from ``default_rng(seed)`` (the
+    kernel orthonormalises them at the first sample). A random start has a component along
+    every Oseledets direction with probability one; a basis vector does not when the system
+    has an invariant subspace (identical in-phase planets: the sun's x translation stays in
+    the symmetry-breaking subspace, whose exponent it then reports)."""
+    rng = np.random.default_rng(seed)
+    return rng.standard_normal((int(points), int(k), int(n)))
+
+
+def exponent_estimate(
+    log_stretch: np.ndarray, dt: float, *, blocks: int = LYAPUNOV_BLOCKS
+) -> tuple[float, float]:
+    """λ₁ and its standard error from the log stretch factors of one tangent vector.
+
+    Parameters
+    ----------
+    log_stretch
+        ln‖v(τ_j)‖ / ‖v(τ_{j−1})‖ over consecutive renormalisation intervals of length ``dt``
+        (NaN entries, such as the first sample's, are dropped).
+    dt
+        The renormalisation interval (T / renormalisations per period).
+    blocks
+        Number B of consecutive blocks (batch means).
+
+    Returns
+    -------
+    (float, float)
+        λ₁ = Σ ln stretch / (m·dt), and the standard error s_B/√B of the B block means λ_b
+        (s_B their sample standard deviation): for a chaotic attractor the block means are
+        nearly independent once a block is much longer than the correlation time, and the
+        error falls like 1/√(record); for a regular attractor they scatter around zero by
+        O(ln C / block length). NaN error with fewer than 2·B intervals.
+    """
+    x = np.asarray(log_stretch, dtype=np.float64)
+    x = x[np.isfinite(x)]
+    m = x.size
+    if m == 0:
+        return math.nan, math.nan
+    lam = float(np.sum(x) / (m * dt))
+    b = int(blocks)
+    if m < 2 * b:
+        return lam, math.nan
+    size = m // b
+    means = x[: size * b].reshape(b, size).sum(axis=1) / (size * dt)
+    return lam, float(np.std(means, ddof=1) / math.sqrt(b))
 
 
 @dataclass(frozen=True)
@@ -40,6 +102,10 @@ class LyapunovResult:
     status: Status
     steps_accepted: int
     steps_rejected: int
+    largest_error: float = math.nan
+
+    def __str__(self) -> str:
+        return f"λ₁ = {format_exponent(self.largest, self.largest_error)}"
 
     @property
     def largest(self) -> float:
@@ -61,6 +127,7 @@ def lyapunov_spectrum(
     n_exponents: int | None = None,
     renormalizations_per_period: int = 1,
     y0: np.ndarray | None = None,
+    seed: int = TANGENT_SEED,
     **solver: Any,
 ) -> LyapunovResult:
     """The ``n_exponents`` largest Lyapunov exponents (all by default) of ``system``.
@@ -75,7 +142,26 @@ def lyapunov_spectrum(
         500 periods averaged over) and/or its fields by name: ``transient_periods``,
         ``periods`` (the statistical error of a chaotic estimate decays like 1/√(periods); a
         regular orbit's like log(·)/periods), ``rtol`` and ``atol`` (of the state and of the
-        normalised tangent vectors), ``max_steps``.
+        normalised tangent vectors), ``max_steps``, ``perturbation`` (of the start from
+        rest: the default takes even an equilibrium start, such as the origin of the Lorenz
+        system, off the equilibrium).
+    y0
+        Initial state (default: the perturbed rest state of the settings).
+    seed
+        Seed of the random initial tangent vectors (:func:`random_tangents`), orthonormalised
+        when the recording starts.
+
+    Returns
+    -------
+    LyapunovResult
+        The exponents, and ``largest_error``: the standard error of λ₁ from
+        :data:`LYAPUNOV_BLOCKS` block means (:func:`exponent_estimate`).
+
+    Warns
+    -----
+    RuntimeWarning
+        When the state does not move over the recorded window (an equilibrium): the exponents
+        are then those of the equilibrium, not of an attractor.
     """
     if not isinstance(system, System):
         raise ParameterError(f"system must be a System: got {type(system).__name__}")
@@ -89,10 +175,25 @@ def lyapunov_spectrum(
     k = n if n_exponents is None else check_int("n_exponents", n_exponents, lo=1, hi=n)
     if cfg.n_samples < 2:
         raise ParameterError("periods × renormalizations_per_period must be >= 2")
-    traj = integrate(system, cfg, y0=y0, n_tangent=k)
+    traj = integrate(
+        system, cfg, y0=y0, n_tangent=k, tangent_start=random_tangents(n, k, seed=seed)
+    )
     ns = cfg.n_samples
-    duration = (ns - 1) * system.period / renormalizations_per_period
+    dt = system.period / renormalizations_per_period
+    duration = (ns - 1) * dt
     ex = traj.tangent_log_sums / duration if traj.ok else np.full(k, np.nan)
+    err = math.nan
+    if traj.ok:
+        _, err = exponent_estimate(traj.tangent_log_stretch, dt)
+        s = traj.states
+        if float(np.max(np.ptp(s, axis=0))) <= 1e-12 * max(1.0, float(np.max(np.abs(s)))):
+            warnings.warn(
+                f"{system.name}: the state stays at {s[-1].tolist()!r} over the recorded "
+                "window (an equilibrium): these are the exponents of that equilibrium; start "
+                "elsewhere (y0, or perturbation > 0)",
+                RuntimeWarning,
+                stacklevel=2,
+            )
     return LyapunovResult(
         exponents=ex,
         duration=duration,
@@ -100,7 +201,17 @@ def lyapunov_spectrum(
         status=traj.status,
         steps_accepted=traj.steps_accepted,
         steps_rejected=traj.steps_rejected,
+        largest_error=err,
     )
+
+
+def format_exponent(value: float, error: float) -> str:
+    """``0.0412 ± 0.0031`` (or the value alone when the error is unknown)."""
+    if not math.isfinite(value):
+        return "—"
+    if not math.isfinite(error):
+        return f"{value:.4g}"
+    return f"{value:.4g} ± {error:.2g}"
 
 
 def max_lyapunov(system: System, **kwargs: object) -> float:

@@ -41,7 +41,12 @@ def _check_tolerances(max_period: Any, rtol: Any, atol: Any) -> None:
 
 
 def periods_of(
-    points: Any, *, max_period: int = 64, rtol: float = 1e-3, atol: float = 0.0
+    points: Any,
+    *,
+    max_period: int = 64,
+    rtol: float = 1e-3,
+    atol: float = 0.0,
+    floor: Any = None,
 ) -> np.ndarray:
     """Vectorised :func:`detect_period` over the leading axes of a batch of section sequences.
 
@@ -52,6 +57,12 @@ def periods_of(
         leading index (e.g. a sweep's (Ω, section, 2) array of (X̄_sp1, X̄'_sp1)).
     max_period, rtol, atol
         As in :func:`detect_period`.
+    floor
+        The noise floor ε of the section points (a scalar, or one per sequence), in their
+        units: a sequence whose spread S is at most ε is one point (period 1), whatever its
+        magnitude. The motion verdict passes ε = 10³ (atol + rtol·max|x|) of the integration
+        (:mod:`gearchaos.dynamics.verdict`). None keeps :func:`detect_period`'s rule
+        S ≤ rtol·max|x|.
 
     Returns
     -------
@@ -73,9 +84,13 @@ def periods_of(
     idx = np.flatnonzero(finite)
     q = p[idx]
     size = np.max(np.ptp(q, axis=1), axis=1)  # attractor size: largest coordinate range
-    # points that agree to the relative precision rtol are one point (count_distinct's rule)
-    mag = np.max(np.abs(q), axis=(1, 2))
-    single = size <= rtol * mag
+    if floor is None:
+        # points that agree to the relative precision rtol are one point (count_distinct's)
+        mag = np.max(np.abs(q), axis=(1, 2))
+        single = size <= rtol * mag
+    else:
+        eps = np.broadcast_to(np.asarray(floor, dtype=np.float64), lead).reshape(-1)[idx]
+        single = size <= eps
     out[idx[single]] = 1
     keep = ~single
     idx, q, size = idx[keep], q[keep], size[keep]

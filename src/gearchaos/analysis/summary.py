@@ -55,7 +55,12 @@ def _num(x: Any) -> float | None:
 
 
 def summarize(
-    result: Any, *, tol: float = 1e-3, max_count: int = 64, lle: float | None = None
+    result: Any,
+    *,
+    tol: float = 1e-3,
+    max_count: int = 64,
+    lle: float | None = None,
+    verdict: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     """JSON-serialisable summary of a simulation result.
 
@@ -68,7 +73,14 @@ def summarize(
     lle
         Largest Lyapunov exponent of the run (per unit τ), if computed
         (:func:`~gearchaos.analysis.lyapunov.max_lyapunov`); it decides quasi-periodic vs
-        chaotic motion, confirmed by the 0–1 test and the spectrum.
+        chaotic motion, confirmed by the 0–1 test and the spectrum. Ignored with ``verdict``.
+    verdict
+        The motion verdict's fields (:meth:`gearchaos.dynamics.verdict.Verdict.to_dict`):
+        then ``motion`` is its label, ``lle``/``lle_error`` its λ₁ and error, and
+        ``evidence``, ``max_multiplier``, ``extra_periods`` and ``motion_note`` (its reason)
+        say what decided it. Without it the label comes from the record alone
+        (:func:`~gearchaos.analysis.classify.classify_motion`) and ``evidence`` is
+        ``record``.
 
     Returns
     -------
@@ -99,9 +111,10 @@ def summarize(
     n = count_distinct(pts, tol=tol, max_count=max(n_recorded, 1))
     mc = classify_motion(
         np.column_stack([x, xd]),
-        lle=lle,
+        lle=None if verdict is not None else lle,
         run_periods=int(result.solver.periods),
         forcing_period=system.period,
+        compute_indicators=verdict is None,
     )
     finite = x[np.isfinite(x)]
     scales = getattr(model, "scales", None)
@@ -130,10 +143,25 @@ def summarize(
         "steps_rejected": int(result.steps_rejected),
     }
     out["recorded_section_points"] = n_recorded
-    out["lle"] = _num(mc.lle) if mc.lle is not None else None
-    out["k01"] = _num(mc.k01) if mc.k01 is not None else None
-    out["indicators_agree"] = bool(mc.agree)
-    out["motion_note"] = mc.note
+    if verdict is not None:
+        out["motion"] = verdict["motion"]
+        out["lle"] = verdict["lle"]
+        out["lle_error"] = verdict["lle_error"]
+        out["k01"] = verdict["k01"]
+        out["evidence"] = verdict["evidence"]
+        out["max_multiplier"] = verdict["max_multiplier"]
+        out["extra_periods"] = verdict["extra_periods"]
+        out["indicators_agree"] = True
+        out["motion_note"] = verdict["reason"]
+    else:
+        out["lle"] = _num(mc.lle) if mc.lle is not None else None
+        out["lle_error"] = None
+        out["k01"] = _num(mc.k01) if mc.k01 is not None else None
+        out["evidence"] = "record"
+        out["max_multiplier"] = None
+        out["extra_periods"] = 0
+        out["indicators_agree"] = bool(mc.agree)
+        out["motion_note"] = mc.note
     out["gearset"] = gs.name if gs is not None else None
     out["mesh_frequency_hz"] = (
         _num(omega * scales.omega_n / (2.0 * math.pi)) if scales is not None else None
@@ -180,6 +208,10 @@ def format_summary(summary: dict[str, Any], *, title: str | None = None) -> Any:
         "sun_speed_rpm": "sun speed [rpm]",
         "distinct_section_points": "distinct section points",
         "motion": "motion",
+        "evidence": "decided by",
+        "max_multiplier": "max |μ| (Floquet)",
+        "lle": "λ₁ [1/τ]",
+        "extra_periods": "periods added to finish the transient",
         "x_sp1_section_min": "X̄_sp1 section min",
         "x_sp1_section_max": "X̄_sp1 section max",
         "load_factor_sp_max": "load factor sun–planet (max)",
@@ -195,6 +227,11 @@ def format_summary(summary: dict[str, Any], *, title: str | None = None) -> Any:
             recorded = summary.get("recorded_section_points")
             if key == "distinct_section_points" and recorded:
                 value = f"{int(value)} of {int(recorded)}"
+            if key == "lle" and value is not None and summary.get("lle_error") is not None:
+                err = summary["lle_error"]
+                value = f"{value:.4g} (exact)" if err == 0 else f"{value:.4g} ± {err:.2g}"
+            if key in ("max_multiplier", "extra_periods") and not value:
+                continue
             table.add_row(escape(label), escape(_fmt(value)))
     style = {"none": "green", "single_sided": "yellow", "double_sided": "red"}
     for c in summary.get("contact", []):

@@ -2,7 +2,7 @@
 
 Both functions run in a worker process (the compiled kernels hold the GIL, so a thread would
 stall the web server) and return plain, picklable values: numbers, text and PNG bytes. They
-reuse the library's front doors — :func:`~gearchaos.analysis.point.analyse_point` (simulation,
+reuse the library's front doors — :func:`~gearchaos.dynamics.point.analyse_point` (simulation,
 λ₁ and the motion label), :func:`~gearchaos.analysis.orbits.periodic_orbit` (Floquet
 multipliers of an nT orbit), the plots of :mod:`gearchaos.plot` (phase portrait, time
 histories, spectrum with the mesh harmonics labelled) and :func:`~gearchaos.sweep.run_sweep`
@@ -70,7 +70,7 @@ def compute_point(
     The point is simulated from rest with the store's protocol (its transient, recorded
     periods and tolerances; :data:`POINT_SAMPLES` samples per forcing period T = 2π/Ω instead
     of one), as ``gearchaos simulate`` would, and its largest Lyapunov exponent λ₁ is
-    integrated with the same settings (:func:`~gearchaos.analysis.point.analyse_point`). When
+    integrated with the same settings (:func:`~gearchaos.dynamics.point.analyse_point`). When
     the motion is nT with n ≤ 8, the period-n orbit is found by shooting from the simulation
     and its Floquet multipliers μ (eigenvalues of the monodromy matrix) are returned.
 
@@ -95,7 +95,7 @@ def compute_point(
         ``(re, im)``, largest modulus first, or ``None``), ``orbit_note`` and ``png``
         (a 2×2 figure: phase portrait, X̄ and contact force against time, spectrum).
     """
-    from ..analysis.point import analyse_point
+    from ..dynamics.point import analyse_point
     from ..sweep.result import open_result
 
     res = open_result(store)

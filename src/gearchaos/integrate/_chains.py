@@ -73,6 +73,7 @@ class ChainRun:
         continuation: bool = False,
         first_step: float | None = None,
         max_step: float = np.inf,
+        tangent_start: np.ndarray | None = None,
     ) -> ChainRun:
         """Pack chains of systems (one kind and parameter layout) with their sample times.
 
@@ -109,6 +110,7 @@ class ChainRun:
             continuation=continuation,
             first_step=first_step,
             max_step=max_step,
+            tangent_start=tangent_start,
         )
 
     @classmethod
@@ -126,16 +128,24 @@ class ChainRun:
         continuation: bool = False,
         first_step: float | None = None,
         max_step: float = np.inf,
+        tangent_start: np.ndarray | None = None,
     ) -> ChainRun:
         """A run from packed parameters ``P`` and switch widths ``SW`` (C, L, …) of systems
         like ``ref``, start times ``t0`` and sample times (C, L): the one place a run is laid
-        out, for callers that pack their own points (shooting, a hot path)."""
+        out, for callers that pack their own points (shooting, a hot path). ``y0`` None starts
+        from rest (:meth:`~gearchaos.integrate.settings.SolverSettings.rest_state`);
+        ``tangent_start`` (k × n, or C × k × n) gives the tangent vectors' start, made
+        orthonormal at the first sample (default: the first k basis vectors)."""
         C = P.shape[0]
         n = ref.n_state
         k = int(n_tangent)
         Y0 = np.zeros((C, n * (1 + k)))
+        if y0 is None:
+            y0 = settings.rest_state(n)  # from rest, perturbed off invariant subspaces
         if y0 is not None:
             Y0[:, :n] = y0
+        if tangent_start is not None:
+            Y0[:, n:] = np.asarray(tangent_start, dtype=np.float64).reshape(-1, n * k)
         return cls(
             kind=ref.kind,
             Y0=Y0,
@@ -224,6 +234,16 @@ class ChainOutput(SampleArrays):
                 )
             )
             start += size
+        return out
+
+    def stretch(self, n: int) -> np.ndarray:
+        """(C, L, s) log stretch ln‖v₁‖ of the first tangent vector over each sample interval
+        (the kernel records the tangents before renormalising them; NaN at the first sample,
+        where they start, and where a sample was not reached)."""
+        v = self.states[..., n : 2 * n]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            out = np.log(np.sqrt(np.sum(v * v, axis=-1)))
+        out[..., 0] = np.nan
         return out
 
     def lyapunov(self, dt: np.ndarray) -> np.ndarray:

@@ -133,16 +133,23 @@ def initial_step(kind, t, y, f0, p, rtol, atol, obs, n, y1, f1):  # pragma: no c
 
 @njit_noalloc
 def _renormalize(kind, t, y, p, obs, K, n, k, lsum, tan_on):  # pragma: no cover - compiled
-    """Tangent vectors in y[n:]: set them orthonormal (first call) or re-orthonormalise them by
-    modified Gram–Schmidt, adding log stretch factors to ``lsum``; refresh their FSAL stage
-    ``K[0]`` (``obs`` holds all observables at (t, y))."""
+    """Tangent vectors in y[n:]: on the first call make them orthonormal — the given vectors
+    by Gram–Schmidt when any is nonzero (a seeded random start), else the first k basis
+    vectors — or, later, re-orthonormalise them by modified Gram–Schmidt, adding log stretch
+    factors to ``lsum``; refresh their FSAL stage ``K[0]`` (``obs`` holds all observables at
+    (t, y))."""
     numba.literally(kind)
+    given = False
     if not tan_on:
-        for r in range(k):
-            o = n + r * n
-            for i in range(n):
-                y[o + i] = 1.0 if i == r else 0.0
-    else:
+        for i in range(n, n + k * n):
+            if y[i] != 0.0:
+                given = True
+        if not given:
+            for r in range(k):
+                o = n + r * n
+                for i in range(n):
+                    y[o + i] = 1.0 if i == r else 0.0
+    if tan_on or given:
         for r in range(k):
             o = n + r * n
             for q in range(r):
@@ -156,7 +163,8 @@ def _renormalize(kind, t, y, p, obs, K, n, k, lsum, tan_on):  # pragma: no cover
             for i in range(n):
                 nrm += y[o + i] * y[o + i]
             nrm = math.sqrt(nrm)
-            lsum[r] += math.log(nrm)
+            if tan_on:
+                lsum[r] += math.log(nrm)
             for i in range(n):
                 y[o + i] /= nrm
     tangent(kind, t, y, p, obs, K[0], n, k)
@@ -273,10 +281,10 @@ def dopri_run(
     j = 0
     tracking = False
     if status == ST_OK and n_samples > 0 and t >= t_rec:
-        if n_tan > 0:
-            tan_on = _renormalize(kind, t, y, p, obs, K, n_base, n_tan, lsum, tan_on)
         out_t[0] = t
         _copy(out_y[0], y, n)
+        if n_tan > 0:
+            tan_on = _renormalize(kind, t, y, p, obs, K, n_base, n_tan, lsum, tan_on)
         _copy(out_obs[0], obs, n_obs)
         j = 1
         tracking = True
@@ -460,10 +468,10 @@ def dopri_run(
                 record = True
             n_sec += 1
         if record:
+            out_t[j] = t
+            _copy(out_y[j], y, n)  # tangents before renormalising: their stretch is readable
             if n_tan > 0:
                 tan_on = _renormalize(kind, t, y, p, obs, K, n_base, n_tan, lsum, tan_on)
-            out_t[j] = t
-            _copy(out_y[j], y, n)
             _copy(out_obs[j], obs, n_obs)
             if not tracking:
                 tracking = True
@@ -558,10 +566,11 @@ def dopri_chains(
                 ws,
             )
             status[c, j] = st
+            # a successor starts from the final system state; its tangent vectors start
+            # afresh from Y0's (zero: the basis, shooting's monodromy factors)
+            _copy(y, Y0[c], y.size)
             if continuation and st == ST_OK:
-                _copy(y, y_final[c, j], y.size)
-            else:
-                _copy(y, Y0[c], y.size)
+                _copy(y, y_final[c, j], n_base)
 
 
 def _guard() -> None:

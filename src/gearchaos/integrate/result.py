@@ -58,7 +58,11 @@ class SimulationResult(Trajectory):
             "status_message": self.status.message,
             "steps_accepted": self.steps_accepted,
             "steps_rejected": self.steps_rejected,
-            "initial_state": "zero" if self.y0 is None else "given",
+            "initial_state": (
+                "given"
+                if self.y0 is not None
+                else ("zero" if self.solver.perturbation == 0 else "rest, perturbed")
+            ),
             **provenance(),
         }
         gs = self.gearset

@@ -20,7 +20,7 @@ import numpy as np
 from .._checks import check_choice, check_int, check_memory, check_real
 from ..errors import ParameterError
 
-__all__ = ["SIMULATION", "SampleTimes", "SolverSettings"]
+__all__ = ["PERTURBATION", "SIMULATION", "SampleTimes", "SolverSettings", "rest_direction"]
 
 #: Bounds of the settings (see :meth:`SolverSettings.check`).
 RTOL_RANGE = (1e-14, 1.0)
@@ -30,6 +30,20 @@ MAX_SAMPLES_PER_PERIOD = 10**6
 MAX_STEP_BUDGET = 2**62
 #: Values of ``settle``.
 SETTLE_CHOICES = ("off", "auto")
+#: Default size of the perturbation of a start from rest, and the largest allowed.
+PERTURBATION = 1e-6
+PERTURBATION_MAX = 1e-2
+#: Seed of the generator that draws the direction of that perturbation (and nothing else).
+PERTURBATION_SEED = 20_161_105
+
+
+def rest_direction(n: int) -> np.ndarray:
+    """The fixed unit vector u ∈ ℝⁿ along which a start from rest is perturbed: standard
+    normal components from ``numpy.random.default_rng(PERTURBATION_SEED)``, normalised.
+    Every component is nonzero (with probability one), so the start leaves every invariant
+    subspace of the state space, the symmetric manifold of in-phase planets included."""
+    u = np.random.default_rng(PERTURBATION_SEED).standard_normal(int(n))
+    return u / float(np.linalg.norm(u))
 
 
 @dataclass(frozen=True)
@@ -66,6 +80,15 @@ class SolverSettings:
     max_steps
         Step attempts allowed before the integration gives up (``Status.MAX_STEPS``); ``None``
         allows 100 000 + 50 000 per simulated period.
+    perturbation
+        Size ε of the reproducible perturbation added to a start from rest (the zero state):
+        the run starts at ε·u, u a fixed unit vector (:func:`rest_direction`, drawn once from a
+        seeded generator, so every run, process and machine starts from the same state). A
+        real gearbox is never exactly symmetric; from the exact zero state a gear set with
+        identical, equally spaced, in-phase planets never leaves its symmetric subspace
+        (sun centred, planets in step), and motions that are unstable to symmetry breaking
+        would be reported as attractors. Default 1e-6 (in state units: b_c for gear sets);
+        0 restores the exact symmetric start. Explicit initial states are never perturbed.
     settle
         ``"off"`` (the seed's protocol): always ``transient_periods`` periods of transient.
         ``"auto"``: the transient ends at the first section point x_k (τ = τ_rec − mT) after
@@ -89,6 +112,7 @@ class SolverSettings:
     atol: float = 1e-10
     max_steps: int | None = None
     settle: str = "off"
+    perturbation: float = PERTURBATION
 
     def __post_init__(self) -> None:
         self.check()
@@ -113,6 +137,7 @@ class SolverSettings:
         if self.max_steps is not None:
             check_int("max_steps", self.max_steps, lo=1, hi=MAX_STEP_BUDGET)
         check_choice("settle", self.settle, SETTLE_CHOICES)
+        check_real("perturbation", self.perturbation, lo=0.0, hi=PERTURBATION_MAX)
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -197,11 +222,19 @@ class SolverSettings:
         }
         if self.settle != "off":
             out["settle"] = self.settle
+        out["perturbation"] = self.perturbation
         return out
+
+    def rest_state(self, n: int) -> np.ndarray | None:
+        """The start "from rest" of an n-dimensional system: ε·u (:func:`rest_direction`), or
+        None (the exact zero state) when ``perturbation`` is 0."""
+        if self.perturbation == 0.0:
+            return None
+        return float(self.perturbation) * rest_direction(n)
 
 
 #: The defaults of one simulation, the same from Python (:func:`gearchaos.simulate`,
-#: :func:`~gearchaos.analysis.point.analyse_point`) and from ``gearchaos simulate``: the
+#: :func:`~gearchaos.dynamics.point.analyse_point`) and from ``gearchaos simulate``: the
 #: seed's protocol with 64 samples per mesh period (time histories, spectra, RMS values).
 SIMULATION = SolverSettings(samples_per_period=64)
 

@@ -41,6 +41,7 @@ def integrate(
     max_step: float = math.inf,
     first_step: float | None = None,
     n_tangent: int = 0,
+    tangent_start: Any = None,
     **solver: Any,
 ) -> Trajectory:
     """Integrate any :class:`System` with the compiled Dormand–Prince 5(4) kernel.
@@ -65,7 +66,11 @@ def integrate(
         With ``k > 0`` the variational equations of k tangent vectors ride along (orthonormal
         from the first sample, re-orthonormalised at every later one) and
         :attr:`Trajectory.tangent_log_sums` holds their accumulated log stretch factors — the
-        raw material of :func:`gearchaos.analysis.lyapunov.lyapunov_spectrum`.
+        raw material of :func:`gearchaos.analysis.lyapunov.lyapunov_spectrum`;
+        :attr:`Trajectory.tangent_log_stretch` the first vector's log stretch per sample.
+    tangent_start
+        (k, n) start of the tangent vectors (orthonormalised at the first sample); default the
+        first k basis vectors.
     """
     if not isinstance(system, System):
         raise ParameterError(f"system must be a System: got {type(system).__name__}")
@@ -87,6 +92,7 @@ def integrate(
         n_tangent=k,
         first_step=h0,
         max_step=step_max,
+        tangent_start=None if k == 0 else tangent_start,
     )
     out = run_chains(run)
     return Trajectory(
@@ -106,6 +112,7 @@ def integrate(
         next_step=float(out.info[0, 0, 3]),
         tau_reached=float(out.info[0, 0, 2]),
         tangent_log_sums=out.log_sums[0, 0],
+        tangent_log_stretch=out.stretch(n)[0, 0] if k else np.empty(0),
     )
 
 

@@ -42,6 +42,7 @@ class Trajectory(SampleArrays):
     next_step: float = 0.0
     tau_reached: float = float("nan")
     tangent_log_sums: np.ndarray = field(default_factory=lambda: np.empty(0))
+    tangent_log_stretch: np.ndarray = field(default_factory=lambda: np.empty(0))
 
     @property
     def samples_per_period(self) -> int:

@@ -151,7 +151,7 @@ def run_gallery(
         An unknown or invalid parameter name, value or setting (checked for every value before
         anything runs), ``param`` also in ``fixed``, no Ω, or invalid ``with_``.
     """
-    from ..analysis.point import analyse_point
+    from ..dynamics.point import analyse_point
     from ..model.target import resolve
     from ..plot import axis_symbol
     from ..plot.gallery import parse_extras, poincare_gallery

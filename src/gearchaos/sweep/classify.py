@@ -55,12 +55,14 @@ def classify_dataset(
     ds: Any, *, period_rtol: float = PERIOD_RTOL, max_period: int = MAX_PERIOD
 ) -> dict[str, Any]:
     """Labels and indicators for every point of a sweep dataset (nothing written)."""
-    from ..analysis.classify import classify_sections, regime_table
+    from ..analysis.classify import classify_sections
 
     res = SweepResult.of(ds)
     ds = res.ds
-    pts = _section_pair(res)
     lead_dims, shape = res.lead_dims, res.shape
+    if "verdict" in ds.data_vars:
+        return _from_verdicts(res)
+    pts = _section_pair(res)
     kw: dict[str, Any] = {"details": True, "rtol": period_rtol, "max_period": max_period}
     if "lle" in ds.data_vars:
         kw["lle"] = np.asarray(ds["lle"].values, dtype=float)
@@ -79,6 +81,45 @@ def classify_dataset(
         period[idx] = mc.period or 0
         k01[idx] = np.nan if mc.k01 is None else mc.k01
         agree[idx] = bool(mc.agree)
+    return {
+        "dims": lead_dims,
+        **_contact(res),
+        "motion": labels,
+        "period": period,
+        "k01": k01,
+        "indicators_agree": agree,
+        "regime_table": _regime_table(res, labels),
+    }
+
+
+def _from_verdicts(res: SweepResult) -> dict[str, Any]:
+    """The stored verdicts' labels (:mod:`gearchaos.sweep.verdicts`): nothing is re-decided;
+    the period follows from the label, and the contact regimes and regime table are added."""
+    ds = res.ds
+    labels = np.asarray(ds["motion"].transpose(*res.lead_dims).values).astype(LABEL_DTYPE)
+    status = res.status()
+    labels = np.where(status != 0, "failed", labels).astype(LABEL_DTYPE)
+    period = np.zeros(labels.shape, dtype=np.int16)
+    for idx in np.ndindex(*labels.shape):
+        lab = str(labels[idx])
+        if lab.endswith("T") and lab[:-1].isdigit():
+            period[idx] = int(lab[:-1])
+    return {
+        "dims": res.lead_dims,
+        **_contact(res),
+        "motion": labels,
+        "period": period,
+        "k01": np.asarray(ds["k01"].transpose(*res.lead_dims).values, dtype=float),
+        "indicators_agree": np.ones(labels.shape, dtype=bool),
+        "regime_table": _regime_table(res, labels),
+    }
+
+
+def _regime_table(res: SweepResult, labels: np.ndarray) -> dict[str, Any]:
+    """Fraction of the points in each regime, per family value when there is a family."""
+    from ..analysis.classify import regime_table
+
+    ds, lead_dims = res.ds, res.lead_dims
     fam = res.layout().family
     table: dict[str, Any]
     if fam is not None and fam in lead_dims:
@@ -89,15 +130,7 @@ def classify_dataset(
         }
     else:
         table = {"all": regime_table(labels.ravel())}
-    return {
-        "dims": lead_dims,
-        **_contact(res),
-        "motion": labels,
-        "period": period,
-        "k01": k01,
-        "indicators_agree": agree,
-        "regime_table": table,
-    }
+    return table
 
 
 def label_periods(

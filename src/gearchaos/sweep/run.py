@@ -30,6 +30,7 @@ from .orbits import ORBIT_VARIABLES, status_attrs, task_orbits
 from .progress import _Bar
 from .spec import DEFAULT_OBSERVE, SweepSpec
 from .store import SweepStore
+from .verdicts import VERDICT_VARIABLES, task_verdicts, verdict_attrs
 
 __all__ = ["bifurcation", "run_sweep"]
 
@@ -102,6 +103,10 @@ class _Layout:
                 },
             )
             chunks["lle"] = ch
+        if spec.verdicts:
+            for nm, (doc, dtype, fill) in VERDICT_VARIABLES.items():
+                var[nm] = (lead, (shp, dtype), fill, {"long_name": doc, **verdict_attrs(nm)})
+                chunks[nm] = ch
         if spec.orbits:
             for nm, (doc, dtype, fill) in ORBIT_VARIABLES.items():
                 extra = status_attrs() if nm == "orbit_status" else {}
@@ -176,6 +181,8 @@ class _Layout:
                 data["final_state"][pos] = out.final_state[c, j, :n_st]
                 if spec.lyapunov:
                     data["lle"][pos] = lle[c, j, 0]
+        if spec.verdicts:
+            task_verdicts(self.grid, self.observed, task, out, data)
         if spec.orbits:
             data.update(task_orbits(self.grid, self.observed, task, run, data))
         return data

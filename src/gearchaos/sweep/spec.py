@@ -213,6 +213,7 @@ SPEC_OPTIONS = (
     "direction",
     "lyapunov",
     "orbits",
+    "verdicts",
     "response",
 )
 
@@ -264,6 +265,11 @@ class SweepSpec:
         Confirm every label nT (n ≤ 8) by a converged period-n orbit shot from the point's
         final state, and store its residual, largest multiplier modulus and a status flag
         (:mod:`gearchaos.sweep.orbits`).
+    verdicts
+        Decide every point's motion with the verdict (:mod:`gearchaos.dynamics.verdict`):
+        nT confirmed by shooting, chaos and QP by λ₁ ± its error, transients finished by
+        extending the run (the stored section record is then the finished one). False
+        labels the points from their records alone (faster, heuristic).
     response
         Also store the frequency-response quantities of every point
         (:mod:`gearchaos.model.response`): RMS and peak contact force of every mesh, dynamic
@@ -282,6 +288,7 @@ class SweepSpec:
     solver: SolverSettings = SWEEP_SOLVER
     lyapunov: bool = False
     orbits: bool = False
+    verdicts: bool = True
     extra: tuple[tuple[str, Any], ...] = field(default=())
     response: bool = False
 
@@ -336,6 +343,7 @@ class SweepSpec:
             )
         check_bool("lyapunov", self.lyapunov)
         check_bool("orbits", self.orbits)
+        check_bool("verdicts", self.verdicts)
 
     @classmethod
     def build(
@@ -435,10 +443,12 @@ class SweepSpec:
             f"periods = {val(self.solver.periods)}",
             f"rtol = {val(float(self.solver.rtol))}",
             f"atol = {val(float(self.solver.atol))}",
+            f"perturbation = {val(float(self.solver.perturbation))}",
             f"lyapunov = {val(self.lyapunov)}",
             f"observe = {val(list(self.observe))}",
             f"planets = {val(list(self.planets))}",
             *([f"orbits = {val(self.orbits)}"] if self.orbits else []),
+            *([f"verdicts = {val(self.verdicts)}"] if self.verdicts else []),
             *(
                 [
                     f"response = {val(True)}",
@@ -495,9 +505,12 @@ class SweepSpec:
                     atol=d["atol"],
                     samples_per_period=int(d.get("samples_per_period", 1)),
                     settle=d.get("settle", "off"),
+                    # stores written before the perturbed start began exactly at rest
+                    perturbation=float(d.get("perturbation", 0.0)),
                 ),
                 lyapunov=bool(d.get("lyapunov", False)),
                 orbits=bool(d.get("orbits", False)),
+                verdicts=bool(d.get("verdicts", False)),
                 response=bool(d.get("response", False)),
                 extra=tuple(sorted(d.get("extra", {}).items())),
             )

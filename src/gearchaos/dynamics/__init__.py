@@ -1,0 +1,16 @@
+"""What drives the integrator to decide a question about the motion.
+
+:mod:`.verdict` — the one motion verdict (nT confirmed by shooting and Floquet multipliers,
+chaos and quasi-periodicity by a Lyapunov exponent with its error, transients finished by
+extending the run) used by ``simulate``, sweeps, ``classify``, galleries, ``attractors``, the
+explorer, ``response`` and the reproduction report.
+"""
+
+from .verdict import (
+    EVIDENCE,
+    Verdict,
+    VerdictSettings,
+    decide_motion,
+)
+
+__all__ = ["EVIDENCE", "Verdict", "VerdictSettings", "decide_motion"]

@@ -1,0 +1,147 @@
+"""One operating point examined end to end: simulate, the motion verdict, summary.
+
+:func:`analyse_point` is the sequence behind ``gearchaos simulate``, every panel of a Poincaré
+gallery (``gearchaos poincare``, the seed's Figs. 5, 7 and 10) and the explorer's point view:
+resolve the target at the given parameter values, simulate it with the seed's protocol, decide
+the motion (:func:`~gearchaos.dynamics.verdict.decide_motion`: an orbit confirmed by shooting,
+or λ₁ with its error from an extension of the run), and summarise it. When the verdict had to
+extend the run to finish a transient, the simulation is repeated with the transient lengthened
+by the same number of periods, so the record shown is the one the verdict is about.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .._checks import check_bool
+from ..analysis.shooting import section_fraction
+from ..analysis.summary import summarize
+from ..errors import Status
+from ..integrate.result import SimulationResult
+from ..integrate.settings import SIMULATION, SolverSettings
+from ..integrate.simulate import run_simulation
+from ..model.target import resolve
+from .verdict import Verdict, VerdictSettings, decide_motion
+
+__all__ = ["PointAnalysis", "analyse_point", "point_verdict"]
+
+
+@dataclass(frozen=True)
+class PointAnalysis:
+    """What :func:`analyse_point` found at one point.
+
+    Attributes
+    ----------
+    result
+        The simulation (``result.system`` is the resolved system); its transient is the
+        protocol's plus the periods the verdict added.
+    lle
+        Largest Lyapunov exponent λ₁ per unit τ (exact, ln max|μ|/(nT), for a confirmed
+        orbit); ``None`` when not computed.
+    lyapunov_status
+        Status of the run behind λ₁ (``None`` when none ran).
+    summary
+        :func:`~gearchaos.analysis.summary.summarize` of the result with the verdict; its
+        ``motion`` is ``failed`` when the simulation failed.
+    verdict
+        The :class:`~gearchaos.dynamics.verdict.Verdict` (``None`` with ``lyapunov=False``).
+    """
+
+    result: SimulationResult
+    lle: float | None
+    lyapunov_status: Status | None
+    summary: dict[str, Any]
+    verdict: Verdict | None = None
+
+    @property
+    def ok(self) -> bool:
+        return self.result.status.ok
+
+
+def analyse_point(
+    target: Any,
+    values: Mapping[str, Any] | None = None,
+    settings: SolverSettings | None = None,
+    *,
+    lyapunov: bool = True,
+    default_omega: float | None = None,
+    check: bool = False,
+    verdict: VerdictSettings | None = None,
+) -> PointAnalysis:
+    """Simulate ``target`` at ``values`` (dotted names, ``omega`` included), decide the motion,
+    and summarise it.
+
+    Parameters
+    ----------
+    target
+        A :class:`~gearchaos.gearset.GearSet` or a :class:`~gearchaos.model.System`.
+    values
+        Parameter values by dotted name (:func:`~gearchaos.model.target.resolve`).
+    settings
+        Protocol and tolerances (default: :data:`~gearchaos.integrate.settings.SIMULATION`,
+        as :func:`gearchaos.simulate` and ``gearchaos simulate``).
+    lyapunov
+        Decide the motion with the verdict (the default). False labels from the record alone
+        (:func:`~gearchaos.analysis.classify.classify_motion`, no shooting, no λ₁): faster, and
+        the summary says so.
+    default_omega
+        Ω when ``values`` has none (a gear set needs one).
+    check
+        Raise :class:`~gearchaos.errors.IntegrationError` when the simulation fails, instead of
+        returning a result labelled ``failed``.
+    verdict
+        :class:`~gearchaos.dynamics.verdict.VerdictSettings` (budget, tolerances).
+    """
+    cfg = SIMULATION if settings is None else SolverSettings.build(settings)
+    want = check_bool("lyapunov", lyapunov)  # flags checked before any run
+    check = check_bool("check", check)
+    system = resolve(target, values, default_omega=default_omega)
+    result = run_simulation(system, cfg, check=check)
+    if not want or not result.status.ok:
+        summary = summarize(result)
+        if not result.status.ok:
+            summary["motion"] = "failed"
+        return PointAnalysis(result, None, None, summary)
+    v = point_verdict(target, values, result, verdict)
+    if v.record is not None and v.label != "failed":
+        # the record shown is the finished one the verdict is about
+        if v.orbit_state is not None and section_fraction(cfg) == 0.0:
+            # the confirmed orbit: the same protocol started on it (τ = 0 is on its section)
+            result = run_simulation(system, cfg, y0=v.orbit_state, check=check)
+        else:
+            extra = float(v.extra_periods or v.record.states.shape[0])
+            longer = cfg.replace(transient_periods=float(cfg.transient_periods) + extra)
+            result = run_simulation(system, longer, check=check)
+    lle = v.lle if math.isfinite(v.lle) else None
+    summary = summarize(result, verdict=v.to_dict())
+    if not result.status.ok:
+        summary["motion"] = "failed"
+    return PointAnalysis(result, lle, Status.OK, summary, v)
+
+
+def point_verdict(
+    target: Any,
+    values: Mapping[str, Any] | None,
+    result: SimulationResult,
+    verdict: VerdictSettings | None = None,
+) -> Verdict:
+    """The verdict of one simulation result, from its full-state section record."""
+    system = result.system
+    secs = result.states[result.section_index]
+    vals = dict(values or {})
+    vals.setdefault("omega", float(system.omega))
+    return decide_motion(
+        target,
+        [vals],
+        [system],
+        secs[None],
+        np.asarray(result.final_state)[None],
+        [result.status.ok],
+        result.solver,
+        verdict,
+    )[0]

@@ -1,0 +1,648 @@
+"""The motion verdict: one decision procedure for what an attractor is, with its evidence.
+
+A label is a claim about the motion, and the project owns the tools to check it. The verdict
+asks them, for K points at once (a sweep task, or one point):
+
+1. **Candidates from the record.** The recorded section sequence (full states where available)
+   repeats with period n when ‖x_{k+n} − x_k‖ ≤ ``period_rtol``·S + ε for every k, S the
+   attractor's size (largest coordinate range) and ε = ``noise_factor``·(atol + rtol·max|x|)
+   the integration's noise floor; a sequence whose spread is within ε is one point (period 1).
+   A sequence that does not repeat but whose recurrence gaps ‖x_{k+n} − x_k‖ decay
+   geometrically (a transient still converging) gives the candidate n of the fastest decay.
+2. **Confirmation by shooting.** Newton on Pⁿ(y) − y = 0 from the final state
+   (:func:`~gearchaos.analysis.orbit_batch.periodic_orbits`, every point of one n in one batch).
+   The label nT stands when Newton converged, the orbit is the record's (its section points
+   lie within ``same_orbit`` of the final state, or the record was converging), its minimal
+   period d (the label is then dT) and every Floquet multiplier |μ| < 1 − ``margin``. Its
+   λ₁ is then exactly ln max|μ| / (dT). An orbit found unstable is never labelled: the run is
+   continued from the final state pushed along the unstable eigenvector.
+3. **Extension with a Lyapunov exponent.** Every point not yet decided is integrated further,
+   ``extension_periods`` at a time, with one tangent vector from a seeded random start; λ₁
+   and its standard error σ come from block means
+   (:func:`~gearchaos.analysis.lyapunov.exponent_estimate`). The new record goes back to
+   step 1 (a transient may now have finished). Without a confirmed period:
+   ``chaos`` when λ₁ − cσ > 0 and λ₁ > θ; ``QP`` when λ₁ + cσ ≥ 0 and λ₁ ≤ θ (no
+   contraction, no growth beyond a regular attractor's finite-time bias θ = c_θ/t, t the
+   extension's duration, :func:`~gearchaos.analysis.classify.lle_threshold_for`); a
+   contracting exponent (λ₁ + cσ < 0) or an interval across θ is extended again, within
+   ``budget_periods``. A candidate period n > ``max_period`` (too long to shoot) is labelled
+   nT when the record repeats and λ₁ + cσ < 0 (a contracting periodic attractor).
+4. **Unresolved, with its reason**, when the budget is spent: contracting without a period
+   found, an interval that straddles θ, or an unstable orbit the motion did not leave.
+
+Every :class:`Verdict` carries the label, the evidence code (:data:`EVIDENCE`), max |μ| of the
+orbit shot (confirmed or unstable), λ₁ ± σ, the periods integrated, the 0–1 test value where
+computed, and a sentence saying why. The extension's record replaces the original one where
+it was used (``Verdict.record``), so a label is never shown beside the unfinished transient
+that preceded it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .._checks import check_int, check_real
+from ..analysis.chaos01 import MIN_LENGTH as MIN_LENGTH_01
+from ..analysis.chaos01 import chaos01
+from ..analysis.classify import LLE_C
+from ..analysis.lyapunov import LYAPUNOV_BLOCKS, exponent_estimate, random_tangents
+from ..analysis.periodicity import periods_of
+from ..analysis.shooting import section_fraction
+from ..errors import ParameterError
+from ..integrate._chains import ChainRun, run_chains
+from ..integrate.settings import SampleTimes, SolverSettings
+from ..model.system import System
+
+__all__ = ["EVIDENCE", "Verdict", "VerdictRecord", "VerdictSettings", "decide_motion"]
+
+#: What decided a label (the flag values of a store's ``verdict`` variable).
+EVIDENCE = {
+    "not_computed": -1,
+    "floquet": 0,  # nT: a converged, stable orbit of minimal period n (multipliers)
+    "lyapunov": 1,  # chaos or QP: the λ₁ interval, no period found or confirmed
+    "record_contracting": 2,  # nT, n too long to shoot: the record repeats, λ₁ < 0
+    "contracting": 3,  # unresolved: λ₁ < 0 but no period found within the budget
+    "ambiguous": 4,  # unresolved: the λ₁ interval straddles the threshold
+    "unstable_orbit": 5,  # unresolved: near an unstable orbit, not left within the budget
+    "failed": 6,  # the integration failed
+}
+
+
+@dataclass(frozen=True)
+class VerdictSettings:
+    """Tolerances and budget of :func:`decide_motion`.
+
+    Parameters
+    ----------
+    max_period
+        Longest period confirmed by shooting (Newton with the full monodromy over n periods).
+    longest_period
+        Longest period recognised in a record at all.
+    period_rtol
+        Recurrence tolerance relative to the attractor's size S.
+    noise_factor
+        The noise floor ε = noise_factor · (atol + rtol · max|x|) of the section points.
+    margin
+        Stability margin: confirmed orbits have every |μ| < 1 − margin.
+    same_orbit
+        Largest distance (∞-norm, relative to max(1, ‖y*‖)) between the final state and the
+        orbit's section points for the orbit to be the record's.
+    approach
+        A record whose recurrence gaps over its last quarter stay within this fraction of
+        max(1, max|x|) lingers near a periodic orbit: it is shot, and the orbit confirmed when
+        stable and the record comes closer to it.
+    extension_periods
+        Periods per extension (None: the record's length, at least 2·blocks + 1).
+    budget_periods
+        Most periods added to a point by extensions.
+    blocks, confidence
+        Block means of the λ₁ error estimate, and the half-width c of its interval in
+        standard errors.
+    lle_c
+        c_θ of the finite-time bias bound θ = c_θ / t.
+    seed
+        Seed of the random initial tangent vectors.
+    """
+
+    max_period: int = 8
+    longest_period: int = 64
+    period_rtol: float = 1e-3
+    noise_factor: float = 1e3
+    margin: float = 1e-4
+    same_orbit: float = 1e-2
+    approach: float = 2e-2
+    extension_periods: int | None = None
+    budget_periods: int = 400
+    blocks: int = LYAPUNOV_BLOCKS
+    confidence: float = 2.0
+    lle_c: float = LLE_C
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        check_int("max_period", self.max_period, lo=1, hi=64)
+        check_int("longest_period", self.longest_period, lo=self.max_period, hi=10_000)
+        check_real("period_rtol", self.period_rtol, lo=0.0, hi=0.5, lo_open=True)
+        check_real("noise_factor", self.noise_factor, lo=1.0)
+        check_real("margin", self.margin, lo=0.0, hi=0.5)
+        check_real("same_orbit", self.same_orbit, lo=0.0, hi=1.0, lo_open=True)
+        check_real("approach", self.approach, lo=0.0, hi=1.0)
+        if self.extension_periods is not None:
+            check_int("extension_periods", self.extension_periods, lo=2 * self.blocks + 1)
+        check_int("budget_periods", self.budget_periods, lo=0, hi=10**7)
+        check_int("blocks", self.blocks, lo=2, hi=1000)
+        check_real("confidence", self.confidence, lo=0.0, lo_open=True)
+        check_real("lle_c", self.lle_c, lo=0.0, lo_open=True)
+        check_int("seed", self.seed, lo=0)
+
+    def extension_for(self, record_periods: int) -> int:
+        """Periods of one extension of a record of ``record_periods``."""
+        if self.extension_periods is not None:
+            return int(self.extension_periods)
+        return max(int(record_periods), 2 * self.blocks + 1)
+
+
+@dataclass(frozen=True, eq=False)
+class VerdictRecord:
+    """The section record of an extension that replaced the original one: ``states``
+    (m, n_state) and ``observables`` (m, n_obs) at the section, and ``final_state``."""
+
+    states: np.ndarray
+    observables: np.ndarray
+    final_state: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class Verdict:
+    """What the motion is at one point, and what decided it.
+
+    Attributes
+    ----------
+    label
+        ``1T`` … ``nT``, ``QP``, ``chaos``, ``unresolved`` or ``failed``.
+    period
+        n of an nT label, else 0.
+    evidence
+        Key of :data:`EVIDENCE`.
+    max_multiplier
+        max |μ| of the orbit that confirmed the label, or of the unstable orbit found near
+        the record (NaN when none was shot).
+    lle, lle_error
+        λ₁ per unit τ and its standard error: exactly ln max|μ| / (nT) with error 0 for a
+        confirmed orbit; from the last extension otherwise (NaN when none ran).
+    k01
+        0–1 test value of the record where computed (non-periodic labels), else NaN.
+    extra_periods
+        Periods integrated beyond the original record (extensions).
+    reason
+        One sentence: why this label.
+    record
+        The record that replaced the original one, else None: the extension's, or, when the
+        original record was still converging onto the confirmed orbit, the orbit's own
+        (integrated from its state for as many periods).
+    orbit_state
+        The confirmed orbit's state on the section (``floquet`` only).
+    """
+
+    label: str
+    period: int
+    evidence: str
+    max_multiplier: float = math.nan
+    lle: float = math.nan
+    lle_error: float = math.nan
+    k01: float = math.nan
+    extra_periods: int = 0
+    reason: str = ""
+    record: VerdictRecord | None = field(default=None, repr=False)
+    orbit_state: np.ndarray | None = field(default=None, repr=False)
+
+    @property
+    def code(self) -> int:
+        """The :data:`EVIDENCE` flag value."""
+        return EVIDENCE[self.evidence]
+
+    @property
+    def periodic(self) -> bool:
+        return self.period > 0
+
+    def lle_text(self) -> str:
+        """λ₁ with its error as printed next to the label (``exact`` for Floquet)."""
+        from ..analysis.lyapunov import format_exponent
+
+        if not math.isfinite(self.lle):
+            return "—"
+        if self.evidence == "floquet":
+            return f"{self.lle:.4g} (= ln|μ|/nT)"
+        return format_exponent(self.lle, self.lle_error)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready fields (NaN → None)."""
+
+        def num(v: float) -> float | None:
+            return float(v) if math.isfinite(v) else None
+
+        return {
+            "motion": self.label,
+            "period": int(self.period),
+            "evidence": self.evidence,
+            "max_multiplier": num(self.max_multiplier),
+            "lle": num(self.lle),
+            "lle_error": num(self.lle_error),
+            "k01": num(self.k01),
+            "extra_periods": int(self.extra_periods),
+            "reason": self.reason,
+        }
+
+
+# ----------------------------------------------------------------------------- the record
+def _noise_floor(sections: np.ndarray, settings: SolverSettings, factor: float) -> np.ndarray:
+    """ε per point: factor · (atol + rtol · max|x|) of its section sequence."""
+    with np.errstate(invalid="ignore"):
+        mag = np.nanmax(np.abs(sections), axis=(1, 2))
+    mag = np.where(np.isfinite(mag), mag, 0.0)
+    return factor * (float(settings.atol) + float(settings.rtol) * mag)
+
+
+def _converging(x: np.ndarray, max_n: int) -> int:
+    """The n ≤ max_n whose recurrence gaps g_k = ‖x_{k+n} − x_k‖ decay geometrically over
+    the second half of the record (a least-squares line through ln g_k falling by more than
+    four times its residual scatter and by at least 20 % overall), fastest first; 0: none."""
+    m = x.shape[0]
+    best, best_slope = 0, 0.0
+    for n in range(1, max_n + 1):
+        if m - n < 16:
+            break
+        g = np.sqrt(np.sum((x[n:] - x[:-n]) ** 2, axis=1))
+        h = g[(m - n) // 2 :]
+        if h.size < 8 or not np.all(h > 0) or not np.all(np.isfinite(h)):
+            continue
+        k = np.arange(h.size, dtype=float)
+        y = np.log(h)
+        slope, icpt = np.polyfit(k, y, 1)
+        scatter = float(np.std(y - (slope * k + icpt)))
+        drop = -slope * (h.size - 1)
+        if slope < 0 and drop > max(4.0 * scatter, math.log(1.25)) and slope < best_slope:
+            best, best_slope = n, float(slope)
+    return best
+
+
+def _near_periodic(x: np.ndarray, max_n: int, reach: float) -> int:
+    """The n ≤ max_n with the smallest median recurrence gap over the last quarter of the
+    record, when that gap is at most ``reach`` · max(1, max|x|) (the record lingers near a
+    period-n orbit, as a slowly spiralling transient does); 0: none."""
+    m = x.shape[0]
+    scale = max(1.0, float(np.max(np.abs(x))))
+    gaps = []
+    for n in range(1, max_n + 1):
+        if m - n < 8:
+            break
+        g = np.max(np.abs(x[n:] - x[:-n]), axis=1)
+        gaps.append(float(np.median(g[3 * (m - n) // 4 :])))
+    if not gaps or min(gaps) > reach * scale:
+        return 0
+    # the shortest period within twice the best gap (a multiple of the period repeats too)
+    return next(n for n, g in enumerate(gaps, start=1) if g <= 2.0 * min(gaps))
+
+
+def _distance_to_orbit(y: np.ndarray, sections: np.ndarray) -> np.ndarray:
+    """∞-norm distance of the state(s) y (…, n) from the nearest section point of an orbit."""
+    y = np.asarray(y)
+    d = np.max(np.abs(y[..., None, :] - sections), axis=-1)
+    return np.min(d, axis=-1)
+
+
+def _approaches(record: np.ndarray, sections: np.ndarray) -> bool:
+    """Whether a full-state record comes closer to an orbit: the median distance over its
+    second half is below that over its first half."""
+    d = _distance_to_orbit(record, sections)
+    h = d.size // 2
+    return bool(h >= 4 and np.median(d[h:]) < np.median(d[:h]))
+
+
+# ----------------------------------------------------------------------------- extension
+def _extend(
+    systems: Sequence[System],
+    states: np.ndarray,
+    settings: SolverSettings,
+    periods: int,
+    seed: int,
+) -> Any:
+    """Integrate K states (at the section of ``settings``) ``periods`` further with one
+    random tangent vector; samples at the next ``periods`` section times."""
+    ref = systems[0]
+    K, n = len(systems), ref.n_state
+    T = np.array([s.period for s in systems])
+    t0 = (section_fraction(settings) * T)[:, None]
+    times = SampleTimes(
+        t_rec=t0 + T[:, None],
+        dt=T[:, None].copy(),
+        n_samples=int(periods),
+        t_end=t0 + periods * T[:, None],
+        max_steps=int(100_000 + 50_000 * periods),
+    )
+    run = ChainRun.from_arrays(
+        ref,
+        np.array([s.params for s in systems])[:, None, :],
+        np.array([s.switch_widths for s in systems])[:, None, :],
+        t0,
+        times,
+        settings,
+        y0=states,
+        n_tangent=1,
+        tangent_start=random_tangents(n, 1, seed=seed, points=K),
+    )
+    return run_chains(run)
+
+
+# ----------------------------------------------------------------------------- decision
+@dataclass
+class _Point:
+    """Working state of one undecided point."""
+
+    sections: np.ndarray
+    final: np.ndarray
+    extra: int = 0
+    lle: float = math.nan
+    err: float = math.nan
+    theta: float = math.nan
+    unstable: tuple[int, float, np.ndarray] | None = None
+    record: VerdictRecord | None = None
+    long_period: int = 0
+
+
+def _shoot_candidates(
+    target: Any,
+    values: Sequence[Mapping[str, Any]],
+    pts: dict[int, _Point],
+    cands: dict[int, tuple[int, bool]],
+    settings: SolverSettings,
+    vs: VerdictSettings,
+    done: dict[int, Verdict],
+    systems: Sequence[System],
+) -> None:
+    """Shoot the candidates {point: (n, how)}, ``how`` ``repeat`` (the record repeats: the
+    orbit must be the record's) or ``approach`` (the record converges or lingers near an
+    orbit: a full-state record must come closer to it); decide the confirmed ones in
+    ``done``, and note an unstable orbit the record sits on."""
+    from ..analysis.orbit_batch import periodic_orbits
+
+    finish: list[int] = []  # confirmed while the record was converging: show the orbit
+    for n in sorted({c[0] for c in cands.values()}):
+        idx = [k for k, c in cands.items() if c[0] == n]
+        orbits = periodic_orbits(
+            target,
+            [values[k] for k in idx],
+            period=n,
+            guesses=np.array([pts[k].final for k in idx]),
+            settings=settings,
+            max_iterations=8,
+        )
+        for k, orb in zip(idx, orbits, strict=True):
+            p = pts[k]
+            if not orb.converged or not np.isfinite(orb.max_multiplier):
+                continue
+            d = orb.minimal_period
+            mu_n = float(orb.max_multiplier)  # of Pⁿ: the d-periodic orbit's to the power n/d
+            mu = mu_n ** (d / n)
+            secs = orb.sections
+            scale = max(1.0, float(np.max(np.abs(orb.state))))
+            near = float(_distance_to_orbit(p.final, secs)) <= vs.same_orbit * scale
+            repeat = cands[k][1] == "repeat"
+            if repeat:
+                follows = near
+            elif p.sections.shape[1] == secs.shape[1]:
+                follows = _approaches(p.sections, secs)
+            else:  # a projected record: its recurrence gaps decayed (the trend test)
+                follows = True
+            if mu < 1.0 - vs.margin and follows:
+                T = systems[k].period
+                how = (
+                    "the record repeats with this period"
+                    if repeat
+                    else "the record was still converging onto it"
+                )
+                done[k] = Verdict(
+                    label=f"{d}T",
+                    period=d,
+                    evidence="floquet",
+                    max_multiplier=mu,
+                    lle=math.log(mu) / (d * T),
+                    lle_error=0.0,
+                    extra_periods=p.extra,
+                    reason=(
+                        f"a period-{d} orbit converged by shooting, every Floquet multiplier "
+                        f"|μ| ≤ {mu:.6g} < 1; {how}"
+                    ),
+                    record=p.record,
+                    orbit_state=orb.state.copy(),
+                )
+                if not repeat:
+                    finish.append(k)
+            elif mu >= 1.0 - vs.margin and near and repeat:
+                w, v = np.linalg.eig(orb.monodromy)
+                vec = np.real(v[:, int(np.argmax(np.abs(w)))])
+                p.unstable = (d, mu, vec / max(float(np.max(np.abs(vec))), 1e-300))
+    if finish:
+        n_state = systems[0].n_state
+        m = max(pts[k].sections.shape[0] for k in finish)
+        ys = np.array([done[k].orbit_state for k in finish])
+        out = _extend([systems[k] for k in finish], ys, settings, max(m, 2), vs.seed)
+        for i, k in enumerate(finish):
+            if int(out.status[i, 0]) != 0:
+                continue
+            states = out.states[i, 0, :, :n_state].copy()
+            rec = VerdictRecord(states, out.observables[i, 0].copy(), states[-1].copy())
+            done[k] = dataclasses.replace(done[k], record=rec)
+
+
+def _decide_by_exponent(k: int, p: _Point, vs: VerdictSettings, last: bool) -> Verdict | None:
+    """The λ₁ rules for a point with no confirmed period (None: extend again)."""
+    lam, err, theta, c = p.lle, p.err, p.theta, vs.confidence
+    if not math.isfinite(lam) or not math.isfinite(err):
+        return None
+    lo, hi = lam - c * err, lam + c * err
+    text = f"λ₁ = {lam:.4g} ± {err:.2g} (θ = {theta:.3g})"
+    k01 = math.nan
+    if p.sections.shape[0] >= MIN_LENGTH_01:
+        k01 = chaos01(p.sections[:, :2])
+    common = {
+        "lle": lam,
+        "lle_error": err,
+        "k01": k01,
+        "extra_periods": p.extra,
+        "record": p.record,
+    }
+    if p.long_period and hi < 0:
+        n = p.long_period
+        return Verdict(
+            label=f"{n}T",
+            period=n,
+            evidence="record_contracting",
+            reason=f"the record repeats with period {n} (too long to shoot) and {text} < 0",
+            **common,
+        )
+    if lo > 0 and lam > theta:
+        return Verdict(
+            label="chaos",
+            period=0,
+            evidence="lyapunov",
+            reason=f"no period ≤ {vs.longest_period} confirmed; {text}: λ₁ − {c:g}σ > 0 and λ₁ > θ",
+            **common,
+        )
+    if hi >= 0 and lam <= theta and p.unstable is None:
+        return Verdict(
+            label="QP",
+            period=0,
+            evidence="lyapunov",
+            reason=(
+                f"no period ≤ {vs.longest_period} and no converging orbit; {text}: "
+                f"λ₁ + {c:g}σ ≥ 0 and λ₁ ≤ θ (no contraction, no growth beyond a regular "
+                "attractor's finite-time bias)"
+            ),
+            **common,
+        )
+    if not last:
+        return None
+    if p.unstable is not None:
+        d, mu, _ = p.unstable
+        return Verdict(
+            label="unresolved",
+            period=0,
+            evidence="unstable_orbit",
+            max_multiplier=mu,
+            reason=(
+                f"the motion stays near an unstable period-{d} orbit (max |μ| = {mu:.6g}) "
+                f"and was not decided within {p.extra} further periods; {text}"
+            ),
+            **common,
+        )
+    if hi < 0:
+        return Verdict(
+            label="unresolved",
+            period=0,
+            evidence="contracting",
+            reason=(
+                f"{text} < 0: a contracting (periodic) attractor, but no period "
+                f"≤ {vs.longest_period} was found or confirmed within {p.extra} further periods"
+            ),
+            **common,
+        )
+    return Verdict(
+        label="unresolved",
+        period=0,
+        evidence="ambiguous",
+        reason=f"{text}: the interval straddles θ after {p.extra} further periods",
+        **common,
+    )
+
+
+def decide_motion(
+    target: Any,
+    values: Sequence[Mapping[str, Any]],
+    systems: Sequence[System],
+    sections: np.ndarray,
+    final_states: np.ndarray,
+    ok: Sequence[bool] | np.ndarray,
+    settings: SolverSettings,
+    verdict: VerdictSettings | None = None,
+) -> list[Verdict]:
+    """The motion verdict of K points (see the module docstring).
+
+    Parameters
+    ----------
+    target, values, systems
+        The gear set or system, each point's parameter values by name, and its resolved
+        :class:`~gearchaos.model.System` (one kind and layout).
+    sections
+        (K, m, d) the recorded section sequence of every point (full states preferably;
+        any d ≥ 1 columns).
+    final_states
+        (K, n_state) the state at the end of the record, on the section of ``settings``.
+    ok
+        (K,) whether each integration succeeded (a failed point is labelled ``failed``).
+    settings
+        The solver settings of the record (tolerances, section).
+    verdict
+        :class:`VerdictSettings` (default: the defaults).
+
+    Returns
+    -------
+    list of Verdict
+        One per point, in order.
+    """
+    vs = VerdictSettings() if verdict is None else verdict
+    if not isinstance(vs, VerdictSettings):
+        raise ParameterError(f"verdict must be a VerdictSettings: got {type(vs).__name__}")
+    K = len(systems)
+    sec = np.asarray(sections, dtype=np.float64)
+    if sec.ndim != 3 or sec.shape[0] != K:
+        raise ParameterError(f"sections must have shape ({K}, m, d): got {sec.shape}")
+    fin = np.asarray(final_states, dtype=np.float64).reshape(K, -1)
+    okv = np.asarray(ok, dtype=bool).reshape(K)
+    done: dict[int, Verdict] = {}
+    pts: dict[int, _Point] = {}
+    for k in range(K):
+        if not okv[k] or not np.all(np.isfinite(fin[k])) or not np.all(np.isfinite(sec[k])):
+            done[k] = Verdict("failed", 0, "failed", reason="the integration failed")
+        else:
+            pts[k] = _Point(sections=sec[k], final=fin[k].copy())
+    ext_periods = vs.extension_for(sec.shape[1])
+    rounds = vs.budget_periods // ext_periods
+    for r in range(rounds + 1):
+        live = [k for k in pts if k not in done]
+        if not live:
+            break
+        # 1. candidates: a repeating record, else a converging one
+        cands: dict[int, tuple[int, bool]] = {}
+        for k in live:
+            p = pts[k]
+            floor = _noise_floor(p.sections[None], settings, vs.noise_factor)
+            n = int(
+                periods_of(
+                    p.sections[None],
+                    max_period=vs.longest_period,
+                    rtol=vs.period_rtol,
+                    atol=float(floor[0]),
+                    floor=floor,
+                )[0]
+            )
+            p.long_period = n if n > vs.max_period else 0
+            if 1 <= n <= vs.max_period:
+                cands[k] = (n, "repeat")
+            elif n == 0:
+                nc = _converging(p.sections, vs.max_period) or _near_periodic(
+                    p.sections, vs.max_period, vs.approach
+                )
+                if nc:
+                    cands[k] = (nc, "approach")
+        for k in live:
+            pts[k].unstable = None
+        if cands:
+            _shoot_candidates(target, values, pts, cands, settings, vs, done, systems)
+        # 2. the exponent of the last extension decides the rest, or they are extended
+        last = r == rounds
+        for k in [k for k in live if k not in done]:
+            if r > 0:
+                v = _decide_by_exponent(k, pts[k], vs, last)
+                if v is not None:
+                    done[k] = v
+        todo = [k for k in live if k not in done]
+        if last or not todo:
+            break
+        starts = []
+        for k in todo:
+            p = pts[k]
+            y = p.final.copy()
+            if p.unstable is not None:  # leave the unstable orbit along its eigenvector
+                y = y + 1e-3 * max(1.0, float(np.max(np.abs(y)))) * p.unstable[2]
+            starts.append(y)
+        out = _extend(
+            [systems[k] for k in todo], np.array(starts), settings, ext_periods, vs.seed + r
+        )
+        n_state = systems[0].n_state
+        stretch = out.stretch(n_state)
+        for i, k in enumerate(todo):
+            p = pts[k]
+            p.extra += ext_periods
+            if int(out.status[i, 0]) != 0:
+                done[k] = Verdict(
+                    "failed",
+                    0,
+                    "failed",
+                    extra_periods=p.extra,
+                    reason="the integration failed while the run was extended",
+                )
+                continue
+            T = systems[k].period
+            p.lle, p.err = exponent_estimate(stretch[i, 0], T, blocks=vs.blocks)
+            p.theta = vs.lle_c / ((ext_periods - 1) * T)
+            states = out.states[i, 0, :, :n_state].copy()
+            p.sections = states
+            p.final = out.final_state[i, 0, :n_state].copy()
+            p.record = VerdictRecord(states, out.observables[i, 0].copy(), p.final.copy())
+    return [done[k] for k in range(K)]
