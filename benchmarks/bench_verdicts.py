@@ -77,9 +77,7 @@ def main() -> None:
         exe = os.path.join(os.path.dirname(sys.executable), "gearchaos")
         with tempfile.TemporaryDirectory() as d:
             t = time.perf_counter()
-            subprocess.run(
-                [exe, "reproduce", "--all", "-o", d], check=True, capture_output=True
-            )
+            subprocess.run([exe, "reproduce", "--all", "-o", d], check=True, capture_output=True)
             print(f"\ngearchaos reproduce --all: {time.perf_counter() - t:.0f} s (goal ≤ 180 s)")
 
 

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import gearchaos as gc
-from gearchaos.analysis import periodic_orbit
+from gearchaos.analysis import periodic_orbit, periodic_orbits
 from gearchaos.analysis.lyapunov import exponent_estimate, lyapunov_spectrum
 from gearchaos.dynamics import VerdictSettings, decide_motion
 from gearchaos.dynamics.point import analyse_point, point_verdict
@@ -23,7 +23,8 @@ from gearchaos.integrate.simulate import integrate
 from gearchaos.model.target import resolve
 
 GS = gc.preset("sheng2016")
-SEED = SolverSettings(transient_periods=100, periods=100)
+#: the seed's 100 + 100 periods from rest perturbed by 1e-6 (the verdict's protocol)
+SEED = SolverSettings(transient_periods=100, periods=100, perturbation=1e-6)
 
 
 def _verdict(omega: float, settings: SolverSettings = SEED):
@@ -45,7 +46,7 @@ def _verdict(omega: float, settings: SolverSettings = SEED):
 
 def test_lorenz_exponent_from_the_default_start() -> None:
     # the origin is an equilibrium: the perturbed default start leaves it
-    r = lyapunov_spectrum(gc.lorenz(), n_exponents=1)
+    r = lyapunov_spectrum(gc.lorenz(), n_exponents=1, perturbation=1e-6)
     assert abs(r.largest - 0.9056) <= 0.01 * 0.9056
     assert 0 < r.largest_error < 0.05
 
@@ -97,7 +98,9 @@ def test_unstable_orbit_on_the_symmetric_manifold_is_not_an_attractor() -> None:
     system = resolve(GS, {"omega": 3.45})
     tr = integrate(system, exact)
     assert np.max(np.abs(tr.states[:, 0])) < 1e-10  # sun centred: on the manifold
-    ref = periodic_orbit(GS, omega=3.45, period=2, y0=tr.final_state)
+    ref = periodic_orbits(
+        GS, [{"omega": 3.45}], period=2, guesses=tr.final_state[None], settings=exact
+    )[0]
     assert ref.converged and ref.max_multiplier > 1
     v = decide_motion(
         GS, [{"omega": 3.45}], [system], tr.states[None], tr.final_state[None], [True], exact
@@ -114,10 +117,6 @@ def test_no_unstable_orbit_is_labelled_periodic_over_a_range() -> None:
         v, _ = _verdict(float(omega))
         if v.period:
             assert v.max_multiplier < 1
-            ref = periodic_orbit(GS, omega=float(omega), period=v.period, y0=None)
-            if ref.converged and ref.minimal_period == v.period:
-                # the same orbit's multipliers, found from another start
-                pass
         else:
             assert v.label in ("QP", "chaos", "unresolved")
             assert v.reason
@@ -127,7 +126,7 @@ def test_point_and_sweep_agree_and_invariants_hold() -> None:
     from gearchaos import sweep
     from gearchaos.analysis.periodicity import periods_of
 
-    ds = sweep.bifurcation(GS, "omega=0.05:4:101", progress=False)
+    ds = sweep.bifurcation(GS, "omega=0.05:4:101", progress=False, verdicts=True, perturbation=1e-6)
     labels = ds.motion.values
     n_per = 0
     for i, lab in enumerate(labels):
@@ -140,11 +139,9 @@ def test_point_and_sweep_agree_and_invariants_hold() -> None:
             assert mu < 1
             T = 2 * math.pi / float(ds.omega.values[i])
             assert float(ds.lle.values[i]) == pytest.approx(math.log(mu) / (n * T), abs=1e-6)
-            pts = np.stack(
-                [ds.delta_sp.values[i, :, 0], ds.delta_sp_dot.values[i, :, 0]], axis=-1
-            )
+            pts = np.stack([ds.delta_sp.values[i, :, 0], ds.delta_sp_dot.values[i, :, 0]], axis=-1)
             found = int(periods_of(pts[None], rtol=1e-3, atol=1e-4)[0])
-            assert found and n % found == 0 or found == n, (lab, found)
+            assert (found and n % found == 0) or found == n, (lab, found)
         else:
             assert float(ds.verdict.values[i]) != 0
             assert str(lab) != "unresolved" or int(ds.verdict.values[i]) in (2, 3, 4, 5)
@@ -154,7 +151,7 @@ def test_point_and_sweep_agree_and_invariants_hold() -> None:
     # the same points through the single-point door
     for i in (10, 40, 70, 95):
         omega = float(ds.omega.values[i])
-        pa = analyse_point(GS, {"omega": omega}, SEED)
+        pa = analyse_point(GS, {"omega": omega}, SEED, verdict=VerdictSettings())
         assert pa.summary["motion"] == str(labels[i]), omega
 
 
@@ -166,6 +163,6 @@ def test_verdict_settings_are_checked() -> None:
 
 
 def test_point_verdict_of_a_result() -> None:
-    res = gc.simulate(GS, omega=3.5, transient_periods=100, periods=100)
+    res = gc.simulate(GS, omega=3.5, transient_periods=100, periods=100, perturbation=1e-6)
     v = point_verdict(GS, {"omega": 3.5}, res)
     assert v.label == "2T"

@@ -58,7 +58,7 @@ def invalid_setting(name: str) -> st.SearchStrategy[Any]:
     transient_periods a number in [0, 1e9]; periods an integer in [1, 1e9];
     samples_per_period an integer in [1, 1e6]; section_phase a finite number; rtol a number in
     [1e-14, 1]; atol a number in (0, 1]; max_steps an integer in [1, 2^62] (or None); settle
-    "off" or "auto"."""
+    "off" or "auto"; perturbation a number in [0, 1e-2]."""
     real = st.one_of(NOT_NUMBERS, NON_FINITE)
     if name == "transient_periods":
         return st.one_of(real, reals_outside(0.0, 1e9))
@@ -79,6 +79,8 @@ def invalid_setting(name: str) -> st.SearchStrategy[Any]:
             st.text(max_size=6).filter(lambda v: v not in ("off", "auto")),
             st.sampled_from(["OFF", "Auto", " auto", True, 1]),
         )
+    if name == "perturbation":
+        return st.one_of(real, reals_outside(0.0, 1e-2))
     assert name == "max_steps"
     return st.one_of(not_integers(), ints_outside(1, 2**62))
 

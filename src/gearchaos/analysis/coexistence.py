@@ -193,6 +193,7 @@ def attractors(
         λ₁ (> 0 for chaos, < 0 for a stable orbit: ln max|μ| / nT).
     """
     from .classify import classify_sections
+    from .lyapunov import random_tangents
     from .orbit_batch import periodic_orbits
 
     k = check_int("starts", starts, lo=1, hi=10_000)
@@ -203,7 +204,9 @@ def attractors(
     cfg = cfg.replace(samples_per_period=1)
     system = resolve(target, values)
     y0 = _starts(system, cfg, k, seed)
-    run = ChainRun.from_systems([[system]] * k, cfg, y0=y0, n_tangent=1)
+    run = ChainRun.from_systems(
+        [[system]] * k, cfg, y0=y0, n_tangent=1, tangent_start=random_tangents(system.n_state)
+    )
     out = run_chains(run)
     lle = out.lyapunov(run.dt)[:, 0, 0]
     m = system.n_state

@@ -127,7 +127,7 @@ def lyapunov_spectrum(
     n_exponents: int | None = None,
     renormalizations_per_period: int = 1,
     y0: np.ndarray | None = None,
-    seed: int = TANGENT_SEED,
+    seed: int | None = TANGENT_SEED,
     **solver: Any,
 ) -> LyapunovResult:
     """The ``n_exponents`` largest Lyapunov exponents (all by default) of ``system``.
@@ -149,7 +149,8 @@ def lyapunov_spectrum(
         Initial state (default: the perturbed rest state of the settings).
     seed
         Seed of the random initial tangent vectors (:func:`random_tangents`), orthonormalised
-        when the recording starts.
+        when the recording starts; None starts them as the first basis vectors (for
+        comparison with a tangent map computed from the identity).
 
     Returns
     -------
@@ -176,7 +177,11 @@ def lyapunov_spectrum(
     if cfg.n_samples < 2:
         raise ParameterError("periods × renormalizations_per_period must be >= 2")
     traj = integrate(
-        system, cfg, y0=y0, n_tangent=k, tangent_start=random_tangents(n, k, seed=seed)
+        system,
+        cfg,
+        y0=y0,
+        n_tangent=k,
+        tangent_start=None if seed is None else random_tangents(n, k, seed=seed),
     )
     ns = cfg.n_samples
     dt = system.period / renormalizations_per_period

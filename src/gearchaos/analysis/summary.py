@@ -232,6 +232,8 @@ def format_summary(summary: dict[str, Any], *, title: str | None = None) -> Any:
                 value = f"{value:.4g} (exact)" if err == 0 else f"{value:.4g} ± {err:.2g}"
             if key in ("max_multiplier", "extra_periods") and not value:
                 continue
+            if key in ("evidence", "lle") and summary.get("evidence", "record") == "record":
+                continue
             table.add_row(escape(label), escape(_fmt(value)))
     style = {"none": "green", "single_sided": "yellow", "double_sided": "red"}
     for c in summary.get("contact", []):

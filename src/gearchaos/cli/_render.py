@@ -221,15 +221,19 @@ def regime_table(table: Mapping[str, Mapping[str, float]], *, title: str | None)
 def add_motion_rows(table: Table, summary: Mapping[str, Any]) -> None:
     """The evidence behind a summary's motion label as rows of its table (λ₁ and the
     multiplier are rows of :func:`~gearchaos.analysis.summary.format_summary`)."""
+    lle = summary.get("lle")
     k01 = summary.get("k01")
-    if k01 is not None:
-        table.add_row("0–1 test K", f"{k01:.3f}")
+    if summary.get("evidence", "record") == "record":
+        table.add_row("largest Lyapunov exponent λ₁", "—" if lle is None else f"{lle:.4g}")
+    table.add_row("0–1 test K", "—" if k01 is None else f"{k01:.3f}")
     agree = summary.get("indicators_agree")
-    if agree is False:
-        table.add_row("indicators agree", Text("no", style="bold red"))
+    if agree is not None:
+        table.add_row(
+            "indicators agree", Text("yes" if agree else "no", style="" if agree else "bold red")
+        )
     note = summary.get("motion_note")
     if note:
-        table.add_row("why", escape(str(note)))
+        table.add_row("motion note", escape(str(note)))
 
 
 def gallery_rows_table(rows: Sequence[Mapping[str, Any]], param: str, *, title: str) -> Table:

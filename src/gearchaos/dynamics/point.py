@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from .._checks import check_bool
+from ..analysis.lyapunov import lyapunov_spectrum
 from ..analysis.shooting import section_fraction
 from ..analysis.summary import summarize
 from ..errors import Status
@@ -86,27 +87,35 @@ def analyse_point(
         Protocol and tolerances (default: :data:`~gearchaos.integrate.settings.SIMULATION`,
         as :func:`gearchaos.simulate` and ``gearchaos simulate``).
     lyapunov
-        Decide the motion with the verdict (the default). False labels from the record alone
-        (:func:`~gearchaos.analysis.classify.classify_motion`, no shooting, no λ₁): faster, and
-        the summary says so.
+        Without ``verdict``: also compute λ₁ (seeded random tangent vector) for the
+        record-based label (:func:`~gearchaos.analysis.classify.classify_motion`).
     default_omega
         Ω when ``values`` has none (a gear set needs one).
     check
         Raise :class:`~gearchaos.errors.IntegrationError` when the simulation fails, instead of
         returning a result labelled ``failed``.
     verdict
-        :class:`~gearchaos.dynamics.verdict.VerdictSettings` (budget, tolerances).
+        :class:`~gearchaos.dynamics.verdict.VerdictSettings`: decide the motion with the
+        verdict (shooting and Floquet multipliers, λ₁ ± its error, transients finished) with
+        these tolerances and budget; None labels from the record.
     """
     cfg = SIMULATION if settings is None else SolverSettings.build(settings)
     want = check_bool("lyapunov", lyapunov)  # flags checked before any run
     check = check_bool("check", check)
     system = resolve(target, values, default_omega=default_omega)
     result = run_simulation(system, cfg, check=check)
-    if not want or not result.status.ok:
-        summary = summarize(result)
+    if verdict is None or not result.status.ok:
+        lle: float | None = None
+        lstatus: Status | None = None
+        if want and result.status.ok:
+            lr = lyapunov_spectrum(system, cfg.replace(samples_per_period=1), n_exponents=1)
+            lstatus = lr.status
+            if lr.status.ok and math.isfinite(lr.largest):
+                lle = float(lr.largest)
+        summary = summarize(result, lle=lle)
         if not result.status.ok:
             summary["motion"] = "failed"
-        return PointAnalysis(result, None, None, summary)
+        return PointAnalysis(result, lle, lstatus, summary)
     v = point_verdict(target, values, result, verdict)
     if v.record is not None and v.label != "failed":
         # the record shown is the finished one the verdict is about

@@ -53,6 +53,13 @@ from ..analysis.chaos01 import chaos01
 from ..analysis.classify import LLE_C
 from ..analysis.lyapunov import LYAPUNOV_BLOCKS, exponent_estimate, random_tangents
 from ..analysis.periodicity import periods_of
+from ..analysis.recurrence import (
+    approaches,
+    converging_period,
+    distance_to_orbit,
+    near_period,
+    noise_floor,
+)
 from ..analysis.shooting import section_fraction
 from ..errors import ParameterError
 from ..integrate._chains import ChainRun, run_chains
@@ -239,71 +246,6 @@ class Verdict:
         }
 
 
-# ----------------------------------------------------------------------------- the record
-def _noise_floor(sections: np.ndarray, settings: SolverSettings, factor: float) -> np.ndarray:
-    """ε per point: factor · (atol + rtol · max|x|) of its section sequence."""
-    with np.errstate(invalid="ignore"):
-        mag = np.nanmax(np.abs(sections), axis=(1, 2))
-    mag = np.where(np.isfinite(mag), mag, 0.0)
-    return factor * (float(settings.atol) + float(settings.rtol) * mag)
-
-
-def _converging(x: np.ndarray, max_n: int) -> int:
-    """The n ≤ max_n whose recurrence gaps g_k = ‖x_{k+n} − x_k‖ decay geometrically over
-    the second half of the record (a least-squares line through ln g_k falling by more than
-    four times its residual scatter and by at least 20 % overall), fastest first; 0: none."""
-    m = x.shape[0]
-    best, best_slope = 0, 0.0
-    for n in range(1, max_n + 1):
-        if m - n < 16:
-            break
-        g = np.sqrt(np.sum((x[n:] - x[:-n]) ** 2, axis=1))
-        h = g[(m - n) // 2 :]
-        if h.size < 8 or not np.all(h > 0) or not np.all(np.isfinite(h)):
-            continue
-        k = np.arange(h.size, dtype=float)
-        y = np.log(h)
-        slope, icpt = np.polyfit(k, y, 1)
-        scatter = float(np.std(y - (slope * k + icpt)))
-        drop = -slope * (h.size - 1)
-        if slope < 0 and drop > max(4.0 * scatter, math.log(1.25)) and slope < best_slope:
-            best, best_slope = n, float(slope)
-    return best
-
-
-def _near_periodic(x: np.ndarray, max_n: int, reach: float) -> int:
-    """The n ≤ max_n with the smallest median recurrence gap over the last quarter of the
-    record, when that gap is at most ``reach`` · max(1, max|x|) (the record lingers near a
-    period-n orbit, as a slowly spiralling transient does); 0: none."""
-    m = x.shape[0]
-    scale = max(1.0, float(np.max(np.abs(x))))
-    gaps = []
-    for n in range(1, max_n + 1):
-        if m - n < 8:
-            break
-        g = np.max(np.abs(x[n:] - x[:-n]), axis=1)
-        gaps.append(float(np.median(g[3 * (m - n) // 4 :])))
-    if not gaps or min(gaps) > reach * scale:
-        return 0
-    # the shortest period within twice the best gap (a multiple of the period repeats too)
-    return next(n for n, g in enumerate(gaps, start=1) if g <= 2.0 * min(gaps))
-
-
-def _distance_to_orbit(y: np.ndarray, sections: np.ndarray) -> np.ndarray:
-    """∞-norm distance of the state(s) y (…, n) from the nearest section point of an orbit."""
-    y = np.asarray(y)
-    d = np.max(np.abs(y[..., None, :] - sections), axis=-1)
-    return np.min(d, axis=-1)
-
-
-def _approaches(record: np.ndarray, sections: np.ndarray) -> bool:
-    """Whether a full-state record comes closer to an orbit: the median distance over its
-    second half is below that over its first half."""
-    d = _distance_to_orbit(record, sections)
-    h = d.size // 2
-    return bool(h >= 4 and np.median(d[h:]) < np.median(d[:h]))
-
-
 # ----------------------------------------------------------------------------- extension
 def _extend(
     systems: Sequence[System],
@@ -359,7 +301,7 @@ def _shoot_candidates(
     target: Any,
     values: Sequence[Mapping[str, Any]],
     pts: dict[int, _Point],
-    cands: dict[int, tuple[int, bool]],
+    cands: dict[int, tuple[int, str]],
     settings: SolverSettings,
     vs: VerdictSettings,
     done: dict[int, Verdict],
@@ -391,12 +333,12 @@ def _shoot_candidates(
             mu = mu_n ** (d / n)
             secs = orb.sections
             scale = max(1.0, float(np.max(np.abs(orb.state))))
-            near = float(_distance_to_orbit(p.final, secs)) <= vs.same_orbit * scale
+            near = float(distance_to_orbit(p.final, secs)) <= vs.same_orbit * scale
             repeat = cands[k][1] == "repeat"
             if repeat:
                 follows = near
             elif p.sections.shape[1] == secs.shape[1]:
-                follows = _approaches(p.sections, secs)
+                follows = approaches(p.sections, secs)
             else:  # a projected record: its recurrence gaps decayed (the trend test)
                 follows = True
             if mu < 1.0 - vs.margin and follows:
@@ -450,7 +392,7 @@ def _decide_by_exponent(k: int, p: _Point, vs: VerdictSettings, last: bool) -> V
     k01 = math.nan
     if p.sections.shape[0] >= MIN_LENGTH_01:
         k01 = chaos01(p.sections[:, :2])
-    common = {
+    common: dict[str, Any] = {
         "lle": lam,
         "lle_error": err,
         "k01": k01,
@@ -578,10 +520,10 @@ def decide_motion(
         if not live:
             break
         # 1. candidates: a repeating record, else a converging one
-        cands: dict[int, tuple[int, bool]] = {}
+        cands: dict[int, tuple[int, str]] = {}
         for k in live:
             p = pts[k]
-            floor = _noise_floor(p.sections[None], settings, vs.noise_factor)
+            floor = noise_floor(p.sections[None], settings, vs.noise_factor)
             n = int(
                 periods_of(
                     p.sections[None],
@@ -595,7 +537,7 @@ def decide_motion(
             if 1 <= n <= vs.max_period:
                 cands[k] = (n, "repeat")
             elif n == 0:
-                nc = _converging(p.sections, vs.max_period) or _near_periodic(
+                nc = converging_period(p.sections, vs.max_period) or near_period(
                     p.sections, vs.max_period, vs.approach
                 )
                 if nc:

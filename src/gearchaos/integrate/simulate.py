@@ -130,6 +130,7 @@ def simulate(
     max_steps: int | None = None,
     check: bool = True,
     settle: str = _DEFAULT.settle,
+    perturbation: float = _DEFAULT.perturbation,
 ) -> SimulationResult:
     """Simulate a gear set (or any :class:`System`) with the seed's protocol.
 
@@ -147,7 +148,7 @@ def simulate(
     rtol, atol
         Error tolerances of the Dormand–Prince 5(4) controller.
     y0
-        Initial state (default: zero, MODEL.md §6).
+        Initial state (default: rest, MODEL.md §6, perturbed by ``perturbation``).
     section_phase
         Phase φ of the Poincaré section, τ_k = (2πk + φ)/Ω.
     max_steps
@@ -155,6 +156,9 @@ def simulate(
     check
         Raise :class:`~gearchaos.errors.IntegrationError` (carrying ``.result``) when the
         integration fails; with ``check=False`` inspect ``result.status`` instead.
+    perturbation
+        Size of the reproducible perturbation of the start from rest (default 1e-6; 0: the
+        exact zero state; see :class:`~gearchaos.integrate.settings.SolverSettings`).
     settle
         ``"auto"``: end the transient early once the section sequence repeats (see
         :class:`~gearchaos.integrate.settings.SolverSettings`); ``"off"`` (default): the full
@@ -175,6 +179,7 @@ def simulate(
         atol=atol,
         max_steps=max_steps,
         settle=settle,
+        perturbation=perturbation,
     )
     raise_on_failure = check_bool("check", check)
     system = resolve(system_or_gearset, {} if omega is None else {"omega": omega})

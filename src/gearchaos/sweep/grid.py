@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from ..analysis.lyapunov import random_tangents
 from ..errors import ParameterError
 from ..integrate._chains import ChainRun
 from ..model.system import System
@@ -138,9 +139,12 @@ class Grid:
         """The numbers a worker needs to run ``task``: its chains of packed systems."""
         spec = self.spec
         systems = [[self.system(i) for i in chain] for chain in task.chains]
+        n = systems[0][0].n_state
         return ChainRun.from_systems(
             systems,
             spec.solver,
             n_tangent=int(spec.lyapunov),
             continuation=spec.initial_conditions == "continuation",
+            # the random start of max_lyapunov: one λ₁ for a point, whatever computes it
+            tangent_start=random_tangents(n, 1) if spec.lyapunov else None,
         )

@@ -288,7 +288,7 @@ class SweepSpec:
     solver: SolverSettings = SWEEP_SOLVER
     lyapunov: bool = False
     orbits: bool = False
-    verdicts: bool = True
+    verdicts: bool = False
     extra: tuple[tuple[str, Any], ...] = field(default=())
     response: bool = False
 
@@ -443,7 +443,12 @@ class SweepSpec:
             f"periods = {val(self.solver.periods)}",
             f"rtol = {val(float(self.solver.rtol))}",
             f"atol = {val(float(self.solver.atol))}",
-            f"perturbation = {val(float(self.solver.perturbation))}",
+            # written only when used: stores of the exact start stay identical
+            *(
+                [f"perturbation = {val(float(self.solver.perturbation))}"]
+                if self.solver.perturbation
+                else []
+            ),
             f"lyapunov = {val(self.lyapunov)}",
             f"observe = {val(list(self.observe))}",
             f"planets = {val(list(self.planets))}",
