@@ -61,8 +61,8 @@ __all__ = [
 
 if TYPE_CHECKING:
     from .analysis.arclength import continuation
-    from .analysis.coexistence import attractors
     from .analysis.orbits import PeriodicOrbit, periodic_orbit
+    from .dynamics.coexistence import attractors
     from .explore import explore
 
 _LAZY_SUBPACKAGES = ("analysis", "plot", "paper", "explore")
@@ -71,7 +71,7 @@ _LAZY_ATTRIBUTES = {
     "PeriodicOrbit": "analysis.orbits",
     "periodic_orbit": "analysis.orbits",
     "continuation": "analysis.arclength",
-    "attractors": "analysis.coexistence",
+    "attractors": "dynamics.coexistence",
 }
 
 

@@ -4,6 +4,7 @@ fig5``: regime tables, motion labels and Poincaré galleries from the command li
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -105,16 +106,24 @@ def test_bifurcation_lyapunov_stores_lle_and_prints_the_regime_table(
 def test_simulate_lyapunov_json_labels_the_1t_response(runner: CliRunner) -> None:
     # sheng2016 at Ω = 0.5 (below the first resonance): one section point, no separation
     args = ["simulate", "--set", "omega=0.5", "--transient", "20", "--periods", "100"]
-    result = runner.invoke(app, [*args, "--lyapunov", "--json"])
+    # the verdict (default): a stable orbit by shooting, λ₁ = ln max|μ| / T exactly
+    result = runner.invoke(app, [*args, "--json"])
     assert result.exit_code == 0, result.output
     data = json.loads(result.stdout)
-    assert data["motion"] == "1T"
+    assert data["motion"] == "1T" and data["evidence"] == "floquet"
+    assert 0 < data["max_multiplier"] < 1 and data["lle_error"] == 0
+    assert data["lle"] == pytest.approx(math.log(data["max_multiplier"]) / (2 * math.pi / 0.5))
+    human = runner.invoke(app, args).stdout
+    assert "decided by" in human and "floquet" in human and "(exact)" in human
+    # from the record alone: λ₁ only with --lyapunov, the indicators in the table
+    result = runner.invoke(app, [*args, "--no-verdict", "--lyapunov", "--json"])
+    data = json.loads(result.stdout)
+    assert data["motion"] == "1T" and data["evidence"] == "record"
     assert data["lle"] is not None and data["lle"] < 0
     assert data["indicators_agree"] is True
-    # without --lyapunov there is no exponent; the human table shows the indicators
-    plain = json.loads(runner.invoke(app, [*args, "--json"]).stdout)
+    plain = json.loads(runner.invoke(app, [*args, "--no-verdict", "--json"]).stdout)
     assert plain["lle"] is None and plain["motion"] == "1T"
-    human = runner.invoke(app, [*args, "--lyapunov"]).stdout
+    human = runner.invoke(app, [*args, "--no-verdict", "--lyapunov"]).stdout
     assert "λ₁" in human and "0–1 test K" in human and "indicators agree" in human
 
 

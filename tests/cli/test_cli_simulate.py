@@ -13,8 +13,10 @@ from typer.testing import CliRunner
 
 import gearchaos as gc
 from gearchaos.cli import app
+from gearchaos.dynamics.point import analyse_point
 from gearchaos.errors import IntegrationError
 from gearchaos.gearset import GearSet, preset
+from gearchaos.integrate.settings import SolverSettings
 
 #: The JSON contract of ``simulate --json`` (gearchaos.analysis.summary.summarize), in order.
 CONTRACT = [
@@ -50,7 +52,12 @@ def test_json_keys_and_values_match_the_python_api(runner: CliRunner) -> None:
     assert list(out)[: len(CONTRACT)] == CONTRACT
 
     gs = preset("sheng2016")
-    res = gc.simulate(gs, omega=1.5, transient_periods=20, periods=20, samples_per_period=8)
+    # the CLI is analyse_point: the simulation, then the verdict (which may show the
+    # finished record: the run from the confirmed orbit or the extended run)
+    cfg = SolverSettings(transient_periods=20, periods=20, samples_per_period=8)
+    point = analyse_point(gs, {"omega": 1.5}, cfg)
+    res = point.result
+    assert out["motion"] == point.summary["motion"] and out["evidence"] == "floquet"
     ds = res.to_dataset()
     x = ds.delta_sp.sel(planet=1).values
     assert out["omega"] == 1.5

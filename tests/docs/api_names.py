@@ -14,7 +14,17 @@ from __future__ import annotations
 import importlib
 import importlib.util
 
-SUBPACKAGES = ("gearset", "model", "integrate", "analysis", "sweep", "plot", "paper", "explore")
+SUBPACKAGES = (
+    "gearset",
+    "model",
+    "integrate",
+    "analysis",
+    "dynamics",
+    "sweep",
+    "plot",
+    "paper",
+    "explore",
+)
 PACKAGES = ("gearchaos", *(f"gearchaos.{p}" for p in SUBPACKAGES))
 NOT_DOCUMENTABLE = {"__version__"}  # a plain string, described in the page's text
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from matplotlib.colors import to_rgba
@@ -108,6 +110,10 @@ def test_runner_labels_every_value_of_a_reference_system() -> None:
         assert r["motion"] == "1T"
         assert r["lle"] == pytest.approx(-0.1, abs=1e-3)
         assert r["status"] == "ok"
+        # confirmed by the multipliers: λ₁ = ln max|μ| / T exactly, e^(−ζT) for this system
+        assert r["evidence"] == "floquet" and r["lle_error"] == 0
+        T = 2 * math.pi / r["value"]
+        assert r["max_multiplier"] == pytest.approx(math.exp(-0.1 * T), rel=1e-3)
 
 
 def test_runner_checks_every_point_before_running() -> None:

@@ -69,9 +69,25 @@ def test_in_memory_result_equals_the_store(sheng, reference):
     assert_bitwise_equal(ds, reference)
 
 
+@pytest.fixture(scope="module")
+def plain(sheng):
+    """The same sweep without verdicts: every point's record is its protocol run's."""
+    return gc.bifurcation(sheng, VARY, family=FAMILY, **SHORT, progress=False, verdicts=False)
+
+
+def test_verdicts_keep_the_protocol_record_where_they_do_not_replace_it(reference, plain):
+    # the verdict changes a point's record only where it says so (record != protocol)
+    kept = reference.record.values == 0
+    assert kept.any() and (~kept).any()
+    for name in ("delta_sp", "delta_sp_dot", "final_state"):
+        a, b = reference[name].values, plain[name].values
+        np.testing.assert_array_equal(a[kept], b[kept])
+    assert not np.array_equal(reference.delta_sp.values[~kept], plain.delta_sp.values[~kept])
+
+
 @pytest.mark.parametrize(("i_xi", "i_omega"), [(0, 0), (0, 7), (1, 4), (1, 11)])
-def test_points_equal_single_simulations(sheng, reference, i_xi, i_omega):
-    pt = reference.isel(xi=i_xi, omega=i_omega)
+def test_points_equal_single_simulations(sheng, plain, i_xi, i_omega):
+    pt = plain.isel(xi=i_xi, omega=i_omega)
     xi, omega = float(pt.xi), float(pt.omega)
     assert (xi, omega) == (FAMILY["xi"][i_xi], np.linspace(0.5, 3, 12)[i_omega])
     res = _simulate(sheng.evolve(xi=xi), omega=omega, **SHORT, rtol=1e-8, atol=1e-10)

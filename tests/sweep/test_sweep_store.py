@@ -20,7 +20,10 @@ _simulate = functools.partial(gc.simulate, samples_per_period=1)
 FAMILY = {"xi": [0.03, 0.09]}
 VARY = {"omega": "0.8,1.6,2.4", "backlash.sun_planet": "2:5:4"}
 FIXED = {"clearance.sun_bearing": 1.5}
+#: the record of the protocol run at every point (a verdict would replace the unfinished
+#: ones): these tests compare stored points with single simulations
 SETTINGS = {
+    "verdicts": False,
     "observe": ("delta_sp", "delta_rp", "x_s"),
     "planets": (1, 3),
     "transient_periods": 10,
@@ -120,6 +123,7 @@ def test_reference_system_store_uses_state_names(tmp_path):
         periods=8,
         store=tmp_path / "bo.zarr",
         progress=False,
+        verdicts=False,  # the protocol's record, compared with a single simulation below
     )
     ds = xr.open_zarr(tmp_path / "bo.zarr")
     assert ds.x.dims == ("zeta", "omega", "section")
@@ -146,6 +150,9 @@ GAMMAS = [0.05, 0.3, 0.1, 1.0, 0.08]
 
 
 def escape_sweep(tmp_path, **kw):
+    """The protocol's record at every point (no verdict replaces the unfinished ones): the
+    tests compare points with single runs."""
+    kw.setdefault("verdicts", False)
     path = tmp_path / "escape.zarr"
     gc.bifurcation(
         gc.duffing(1.0, gamma=0.05, **WELL),

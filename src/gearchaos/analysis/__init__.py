@@ -6,7 +6,6 @@
 (a JSON-serialisable summary of one simulation), :mod:`.orbits` (periodic orbits by shooting,
 Floquet multipliers; :mod:`.shooting` holds the map evaluations and the Newton corrector,
 :mod:`.orbit_batch` many orbits in one Newton iteration),
-:mod:`.coexistence` (coexisting attractors at one point, from several starts),
 :mod:`.arclength` (pseudo-arclength continuation of branches, :mod:`.branch_events` their folds,
 period doublings, Neimark–Sacker and grazing events, :mod:`.branch` their datasets and files)
 and, for gear sets, :mod:`.modal` (linear natural frequencies).
@@ -24,7 +23,6 @@ from .classify import (
     sort_labels,
     spectral_broadband,
 )
-from .coexistence import Attractor, attractors
 from .contact import contact_fractions, contact_regime, contact_regimes, separation_fraction
 from .lyapunov import LyapunovResult, lyapunov_spectrum, max_lyapunov
 from .orbit_batch import periodic_orbits
@@ -34,12 +32,10 @@ from .poincare import count_distinct, section_points
 from .summary import format_summary, summarize
 
 __all__ = [
-    "Attractor",
     "Event",
     "LyapunovResult",
     "MotionClass",
     "PeriodicOrbit",
-    "attractors",
     "branch_multipliers",
     "branch_summary",
     "chaos01",

@@ -210,12 +210,15 @@ def lyapunov_spectrum(
     )
 
 
-def format_exponent(value: float, error: float) -> str:
-    """``0.0412 ± 0.0031`` (or the value alone when the error is unknown)."""
-    if not math.isfinite(value):
+def format_exponent(value: float | None, error: float | None) -> str:
+    """``0.0412 ± 0.0031``, ``-0.0125 (exact)`` for error 0 (from Floquet multipliers), the
+    value alone when the error is unknown, ``—`` without a value."""
+    if value is None or not math.isfinite(value):
         return "—"
-    if not math.isfinite(error):
+    if error is None or not math.isfinite(error):
         return f"{value:.4g}"
+    if error == 0:
+        return f"{value:.4g} (exact)"
     return f"{value:.4g} ± {error:.2g}"
 
 

@@ -17,6 +17,7 @@ from ..errors import ParameterError
 from ..model.response import response_quantities
 from .classify import classify_motion
 from .contact import contact_regimes, separation_fraction
+from .lyapunov import format_exponent
 from .poincare import count_distinct, section_points
 
 __all__ = ["SUMMARY_KEYS", "format_summary", "motion_name", "summarize"]
@@ -151,6 +152,7 @@ def summarize(
         out["evidence"] = verdict["evidence"]
         out["max_multiplier"] = verdict["max_multiplier"]
         out["extra_periods"] = verdict["extra_periods"]
+        out["record"] = verdict["record"]
         out["indicators_agree"] = True
         out["motion_note"] = verdict["reason"]
     else:
@@ -160,6 +162,7 @@ def summarize(
         out["evidence"] = "record"
         out["max_multiplier"] = None
         out["extra_periods"] = 0
+        out["record"] = "protocol"
         out["indicators_agree"] = bool(mc.agree)
         out["motion_note"] = mc.note
     out["gearset"] = gs.name if gs is not None else None
@@ -227,9 +230,8 @@ def format_summary(summary: dict[str, Any], *, title: str | None = None) -> Any:
             recorded = summary.get("recorded_section_points")
             if key == "distinct_section_points" and recorded:
                 value = f"{int(value)} of {int(recorded)}"
-            if key == "lle" and value is not None and summary.get("lle_error") is not None:
-                err = summary["lle_error"]
-                value = f"{value:.4g} (exact)" if err == 0 else f"{value:.4g} ± {err:.2g}"
+            if key == "lle" and value is not None:
+                value = format_exponent(value, summary.get("lle_error"))
             if key in ("max_multiplier", "extra_periods") and not value:
                 continue
             if key in ("evidence", "lle") and summary.get("evidence", "record") == "record":

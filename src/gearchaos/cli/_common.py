@@ -244,13 +244,14 @@ def solver_settings(
     atol: float,
     samples_per_period: int = 1,
     settle: str = "off",
+    perturbation: float | None = None,
 ) -> SolverSettings:
     """The :class:`~gearchaos.integrate.settings.SolverSettings` of the solver options;
     invalid values exit 2 naming the setting."""
     from ..integrate.settings import SolverSettings
 
     try:
-        return SolverSettings(
+        settings = SolverSettings(
             transient_periods=transient,
             periods=periods,
             samples_per_period=samples_per_period,
@@ -258,6 +259,7 @@ def solver_settings(
             atol=atol,
             settle=settle,
         )
+        return settings if perturbation is None else settings.replace(perturbation=perturbation)
     except ParameterError as exc:
         setting = str(exc).split(" ", 1)[0]
         option = _OPTIONS.get(setting)
@@ -272,6 +274,7 @@ _OPTIONS = {
     "rtol": "--rtol",
     "settle": "--settle",
     "atol": "--atol",
+    "perturbation": "--perturbation",
 }
 
 
@@ -325,6 +328,18 @@ SettleOpt = Annotated[
             "off: always --transient periods of transient; auto: end it early once the Poincaré "
             "sections repeat (period ≤ 64), never later than --transient."
         ),
+    ),
+]
+PerturbationOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--perturbation",
+        help=(
+            "Size of the reproducible perturbation of the start from rest that breaks the "
+            "planets' symmetry as in any real gearbox (default 1e-6; 0: the exact symmetric "
+            "start)."
+        ),
+        show_default=False,
     ),
 ]
 PeriodsOpt = Annotated[

@@ -237,12 +237,16 @@ def add_motion_rows(table: Table, summary: Mapping[str, Any]) -> None:
 
 
 def gallery_rows_table(rows: Sequence[Mapping[str, Any]], param: str, *, title: str) -> Table:
-    """One row per value: value, motion (in its palette colour), λ₁, K, agree, points."""
+    """One row per value: value, motion (in its palette colour), what decided it, max |μ|,
+    λ₁ ± its error, K, agree, points."""
+    from ..analysis.lyapunov import format_exponent
     from ..plot.regimes import regime_colour
 
     table = Table(title=escape(title), title_justify="left")
     table.add_column(escape(symbol(param)), justify="right")
     table.add_column("motion", no_wrap=True)
+    table.add_column("decided by", no_wrap=True)
+    table.add_column("max |μ|", justify="right")
     table.add_column("λ₁", justify="right")
     table.add_column("0–1 K", justify="right")
     table.add_column("agree", justify="center")
@@ -254,7 +258,9 @@ def gallery_rows_table(rows: Sequence[Mapping[str, Any]], param: str, *, title: 
         table.add_row(
             f"{float(r['value']):g}",
             Text("■ ", style=regime_colour(motion)) + Text(motion),
-            "—" if lle is None else f"{lle:.3g}",
+            str(r.get("evidence", "record")),
+            "—" if r.get("max_multiplier") is None else f"{r['max_multiplier']:.4g}",
+            format_exponent(lle, r.get("lle_error")),
             "—" if k01 is None else f"{k01:.3f}",
             Text("yes" if agree else "no", style="" if agree else "bold red"),
             str(r.get("distinct_section_points", "—")),

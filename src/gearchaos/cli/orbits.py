@@ -249,7 +249,7 @@ def attractors(
     Example (a stable 1T orbit beside a chaotic attractor): **gearchaos attractors --set
     omega=1.5**
     """
-    from ..analysis.coexistence import attractors as find
+    from ..dynamics.coexistence import attractors as find
 
     with c.reported_errors():
         omega, changes = c.parse_sets(set_ or [])

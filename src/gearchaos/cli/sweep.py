@@ -121,6 +121,7 @@ def bifurcation(
     ] = "up",
     transient: c.TransientOpt = 100.0,
     settle: c.SettleOpt = "off",
+    perturbation: c.PerturbationOpt = None,
     periods: Annotated[
         int,
         typer.Option("--periods", help="Mesh periods recorded at every point (section points)."),
@@ -155,6 +156,17 @@ def bifurcation(
             ),
         ),
     ] = False,
+    verdicts: Annotated[
+        bool,
+        typer.Option(
+            "--verdicts/--no-verdicts",
+            help=(
+                "Decide every point's motion with the verdict: nT confirmed by shooting "
+                "(Floquet multipliers), chaos and QP by λ₁ ± its error, transients finished. "
+                "--no-verdicts labels from the records alone (faster)."
+            ),
+        ),
+    ] = True,
     orbits: Annotated[
         bool,
         typer.Option(
@@ -203,7 +215,9 @@ def bifurcation(
                 f"--direction {direction} needs --ic continuation "
                 "(fresh starts do not depend on the sweep direction)"
             )
-        settings = c.solver_settings(transient, periods, rtol, atol, settle=settle)
+        settings = c.solver_settings(
+            transient, periods, rtol, atol, settle=settle, perturbation=perturbation
+        )
         omega, changes = c.parse_sets(set_ or [])
         gs = c.load_gearset(preset, gearset)
         swept = {_axis_name(v) for v in vary} | ({_axis_name(family)} if family else set())
@@ -228,6 +242,7 @@ def bifurcation(
             direction=direction,
             lyapunov=lyapunov,
             orbits=orbits,
+            verdicts=verdicts,
             scheduler=scheduler,
             dask_local=dask_local,
         )

@@ -72,7 +72,7 @@ def analyse_point(
     lyapunov: bool = True,
     default_omega: float | None = None,
     check: bool = False,
-    verdict: VerdictSettings | None = None,
+    verdict: VerdictSettings | bool = True,
 ) -> PointAnalysis:
     """Simulate ``target`` at ``values`` (dotted names, ``omega`` included), decide the motion,
     and summarise it.
@@ -87,24 +87,27 @@ def analyse_point(
         Protocol and tolerances (default: :data:`~gearchaos.integrate.settings.SIMULATION`,
         as :func:`gearchaos.simulate` and ``gearchaos simulate``).
     lyapunov
-        Without ``verdict``: also compute λ₁ (seeded random tangent vector) for the
-        record-based label (:func:`~gearchaos.analysis.classify.classify_motion`).
+        With ``verdict=False``: also compute λ₁ (seeded random tangent vector) for the
+        record-based label (:func:`~gearchaos.analysis.classify.classify_motion`). Ignored
+        by the verdict, which computes λ₁ itself.
     default_omega
         Ω when ``values`` has none (a gear set needs one).
     check
         Raise :class:`~gearchaos.errors.IntegrationError` when the simulation fails, instead of
         returning a result labelled ``failed``.
     verdict
-        :class:`~gearchaos.dynamics.verdict.VerdictSettings`: decide the motion with the
-        verdict (shooting and Floquet multipliers, λ₁ ± its error, transients finished) with
-        these tolerances and budget; None labels from the record.
+        True (default) or :class:`~gearchaos.dynamics.verdict.VerdictSettings`: decide the
+        motion with the verdict (shooting and Floquet multipliers, λ₁ ± its error,
+        transients finished), with the default or these tolerances and budget. False labels
+        from the record alone (faster; the summary's ``evidence`` is ``record``).
     """
     cfg = SIMULATION if settings is None else SolverSettings.build(settings)
     want = check_bool("lyapunov", lyapunov)  # flags checked before any run
     check = check_bool("check", check)
     system = resolve(target, values, default_omega=default_omega)
     result = run_simulation(system, cfg, check=check)
-    if verdict is None or not result.status.ok:
+    vs = _verdict_settings(verdict)
+    if vs is None or not result.status.ok:
         lle: float | None = None
         lstatus: Status | None = None
         if want and result.status.ok:
@@ -116,7 +119,7 @@ def analyse_point(
         if not result.status.ok:
             summary["motion"] = "failed"
         return PointAnalysis(result, lle, lstatus, summary)
-    v = point_verdict(target, values, result, verdict)
+    v = point_verdict(target, values, result, vs)
     if v.record is not None and v.label != "failed":
         # the record shown is the finished one the verdict is about
         if v.orbit_state is not None and section_fraction(cfg) == 0.0:
@@ -131,6 +134,12 @@ def analyse_point(
     if not result.status.ok:
         summary["motion"] = "failed"
     return PointAnalysis(result, lle, Status.OK, summary, v)
+
+
+def _verdict_settings(verdict: Any) -> VerdictSettings | None:
+    if isinstance(verdict, VerdictSettings):
+        return verdict
+    return VerdictSettings() if check_bool("verdict", verdict) else None
 
 
 def point_verdict(

@@ -51,7 +51,7 @@ from .._checks import check_int, check_real
 from ..analysis.chaos01 import MIN_LENGTH as MIN_LENGTH_01
 from ..analysis.chaos01 import chaos01
 from ..analysis.classify import LLE_C
-from ..analysis.lyapunov import LYAPUNOV_BLOCKS, exponent_estimate, random_tangents
+from ..analysis.lyapunov import LYAPUNOV_BLOCKS, exponent_estimate
 from ..analysis.periodicity import periods_of
 from ..analysis.recurrence import (
     approaches,
@@ -60,13 +60,19 @@ from ..analysis.recurrence import (
     near_period,
     noise_floor,
 )
-from ..analysis.shooting import section_fraction
 from ..errors import ParameterError
-from ..integrate._chains import ChainRun, run_chains
-from ..integrate.settings import SampleTimes, SolverSettings
+from ..integrate.settings import SolverSettings
 from ..model.system import System
+from .extension import RECORD_SOURCES, VerdictRecord, extend
 
-__all__ = ["EVIDENCE", "Verdict", "VerdictRecord", "VerdictSettings", "decide_motion"]
+__all__ = [
+    "EVIDENCE",
+    "RECORD_SOURCES",
+    "Verdict",
+    "VerdictRecord",
+    "VerdictSettings",
+    "decide_motion",
+]
 
 #: What decided a label (the flag values of a store's ``verdict`` variable).
 EVIDENCE = {
@@ -105,7 +111,11 @@ class VerdictSettings:
         max(1, max|x|) lingers near a periodic orbit: it is shot, and the orbit confirmed when
         stable and the record comes closer to it.
     extension_periods
-        Periods per extension (None: the record's length, at least 2·blocks + 1).
+        Periods per extension (None: the record's length, at least ``min_extension``).
+    min_extension
+        Shortest extension when ``extension_periods`` is None: the bias bound θ = c_θ/t
+        shrinks with the extension's duration t, and a short one (θ large) would call a
+        slowly contracting motion QP.
     budget_periods
         Most periods added to a point by extensions.
     blocks, confidence
@@ -125,6 +135,7 @@ class VerdictSettings:
     same_orbit: float = 1e-2
     approach: float = 2e-2
     extension_periods: int | None = None
+    min_extension: int = 100
     budget_periods: int = 400
     blocks: int = LYAPUNOV_BLOCKS
     confidence: float = 2.0
@@ -141,6 +152,7 @@ class VerdictSettings:
         check_real("approach", self.approach, lo=0.0, hi=1.0)
         if self.extension_periods is not None:
             check_int("extension_periods", self.extension_periods, lo=2 * self.blocks + 1)
+        check_int("min_extension", self.min_extension, lo=2 * self.blocks + 1, hi=10**6)
         check_int("budget_periods", self.budget_periods, lo=0, hi=10**7)
         check_int("blocks", self.blocks, lo=2, hi=1000)
         check_real("confidence", self.confidence, lo=0.0, lo_open=True)
@@ -151,17 +163,7 @@ class VerdictSettings:
         """Periods of one extension of a record of ``record_periods``."""
         if self.extension_periods is not None:
             return int(self.extension_periods)
-        return max(int(record_periods), 2 * self.blocks + 1)
-
-
-@dataclass(frozen=True, eq=False)
-class VerdictRecord:
-    """The section record of an extension that replaced the original one: ``states``
-    (m, n_state) and ``observables`` (m, n_obs) at the section, and ``final_state``."""
-
-    states: np.ndarray
-    observables: np.ndarray
-    final_state: np.ndarray
+        return max(int(record_periods), self.min_extension)
 
 
 @dataclass(frozen=True, eq=False)
@@ -218,13 +220,9 @@ class Verdict:
         return self.period > 0
 
     def lle_text(self) -> str:
-        """λ₁ with its error as printed next to the label (``exact`` for Floquet)."""
+        """λ₁ with its error as printed next to the label (``(exact)`` for Floquet)."""
         from ..analysis.lyapunov import format_exponent
 
-        if not math.isfinite(self.lle):
-            return "—"
-        if self.evidence == "floquet":
-            return f"{self.lle:.4g} (= ln|μ|/nT)"
         return format_exponent(self.lle, self.lle_error)
 
     def to_dict(self) -> dict[str, Any]:
@@ -242,43 +240,9 @@ class Verdict:
             "lle_error": num(self.lle_error),
             "k01": num(self.k01),
             "extra_periods": int(self.extra_periods),
+            "record": self.record.source if self.record is not None else "protocol",
             "reason": self.reason,
         }
-
-
-# ----------------------------------------------------------------------------- extension
-def _extend(
-    systems: Sequence[System],
-    states: np.ndarray,
-    settings: SolverSettings,
-    periods: int,
-    seed: int,
-) -> Any:
-    """Integrate K states (at the section of ``settings``) ``periods`` further with one
-    random tangent vector; samples at the next ``periods`` section times."""
-    ref = systems[0]
-    K, n = len(systems), ref.n_state
-    T = np.array([s.period for s in systems])
-    t0 = (section_fraction(settings) * T)[:, None]
-    times = SampleTimes(
-        t_rec=t0 + T[:, None],
-        dt=T[:, None].copy(),
-        n_samples=int(periods),
-        t_end=t0 + periods * T[:, None],
-        max_steps=int(100_000 + 50_000 * periods),
-    )
-    run = ChainRun.from_arrays(
-        ref,
-        np.array([s.params for s in systems])[:, None, :],
-        np.array([s.switch_widths for s in systems])[:, None, :],
-        t0,
-        times,
-        settings,
-        y0=states,
-        n_tangent=1,
-        tangent_start=random_tangents(n, 1, seed=seed, points=K),
-    )
-    return run_chains(run)
 
 
 # ----------------------------------------------------------------------------- decision
@@ -373,12 +337,19 @@ def _shoot_candidates(
         n_state = systems[0].n_state
         m = max(pts[k].sections.shape[0] for k in finish)
         ys = np.array([done[k].orbit_state for k in finish])
-        out = _extend([systems[k] for k in finish], ys, settings, max(m, 2), vs.seed)
+        out = extend([systems[k] for k in finish], ys, settings, max(m, 2), vs.seed)
         for i, k in enumerate(finish):
             if int(out.status[i, 0]) != 0:
                 continue
             states = out.states[i, 0, :, :n_state].copy()
-            rec = VerdictRecord(states, out.observables[i, 0].copy(), states[-1].copy())
+            rec = VerdictRecord(
+                states,
+                out.observables[i, 0].copy(),
+                out.final_state[i, 0, :n_state].copy(),
+                out.obs_min[i, 0].copy(),
+                out.obs_max[i, 0].copy(),
+                source="orbit",
+            )
             done[k] = dataclasses.replace(done[k], record=rec)
 
 
@@ -563,7 +534,7 @@ def decide_motion(
             if p.unstable is not None:  # leave the unstable orbit along its eigenvector
                 y = y + 1e-3 * max(1.0, float(np.max(np.abs(y)))) * p.unstable[2]
             starts.append(y)
-        out = _extend(
+        out = extend(
             [systems[k] for k in todo], np.array(starts), settings, ext_periods, vs.seed + r
         )
         n_state = systems[0].n_state
@@ -586,5 +557,11 @@ def decide_motion(
             states = out.states[i, 0, :, :n_state].copy()
             p.sections = states
             p.final = out.final_state[i, 0, :n_state].copy()
-            p.record = VerdictRecord(states, out.observables[i, 0].copy(), p.final.copy())
+            p.record = VerdictRecord(
+                states,
+                out.observables[i, 0].copy(),
+                p.final.copy(),
+                out.obs_min[i, 0].copy(),
+                out.obs_max[i, 0].copy(),
+            )
     return [done[k] for k in range(K)]

@@ -30,6 +30,7 @@ from bokeh.models import ColumnDataSource, HoverTool, Range1d
 from bokeh.models.annotations import Span
 from bokeh.plotting import figure
 
+from ..analysis.lyapunov import format_exponent
 from ..errors import ParameterError
 from ..plot.regimes import REGIME_COLOURS
 from ..sweep.result import open_result
@@ -367,9 +368,11 @@ class Explorer(pn.viewable.Viewer):
         self.poincare.xaxis.axis_label = xl
         self.poincare.yaxis.axis_label = yl
         lle = m.lle(point)
+        evidence = m.evidence(point)
         self.info.object = (
-            f"**{point.title()}**  \nmotion (stored): **{label}**  \n"
-            f"λ₁ (stored): {'—' if lle is None else f'{lle:.4g}'} per unit τ  \n"
+            f"**{point.title()}**  \nmotion (stored): **{label}**"
+            f"{f' ({evidence})' if evidence else ''}  \n"
+            f"λ₁ (stored): {format_exponent(lle, m.lle_error(point))} per unit τ  \n"
             f"status: {m.status(point)} · {x.size} section points"
         )
         vidx = self._vary_index(point)
@@ -473,10 +476,12 @@ def _stack(*figs: Any) -> Any:
 
 
 def _computed_text(out: Mapping[str, Any]) -> str:
-    lle = out.get("lle")
+    summary = out.get("summary") or {}
+    lle = format_exponent(out.get("lle"), summary.get("lle_error"))
     lines = [
         f"**computed at {', '.join(f'{k} = {v:.6g}' for k, v in out['values'].items())}**: "
-        f"motion **{out['motion']}**, λ₁ = {'—' if lle is None else f'{lle:.4g}'} per unit τ, "
+        f"motion **{out['motion']}** (decided by {summary.get('evidence', 'record')}), "
+        f"λ₁ = {lle} per unit τ, "
         f"{out['distinct']} distinct section points, status {out['status']} "
         "(simulated from rest with the store's protocol)"
     ]

@@ -273,6 +273,27 @@ class ExploreModel:
         v = float(self._at("lle", point))
         return v if math.isfinite(v) else None
 
+    def lle_error(self, point: Point) -> float | None:
+        """The stored standard error of λ₁ (0: exact, from the multipliers), or ``None``."""
+        if "lle_error" not in self.full.ds.data_vars:
+            return None
+        v = float(self._at("lle_error", point))
+        return v if math.isfinite(v) else None
+
+    def evidence(self, point: Point) -> str:
+        """What decided the stored label (the verdict's flag and max |μ|), or ``""`` for a
+        store labelled from its records alone."""
+        from ..dynamics.verdict import EVIDENCE
+
+        if "verdict" not in self.full.ds.data_vars:
+            return ""
+        names = {v: k for k, v in EVIDENCE.items()}
+        text = f"decided by {names.get(int(self._at('verdict', point)), 'unknown')}"
+        mu = float(self._at("max_multiplier", point))
+        if math.isfinite(mu):
+            text += f", max |μ| = {mu:.6g}"
+        return text
+
     def status(self, point: Point) -> str:
         return Status(int(self._at("status", point))).name.lower()
 

@@ -30,7 +30,7 @@ MAX_SAMPLES_PER_PERIOD = 10**6
 MAX_STEP_BUDGET = 2**62
 #: Values of ``settle``.
 SETTLE_CHOICES = ("off", "auto")
-#: Recommended size of the perturbation of a start from rest, and the largest allowed.
+#: Default size of the perturbation of a start from rest, and the largest allowed.
 PERTURBATION = 1e-6
 PERTURBATION_MAX = 1e-2
 #: Seed of the generator that draws the direction of that perturbation (and nothing else).
@@ -87,9 +87,9 @@ class SolverSettings:
         real gearbox is never exactly symmetric; from the exact zero state a gear set with
         identical, equally spaced, in-phase planets never leaves its symmetric subspace
         (sun centred, planets in step), and motions that are unstable to symmetry breaking
-        would be reported as attractors. :data:`PERTURBATION` = 1e-6 (in state units: b_c
-        for gear sets) is the recommended size; the default 0 is the exact symmetric start
-        (the seed's protocol). Explicit initial states are never perturbed.
+        would be reported as attractors. Default :data:`PERTURBATION` = 1e-6 (in state
+        units: b_c for gear sets); 0 restores the exact symmetric start. Explicit initial
+        states are never perturbed.
     settle
         ``"off"`` (the seed's protocol): always ``transient_periods`` periods of transient.
         ``"auto"``: the transient ends at the first section point x_k (τ = τ_rec − mT) after
@@ -113,7 +113,7 @@ class SolverSettings:
     atol: float = 1e-10
     max_steps: int | None = None
     settle: str = "off"
-    perturbation: float = 0.0
+    perturbation: float = PERTURBATION
 
     def __post_init__(self) -> None:
         self.check()

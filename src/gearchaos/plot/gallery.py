@@ -36,13 +36,18 @@ def _minus(text: str) -> str:
 
 def gallery_title(param: str, value: float, summary: dict[str, Any] | None) -> str:
     """Panel title ``Ω = 1.875 · 2T · λ₁ = −0.012`` (mathtext symbols; the LLE only when
-    the summary has one, ``failed`` for a failed integration)."""
+    the summary has one, with its standard error when the verdict estimated it —
+    ``λ₁ = 0.065 ± 0.005`` —, ``failed`` for a failed integration)."""
     parts = [f"{axis_symbol(param)} = {_minus(f'{float(value):g}')}"]
     if summary is not None:
         parts.append(str(summary.get("motion", "?")))
         lle = summary.get("lle")
         if lle is not None and math.isfinite(float(lle)):
-            parts.append(rf"$\lambda_1$ = {_minus(f'{float(lle):.2g}')}")
+            text = rf"$\lambda_1$ = {_minus(f'{float(lle):.2g}')}"
+            err = summary.get("lle_error")
+            if err is not None and math.isfinite(float(err)) and err > 0:
+                text += f" ± {float(err):.1g}"
+            parts.append(text)
     return " · ".join(parts)
 
 

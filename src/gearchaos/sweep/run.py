@@ -182,7 +182,7 @@ class _Layout:
                 if spec.lyapunov:
                     data["lle"][pos] = lle[c, j, 0]
         if spec.verdicts:
-            task_verdicts(self.grid, self.observed, task, out, data)
+            task_verdicts(self, task, out, data)
         if spec.orbits:
             data.update(task_orbits(self.grid, self.observed, task, run, data))
         return data

@@ -288,7 +288,7 @@ class SweepSpec:
     solver: SolverSettings = SWEEP_SOLVER
     lyapunov: bool = False
     orbits: bool = False
-    verdicts: bool = False
+    verdicts: bool = True
     extra: tuple[tuple[str, Any], ...] = field(default=())
     response: bool = False
 

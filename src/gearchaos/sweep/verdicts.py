@@ -10,7 +10,10 @@ integrating them (in the worker, all points of a period together), and writes pe
 * ``lle`` and ``lle_error`` — λ₁ per unit τ and its standard error (exact, error 0, for a
   confirmed orbit);
 * ``k01`` — the 0–1 test of the record behind a QP, chaos or unresolved label;
-* ``extra_periods`` — periods the verdict added to finish a transient.
+* ``extra_periods`` — periods the verdict added to finish a transient;
+* ``record`` — where the stored section record comes from: ``protocol`` (the sweep's own
+  run), ``extension`` (that run continued by ``extra_periods``) or ``orbit`` (the confirmed
+  orbit, integrated from its state, onto which the run was still converging).
 
 Where the verdict extended a run, the point's stored section values and final state are those
 of the extension (the finished record), so the diagram never shows a label beside the
@@ -24,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from ..dynamics.verdict import EVIDENCE, VerdictSettings, decide_motion
+from ..dynamics.verdict import EVIDENCE, RECORD_SOURCES, VerdictSettings, decide_motion
 
 __all__ = ["VERDICT_VARIABLES", "task_verdicts", "verdict_attrs"]
 
@@ -45,27 +48,31 @@ VERDICT_VARIABLES: dict[str, tuple[str, str, Any]] = {
     ),
     "k01": ("0–1 test for chaos K of the record (non-periodic labels)", "float64", np.nan),
     "extra_periods": ("periods added by the verdict to finish a transient", "int64", -1),
+    "record": ("where the stored section record comes from (see flag_meanings)", "int8", -1),
 }
 
 
 def verdict_attrs(name: str) -> dict[str, Any]:
-    """Extra attributes of a verdict variable (the flag legend of ``verdict``)."""
-    if name != "verdict":
+    """Extra attributes of a verdict variable (the flag legends of ``verdict`` and
+    ``record``)."""
+    flags = {"verdict": EVIDENCE, "record": RECORD_SOURCES}.get(name)
+    if flags is None:
         return {}
-    return {"flag_values": list(EVIDENCE.values()), "flag_meanings": " ".join(EVIDENCE)}
+    return {"flag_values": list(flags.values()), "flag_meanings": " ".join(flags)}
 
 
 def task_verdicts(
-    grid: Any,
-    observed: Any,
+    layout: Any,
     task: Any,
     out: Any,
     data: dict[str, np.ndarray],
     verdict: VerdictSettings | None = None,
 ) -> None:
     """Decide the motion of a task's points from the kernel outputs ``out`` and write the
-    verdict variables into its block arrays ``data`` (replacing the record where the verdict
-    extended the run)."""
+    verdict variables into its block arrays ``data`` (replacing the record — sections,
+    tracked extrema, final state — where the verdict replaced it). ``layout`` is the sweep's
+    store layout (its grid, observed and tracked variables)."""
+    grid, observed = layout.grid, layout.observed
     spec = grid.spec
     starts = tuple(b.start for b in task.block)
     where = [(c, j, idx) for c, ch in enumerate(task.chains) for j, idx in enumerate(ch)]
@@ -93,8 +100,14 @@ def task_verdicts(
         data["extra_periods"][pos] = v.extra_periods
         rec = v.record
         if rec is None or spp != 1:
+            data["record"][pos] = RECORD_SOURCES["protocol"]
             continue
+        data["record"][pos] = rec.code
         m = data[observed[0].name][pos].shape[0]
         for ob in observed:
             data[ob.name][pos] = ob.take(rec.states[-m:], rec.observables[-m:])
+        for nm, cols, per_planet in layout.tracked:
+            lo, hi = rec.obs_min[cols], rec.obs_max[cols]
+            data[f"{nm}_min"][pos] = lo if per_planet else lo[0]
+            data[f"{nm}_max"][pos] = hi if per_planet else hi[0]
         data["final_state"][pos] = rec.final_state

@@ -3,12 +3,13 @@
 A forced gear train with clearances often has more than one attractor at the same parameters
 (a stable 1T orbit beside a chaotic attractor, two 2T orbits …); which one a simulation shows
 depends on where it starts. :func:`attractors` simulates from K initial conditions in one
-compiled call — the state at rest (the seed's start) and K − 1 states drawn (seeded) around
-the rest start's motion, each component uniform in mid ± s·range with s = 1, 2, 3, 4 in turn,
-``mid`` and ``range`` the middle and the extent of the component over the rest start's
-recorded window — integrates the largest Lyapunov exponent with each, labels each run as a
-sweep labels its points (:func:`~gearchaos.analysis.classify.classify_sections`) and groups
-the runs into distinct attractors:
+compiled call — the state at rest (the protocol's start, perturbed as the settings say) and
+K − 1 states drawn (seeded) around the rest start's motion, each component uniform in
+mid ± s·range with s = 1, 2, 3, 4 in turn, ``mid`` and ``range`` the middle and the extent of
+the component over the rest start's recorded window — decides each run's motion with the
+verdict (:func:`~gearchaos.dynamics.verdict.decide_motion`, as a sweep decides its points:
+orbits confirmed by shooting, λ₁ ± its error, transients finished) and groups the runs into
+distinct attractors:
 
 * two periodic runs are the same attractor when they have the same period n and every section
   point of one lies within ``tol`` of a section point of the other (states scaled per
@@ -33,10 +34,11 @@ from typing import Any
 import numpy as np
 
 from .._checks import check_int, check_real
+from ..analysis.orbits import PeriodicOrbit, split_values
 from ..integrate._chains import ChainRun, run_chains
 from ..integrate.settings import SolverSettings
 from ..model.target import resolve
-from .orbits import PeriodicOrbit, split_values
+from .verdict import Verdict, decide_motion
 
 __all__ = ["ATTRACTOR_SETTINGS", "Attractor", "attractors"]
 
@@ -50,9 +52,10 @@ class Attractor:
 
     Attributes
     ----------
-    label : motion label (``1T`` … ``nT``, ``QP``, ``chaos``, ``unresolved``).
+    label : motion verdict (``1T`` … ``nT``, ``QP``, ``chaos``, ``unresolved``).
     period : n for an nT label, else 0.
-    lle : largest Lyapunov exponent λ₁ per unit τ of its first run (the mean over its runs).
+    lle : largest Lyapunov exponent λ₁ per unit τ of its first run (the verdict's: exactly
+        ln max|μ|/(nT) for a confirmed orbit).
     starts : indices of the starts that reached it (0 is the start at rest).
     initial_states : (len(starts), n_state) those starts.
     final_state : the state at the end of its first run (on the section).
@@ -60,6 +63,8 @@ class Attractor:
     sections : (periods, n_obs) the observables there.
     system : the :class:`~gearchaos.model.System` (model and Ω).
     orbit : the period-n orbit shot from ``final_state`` (periodic attractors), else None.
+    verdict : the :class:`~gearchaos.dynamics.verdict.Verdict` of its first run (evidence,
+        λ₁'s error, the reason).
     """
 
     label: str
@@ -73,6 +78,7 @@ class Attractor:
     system: Any
     orbit: PeriodicOrbit | None = None
     values: Mapping[str, Any] = field(default_factory=dict)
+    verdict: Verdict | None = None
 
     @property
     def max_multiplier(self) -> float:
@@ -99,6 +105,8 @@ class Attractor:
         out: dict[str, Any] = {
             "label": self.label,
             "lle": float(self.lle),
+            "lle_error": None if self.verdict is None else self.verdict.to_dict()["lle_error"],
+            "evidence": None if self.verdict is None else self.verdict.evidence,
             "starts": [int(s) for s in self.starts],
             "x_sp1": [float(v) for v in distinct]
             if distinct.size <= 8
@@ -123,6 +131,9 @@ def _starts(system: Any, cfg: SolverSettings, k: int, seed: int) -> np.ndarray:
 
     m = system.n_state
     y0 = np.zeros((k, m))
+    rest = cfg.rest_state(m)
+    if rest is not None:
+        y0[0] = rest  # the protocol's start
     traj = integrate(system, cfg.replace(samples_per_period=16))
     st = np.asarray(traj.states, dtype=float)
     ok = np.all(np.isfinite(st), axis=1)
@@ -192,9 +203,7 @@ def attractors(
         them. Periodic ones carry their shot orbit (multipliers, stability); every one carries
         λ₁ (> 0 for chaos, < 0 for a stable orbit: ln max|μ| / nT).
     """
-    from .classify import classify_sections
-    from .lyapunov import random_tangents
-    from .orbit_batch import periodic_orbits
+    from ..analysis.orbit_batch import periodic_orbits
 
     k = check_int("starts", starts, lo=1, hi=10_000)
     check_int("seed", seed, lo=0)
@@ -204,26 +213,24 @@ def attractors(
     cfg = cfg.replace(samples_per_period=1)
     system = resolve(target, values)
     y0 = _starts(system, cfg, k, seed)
-    run = ChainRun.from_systems(
-        [[system]] * k, cfg, y0=y0, n_tangent=1, tangent_start=random_tangents(system.n_state)
-    )
+    run = ChainRun.from_systems([[system]] * k, cfg, y0=y0)
     out = run_chains(run)
-    lle = out.lyapunov(run.dt)[:, 0, 0]
     m = system.n_state
-    states = out.states[:, 0, :, :m]
-    obs = out.observables[:, 0]
-    first = system.obs_names[0]
-    nt = system.n_track
-    pair_names = [first, system.obs_names[nt]] if len(system.obs_names) > nt else [first]
-    cols = [system.obs_names.index(n) for n in pair_names]
-    labels = classify_sections(
-        obs[:, :, cols],
-        lle=lle,
-        run_periods=int(cfg.periods),
-        forcing_period=np.full(k, system.period),
+    states = out.states[:, 0, :, :m].copy()
+    obs = out.observables[:, 0].copy()
+    finals = out.final_state[:, 0, :m].copy()
+    verdicts = decide_motion(
+        target, [values] * k, [system] * k, states, finals, out.status[:, 0] == 0, cfg
     )
-    ok = out.status[:, 0] == 0
-    runs = [j for j in range(k) if ok[j]]
+    for j, v in enumerate(verdicts):
+        if v.record is not None:  # the finished record the verdict is about
+            n_rec = states.shape[1]
+            states[j] = v.record.states[-n_rec:]
+            obs[j] = v.record.observables[-n_rec:]
+            finals[j] = v.record.final_state
+    labels = [v.label for v in verdicts]
+    lle = np.array([v.lle for v in verdicts])
+    runs = [j for j in range(k) if labels[j] != "failed"]
     finite = np.concatenate([states[j] for j in runs]) if runs else np.ones((1, m))
     scale = np.maximum(1.0, np.ptp(finite, axis=0))
     groups: list[list[int]] = []
@@ -255,14 +262,15 @@ def attractors(
             Attractor(
                 label=lab,
                 period=n,
-                lle=float(np.mean(lle[g])),
+                lle=float(lle[g[0]]),
                 starts=tuple(g),
                 initial_states=y0[g],
-                final_state=out.final_state[g[0], 0, :m].copy(),
+                final_state=finals[g[0]].copy(),
                 section_states=states[g[0]].copy(),
                 sections=obs[g[0]].copy(),
                 system=system,
                 values=dict(values),
+                verdict=verdicts[g[0]],
             )
         )
     for n in sorted({a.period for a in found if a.period}):

@@ -1,0 +1,78 @@
+"""Running on from recorded states: :func:`extend` integrates K states further, with one
+random tangent vector (λ₁ and its error), and :class:`VerdictRecord` is the record that then
+replaces the original one.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..analysis.lyapunov import random_tangents
+from ..analysis.shooting import section_fraction
+from ..integrate._chains import ChainRun, run_chains
+from ..integrate.settings import SampleTimes, SolverSettings
+from ..model.system import System
+
+__all__ = ["RECORD_SOURCES", "VerdictRecord", "extend"]
+
+
+#: Where a point's shown record comes from (the flag values of a store's ``record``).
+RECORD_SOURCES = {"protocol": 0, "extension": 1, "orbit": 2}
+
+
+@dataclass(frozen=True, eq=False)
+class VerdictRecord:
+    """The section record that replaced the original one: ``states`` (m, n_state) and
+    ``observables`` (m, n_obs) at the section, ``final_state``, the extrema ``obs_min`` /
+    ``obs_max`` of the tracked observables over its window, and its ``source``:
+    ``extension`` (the run continued) or ``orbit`` (integrated from the confirmed orbit's
+    state, onto which the original record was still converging)."""
+
+    states: np.ndarray
+    observables: np.ndarray
+    final_state: np.ndarray
+    obs_min: np.ndarray
+    obs_max: np.ndarray
+    source: str = "extension"
+
+    @property
+    def code(self) -> int:
+        return RECORD_SOURCES[self.source]
+
+
+def extend(
+    systems: Sequence[System],
+    states: np.ndarray,
+    settings: SolverSettings,
+    periods: int,
+    seed: int,
+) -> Any:
+    """Integrate K states (at the section of ``settings``) ``periods`` further with one
+    random tangent vector; samples at the next ``periods`` section times."""
+    ref = systems[0]
+    K, n = len(systems), ref.n_state
+    T = np.array([s.period for s in systems])
+    t0 = (section_fraction(settings) * T)[:, None]
+    times = SampleTimes(
+        t_rec=t0 + T[:, None],
+        dt=T[:, None].copy(),
+        n_samples=int(periods),
+        t_end=t0 + periods * T[:, None],
+        max_steps=int(100_000 + 50_000 * periods),
+    )
+    run = ChainRun.from_arrays(
+        ref,
+        np.array([s.params for s in systems])[:, None, :],
+        np.array([s.switch_widths for s in systems])[:, None, :],
+        t0,
+        times,
+        settings,
+        y0=states,
+        n_tangent=1,
+        tangent_start=random_tangents(n, 1, seed=seed, points=K),
+    )
+    return run_chains(run)
