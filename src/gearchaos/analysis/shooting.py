@@ -111,10 +111,12 @@ def shoot(
     settings: SolverSettings,
     *,
     tangents: bool = True,
+    tangent_tol: float = 1.0,
 ) -> Shot:
     """Integrate C states of C systems (one kind and layout) over ``period`` forcing periods
     from their section time (:func:`section_time`) in one :func:`run_chains` call (on one
-    thread for one or two chains: waking the thread pool costs more than they take)."""
+    thread for one or two chains: waking the thread pool costs more than they take).
+    ``tangent_tol`` scales the tolerances of the monodromy's columns (1: the state's)."""
     import numba
 
     C = len(systems)
@@ -147,6 +149,7 @@ def shoot(
         y0=y,
         n_tangent=k,
         continuation=True,
+        tangent_tol=tangent_tol,
     )
     threads = numba.get_num_threads()
     # waking a thread pool costs more than one or two short chains take

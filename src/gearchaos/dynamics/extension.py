@@ -49,10 +49,14 @@ def extend(
     states: np.ndarray,
     settings: SolverSettings,
     periods: int,
-    seed: int,
+    seed: int | None,
+    *,
+    tangent_tol: float = 1.0,
 ) -> Any:
-    """Integrate K states (at the section of ``settings``) ``periods`` further with one
-    random tangent vector; samples at the next ``periods`` section times."""
+    """Integrate K states (at the section of ``settings``) ``periods`` further, with one
+    random tangent vector from ``default_rng(seed)`` (none when ``seed`` is None) whose
+    tolerances are ``tangent_tol`` times the state's; samples at the next ``periods``
+    section times."""
     ref = systems[0]
     K, n = len(systems), ref.n_state
     T = np.array([s.period for s in systems])
@@ -72,7 +76,8 @@ def extend(
         times,
         settings,
         y0=states,
-        n_tangent=1,
-        tangent_start=random_tangents(n, 1, seed=seed, points=K),
+        n_tangent=0 if seed is None else 1,
+        tangent_start=None if seed is None else random_tangents(n, 1, seed=seed, points=K),
+        tangent_tol=tangent_tol,
     )
     return run_chains(run)

@@ -118,6 +118,15 @@ class VerdictSettings:
         slowly contracting motion QP.
     budget_periods
         Most periods added to a point by extensions.
+    newton_iterations
+        Newton iterations for a record that repeats, and for one that converges onto or
+        lingers near an orbit (its final state is farther away; a miss is retried with the
+        next record, after an extension).
+    tangent_tol
+        Factor on the integrator's tolerances for the tangent vectors (the monodromy's
+        columns, the extension's Lyapunov vector): multipliers and λ₁ need a few digits, not
+        the state's ten; 100 makes a tangent period about half as costly as at 1 and moves
+        max |μ| by about 10⁻⁶, far inside ``margin``.
     blocks, confidence
         Block means of the λ₁ error estimate, and the half-width c of its interval in
         standard errors.
@@ -137,6 +146,8 @@ class VerdictSettings:
     extension_periods: int | None = None
     min_extension: int = 100
     budget_periods: int = 400
+    tangent_tol: float = 100.0
+    newton_iterations: tuple[int, int] = (6, 4)
     blocks: int = LYAPUNOV_BLOCKS
     confidence: float = 2.0
     lle_c: float = LLE_C
@@ -154,6 +165,14 @@ class VerdictSettings:
             check_int("extension_periods", self.extension_periods, lo=2 * self.blocks + 1)
         check_int("min_extension", self.min_extension, lo=2 * self.blocks + 1, hi=10**6)
         check_int("budget_periods", self.budget_periods, lo=0, hi=10**7)
+        check_real("tangent_tol", self.tangent_tol, lo=1.0, hi=1e6)
+        if not (isinstance(self.newton_iterations, tuple) and len(self.newton_iterations) == 2):
+            raise ParameterError(
+                "newton_iterations must be a pair (repeating record, converging record): "
+                f"got {self.newton_iterations!r}"
+            )
+        for it in self.newton_iterations:
+            check_int("newton_iterations", it, lo=1, hi=100)
         check_int("blocks", self.blocks, lo=2, hi=1000)
         check_real("confidence", self.confidence, lo=0.0, lo_open=True)
         check_real("lle_c", self.lle_c, lo=0.0, lo_open=True)
@@ -278,15 +297,16 @@ def _shoot_candidates(
     from ..analysis.orbit_batch import periodic_orbits
 
     finish: list[int] = []  # confirmed while the record was converging: show the orbit
-    for n in sorted({c[0] for c in cands.values()}):
-        idx = [k for k, c in cands.items() if c[0] == n]
+    for n, how in sorted(set(cands.values())):
+        idx = [k for k, c in cands.items() if c == (n, how)]
         orbits = periodic_orbits(
             target,
             [values[k] for k in idx],
             period=n,
             guesses=np.array([pts[k].final for k in idx]),
             settings=settings,
-            max_iterations=8,
+            max_iterations=vs.newton_iterations[how == "approach"],
+            tangent_tol=vs.tangent_tol,
         )
         for k, orb in zip(idx, orbits, strict=True):
             p = pts[k]
@@ -337,7 +357,7 @@ def _shoot_candidates(
         n_state = systems[0].n_state
         m = max(pts[k].sections.shape[0] for k in finish)
         ys = np.array([done[k].orbit_state for k in finish])
-        out = extend([systems[k] for k in finish], ys, settings, max(m, 2), vs.seed)
+        out = extend([systems[k] for k in finish], ys, settings, max(m, 2), None)
         for i, k in enumerate(finish):
             if int(out.status[i, 0]) != 0:
                 continue
@@ -535,7 +555,12 @@ def decide_motion(
                 y = y + 1e-3 * max(1.0, float(np.max(np.abs(y)))) * p.unstable[2]
             starts.append(y)
         out = extend(
-            [systems[k] for k in todo], np.array(starts), settings, ext_periods, vs.seed + r
+            [systems[k] for k in todo],
+            np.array(starts),
+            settings,
+            ext_periods,
+            vs.seed + r,
+            tangent_tol=vs.tangent_tol,
         )
         n_state = systems[0].n_state
         stretch = out.stretch(n_state)

@@ -32,7 +32,8 @@ class ChainRun:
     vectors); ``P`` (C, L, n_par) packed parameters; ``SW`` (C, L, n_track) dead-zone half
     widths; ``t0``, ``t_rec``, ``dt``, ``t_end`` (C, L) start, first sample, sample interval
     and end times; ``settle_spp`` the samples per period when the transient may end early
-    (``settle="auto"``), else 0.
+    (``settle="auto"``), else 0; ``tangent_tol`` the factor on the error tolerances of the
+    tangent components (1: those of the state).
     """
 
     kind: int
@@ -55,6 +56,7 @@ class ChainRun:
     h_init: float = -1.0
     max_step: float = np.inf
     settle_spp: int = 0
+    tangent_tol: float = 1.0
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -74,6 +76,7 @@ class ChainRun:
         first_step: float | None = None,
         max_step: float = np.inf,
         tangent_start: np.ndarray | None = None,
+        tangent_tol: float = 1.0,
     ) -> ChainRun:
         """Pack chains of systems (one kind and parameter layout) with their sample times.
 
@@ -111,6 +114,7 @@ class ChainRun:
             first_step=first_step,
             max_step=max_step,
             tangent_start=tangent_start,
+            tangent_tol=tangent_tol,
         )
 
     @classmethod
@@ -129,13 +133,15 @@ class ChainRun:
         first_step: float | None = None,
         max_step: float = np.inf,
         tangent_start: np.ndarray | None = None,
+        tangent_tol: float = 1.0,
     ) -> ChainRun:
         """A run from packed parameters ``P`` and switch widths ``SW`` (C, L, …) of systems
         like ``ref``, start times ``t0`` and sample times (C, L): the one place a run is laid
         out, for callers that pack their own points (shooting, a hot path). ``y0`` None starts
         from rest (:meth:`~gearchaos.integrate.settings.SolverSettings.rest_state`);
         ``tangent_start`` (k × n, or C × k × n) gives the tangent vectors' start, made
-        orthonormal at the first sample (default: the first k basis vectors)."""
+        orthonormal at the first sample (default: the first k basis vectors); ``tangent_tol``
+        scales the error tolerances of the tangent components (1: the state's)."""
         C = P.shape[0]
         n = ref.n_state
         k = int(n_tangent)
@@ -167,6 +173,7 @@ class ChainRun:
             h_init=-1.0 if first_step is None else float(first_step),
             max_step=float(max_step),
             settle_spp=int(settings.samples_per_period) if settings.settle == "auto" else 0,
+            tangent_tol=float(tangent_tol),
         )
 
     @classmethod
@@ -290,16 +297,18 @@ def run_chains(run: ChainRun, *, single_thread: bool = False) -> ChainOutput:
     numbers = (
         int(ns), int(run.n_obs), int(run.n_track), int(run.n_state), float(run.rtol),
         float(run.atol), float(run.h_init), float(run.max_step), int(run.max_steps),
-        bool(run.continuation), int(run.settle_spp),
+        bool(run.continuation), int(run.settle_spp), float(run.tangent_tol),
     )  # fmt: skip
 
     def args(lo: int, hi: int) -> tuple[Any, ...]:
         """The kernel's arguments for chains lo … hi − 1 (C-contiguous views)."""
         Y0, P, SW, t0, t_rec, dt, t_end = (x[lo:hi] for x in inputs)
-        ns_, n_obs, n_track, n_state, rtol, atol, h_init, max_step, max_steps, cont, spp = numbers
+        ns_, n_obs, n_track, n_state, rtol, atol, h_init, max_step, max_steps, cont, spp, ttol = (
+            numbers
+        )
         return (
             Y0, P, SW, t0, t_rec, dt, ns_, t_end, n_obs, n_track, n_state, rtol, atol, h_init,
-            max_step, max_steps, cont, *(x[lo:hi] for x in outputs), spp,
+            max_step, max_steps, cont, *(x[lo:hi] for x in outputs), spp, ttol,
         )  # fmt: skip
 
     entry = entry_point(dopri_chains, run.kind, *args(0, C))

@@ -217,8 +217,9 @@ def dopri_run(
 ):  # pragma: no cover - compiled
     """Integrate one system; fill the output arrays ``out`` = (out_t, out_y, out_obs,
     obs_min, obs_max, y_final); return the status code. ``cfg`` = (n_samples, n_obs, n_track,
-    n_base, rtol, atol, h_init, max_step, max_steps, settle_spp): the numbers every point of a
-    run shares, one tuple so that their list is written once (:func:`dopri_chains`).
+    n_base, rtol, atol, h_init, max_step, max_steps, settle_spp, tan_tol): the numbers every
+    point of a run shares, one tuple so that their list is written once
+    (:func:`dopri_chains`). ``tan_tol`` scales the error tolerances of the tangent components.
 
     Samples are taken at τ_j = t_rec + j·dt_sample, j = 0 … n_samples−1 (t_rec ≥ t0), then the
     integration goes on to t_end ≥ τ_last. Extrema of obs[:n_track] are tracked over
@@ -245,7 +246,10 @@ def dopri_run(
     to the tolerance, not bitwise.
     """
     numba.literally(kind)
-    n_samples, n_obs, n_track, n_base, rtol, atol, h_init, max_step, max_steps, settle_spp = cfg
+    n_samples, n_obs, n_track, n_base, rtol, atol, h_init, max_step, max_steps, settle_spp = cfg[
+        :10
+    ]
+    tan_tol = cfg[10]
     out_t, out_y, out_obs, obs_min, obs_max, y_final = out
     y, yt, K, obs, hist, t_hist, ring, runs, f1, o1 = ws
     n = y0.size
@@ -399,7 +403,10 @@ def dopri_run(
                 E1 * K[0, i] + E3 * K[2, i] + E4 * K[3, i] + E5 * K[4, i] + E6 * K[5, i]
                 + E7 * K[6, i]
             )  # fmt: skip
-            r = e / (atol + rtol * max(abs(y[i]), abs(yt[i])))
+            sc = atol + rtol * max(abs(y[i]), abs(yt[i]))
+            if i >= n_base:
+                sc *= tan_tol  # the tangent vectors' own tolerance (1: the state's)
+            r = e / sc
             acc += r * r + 0.0 * yt[i]
         err = math.sqrt(acc / n)
 
@@ -525,6 +532,7 @@ def dopri_chains(
     status,
     LSUM,
     settle_spp,
+    tan_tol,
 ):  # pragma: no cover - compiled
     """Chains of integrations, one chain after another, points of a chain in order: the one
     compiled entry point of the integrator (single runs are chains of length one). It releases
@@ -543,7 +551,10 @@ def dopri_chains(
     numba.literally(kind)
     n_chains = P.shape[0]
     length = P.shape[1]
-    cfg = (n_samples, n_obs, n_track, n_base, rtol, atol, h_init, max_step, max_steps, settle_spp)
+    cfg = (
+        n_samples, n_obs, n_track, n_base, rtol, atol, h_init, max_step, max_steps, settle_spp,
+        tan_tol,
+    )  # fmt: skip
     ws = workspace(Y0.shape[1], n_obs, n_track, n_base)
     for c in range(n_chains):
         y = Y0[c].copy()

@@ -370,63 +370,72 @@ planetary_rhs = _planetary_rhs(0)
 # needs from ``obs``. V holds k tangent vectors in y[n:], row after row.
 
 
-@njit_noalloc
-def planetary_tangent(t, y, p, obs, dydt, n, k):  # pragma: no cover - compiled
-    N = int(p[P_N])
-    nd = N + 3
-    csp = p[P_CSP]
-    crp = p[P_CRP]
-    bsp = p[P_BSP]
-    brp = p[P_BRP]
-    inv_mus = p[P_INV_MUS]
-    inv_mup = p[P_INV_MUP]
-    inv_muc = p[P_INV_MUC]
-    cas = p[P_COS_AS]
-    car = p[P_COS_AR]
-    kb = p[P_KB] * engaged(obs[2 * N], p[P_BS])
-    kby = p[P_KB] * engaged(obs[2 * N + 1], p[P_BS])
-    cb = p[P_CS]
-    inv_ms = p[P_INV_MU_S]
-    for r in range(k):
-        o = n + r * n
-        xv = y[o]
-        yv = y[o + 1]
-        sv = y[o + N + 2]
-        xdv = y[o + nd]
-        ydv = y[o + nd + 1]
-        sdv = y[o + nd + N + 2]
-        sum_fsp = 0.0
-        sum_frp = 0.0
-        sum_fx = 0.0
-        sum_fy = 0.0
-        for i in range(N):
-            si, ci = _planet_direction(p, N, i)
-            pv = y[o + 2 + i]
-            pdv = y[o + nd + 2 + i]
-            dsp = pv - xv * si + yv * ci
-            dsp_d = pdv - xdv * si + ydv * ci
-            drp = sv - pv
-            drp_d = sdv - pdv
-            fsp = obs[10 * N + 4 + i] * engaged(obs[i], bsp) * dsp + csp * dsp_d
-            frp = obs[11 * N + 4 + i] * engaged(obs[N + i], brp) * drp + crp * drp_d
-            dydt[o + nd + 2 + i] = (frp - fsp) * inv_mup  # completed below
-            sum_fsp += fsp
-            sum_frp += frp
-            sum_fx += fsp * si
-            sum_fy -= fsp * ci
-        qs = -sum_fsp * inv_mus
-        qc = (cas * sum_fsp + car * sum_frp) * inv_muc
-        for j in range(nd):
-            dydt[o + j] = y[o + nd + j]
-        dydt[o + nd] = (sum_fx - cb * xdv - kb * xv) * inv_ms
-        dydt[o + nd + 1] = (sum_fy - cb * ydv - kby * yv) * inv_ms
-        for i in range(N):
-            dydt[o + nd + 2 + i] += qs - cas * qc
-        dydt[o + nd + N + 2] = qs - (cas + car) * qc
+def _planetary_tangent(n_fixed):
+    """The planetary tangent kernel for any planet count (``n_fixed`` = 0) or compiled for
+    ``n_fixed`` planets, as :func:`_planetary_rhs`."""
+
+    @njit_noalloc
+    def planetary_tangent(t, y, p, obs, dydt, n, k):  # pragma: no cover - compiled
+        N = n_fixed if n_fixed > 0 else int(p[P_N])
+        nd = N + 3
+        csp = p[P_CSP]
+        crp = p[P_CRP]
+        bsp = p[P_BSP]
+        brp = p[P_BRP]
+        inv_mus = p[P_INV_MUS]
+        inv_mup = p[P_INV_MUP]
+        inv_muc = p[P_INV_MUC]
+        cas = p[P_COS_AS]
+        car = p[P_COS_AR]
+        kb = p[P_KB] * engaged(obs[2 * N], p[P_BS])
+        kby = p[P_KB] * engaged(obs[2 * N + 1], p[P_BS])
+        cb = p[P_CS]
+        inv_ms = p[P_INV_MU_S]
+        for r in range(k):
+            o = n + r * n
+            xv = y[o]
+            yv = y[o + 1]
+            sv = y[o + N + 2]
+            xdv = y[o + nd]
+            ydv = y[o + nd + 1]
+            sdv = y[o + nd + N + 2]
+            sum_fsp = 0.0
+            sum_frp = 0.0
+            sum_fx = 0.0
+            sum_fy = 0.0
+            for i in range(N):
+                si, ci = _planet_direction(p, N, i)
+                pv = y[o + 2 + i]
+                pdv = y[o + nd + 2 + i]
+                dsp = pv - xv * si + yv * ci
+                dsp_d = pdv - xdv * si + ydv * ci
+                drp = sv - pv
+                drp_d = sdv - pdv
+                fsp = obs[10 * N + 4 + i] * engaged(obs[i], bsp) * dsp + csp * dsp_d
+                frp = obs[11 * N + 4 + i] * engaged(obs[N + i], brp) * drp + crp * drp_d
+                dydt[o + nd + 2 + i] = (frp - fsp) * inv_mup  # completed below
+                sum_fsp += fsp
+                sum_frp += frp
+                sum_fx += fsp * si
+                sum_fy -= fsp * ci
+            qs = -sum_fsp * inv_mus
+            qc = (cas * sum_fsp + car * sum_frp) * inv_muc
+            for j in range(nd):
+                dydt[o + j] = y[o + nd + j]
+            dydt[o + nd] = (sum_fx - cb * xdv - kb * xv) * inv_ms
+            dydt[o + nd + 1] = (sum_fy - cb * ydv - kby * yv) * inv_ms
+            for i in range(N):
+                dydt[o + nd + 2 + i] += qs - cas * qc
+            dydt[o + nd + N + 2] = qs - (cas + car) * qc
+
+    return planetary_tangent
+
+
+planetary_tangent = _planetary_tangent(0)
 
 
 _TANGENTS = {
-    **{planetary_kind(n): planetary_tangent for n in PLANETARY_FIXED_N},
+    **{planetary_kind(n): _planetary_tangent(n) for n in PLANETARY_FIXED_N},
     KIND_PLANETARY: planetary_tangent,
     KIND_BACKLASH_OSCILLATOR: backlash_oscillator_tangent,
     KIND_LINEAR: linear_tangent,
