@@ -117,7 +117,8 @@ class VerdictSettings:
         shrinks with the extension's duration t, and a short one (θ large) would call a
         slowly contracting motion QP.
     budget_periods
-        Most periods added to a point by extensions.
+        Most periods added to a point by extensions (one extension always runs: an
+        undecided point needs λ₁).
     newton_iterations
         Newton iterations for a record that repeats, and for one that converges onto or
         lingers near an orbit (its final state is farther away; a miss is retried with the
@@ -505,7 +506,8 @@ def decide_motion(
         else:
             pts[k] = _Point(sections=sec[k], final=fin[k].copy())
     ext_periods = vs.extension_for(sec.shape[1])
-    rounds = vs.budget_periods // ext_periods
+    # one extension at least (λ₁ needs one), more within the budget
+    rounds = max(1, vs.budget_periods // ext_periods)
     for r in range(rounds + 1):
         live = [k for k in pts if k not in done]
         if not live:
@@ -589,4 +591,8 @@ def decide_motion(
                 out.obs_min[i, 0].copy(),
                 out.obs_max[i, 0].copy(),
             )
+    for k in pts:  # not reached: the last round decides every point it extends
+        done.setdefault(
+            k, Verdict("unresolved", 0, "ambiguous", reason="not decided within the budget")
+        )
     return [done[k] for k in range(K)]

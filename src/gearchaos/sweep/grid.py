@@ -143,8 +143,8 @@ class Grid:
         return ChainRun.from_systems(
             systems,
             spec.solver,
-            n_tangent=int(spec.lyapunov),
+            n_tangent=int(spec.recorded_lyapunov),
             continuation=spec.initial_conditions == "continuation",
             # the random start of max_lyapunov: one λ₁ for a point, whatever computes it
-            tangent_start=random_tangents(n, 1) if spec.lyapunov else None,
+            tangent_start=random_tangents(n, 1) if spec.recorded_lyapunov else None,
         )

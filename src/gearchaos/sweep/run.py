@@ -148,7 +148,7 @@ class _Layout:
             data[SKIPPED] = np.full(bshape, -1, dtype=np.int64)
         n_st = len(self.state_names)
         data["final_state"] = np.full((*bshape, n_st), np.nan)
-        if spec.lyapunov:
+        if spec.recorded_lyapunov:
             data["lle"] = np.full(bshape, np.nan)
             lle = out.lyapunov(run.dt)
         spp = int(spec.solver.samples_per_period)  # > 1 only in response sweeps
@@ -179,7 +179,7 @@ class _Layout:
                 if settle:
                     data[SKIPPED][pos] = int(out.info[c, j, 4])
                 data["final_state"][pos] = out.final_state[c, j, :n_st]
-                if spec.lyapunov:
+                if spec.recorded_lyapunov:
                     data["lle"][pos] = lle[c, j, 0]
         if spec.verdicts:
             task_verdicts(self, task, out, data)
@@ -357,7 +357,7 @@ def _check_sizes(grid: Grid, variables: dict[str, Any], path: str | None) -> Non
 
     ref = grid.reference
     per_point = grid.spec.solver.n_samples * (
-        ref.n_state * (1 + int(grid.spec.lyapunov)) + ref.n_obs + 1
+        ref.n_state * (1 + int(grid.spec.recorded_lyapunov)) + ref.n_obs + 1
     )
     largest = int(np.prod(grid.chunks))  # points of the largest task
     check_memory(f"one task of the sweep ({largest} points)", 8.0 * per_point * largest)

@@ -345,6 +345,12 @@ class SweepSpec:
         check_bool("orbits", self.orbits)
         check_bool("verdicts", self.verdicts)
 
+    @property
+    def recorded_lyapunov(self) -> bool:
+        """Whether the kernel integrates λ₁ over the recorded window (``lyapunov`` without
+        ``verdicts``: with verdicts, the verdict supplies every point's λ₁ and its error)."""
+        return bool(self.lyapunov and not self.verdicts)
+
     @classmethod
     def build(
         cls,
