@@ -11,6 +11,7 @@ by the same number of periods, so the record shown is the one the verdict is abo
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -121,19 +122,30 @@ def analyse_point(
         return PointAnalysis(result, lle, lstatus, summary)
     v = point_verdict(target, values, result, vs)
     if v.record is not None and v.label != "failed":
-        # the record shown is the finished one the verdict is about
-        if v.orbit_state is not None and section_fraction(cfg) == 0.0:
-            # the confirmed orbit: the same protocol started on it (τ = 0 is on its section)
-            result = run_simulation(system, cfg, y0=v.orbit_state, check=check)
-        else:
-            extra = float(v.extra_periods or v.record.states.shape[0])
-            longer = cfg.replace(transient_periods=float(cfg.transient_periods) + extra)
-            result = run_simulation(system, longer, check=check)
+        result = _finished(system, cfg, v, check)
     lle = v.lle if math.isfinite(v.lle) else None
     summary = summarize(result, verdict=v.to_dict())
     if not result.status.ok:
         summary["motion"] = "failed"
     return PointAnalysis(result, lle, Status.OK, summary, v)
+
+
+def _finished(system: Any, cfg: SolverSettings, v: Verdict, check: bool) -> SimulationResult:
+    """The record the verdict is about, with the protocol's samples: the recorded window
+    integrated again from where the verdict's record starts — on the confirmed orbit (a
+    record that was still converging onto it), or ``periods`` sections before the end of the
+    extension — at the section time; its settings say the transient the record follows."""
+    assert v.record is not None
+    m = int(cfg.periods)
+    if v.record.source == "orbit" and v.orbit_state is not None:
+        start = v.orbit_state
+    else:
+        start = v.record.states[max(0, v.record.states.shape[0] - m)]
+    window = cfg.replace(transient_periods=0.0, section_phase=0.0)
+    tau_s = section_fraction(cfg) * system.period
+    result = run_simulation(system, window, y0=start, t0=tau_s, check=check)
+    shown = cfg.replace(transient_periods=float(cfg.transient_periods) + v.extra_periods)
+    return dataclasses.replace(result, solver=shown)
 
 
 def _verdict_settings(verdict: Any) -> VerdictSettings | None:

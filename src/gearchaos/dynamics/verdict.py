@@ -20,11 +20,13 @@ asks them, for K points at once (a sweep task, or one point):
    ``extension_periods`` at a time, with one tangent vector from a seeded random start; λ₁
    and its standard error σ come from block means
    (:func:`~gearchaos.analysis.lyapunov.exponent_estimate`). The new record goes back to
-   step 1 (a transient may now have finished). Without a confirmed period:
-   ``chaos`` when λ₁ − cσ > 0 and λ₁ > θ; ``QP`` when λ₁ + cσ ≥ 0 and λ₁ ≤ θ (no
-   contraction, no growth beyond a regular attractor's finite-time bias θ = c_θ/t, t the
-   extension's duration, :func:`~gearchaos.analysis.classify.lle_threshold_for`); a
-   contracting exponent (λ₁ + cσ < 0) or an interval across θ is extended again, within
+   step 1 (a transient may now have finished). Without a confirmed period, with θ = c_θ/t
+   the finite-time bias bound of a regular attractor (t the extension's duration,
+   :func:`~gearchaos.analysis.classify.lle_threshold_for`) and K the 0–1 test of the
+   extension's record: ``chaos`` when λ₁ − cσ > 0 and (λ₁ > θ or K > 0.8); ``QP`` when
+   λ₁ + cσ ≥ 0, λ₁ ≤ θ, K ≤ 0.8 and (the interval holds 0 or K < 0.2). Anything else — a
+   contracting exponent (λ₁ + cσ < 0), a positive interval below θ that the 0–1 test does not
+   settle — is extended again (θ shrinks like 1/t, a torus's estimate like ln t / t), within
    ``budget_periods``. A candidate period n > ``max_period`` (too long to shoot) is labelled
    nT when the record repeats and λ₁ + cσ < 0 (a contracting periodic attractor).
 4. **Unresolved, with its reason**, when the budget is spent: contracting without a period
@@ -50,7 +52,7 @@ import numpy as np
 from .._checks import check_int, check_real
 from ..analysis.chaos01 import MIN_LENGTH as MIN_LENGTH_01
 from ..analysis.chaos01 import chaos01
-from ..analysis.classify import LLE_C
+from ..analysis.classify import K_CHAOS, K_REGULAR, LLE_C
 from ..analysis.lyapunov import LYAPUNOV_BLOCKS, exponent_estimate
 from ..analysis.periodicity import periods_of
 from ..analysis.recurrence import (
@@ -318,7 +320,13 @@ def _shoot_candidates(
             mu = mu_n ** (d / n)
             secs = orb.sections
             scale = max(1.0, float(np.max(np.abs(orb.state))))
-            near = float(distance_to_orbit(p.final, secs)) <= vs.same_orbit * scale
+            gap = float(distance_to_orbit(p.final, secs))
+            near = gap <= vs.same_orbit * scale
+            # settled: the whole record on the orbit to the integration's noise floor (else the
+            # orbit's own record is shown, not one still converging within the tolerance)
+            if p.sections.shape[1] == secs.shape[1]:
+                gap = max(gap, float(np.max(distance_to_orbit(p.sections, secs))))
+            settled = gap <= vs.noise_factor * (settings.atol + settings.rtol * scale)
             repeat = cands[k][1] == "repeat"
             if repeat:
                 follows = near
@@ -330,7 +338,7 @@ def _shoot_candidates(
                 T = systems[k].period
                 how = (
                     "the record repeats with this period"
-                    if repeat
+                    if repeat and settled
                     else "the record was still converging onto it"
                 )
                 done[k] = Verdict(
@@ -348,7 +356,7 @@ def _shoot_candidates(
                     record=p.record,
                     orbit_state=orb.state.copy(),
                 )
-                if not repeat:
+                if not (repeat and settled):
                     finish.append(k)
             elif mu >= 1.0 - vs.margin and near and repeat:
                 w, v = np.linalg.eig(orb.monodromy)
@@ -400,26 +408,31 @@ def _decide_by_exponent(k: int, p: _Point, vs: VerdictSettings, last: bool) -> V
             reason=f"the record repeats with period {n} (too long to shoot) and {text} < 0",
             **common,
         )
-    if lo > 0 and lam > theta:
+    kk = f"0–1 test K = {k01:.3g}" if math.isfinite(k01) else "no 0–1 test"
+    chaotic01 = math.isfinite(k01) and k01 > K_CHAOS
+    regular01 = math.isfinite(k01) and k01 < K_REGULAR
+    if lo > 0 and (lam > theta or chaotic01):
+        why = "λ₁ > θ" if lam > theta else f"{kk} > {K_CHAOS} (λ₁ ≤ θ)"
         return Verdict(
             label="chaos",
             period=0,
             evidence="lyapunov",
-            reason=f"no period ≤ {vs.longest_period} confirmed; {text}: λ₁ − {c:g}σ > 0 and λ₁ > θ",
+            reason=f"no period ≤ {vs.longest_period} confirmed; {text}: λ₁ − {c:g}σ > 0, {why}",
             **common,
         )
-    if hi >= 0 and lam <= theta and p.unstable is None:
-        return Verdict(
-            label="QP",
-            period=0,
-            evidence="lyapunov",
-            reason=(
-                f"no period ≤ {vs.longest_period} and no converging orbit; {text}: "
-                f"λ₁ + {c:g}σ ≥ 0 and λ₁ ≤ θ (no contraction, no growth beyond a regular "
-                "attractor's finite-time bias)"
-            ),
-            **common,
-        )
+    if hi >= 0 and lam <= theta and p.unstable is None and (lo <= 0 or regular01):
+        if not chaotic01:
+            why = "the interval holds 0" if lo <= 0 else f"{kk} < {K_REGULAR}"
+            return Verdict(
+                label="QP",
+                period=0,
+                evidence="lyapunov",
+                reason=(
+                    f"no period ≤ {vs.longest_period} and no converging orbit; {text}: "
+                    f"λ₁ ≤ θ, the finite-time bias bound of a regular attractor, and {why}"
+                ),
+                **common,
+            )
     if not last:
         return None
     if p.unstable is not None:

@@ -187,11 +187,17 @@ def simulate(
 
 
 def run_simulation(
-    system: System, settings: SolverSettings, *, y0: Any = None, check: bool = True
+    system: System,
+    settings: SolverSettings,
+    *,
+    y0: Any = None,
+    t0: float = 0.0,
+    check: bool = True,
 ) -> SimulationResult:
-    """:func:`simulate` of a resolved system with given settings (the library's own door)."""
+    """:func:`simulate` of a resolved system with given settings (the library's own door),
+    from ``y0`` at τ = ``t0``."""
     system.warn_for("Poincaré section")
-    traj = integrate(system, settings, y0=y0)
+    traj = integrate(system, settings, y0=y0, t0=t0)
     result = SimulationResult.from_trajectory(traj)
     if check and not traj.ok:
         err = IntegrationError(

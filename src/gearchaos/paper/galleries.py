@@ -79,6 +79,12 @@ ROW_KEYS = (
 )
 
 
+def start_text(settings: SolverSettings) -> str:
+    """How a run starts, for a figure title: "start at rest (perturbed by 1e-06)"."""
+    eps = float(settings.perturbation)
+    return f"start at rest (perturbed by {eps:g})" if eps else "exact zero initial state"
+
+
 # --------------------------------------------------------------------------- runner
 def _finite(v: Any) -> float | None:
     if v is None:
@@ -219,7 +225,7 @@ def run_gallery(
             title += "\nat " + ", ".join(given)
         title += (
             f"\n{settings.transient_periods:g} transient + {settings.periods} recorded periods, "
-            "zero initial state"
+            f"{start_text(settings)}; labels and λ₁ from the motion verdict"
         )
     fig = poincare_gallery(
         results, summaries, param=param, values=vals, with_=extras, planet=planet, title=title
@@ -304,7 +310,8 @@ class Gallery:
         text = (
             f"Fig. {number}: Poincaré maps of $\\bar{{X}}_{{sp1}}$ versus "
             f"$\\bar{{X}}'_{{sp1}}$ at {given} and different ${tex(self.param)}$\n"
-            f"{tr} transient + {rec} recorded mesh periods, zero initial state"
+            f"{tr} transient + {rec} recorded mesh periods, "
+            f"{start_text(GALLERY_SETTINGS)}; labels and λ₁ from the motion verdict"
         )
         return text + (" (quick)" if quick else "")
 

@@ -35,6 +35,9 @@ __all__ = [
 CLEARANCE_NOTE_GID = "clearance-note"
 #: Margin around the data range, as a fraction of it.
 MARGIN = 0.05
+#: Margin of data with at most SPARSE distinct values (the points of a short periodic orbit).
+SPARSE = 8
+SPARSE_MARGIN = 0.25
 
 
 @dataclass(frozen=True)
@@ -145,7 +148,9 @@ def data_range(
     """[lo, hi] of the finite values widened by ``margin`` of their span. A span below 10⁻⁶ of
     the largest magnitude (``mag``, default the values') shows ±5 % of that magnitude around
     the centre (±1 around zero): a periodic point spread by integration noise (≈ rtol ≤ 10⁻⁸
-    of it) stays a point, while two section values 10⁻⁴ apart (a narrow 2T) stay two."""
+    of it) stays a point, while two section values 10⁻⁴ apart (a narrow 2T) stay two. Values
+    that take at most ``SPARSE`` distinct levels (to 10⁻³ of their span: the points of an nT
+    orbit) get ``SPARSE_MARGIN`` of their span, so that no point sits on the frame."""
     v = np.asarray(values, dtype=np.float64).ravel()
     v = v[np.isfinite(v)]
     if v.size == 0:
@@ -156,7 +161,8 @@ def data_range(
         centre = 0.5 * (lo + hi)
         half = 0.05 * m if m > 0 else 1.0
         return centre - half, centre + half
-    pad = margin * (hi - lo)
+    levels = np.unique(np.round((v - lo) / (hi - lo), 3)).size
+    pad = (SPARSE_MARGIN if levels <= SPARSE else margin) * (hi - lo)
     return lo - pad, hi + pad
 
 
