@@ -192,3 +192,22 @@ def test_a_record_longer_than_the_budget_is_still_decided() -> None:
     cfg = SolverSettings(transient_periods=50, periods=500, perturbation=1e-6)
     v, _ = _verdict(2.0, cfg)
     assert v.label == "chaos" and v.extra_periods == 500 and v.lle - 2 * v.lle_error > 0
+
+
+def test_the_explorer_computes_the_label_the_sweep_stored(tmp_path) -> None:
+    # the explorer's panel shows the stored verdict and, on demand, recomputes the point
+    # through analyse_point with the store's protocol: the two must agree
+    from gearchaos import sweep
+    from gearchaos.explore.compute import compute_point
+
+    path = tmp_path / "w.zarr"
+    omegas = (1.5, 2.0, 3.5)
+    ds = sweep.bifurcation(
+        GS, {"omega": list(omegas)}, store=path, progress=False, transient_periods=100, periods=100
+    )
+    for i, omega in enumerate(omegas):
+        out = compute_point(str(path), {"omega": omega})
+        assert out["motion"] == str(ds.motion.values[i]), omega
+        assert out["summary"]["evidence"] == (
+            "floquet" if out["motion"].endswith("T") else "lyapunov"
+        )

@@ -45,6 +45,21 @@ class Task:
     def n_points(self) -> int:
         return sum(len(c) for c in self.chains)
 
+    @property
+    def shape(self) -> tuple[int, ...]:
+        """Shape of the task's block of the grid."""
+        return tuple(b.stop - b.start for b in self.block)
+
+    def points(self) -> list[tuple[int, int, tuple[int, ...], tuple[int, ...]]]:
+        """Every point in run order: (chain, place in the chain, grid index, index within the
+        task's block)."""
+        starts = tuple(b.start for b in self.block)
+        return [
+            (c, j, idx, tuple(i - s for i, s in zip(idx, starts, strict=True)))
+            for c, chain in enumerate(self.chains)
+            for j, idx in enumerate(chain)
+        ]
+
 
 class Grid:
     """Maps grid indices to systems and lays out tasks for a spec and a target."""

@@ -160,9 +160,8 @@ def task_orbits(
     (written with them). ``observed`` are the sweep's observables (the first two give the
     section pairs of the label, first observed planet, as :func:`classify_store` reads them)."""
     spec = grid.spec
-    starts = tuple(b.start for b in task.block)
-    where = [(c, j, idx) for c, ch in enumerate(task.chains) for j, idx in enumerate(ch)]
-    pos = [tuple(i - s for i, s in zip(idx, starts, strict=True)) for *_, idx in where]
+    where = task.points()
+    pos = [p for *_, p in where]
     pairs = []
     for ob in observed[:2]:
         v = np.stack([data[ob.name][p] for p in pos])
@@ -173,16 +172,16 @@ def task_orbits(
         np.array([data["status"][p] for p in pos]),
         lle=lle,
         run_periods=int(spec.solver.periods),
-        forcing_period=np.array([run.dt[c, j] for c, j, _ in where]),
+        forcing_period=np.array([run.dt[c, j] for c, j, *_ in where]),
     )
     found = orbit_checks(
         grid.target,
-        [grid.values_at(idx) for *_, idx in where],
+        [grid.values_at(idx) for _, _, idx, _ in where],
         periods,
         np.stack([data["final_state"][p] for p in pos]),
         spec.solver,
     )
-    out = empty(tuple(b.stop - b.start for b in task.block))
+    out = empty(task.shape)
     for k, p in enumerate(pos):
         for nm in out:
             out[nm][p] = found[nm][k]

@@ -126,11 +126,19 @@ class _Layout:
             chunks.update(rc)
         return var, chunks
 
+    def put_extrema(
+        self, data: dict[str, np.ndarray], pos: tuple[int, ...], lo: np.ndarray, hi: np.ndarray
+    ) -> None:
+        """Write the extrema ``lo``/``hi`` of the tracked observables (one run's obs_min and
+        obs_max) into the ``*_min``/``*_max`` block arrays at ``pos``."""
+        for nm, cols, per_planet in self.tracked:
+            data[f"{nm}_min"][pos] = lo[cols] if per_planet else lo[cols][0]
+            data[f"{nm}_max"][pos] = hi[cols] if per_planet else hi[cols][0]
+
     def extract(self, task: Task, run: ChainRun, out: ChainOutput) -> dict[str, np.ndarray]:
         """Block arrays of every variable for one finished task."""
         spec = self.grid.spec
-        bshape = tuple(b.stop - b.start for b in task.block)
-        starts = tuple(b.start for b in task.block)
+        bshape = task.shape
         ns, npl = int(spec.solver.periods), len(spec.planets)
         data: dict[str, np.ndarray] = {}
         for ob in self.observed:
@@ -152,35 +160,28 @@ class _Layout:
             data["lle"] = np.full(bshape, np.nan)
             lle = out.lyapunov(run.dt)
         spp = int(spec.solver.samples_per_period)  # > 1 only in response sweeps
-        for c, chain in enumerate(task.chains):
-            for j, idx in enumerate(chain):
-                pos = tuple(i - s for i, s in zip(idx, starts, strict=True))
-                for ob in self.observed:
-                    data[ob.name][pos] = ob.take(
-                        out.states[c, j][::spp], out.observables[c, j][::spp]
-                    )
-                if spec.response:
-                    response_extract(
-                        data,
-                        pos,
-                        self.grid.system(idx),
-                        out.obs_min[c, j],
-                        out.obs_max[c, j],
-                        out.observables[c, j],
-                        ok=out.status[c, j] == int(Status.OK),
-                    )
-                for nm, cols, per_planet in self.tracked:
-                    lo, hi = out.obs_min[c, j][cols], out.obs_max[c, j][cols]
-                    data[f"{nm}_min"][pos] = lo if per_planet else lo[0]
-                    data[f"{nm}_max"][pos] = hi if per_planet else hi[0]
-                data["status"][pos] = out.status[c, j]
-                data["steps_accepted"][pos] = int(out.info[c, j, 0])
-                data["steps_rejected"][pos] = int(out.info[c, j, 1])
-                if settle:
-                    data[SKIPPED][pos] = int(out.info[c, j, 4])
-                data["final_state"][pos] = out.final_state[c, j, :n_st]
-                if spec.recorded_lyapunov:
-                    data["lle"][pos] = lle[c, j, 0]
+        for c, j, idx, pos in task.points():
+            for ob in self.observed:
+                data[ob.name][pos] = ob.take(out.states[c, j][::spp], out.observables[c, j][::spp])
+            if spec.response:
+                response_extract(
+                    data,
+                    pos,
+                    self.grid.system(idx),
+                    out.obs_min[c, j],
+                    out.obs_max[c, j],
+                    out.observables[c, j],
+                    ok=out.status[c, j] == int(Status.OK),
+                )
+            self.put_extrema(data, pos, out.obs_min[c, j], out.obs_max[c, j])
+            data["status"][pos] = out.status[c, j]
+            data["steps_accepted"][pos] = int(out.info[c, j, 0])
+            data["steps_rejected"][pos] = int(out.info[c, j, 1])
+            if settle:
+                data[SKIPPED][pos] = int(out.info[c, j, 4])
+            data["final_state"][pos] = out.final_state[c, j, :n_st]
+            if spec.recorded_lyapunov:
+                data["lle"][pos] = lle[c, j, 0]
         if spec.verdicts:
             task_verdicts(self, task, out, data)
         if spec.orbits:

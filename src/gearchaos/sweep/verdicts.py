@@ -74,23 +74,21 @@ def task_verdicts(
     store layout (its grid, observed and tracked variables)."""
     grid, observed = layout.grid, layout.observed
     spec = grid.spec
-    starts = tuple(b.start for b in task.block)
-    where = [(c, j, idx) for c, ch in enumerate(task.chains) for j, idx in enumerate(ch)]
-    systems = [grid.system(idx) for *_, idx in where]
-    values = [grid.values_at(idx) for *_, idx in where]
+    where = task.points()
+    systems = [grid.system(idx) for _, _, idx, _ in where]
+    values = [grid.values_at(idx) for _, _, idx, _ in where]
     n = systems[0].n_state
     spp = int(spec.solver.samples_per_period)
-    sections = np.stack([out.states[c, j][::spp, :n] for c, j, _ in where])
-    finals = np.stack([out.final_state[c, j, :n] for c, j, _ in where])
-    ok = [int(out.status[c, j]) == 0 for c, j, _ in where]
+    sections = np.stack([out.states[c, j][::spp, :n] for c, j, *_ in where])
+    finals = np.stack([out.final_state[c, j, :n] for c, j, *_ in where])
+    ok = [int(out.status[c, j]) == 0 for c, j, *_ in where]
     verdicts = decide_motion(
         grid.target, values, systems, sections, finals, ok, spec.solver, verdict
     )
     for name, (_, dtype, fill) in VERDICT_VARIABLES.items():
         if name not in data:
-            data[name] = np.full(tuple(b.stop - b.start for b in task.block), fill, dtype=dtype)
-    for (_, _, idx), v in zip(where, verdicts, strict=True):
-        pos = tuple(i - s for i, s in zip(idx, starts, strict=True))
+            data[name] = np.full(task.shape, fill, dtype=dtype)
+    for (*_, pos), v in zip(where, verdicts, strict=True):
         data["motion"][pos] = v.label
         data["verdict"][pos] = v.code
         data["max_multiplier"][pos] = v.max_multiplier
@@ -106,8 +104,5 @@ def task_verdicts(
         m = data[observed[0].name][pos].shape[0]
         for ob in observed:
             data[ob.name][pos] = ob.take(rec.states[-m:], rec.observables[-m:])
-        for nm, cols, per_planet in layout.tracked:
-            lo, hi = rec.obs_min[cols], rec.obs_max[cols]
-            data[f"{nm}_min"][pos] = lo if per_planet else lo[0]
-            data[f"{nm}_max"][pos] = hi if per_planet else hi[0]
+        layout.put_extrema(data, pos, rec.obs_min, rec.obs_max)
         data["final_state"][pos] = rec.final_state
