@@ -222,7 +222,8 @@ def test_reproduce_fig5_quick(runner: CliRunner, tmp_path: Path) -> None:
     assert [r["value"] for r in saved["rows"]] == saved["values"]
     assert saved["rows"] == data["rows"]
     lines = table.read_text().splitlines()
-    assert lines[0].startswith("value,motion,lle,k01")
+    # the rows carry the verdict's evidence beside the label (ROW_KEYS)
+    assert lines[0].startswith("value,motion,lle,lle_error,evidence,max_multiplier,k01")
     assert len(lines) == 1 + len(saved["values"])
     assert data["points"] == len(saved["values"])
     # the human output is a table of the rows

@@ -8,13 +8,9 @@ to end) and :mod:`.coexistence` (coexisting attractors from several starts) use 
 """
 
 from .coexistence import Attractor, attractors
+from .evidence import EVIDENCE, Verdict
 from .point import PointAnalysis, analyse_point
-from .verdict import (
-    EVIDENCE,
-    Verdict,
-    VerdictSettings,
-    decide_motion,
-)
+from .verdict import VerdictSettings, decide_motion
 
 __all__ = [
     "EVIDENCE",

@@ -38,7 +38,8 @@ from ..analysis.orbits import PeriodicOrbit, split_values
 from ..integrate._chains import ChainRun, run_chains
 from ..integrate.settings import SolverSettings
 from ..model.target import resolve
-from .verdict import Verdict, decide_motion
+from .evidence import Verdict
+from .verdict import decide_motion
 
 __all__ = ["ATTRACTOR_SETTINGS", "Attractor", "attractors"]
 

@@ -28,7 +28,8 @@ from ..integrate.result import SimulationResult
 from ..integrate.settings import SIMULATION, SolverSettings
 from ..integrate.simulate import run_simulation
 from ..model.target import resolve
-from .verdict import Verdict, VerdictSettings, decide_motion
+from .evidence import Verdict
+from .verdict import VerdictSettings, decide_motion
 
 __all__ = ["PointAnalysis", "analyse_point", "point_verdict"]
 

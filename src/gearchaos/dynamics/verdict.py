@@ -44,7 +44,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -65,28 +65,10 @@ from ..analysis.recurrence import (
 from ..errors import ParameterError
 from ..integrate.settings import SolverSettings
 from ..model.system import System
-from .extension import RECORD_SOURCES, VerdictRecord, extend
+from .evidence import Verdict
+from .extension import VerdictRecord, extend
 
-__all__ = [
-    "EVIDENCE",
-    "RECORD_SOURCES",
-    "Verdict",
-    "VerdictRecord",
-    "VerdictSettings",
-    "decide_motion",
-]
-
-#: What decided a label (the flag values of a store's ``verdict`` variable).
-EVIDENCE = {
-    "not_computed": -1,
-    "floquet": 0,  # nT: a converged, stable orbit of minimal period n (multipliers)
-    "lyapunov": 1,  # chaos or QP: the λ₁ interval, no period found or confirmed
-    "record_contracting": 2,  # nT, n too long to shoot: the record repeats, λ₁ < 0
-    "contracting": 3,  # unresolved: λ₁ < 0 but no period found within the budget
-    "ambiguous": 4,  # unresolved: the λ₁ interval straddles the threshold
-    "unstable_orbit": 5,  # unresolved: near an unstable orbit, not left within the budget
-    "failed": 6,  # the integration failed
-}
+__all__ = ["VerdictSettings", "decide_motion"]
 
 
 @dataclass(frozen=True)
@@ -186,85 +168,6 @@ class VerdictSettings:
         if self.extension_periods is not None:
             return int(self.extension_periods)
         return max(int(record_periods), self.min_extension)
-
-
-@dataclass(frozen=True, eq=False)
-class Verdict:
-    """What the motion is at one point, and what decided it.
-
-    Attributes
-    ----------
-    label
-        ``1T`` … ``nT``, ``QP``, ``chaos``, ``unresolved`` or ``failed``.
-    period
-        n of an nT label, else 0.
-    evidence
-        Key of :data:`EVIDENCE`.
-    max_multiplier
-        max |μ| of the orbit that confirmed the label, or of the unstable orbit found near
-        the record (NaN when none was shot).
-    lle, lle_error
-        λ₁ per unit τ and its standard error: exactly ln max|μ| / (nT) with error 0 for a
-        confirmed orbit; from the last extension otherwise (NaN when none ran).
-    k01
-        0–1 test value of the record where computed (non-periodic labels), else NaN.
-    extra_periods
-        Periods integrated beyond the original record (extensions).
-    reason
-        One sentence: why this label.
-    record
-        The record that replaced the original one, else None: the extension's, or, when the
-        original record was still converging onto the confirmed orbit, the orbit's own
-        (integrated from its state for as many periods).
-    orbit_state
-        The confirmed orbit's state on the section (``floquet`` only).
-    """
-
-    label: str
-    period: int
-    evidence: str
-    max_multiplier: float = math.nan
-    lle: float = math.nan
-    lle_error: float = math.nan
-    k01: float = math.nan
-    extra_periods: int = 0
-    reason: str = ""
-    record: VerdictRecord | None = field(default=None, repr=False)
-    orbit_state: np.ndarray | None = field(default=None, repr=False)
-
-    @property
-    def code(self) -> int:
-        """The :data:`EVIDENCE` flag value."""
-        return EVIDENCE[self.evidence]
-
-    @property
-    def periodic(self) -> bool:
-        return self.period > 0
-
-    def lle_text(self) -> str:
-        """λ₁ with its error as printed next to the label (``(exact)`` for Floquet)."""
-        from ..analysis.lyapunov import format_exponent
-
-        return format_exponent(self.lle, self.lle_error)
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready fields (NaN → None)."""
-
-        def num(v: float) -> float | None:
-            return float(v) if math.isfinite(v) else None
-
-        return {
-            "motion": self.label,
-            "period": int(self.period),
-            "evidence": self.evidence,
-            "max_multiplier": num(self.max_multiplier),
-            "lle": num(self.lle),
-            "lle_error": num(self.lle_error),
-            "k01": num(self.k01),
-            "extra_periods": int(self.extra_periods),
-            "record": self.record.source if self.record is not None else "protocol",
-            "reason": self.reason,
-        }
 
 
 # ----------------------------------------------------------------------------- decision

@@ -133,11 +133,9 @@ def initial_step(kind, t, y, f0, p, rtol, atol, obs, n, y1, f1):  # pragma: no c
 
 @njit_noalloc
 def _renormalize(kind, t, y, p, obs, K, n, k, lsum, tan_on):  # pragma: no cover - compiled
-    """Tangent vectors in y[n:]: on the first call make them orthonormal — the given vectors
-    by Gram–Schmidt when any is nonzero (a seeded random start), else the first k basis
-    vectors — or, later, re-orthonormalise them by modified Gram–Schmidt, adding log stretch
-    factors to ``lsum``; refresh their FSAL stage ``K[0]`` (``obs`` holds all observables at
-    (t, y))."""
+    """Tangent vectors in y[n:]: make them orthonormal (first call: the given ones, if any is
+    nonzero, else the first k basis vectors) or re-orthonormalise them by modified Gram–Schmidt,
+    adding log stretch factors to ``lsum``; refresh their FSAL stage ``K[0]`` (``obs``)."""
     numba.literally(kind)
     given = False
     if not tan_on:
@@ -246,10 +244,8 @@ def dopri_run(
     to the tolerance, not bitwise.
     """
     numba.literally(kind)
-    n_samples, n_obs, n_track, n_base, rtol, atol, h_init, max_step, max_steps, settle_spp = cfg[
-        :10
-    ]
-    tan_tol = cfg[10]
+    (n_samples, n_obs, n_track, n_base, rtol, atol, h_init, max_step, max_steps, settle_spp,
+     tan_tol) = cfg  # fmt: skip
     out_t, out_y, out_obs, obs_min, obs_max, y_final = out
     y, yt, K, obs, hist, t_hist, ring, runs, f1, o1 = ws
     n = y0.size
@@ -577,8 +573,7 @@ def dopri_chains(
                 ws,
             )
             status[c, j] = st
-            # a successor starts from the final system state; its tangent vectors start
-            # afresh from Y0's (zero: the basis, shooting's monodromy factors)
+            # a successor: the final system state, tangents afresh from Y0 (monodromy factors)
             _copy(y, Y0[c], y.size)
             if continuation and st == ST_OK:
                 _copy(y, y_final[c, j], n_base)

@@ -143,14 +143,15 @@ def linear_axis(ax: Any, axis: str, k: float, label: str) -> Any:
 
 
 def data_range(
-    values: Any, *, margin: float = MARGIN, mag: float | None = None
+    values: Any, *, margin: float = MARGIN, mag: float | None = None, sparse: bool = False
 ) -> tuple[float, float] | None:
     """[lo, hi] of the finite values widened by ``margin`` of their span. A span below 10⁻⁶ of
     the largest magnitude (``mag``, default the values') shows ±5 % of that magnitude around
     the centre (±1 around zero): a periodic point spread by integration noise (≈ rtol ≤ 10⁻⁸
-    of it) stays a point, while two section values 10⁻⁴ apart (a narrow 2T) stay two. Values
-    that take at most ``SPARSE`` distinct levels (to 10⁻³ of their span: the points of an nT
-    orbit) get ``SPARSE_MARGIN`` of their span, so that no point sits on the frame."""
+    of it) stays a point, while two section values 10⁻⁴ apart (a narrow 2T) stay two. With
+    ``sparse`` (section points), values that take at most ``SPARSE`` distinct levels (to 10⁻³
+    of their span: the points of an nT orbit) get ``SPARSE_MARGIN`` of their span, so that no
+    point sits on the frame."""
     v = np.asarray(values, dtype=np.float64).ravel()
     v = v[np.isfinite(v)]
     if v.size == 0:
@@ -161,8 +162,8 @@ def data_range(
         centre = 0.5 * (lo + hi)
         half = 0.05 * m if m > 0 else 1.0
         return centre - half, centre + half
-    levels = np.unique(np.round((v - lo) / (hi - lo), 3)).size
-    pad = (SPARSE_MARGIN if levels <= SPARSE else margin) * (hi - lo)
+    few = sparse and np.unique(np.round((v - lo) / (hi - lo), 3)).size <= SPARSE
+    pad = (SPARSE_MARGIN if few else margin) * (hi - lo)
     return lo - pad, hi + pad
 
 
@@ -171,7 +172,8 @@ def fit_to_data(
 ) -> None:
     """Set the limits of ``ax`` from the data (``x``, ``y``; either may be ``None`` to keep an
     axis as it is), ignoring clearance and reference lines; turn axis offsets off. With
-    ``joint`` the degenerate-span test uses the larger magnitude of both (x–x' planes);
+    ``joint`` (x–x' planes) the degenerate-span test uses the larger magnitude of both and the
+    points of a short periodic orbit get a wider margin (:func:`data_range`);
     ``mag`` sets that magnitude (for values drawn relative to an offset)."""
     if joint and x is not None and y is not None:
         both = np.concatenate([np.ravel(np.asarray(x, float)), np.ravel(np.asarray(y, float))])
@@ -179,7 +181,7 @@ def fit_to_data(
         mag = float(np.max(np.abs(both))) if both.size else None
     for data, setter, axis in ((x, ax.set_xlim, ax.xaxis), (y, ax.set_ylim, ax.yaxis)):
         if data is not None and axis.get_scale() == "linear":
-            found = data_range(data, mag=mag)
+            found = data_range(data, mag=mag, sparse=joint)
             if found is not None:
                 setter(*found)
         formatter = axis.get_major_formatter()

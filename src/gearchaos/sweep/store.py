@@ -162,8 +162,8 @@ class SweepStore:
         attrs: dict[str, Any],
     ) -> None:
         """Coordinates are written whole; float variables are created empty (NaN fill value);
-        integer variables are written with their "not run" value and carry no fill value, so
-        xarray keeps their integer type.
+        integer and string variables are written with their "not run" value and carry no fill
+        value, so xarray keeps their type.
 
         On disk the store is built under a temporary name and renamed into place, so a store
         path either holds a complete, resumable layout or nothing (a kill during creation
@@ -192,16 +192,17 @@ class SweepStore:
         g = zarr.open_group(target, mode="a", zarr_format=2)
         for name, (dims, shape_dtype, fill, vattrs) in variables.items():
             shape, dtype = shape_dtype
-            integer = np.issubdtype(np.dtype(dtype), np.integer)
+            # integers and strings (labels) carry no fill value, so xarray keeps their type
+            written = np.issubdtype(np.dtype(dtype), np.integer) or np.dtype(dtype).kind == "U"
             arr = g.create_array(
                 name,
                 shape=shape,
                 chunks=chunks[name],
                 dtype=dtype,
-                fill_value=None if integer else fill,
+                fill_value=None if written else fill,
                 attributes={**vattrs, "_ARRAY_DIMENSIONS": list(dims)},
             )
-            if integer:
+            if written:
                 arr[...] = np.full(shape, fill, dtype=dtype)
         consolidate(target)
         if tmp is not None and self.path is not None:

@@ -27,7 +27,9 @@ from typing import Any
 
 import numpy as np
 
-from ..dynamics.verdict import EVIDENCE, RECORD_SOURCES, VerdictSettings, decide_motion
+from ..dynamics.evidence import EVIDENCE
+from ..dynamics.extension import RECORD_SOURCES
+from ..dynamics.verdict import VerdictSettings, decide_motion
 
 __all__ = ["VERDICT_VARIABLES", "task_verdicts", "verdict_attrs"]
 
