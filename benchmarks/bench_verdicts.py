@@ -32,7 +32,7 @@ import numpy as np
 
 import gearchaos as gc
 from gearchaos import sweep
-from gearchaos.dynamics.verdict import EVIDENCE
+from gearchaos.dynamics import EVIDENCE
 
 
 def _sweep(points: int, **options: object) -> tuple[float, object]:
