@@ -86,8 +86,8 @@ def periodic_orbits(
     tangent_tol
         Factor on the error tolerances of the monodromy's columns (1: the state's). The
         residual comes from the map without tangents, so the orbit is as accurate either way;
-        a factor f leaves the multipliers accurate to about f·rtol (the motion verdict uses
-        100: it compares max |μ| with 1 − 10⁻⁴).
+        the multipliers move by roughly f·rtol or less (the motion verdict uses 1000: it
+        compares max |μ| with 1 − 10⁻⁴).
 
     Returns
     -------

@@ -44,7 +44,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -108,10 +108,18 @@ class VerdictSettings:
         lingers near an orbit (its final state is farther away; a miss is retried with the
         next record, after an extension).
     tangent_tol
-        Factor on the integrator's tolerances for the tangent vectors (the monodromy's
-        columns, the extension's Lyapunov vector): multipliers and λ₁ need a few digits, not
-        the state's ten; 100 makes a tangent period about half as costly as at 1 and moves
-        max |μ| by about 10⁻⁶, far inside ``margin``.
+        Factor on the integrator's tolerances for the monodromy's columns: multipliers need a
+        few digits, not the state's ten; 1000 makes a tangent period a fraction as costly as at
+        1 and moves max |μ| by a few 10⁻⁶ (0.997019 → 0.997015 at Ω = 1.5 on ``sheng2016``),
+        far inside ``margin``.
+    newton_tol
+        Residual and correction tolerance of the shooting (relative to max(1, ‖y‖)): the
+        verdict needs the orbit's multipliers, which a 10⁻⁷ orbit gives to far better than
+        ``margin``; a record already on its orbit then converges in one Newton iteration.
+    lyapunov_tol
+        The same factor for the extension's Lyapunov vector: with 10⁴ its steps are those of
+        the state (a tangent period costs about 1.7 plain ones instead of 4–10), and λ₁ of
+        periodic and chaotic points moves by less than 10⁻⁴, far inside its standard error.
     blocks, confidence
         Block means of the λ₁ error estimate, and the half-width c of its interval in
         standard errors.
@@ -131,7 +139,9 @@ class VerdictSettings:
     extension_periods: int | None = None
     min_extension: int = 100
     budget_periods: int = 400
-    tangent_tol: float = 100.0
+    tangent_tol: float = 1000.0
+    lyapunov_tol: float = 1e4
+    newton_tol: float = 1e-7
     newton_iterations: tuple[int, int] = (6, 4)
     blocks: int = LYAPUNOV_BLOCKS
     confidence: float = 2.0
@@ -151,6 +161,8 @@ class VerdictSettings:
         check_int("min_extension", self.min_extension, lo=2 * self.blocks + 1, hi=10**6)
         check_int("budget_periods", self.budget_periods, lo=0, hi=10**7)
         check_real("tangent_tol", self.tangent_tol, lo=1.0, hi=1e6)
+        check_real("lyapunov_tol", self.lyapunov_tol, lo=1.0, hi=1e8)
+        check_real("newton_tol", self.newton_tol, lo=0.0, hi=1e-3, lo_open=True)
         if not (isinstance(self.newton_iterations, tuple) and len(self.newton_iterations) == 2):
             raise ParameterError(
                 "newton_iterations must be a pair (repeating record, converging record): "
@@ -184,13 +196,14 @@ class _Point:
     unstable: tuple[int, float, np.ndarray] | None = None
     record: VerdictRecord | None = None
     long_period: int = 0
+    tried: set[int] = field(default_factory=set)  # approach periods shot in vain
 
 
 def _shoot_candidates(
     target: Any,
     values: Sequence[Mapping[str, Any]],
     pts: dict[int, _Point],
-    cands: dict[int, tuple[int, str]],
+    cands: dict[int, list[tuple[int, str]]],
     settings: SolverSettings,
     vs: VerdictSettings,
     done: dict[int, Verdict],
@@ -203,8 +216,10 @@ def _shoot_candidates(
     from ..analysis.orbit_batch import periodic_orbits
 
     finish: list[int] = []  # confirmed while the record was converging: show the orbit
-    for n, how in sorted(set(cands.values())):
-        idx = [k for k, c in cands.items() if c == (n, how)]
+    for n, how in sorted({c for cs in cands.values() for c in cs}):
+        idx = [k for k, cs in cands.items() if (n, how) in cs and k not in done]
+        if not idx:
+            continue
         orbits = periodic_orbits(
             target,
             [values[k] for k in idx],
@@ -213,9 +228,12 @@ def _shoot_candidates(
             settings=settings,
             max_iterations=vs.newton_iterations[how == "approach"],
             tangent_tol=vs.tangent_tol,
+            tol=vs.newton_tol,
         )
         for k, orb in zip(idx, orbits, strict=True):
             p = pts[k]
+            if how == "approach":
+                p.tried.add(n)  # not shot again at this period if it does not confirm
             if not orb.converged or not np.isfinite(orb.max_multiplier):
                 continue
             d = orb.minimal_period
@@ -230,7 +248,7 @@ def _shoot_candidates(
             if p.sections.shape[1] == secs.shape[1]:
                 gap = max(gap, float(np.max(distance_to_orbit(p.sections, secs))))
             settled = gap <= vs.noise_factor * (settings.atol + settings.rtol * scale)
-            repeat = cands[k][1] == "repeat"
+            repeat = how == "repeat"
             if repeat:
                 follows = near
             elif p.sections.shape[1] == secs.shape[1]:
@@ -429,7 +447,7 @@ def decide_motion(
         if not live:
             break
         # 1. candidates: a repeating record, else a converging one
-        cands: dict[int, tuple[int, str]] = {}
+        cands: dict[int, list[tuple[int, str]]] = {}
         for k in live:
             p = pts[k]
             floor = noise_floor(p.sections[None], settings, vs.noise_factor)
@@ -444,13 +462,17 @@ def decide_motion(
             )
             p.long_period = n if n > vs.max_period else 0
             if 1 <= n <= vs.max_period:
-                cands[k] = (n, "repeat")
-            elif n == 0:
+                cands[k] = [(n, "repeat")]
+            elif n == 0 and not p.lle - vs.confidence * p.err > 0:
+                # (a record whose λ₁ is surely positive converges onto nothing)
                 nc = converging_period(p.sections, vs.max_period) or near_period(
                     p.sections, vs.max_period, vs.approach
                 )
-                if nc:
-                    cands[k] = (nc, "approach")
+                # a spiralling transient recurs at its rotation period, its orbit may be
+                # shorter: the cheap period 1 is shot first
+                tries = [(m, "approach") for m in sorted({1, nc}) if nc and m not in p.tried]
+                if tries:
+                    cands[k] = tries
         for k in live:
             pts[k].unstable = None
         if cands:
@@ -478,7 +500,7 @@ def decide_motion(
             settings,
             ext_periods,
             vs.seed + r,
-            tangent_tol=vs.tangent_tol,
+            tangent_tol=vs.lyapunov_tol,
         )
         n_state = systems[0].n_state
         stretch = out.stretch(n_state)
