@@ -91,6 +91,7 @@ def test_period_doubling_cascade_matches_the_brute_force_sweep() -> None:
     sweep = gc.bifurcation(
         system, "omega=1.8:2.1:31", initial_conditions="continuation", direction="down",
         transient_periods=1500, periods=16, progress=False, **TIGHT,
+        verdicts=False,  # the brute-force reference: the protocol's own records
     )  # fmt: skip
     om = sweep.omega.values
     per = brute_periods(sweep)

@@ -45,6 +45,9 @@ def sweep(direction: str):
         initial_conditions="continuation",
         direction=direction,
         progress=False,
+        # the protocol's records: each point's stored final state is the one its successor
+        # starts from, which the tests check (a verdict would show a finished record)
+        verdicts=False,
         **PROTOCOL,
     ).load()
 

@@ -17,8 +17,9 @@ integrating them (in the worker, all points of a period together), and writes pe
 
 Where the verdict extended a run, the point's stored section values and final state are those
 of the extension (the finished record), so the diagram never shows a label beside the
-transient that preceded it. The variables are written with the task's others, so an
-interrupted sweep resumes with them.
+transient that preceded it (in a continuation sweep the next point still starts from the end
+of the protocol's run, as without verdicts). The variables are written with the task's others,
+so an interrupted sweep resumes with them.
 """
 
 from __future__ import annotations
