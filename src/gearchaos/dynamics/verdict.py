@@ -105,8 +105,9 @@ class VerdictSettings:
         undecided point needs λ₁).
     newton_iterations
         Newton iterations for a record that repeats, and for one that converges onto or
-        lingers near an orbit (its final state is farther away; a miss is retried with the
-        next record, after an extension).
+        lingers near an orbit (its final state is farther away; period 1 is tried first, and
+        a period that failed is not shot again for that point — if the run later settles,
+        its record repeats and is shot as such).
     tangent_tol
         Factor on the integrator's tolerances for the monodromy's columns: multipliers need a
         few digits, not the state's ten; 1000 makes a tangent period a fraction as costly as at
