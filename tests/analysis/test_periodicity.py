@@ -112,6 +112,25 @@ def test_periods_of_matches_detect_period_over_a_batch() -> None:
         assert got[0, i] == (0 if expect is None else expect)
 
 
+def test_periods_of_takes_one_absolute_tolerance_per_sequence() -> None:
+    # noise of 0.01 hides a 2-cycle at atol 0 and shows it at atol 0.05: one call with both
+    # tolerances gives what two calls give
+    seqs = np.stack([cycle(2, 200, noise=0.01), cycle(2, 200, noise=0.01)])
+    got = periods_of(seqs, rtol=1e-6, atol=np.array([0.0, 0.05]))
+    assert (
+        got.tolist()
+        == [
+            int(periods_of(seqs[0], rtol=1e-6, atol=0.0)),
+            int(periods_of(seqs[1], rtol=1e-6, atol=0.05)),
+        ]
+        == [0, 2]
+    )
+    with pytest.raises(ParameterError, match="atol"):
+        periods_of(seqs, atol=np.array([0.0, -1.0]))
+    with pytest.raises(ParameterError, match="one per sequence"):
+        periods_of(seqs, atol=np.zeros(3))
+
+
 def test_period_label() -> None:
     assert period_label(1) == "1T"
     assert period_label(np.int64(12)) == "12T"  # type: ignore[arg-type]

@@ -211,3 +211,40 @@ def test_the_explorer_computes_the_label_the_sweep_stored(tmp_path) -> None:
         assert out["summary"]["evidence"] == (
             "floquet" if out["motion"].endswith("T") else "lyapunov"
         )
+
+
+def test_every_settled_orbit_of_a_batch_is_confirmed_from_its_record() -> None:
+    # at Ω ≤ 0.1 the damping contracts the state by e^(λ₁T) ≈ e^-1 a period (T = 2π/Ω ≥ 63):
+    # after 100 transient periods every record sits on its stable 1T orbit, so the verdict
+    # confirms each point of a batch from its record, with no extension (a confirmed point
+    # must not change how the next point of the same batch is judged)
+    from gearchaos import sweep
+
+    ds = sweep.bifurcation(GS, "omega=0.05:0.1:6", fixed={"xi": 0.03}, progress=False)
+    assert [str(m) for m in ds.motion.values] == ["1T"] * 6
+    assert np.all(ds.extra_periods.values == 0)
+    assert np.all(ds.max_multiplier.values < 1)
+
+
+def test_a_lyapunov_vector_on_the_state_steps() -> None:
+    # lyapunov_tol = inf: the vector is left out of the error control, so the state is
+    # bitwise the plain run's; λ₁ of a stable orbit is then its exact ln|μ|max/T within the
+    # error, and that of a chaotic point agrees with a fully controlled vector (factor 1)
+    from gearchaos.dynamics.extension import extend
+
+    omegas = [1.5, 2.05, 2.9]
+    systems = [resolve(GS, {"omega": w}) for w in omegas]
+    starts = np.array([integrate(s, SEED).final_state for s in systems])
+    plain = extend(systems, starts, SEED, 200, None)
+    riding = extend(systems, starts, SEED, 200, 0, tangent_tol=math.inf)
+    full = extend(systems, starts, SEED, 200, 0, tangent_tol=1.0)
+    n = systems[0].n_state
+    assert np.array_equal(riding.states[..., :n], plain.states[..., :n])
+    lam = [exponent_estimate(riding.stretch(n)[i, 0], s.period) for i, s in enumerate(systems)]
+    ref = [exponent_estimate(full.stretch(n)[i, 0], s.period) for i, s in enumerate(systems)]
+    for w, s, (l1, e1), (l0, e0) in zip(omegas, systems, lam, ref, strict=True):
+        assert abs(l1 - l0) <= 3 * math.hypot(e0, e1), w
+        orb = periodic_orbit(GS, omega=w, guess=starts[omegas.index(w)])
+        if orb.converged and orb.max_multiplier < 1:  # a stable orbit: λ₁ is exact
+            assert abs(l1 - math.log(orb.max_multiplier) / s.period) <= 3 * e1 + 2e-4, w
+    assert lam[1][0] - 2 * lam[1][1] > 0  # Ω = 2.05 is chaotic

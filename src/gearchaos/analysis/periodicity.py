@@ -45,7 +45,7 @@ def periods_of(
     *,
     max_period: int = 64,
     rtol: float = 1e-3,
-    atol: float = 0.0,
+    atol: Any = 0.0,
     floor: Any = None,
 ) -> np.ndarray:
     """Vectorised :func:`detect_period` over the leading axes of a batch of section sequences.
@@ -56,7 +56,7 @@ def periods_of(
         Array of shape (..., m, d): one sequence of m section points in d coordinates per
         leading index (e.g. a sweep's (Ω, section, 2) array of (X̄_sp1, X̄'_sp1)).
     max_period, rtol, atol
-        As in :func:`detect_period`.
+        As in :func:`detect_period`; ``atol`` may also be one value per sequence.
     floor
         The noise floor ε of the section points (a scalar, or one per sequence), in their
         units: a sequence whose spread S is at most ε is one point (period 1), whatever its
@@ -70,11 +70,24 @@ def periods_of(
         Integer array of the leading shape: the period n, or 0 where no period
         n ≤ ``max_period`` is found (or the sequence holds a non-finite value).
     """
-    _check_tolerances(max_period, rtol, atol)
     p = np.asarray(points, dtype=np.float64)
     if p.ndim < 2:
         raise ParameterError(f"points must have shape (..., m, d): got shape {p.shape}")
     lead = p.shape[:-2]
+    atols = np.asarray(atol, dtype=np.float64) if not isinstance(atol, str) else atol
+    if isinstance(atols, np.ndarray) and atols.ndim > 0:
+        try:
+            atols = np.broadcast_to(atols, lead).reshape(-1)
+        except ValueError:
+            raise ParameterError(
+                f"atol must be a number or one per sequence ({lead}): got shape {atols.shape}"
+            ) from None
+        if not np.all(np.isfinite(atols) & (atols >= 0)):
+            raise ParameterError("atol must be finite numbers >= 0: got a negative or NaN value")
+        _check_tolerances(max_period, rtol, float(np.max(atols)) if atols.size else 1.0)
+    else:
+        _check_tolerances(max_period, rtol, atol)
+        atols = np.full(math.prod(lead), float(atol))
     m, d = p.shape[-2:]
     out = np.zeros(math.prod(lead), dtype=np.int64)
     if m == 0 or d == 0:
@@ -94,7 +107,7 @@ def periods_of(
     out[idx[single]] = 1
     keep = ~single
     idx, q, size = idx[keep], q[keep], size[keep]
-    tol2 = (rtol * size + atol) ** 2
+    tol2 = (rtol * size + atols[idx]) ** 2
     for n in range(1, max_period + 1):
         if idx.size == 0 or m < 2 * n + 1:
             break

@@ -36,13 +36,14 @@ def converging_period(x: np.ndarray, max_n: int) -> int:
         h = g[(m - n) // 2 :]
         if h.size < 8 or not np.all(h > 0) or not np.all(np.isfinite(h)):
             continue
-        k = np.arange(h.size, dtype=float)
+        # the least-squares line y ≈ slope·k + icpt, in closed form
+        k = np.arange(h.size, dtype=float) - 0.5 * (h.size - 1)
         y = np.log(h)
-        slope, icpt = np.polyfit(k, y, 1)
-        scatter = float(np.std(y - (slope * k + icpt)))
+        slope = float(k @ (y - y.mean()) / (k @ k))
+        scatter = float(np.std(y - y.mean() - slope * k))
         drop = -slope * (h.size - 1)
         if slope < 0 and drop > max(4.0 * scatter, math.log(1.25)) and slope < best_slope:
-            best, best_slope = n, float(slope)
+            best, best_slope = n, slope
     return best
 
 

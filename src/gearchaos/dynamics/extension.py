@@ -29,8 +29,9 @@ class VerdictRecord:
     """The section record that replaced the original one: ``states`` (m, n_state) and
     ``observables`` (m, n_obs) at the section, ``final_state``, the extrema ``obs_min`` /
     ``obs_max`` of the tracked observables over its window, and its ``source``:
-    ``extension`` (the run continued) or ``orbit`` (integrated from the confirmed orbit's
-    state, onto which the original record was still converging)."""
+    ``extension`` (the run continued) or ``orbit`` (the confirmed d-periodic orbit's own,
+    onto which the original record was still converging: d periods integrated from its state
+    and repeated to the record's length)."""
 
     states: np.ndarray
     observables: np.ndarray

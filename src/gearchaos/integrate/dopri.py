@@ -238,10 +238,9 @@ def dopri_run(
     components followed by k tangent vectors, integrated with the variational equations
     (:func:`~gearchaos.model.kernels.tangent`). They start orthonormal at the first sample and
     are re-orthonormalised (modified Gram–Schmidt) at every later sample; ``lsum`` accumulates
-    the logarithms of the stretch factors. The tangent components take part in the error
-    control (a tangent direction the state does not excite would otherwise be integrated with
-    steps sized for the state alone), so with tangents the trajectory agrees with a plain run
-    to the tolerance, not bitwise.
+    the logarithms of the stretch factors. The tangents take part in the error control (a
+    direction the state does not excite would otherwise get steps sized for the state alone),
+    so the state agrees with a plain run's to the tolerance — bitwise if ``tan_tol`` is inf.
     """
     numba.literally(kind)
     (n_samples, n_obs, n_track, n_base, rtol, atol, h_init, max_step, max_steps, settle_spp,
@@ -249,6 +248,7 @@ def dopri_run(
     out_t, out_y, out_obs, obs_min, obs_max, y_final = out
     y, yt, K, obs, hist, t_hist, ring, runs, f1, o1 = ws
     n = y0.size
+    n_err = n_base if math.isinf(tan_tol) else n  # the components in the error norm
     _copy(y, y0, n)
     for s in range(STAGES):
         for i in range(n):
@@ -401,10 +401,10 @@ def dopri_run(
             )  # fmt: skip
             sc = atol + rtol * max(abs(y[i]), abs(yt[i]))
             if i >= n_base:
-                sc *= tan_tol  # the tangent vectors' own tolerance (1: the state's)
+                sc *= tan_tol  # the tangents' own tolerance (1: the state's; inf: r = 0)
             r = e / sc
             acc += r * r + 0.0 * yt[i]
-        err = math.sqrt(acc / n)
+        err = math.sqrt(acc / n_err)
 
         if not math.isfinite(err):
             nonfinite = True

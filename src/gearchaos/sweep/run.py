@@ -9,6 +9,7 @@ result as an :class:`xarray.Dataset`.
 from __future__ import annotations
 
 import contextlib
+import itertools
 import os
 import signal
 import threading
@@ -393,34 +394,48 @@ def _groups(todo: list[Task], want: int) -> Iterator[list[Task]]:
         yield group
 
 
+#: Driver threads of an in-process sweep: each integrates and extracts (verdicts included) one
+#: group of tasks, so one group's Python work overlaps another's integration.
+_DRIVERS = 3
+
+
 def _run_in_process(
     todo: list[Task], grid: Grid, layout: _Layout, st: SweepStore, fn: Any, bar: Any
 ) -> None:
-    """Run the groups of tasks here, one after another; the next group is integrated (on the
-    kernel's threads, from a driver thread) while this thread writes the previous one to the
-    store, so the writes cost no integration time. An interrupt loses at most the group in
-    flight; everything written stays."""
+    """Run the groups of tasks here: two driver threads each integrate a group (on the
+    kernel's threads) and extract it (the verdicts included), while this thread writes the
+    finished groups to the store in order, so the writes cost no integration time and one
+    group's Python work overlaps the other's integration. An interrupt loses at most the groups
+    in flight; everything written stays."""
+    import collections
     import concurrent.futures as cf
 
     import numba
 
-    def compute(group: list[Task]) -> tuple[list[Task], list[ChainRun], list[Any]]:
+    def compute(group: list[Task]) -> list[tuple[Task, dict[str, np.ndarray], int]]:
         runs = [grid.task_run(t) for t in group]
         res = fn(ChainRun.concat(runs))
-        return group, runs, res.split([len(t.chains) for t in group])
+        parts = res.split([len(t.chains) for t in group])
+        return [
+            (t, layout.extract(t, run, part), int(np.sum(part.status != 0)))
+            for t, run, part in zip(group, runs, parts, strict=True)
+        ]
 
     groups = _groups(todo, 2 * numba.get_num_threads())
-    driver = cf.ThreadPoolExecutor(1, thread_name_prefix="gearchaos-sweep")
+    width = _DRIVERS
+    driver = cf.ThreadPoolExecutor(width, thread_name_prefix="gearchaos-sweep")
+    pending: collections.deque[cf.Future[Any]] = collections.deque()
     try:
-        first = next(groups, None)
-        pending = driver.submit(compute, first) if first is not None else None
-        while pending is not None:
-            group, runs, parts = pending.result()
+        for group in itertools.islice(groups, width):
+            pending.append(driver.submit(compute, group))
+        while pending:
+            done = pending.popleft().result()
             nxt = next(groups, None)
-            pending = driver.submit(compute, nxt) if nxt is not None else None
-            for t, run, part in zip(group, runs, parts, strict=True):
-                st.write(t.index, t.block, layout.extract(t, run, part))
-                bar.advance(t.n_points, int(np.sum(part.status != 0)))
+            if nxt is not None:
+                pending.append(driver.submit(compute, nxt))
+            for t, data, failed in done:
+                st.write(t.index, t.block, data)
+                bar.advance(t.n_points, failed)
     finally:
         driver.shutdown(wait=False, cancel_futures=True)
 
