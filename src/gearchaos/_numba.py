@@ -12,6 +12,7 @@ import warnings
 from typing import Any
 
 import numba
+import numpy as np
 from numba import typeof, types
 from numba.core.errors import NumbaIRAssumptionWarning
 
@@ -49,24 +50,37 @@ def _in_disk_cache(dispatcher: Any) -> bool:
         return True
 
 
+def _type_key(a: Any) -> Any:
+    """What decides numba's type of an argument, cheaply: an array's dtype, dimensions,
+    layout, writability and alignment; a tuple's items'; otherwise the Python type (a
+    number's numba type follows from it)."""
+    if isinstance(a, np.ndarray):
+        f = a.flags
+        return (a.dtype.str, a.ndim, f.c_contiguous, f.f_contiguous, f.writeable, f.aligned)
+    if isinstance(a, tuple):
+        return tuple(_type_key(x) for x in a)
+    return type(a)
+
+
 def entry_point(dispatcher: Any, kind: int, *args: Any) -> Any:
     """The compiled entry point of ``dispatcher`` specialised on the literal ``kind`` for
     arguments like ``args``: compiled (or loaded from the disk cache) on first use, then
-    looked up; call it as ``entry(kind, *args)``. Safe to call from several threads once
-    resolved (resolve it in one thread first)."""
+    looked up by a cheap key of the arguments' types (numba's own typing of every argument
+    costs far more than a short kernel call); call it as ``entry(kind, *args)``. Safe to call
+    from several threads once resolved (resolve it in one thread first)."""
     kind = int(kind)
-    key = (dispatcher, kind, *(typeof(a) for a in args))
-    entry = _ENTRIES.get(key)
+    fast = (dispatcher, kind, *(_type_key(a) for a in args))
+    entry = _ENTRIES.get(fast)
     if entry is None:
         if _FIRST_COMPILE and not _in_disk_cache(dispatcher):
             _FIRST_COMPILE.pop()()
-        sig = (types.literal(kind), *key[2:])
+        sig = (types.literal(kind), *(typeof(a) for a in args))
         with warnings.catch_warnings():
             # numba's IR inliner emits an internal "pedantic" NumbaIRAssumptionWarning for the
             # inlined dispatch of the right-hand side; it is harmless and not actionable
             warnings.simplefilter("ignore", NumbaIRAssumptionWarning)
             entry = dispatcher.compile(sig)  # compiles or loads the literal specialisation
-        _ENTRIES[key] = entry
+        _ENTRIES[fast] = entry
     return entry
 
 

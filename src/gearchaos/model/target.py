@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import dataclasses
 import difflib
+import functools
 from collections.abc import Mapping
 from typing import Any
 
@@ -95,6 +96,19 @@ def split_omega(values: Mapping[str, Any]) -> tuple[float | None, dict[str, Any]
     return check_omega(rest.pop(OMEGA)), rest
 
 
+def _gearset_model(gs: GearSet, changes: tuple[tuple[str, Any], ...], key: Any = None) -> Any:
+    """The planetary model of ``gs`` evolved by ``changes`` (validated); ``key`` identifies
+    ``changes`` for the cache."""
+    return PlanetaryModel.from_gearset(gs.evolve(dict(changes)) if changes else gs)
+
+
+#: The models of the last gear sets and changes asked for: a continuation or a Newton
+#: iteration resolves the same few points (Ω apart) thousands of times, and validating and
+#: non-dimensionalising a gear set costs far more than a short integration. Both are
+#: immutable, so a cached model is the one a fresh call would build.
+_cached_gearset_model = functools.lru_cache(maxsize=256)(_gearset_model)
+
+
 def model_for(target: Any, changes: Mapping[str, Any]) -> Any:
     """The model of ``target`` with ``changes`` (no Ω) applied.
 
@@ -103,8 +117,14 @@ def model_for(target: Any, changes: Mapping[str, Any]) -> Any:
     """
     _check_target(target)
     if isinstance(target, GearSet):
-        gs = target.evolve(dict(changes)) if changes else target
-        return PlanetaryModel.from_gearset(gs)
+        items = tuple(changes.items())
+        # the values' types are part of the key: True == 1, but a bool is never a count
+        key = tuple(sorted((k, type(v).__name__, v) for k, v in items))
+        try:
+            hash(key)
+        except TypeError:  # an unhashable value (a list of harmonics): no cache
+            return _gearset_model(target, items)
+        return _cached_gearset_model(target, items, key)
     if not changes:
         return target.model
     check_names(target, changes)

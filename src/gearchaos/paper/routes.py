@@ -436,6 +436,7 @@ def report_branches(
     figure, and what was done (``{figure: {"panels", "branches", "events", "seconds"}}`` or
     ``{figure: {"error": ...}}``). A quick report continues one panel per figure
     (:data:`QUICK_PANELS`) with coarse steps."""
+    import concurrent.futures as cf
     import time
 
     from ..gearset import preset
@@ -454,6 +455,7 @@ def report_branches(
         try:
             mine: list[dict[str, Any]] = []
             n_branches = n_panels = 0
+            jobs = []
             for fv, x, lab, _ in panels(stores[fig]):
                 if quick and (fv is None or not math.isclose(fv, QUICK_PANELS[fig])):
                     continue
@@ -465,11 +467,23 @@ def report_branches(
                     / "branches"
                     / (f"{fig}-{recipe.family.name}={fv:g}" + ("-quick" if quick else ""))
                 )
-                brs = follow_branches(
-                    target, recipe.vary.name, x, lab, fixed,
+                jobs.append((fv, recipe.vary.name, x, lab, fixed, cache))
+
+            def panel(job: tuple[Any, ...]) -> list[Any]:
+                _, name, x, lab, fixed, cache = job
+                return follow_branches(
+                    target, name, x, lab, fixed,
                     max_period=max_period, max_points=max_points, steps=steps, cache=cache,
                     max_branches=max_branches,
                 )  # fmt: skip
+
+            # the panels are independent: one thread each on up to every core (the kernels
+            # release the GIL; processes would re-import a user's unguarded script), the
+            # results in panel order whatever finishes first
+            width = max(1, min(len(jobs), os.cpu_count() or 1))
+            with cf.ThreadPoolExecutor(width, thread_name_prefix="gearchaos-branches") as pool:
+                found = list(pool.map(panel, jobs))
+            for (fv, *_), brs in zip(jobs, found, strict=True):
                 n_panels += 1
                 n_branches += len(brs)
                 for b in brs:
