@@ -33,7 +33,7 @@ LAYERS = (
     "cli",
     "facade",
 )
-BASE_MODULES = {"errors", "_checks", "_version", "_numba", "_files"}
+BASE_MODULES = {"errors", "_checks", "_version", "_numba", "_files", "_output"}
 MAX_LINES = 600
 
 

@@ -59,7 +59,9 @@ def test_csv_of_a_store_reads_back_to_its_values(store: Path, tmp_path: Path) ->
         assert row["status"] == int(point.status.values)
         lle = float(point.lle.values)
         assert row["lle"] == lle or (np.isnan(row["lle"]) and np.isnan(lle))
-    assert "# gearset = hindawi2021" in out.read_text().splitlines()[0]
+    first, second = out.read_text().splitlines()[:2]
+    assert first.startswith("# gearchaos ") and " export of " in first  # the software
+    assert "# gearset = hindawi2021" in second
 
 
 def test_mat_of_a_store_holds_every_variable(store: Path, tmp_path: Path) -> None:

@@ -37,7 +37,6 @@ from __future__ import annotations
 
 import json
 import os
-import shutil
 from collections.abc import Mapping
 from typing import Any
 
@@ -45,6 +44,7 @@ import numpy as np
 
 from .._checks import check_bool
 from .._files import check_path, check_regular_file
+from .._output import check_replaceable, file_has_mark, is_own_zarr, staged_dir, write_file
 from .._version import provenance
 from ..errors import ParameterError, StoreError
 from .orbits import (
@@ -300,10 +300,10 @@ def check_store(path: str | os.PathLike[str], overwrite: bool = False) -> str:
         kind = "netcdf"
     else:
         raise ParameterError(f"store must end in .nc or .zarr: got {path!r}")
-    if os.path.exists(path) and not overwrite:
+    if os.path.lexists(path) and not overwrite:
         raise StoreError(f"{path} exists; choose another path or pass overwrite=True")
-    if os.path.exists(path) and not (os.path.isdir if kind == "zarr" else os.path.isfile)(path):
-        raise StoreError(f"{path} exists and is no {kind} branch file; choose another path")
+    # overwrite replaces a branch gearchaos wrote, never anything else
+    check_replaceable(path, what=f"{kind} branch file", ours=is_branch_file)
     up = os.path.dirname(os.path.abspath(path))
     while not os.path.exists(up) and os.path.dirname(up) != up:
         up = os.path.dirname(up)
@@ -320,31 +320,37 @@ def save_branch(ds: Any, path: str | os.PathLike[str], *, overwrite: bool = Fals
     """
     kind = check_store(path, overwrite)
     path = os.fspath(path)
-    tmp = path + ".partial"
-    if os.path.isdir(tmp):
-        shutil.rmtree(tmp)
-    elif os.path.exists(tmp):
-        os.remove(tmp)
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     if kind == "zarr":
-        # every chunk written (none skipped as all fill values) and its digest kept
-        ds.to_zarr(tmp, mode="w", consolidated=True, zarr_format=2, write_empty_chunks=True)
-        digests = {key: _digest(os.path.join(tmp, key)) for key in _chunk_files(tmp)}
-        with open(os.path.join(tmp, MANIFEST), "w", encoding="utf-8") as f:
-            json.dump(digests, f)
+        with staged_dir(path, what="branch store") as tmp:
+            # every chunk written (none skipped as all fill values) and its digest kept
+            ds.to_zarr(tmp, mode="w", consolidated=True, zarr_format=2, write_empty_chunks=True)
+            digests = {key: _digest(os.path.join(tmp, key)) for key in _chunk_files(tmp)}
+            with open(os.path.join(tmp, MANIFEST), "w", encoding="utf-8") as f:
+                json.dump(digests, f)
     else:  # HDF5 Fletcher-32 checksums: a damaged chunk is an error when read, never data
         encoding = {
             name: {"fletcher32": True}
             for name, var in ds.variables.items()
             if var.ndim and var.size and var.dtype.kind in "biuf"
         }
-        ds.to_netcdf(tmp, engine="h5netcdf", encoding=encoding)
-    if os.path.isdir(path):
-        shutil.rmtree(path)
-    elif os.path.exists(path):
-        os.remove(path)
-    os.replace(tmp, path)
+        # serialised in memory first: HDF5 crashes on a full disk, a plain write fails cleanly
+        data = ds.to_netcdf(engine="h5netcdf", encoding=encoding)
+        write_file(path, data, what="branch file")
     return path
+
+
+def is_branch_file(path: str) -> bool:
+    """Whether ``path`` is a branch gearchaos wrote (what ``overwrite`` may replace): a Zarr
+    branch holding only its arrays and manifest, or a netCDF file whose attributes name the
+    continued ``parameter`` (a damaged one still carries the gearchaos mark)."""
+    if os.path.isdir(path):
+        return is_own_zarr(path, keys=("parameter",), files=frozenset({MANIFEST}))
+    try:
+        open_branch(path)
+        return True
+    except (StoreError, ParameterError):
+        return file_has_mark(path)
 
 
 def open_branch(path: str | os.PathLike[str]) -> Any:

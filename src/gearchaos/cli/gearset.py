@@ -75,14 +75,20 @@ def init_gearset(
 ) -> None:
     """Write a commented gear-set file to start from (the sheng2016 values, every line
     explained); edit it, then run **gearchaos simulate --gearset FILE**."""
+    from .._output import write_file
     from ..gearset import template_toml
 
-    if file.exists() and not file.is_file():  # a FIFO would block the write forever
-        c.fail(f"{file} exists and is not a regular file; choose another path", c.EXIT_INVALID)
+    if file.is_symlink() or (file.exists() and not file.is_file()):  # a FIFO would block
+        c.fail(
+            f"{file} exists and is not a regular file (a link, directory, FIFO or device); "
+            "choose another path",
+            c.EXIT_INVALID,
+        )
     if file.exists() and not force:
         c.fail(f"{file} already exists; pass --force to overwrite it", c.EXIT_FAILURE)
     with c.reported_errors():
-        file.write_text(template_toml(), encoding="utf-8")
+        # complete or not at all: a full disk leaves the old file (or none), never a part
+        write_file(str(file), template_toml().encode("utf-8"), what="gear-set file")
     c.wrote(file)
     c.stdout().print(
         Text(f"next: gearchaos simulate --gearset {file} --set omega=1.5 -o out/", style="dim")

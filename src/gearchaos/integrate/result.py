@@ -22,11 +22,15 @@ from typing import Any
 import numpy as np
 
 from .._files import check_output_file, check_regular_file
+from .._output import check_replaceable, file_has_mark, write_file
 from .._version import provenance
 from ..errors import ParameterError, StoreError
 from .trajectory import Trajectory
 
 __all__ = ["SimulationResult", "open_simulation"]
+
+#: The start of every simulation file's title: what identifies one.
+SIMULATION_TITLE = "gearchaos simulation"
 
 _DIMLESS = "1"
 
@@ -50,7 +54,7 @@ class SimulationResult(Trajectory):
     # ------------------------------------------------------------------ xarray
     def _attrs(self) -> dict[str, Any]:
         attrs: dict[str, Any] = {
-            "title": f"gearchaos simulation of {self.system.name}",
+            "title": f"{SIMULATION_TITLE} of {self.system.name}",
             "model": self.system.name,
             "omega": self.omega,
             **self.solver.attrs(),
@@ -260,16 +264,11 @@ class SimulationResult(Trajectory):
         is refused with :class:`~gearchaos.errors.StoreError`, as is a failed write.
         """
         text = check_output_file(path, what="simulation file")
-        ds = self.to_dataset()
-        tmp = text + ".partial"
-        try:
-            ds.to_netcdf(tmp, engine="h5netcdf", invalid_netcdf=True)
-            os.replace(tmp, text)  # never leave a half-written file under the final name
-        except OSError as exc:
-            if os.path.isfile(tmp):
-                os.remove(tmp)
-            raise StoreError(f"cannot write {text!r}: {exc.strerror or exc}") from None
-        return text
+        check_replaceable(text, what="simulation file", ours=is_simulation_file)
+        # serialised in memory first (HDF5 crashes on a full disk), then written under a
+        # unique temporary name and renamed: never a half-written file under the final name
+        data = self.to_dataset().to_netcdf(engine="h5netcdf", invalid_netcdf=True)
+        return write_file(text, data, what="simulation file")
 
 
 def open_simulation(path: str | os.PathLike[str]) -> Any:
@@ -284,8 +283,25 @@ def open_simulation(path: str | os.PathLike[str]) -> Any:
 
     name = check_regular_file(path, what="simulation file")
     try:
-        return xr.load_dataset(name, engine="h5netcdf")
+        ds = xr.load_dataset(name, engine="h5netcdf")
     except (OSError, ValueError, KeyError, TypeError) as exc:
         raise StoreError(
             f"simulation file {name!r} is not a readable netCDF-4 file ({type(exc).__name__})"
         ) from None
+    if not str(ds.attrs.get("title", "")).startswith(SIMULATION_TITLE):
+        what = "a branch (open it with open_branch)" if "parameter" in ds.attrs else "another"
+        raise StoreError(
+            f"{name!r} is not a gearchaos simulation file: its title is "
+            f"{ds.attrs.get('title', '(none)')!r}, {what} netCDF file"
+        )
+    return ds
+
+
+def is_simulation_file(path: str) -> bool:
+    """Whether ``path`` is a simulation file gearchaos wrote (what a new one may replace); a
+    damaged one still carries the gearchaos mark."""
+    try:
+        open_simulation(path)
+        return True
+    except (StoreError, ParameterError):
+        return file_has_mark(path)

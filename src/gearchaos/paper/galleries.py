@@ -39,6 +39,7 @@ from types import MappingProxyType
 from typing import Any
 
 from .._checks import check_bool, check_int, check_real
+from .._output import staged_file, write_file
 from ..errors import ParameterError
 from ..gearset.schema import display_symbol, tex
 from ..integrate.settings import SolverSettings
@@ -342,19 +343,17 @@ def get_gallery(name: str) -> Gallery:
 
 
 def _write_json(path: Path, obj: Any) -> None:
-    tmp = path.with_name(path.name + ".partial")
-    tmp.write_text(json.dumps(obj, indent=2, ensure_ascii=False, allow_nan=False) + "\n")
-    os.replace(tmp, path)
+    text = json.dumps(obj, indent=2, ensure_ascii=False, allow_nan=False) + "\n"
+    write_file(str(path), text.encode("utf-8"), what="gallery table")
 
 
 def _write_csv(path: Path, rows: Sequence[Mapping[str, Any]]) -> None:
-    tmp = path.with_name(path.name + ".partial")
-    with tmp.open("w", newline="", encoding="utf-8") as fh:
-        writer = csv.DictWriter(fh, fieldnames=list(ROW_KEYS))
-        writer.writeheader()
-        for row in rows:
-            writer.writerow({k: "" if row.get(k) is None else row.get(k) for k in ROW_KEYS})
-    os.replace(tmp, path)
+    with staged_file(str(path), what="gallery table") as tmp:
+        with open(tmp, "w", newline="", encoding="utf-8") as fh:
+            writer = csv.DictWriter(fh, fieldnames=list(ROW_KEYS))
+            writer.writeheader()
+            for row in rows:
+                writer.writerow({k: "" if row.get(k) is None else row.get(k) for k in ROW_KEYS})
 
 
 def reproduce_gallery(

@@ -32,6 +32,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from .._output import check_replaceable, file_has_mark, write_file
 from ..sweep.result import SweepResult
 
 __all__ = ["FIGURES", "HONESTY", "build_report", "render_html"]
@@ -475,9 +476,8 @@ def build_report(
         gearset_label=label,
     )
     index = out / "index.html"
-    tmp = index.with_name(index.name + ".partial")
-    tmp.write_text(page, encoding="utf-8")
-    os.replace(tmp, index)
+    check_replaceable(str(index), what="report page", ours=file_has_mark)
+    write_file(str(index), page.encode("utf-8"), what="report page")
     summary = {
         "quick": quick,
         "gearset": label,

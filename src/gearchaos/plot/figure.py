@@ -9,6 +9,8 @@ from typing import Any
 import numpy as np
 
 from .._files import check_output_file
+from .._output import check_replaceable, file_has_mark, staged_file
+from .._version import __version__
 from ..errors import ParameterError
 from ._common import is_planetary, message
 from .phase import phase_portrait, poincare_map, sun_orbit
@@ -204,8 +206,10 @@ def summary_figure(
 def savefig(fig: Any, path: str | os.PathLike[str], *, dpi: float = 150) -> str:
     """Write ``fig`` as PNG, PDF or SVG, chosen by the suffix of ``path``; returns the path.
 
-    Raises :class:`~gearchaos.errors.ParameterError` for any other suffix, and writes under a
-    temporary name first so that a failed write never leaves a partial file at ``path``.
+    Raises :class:`~gearchaos.errors.ParameterError` for any other suffix. The file carries
+    the gearchaos mark in its metadata; an existing file without it is never replaced
+    (:class:`~gearchaos.errors.StoreError`), and the figure is written under a unique
+    temporary name and renamed, so a failed write never leaves a partial file at ``path``.
     """
     p = Path(check_output_file(path, what="figure file"))  # never replaces /dev/null or a FIFO
     suffix = p.suffix.lower()
@@ -213,11 +217,9 @@ def savefig(fig: Any, path: str | os.PathLike[str], *, dpi: float = 150) -> str:
         raise ParameterError(
             f"path must end in one of {', '.join(SAVE_FORMATS)}: got {os.fspath(path)!r}"
         )
-    tmp = p.with_name(p.name + ".partial")
-    try:
-        fig.savefig(tmp, format=suffix[1:], dpi=dpi)
-        os.replace(tmp, p)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
+    # an existing file is replaced only if gearchaos drew it (the mark in its metadata)
+    check_replaceable(str(p), what="figure", ours=file_has_mark)
+    key = "Software" if suffix == ".png" else "Creator"
+    with staged_file(str(p), what="figure") as tmp:
+        fig.savefig(tmp, format=suffix[1:], dpi=dpi, metadata={key: f"gearchaos {__version__}"})
     return str(p)

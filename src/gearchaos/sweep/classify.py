@@ -16,11 +16,14 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
+import tempfile
 from typing import Any
 
 import numpy as np
 
 from .._checks import check_int, check_real
+from .._output import write_error, write_file
 from ..errors import ParameterError, StoreError
 from .result import SweepResult
 from .store import SweepStore, consolidate, foreign_files_ignored, open_sweep
@@ -178,6 +181,33 @@ def _contact(res: SweepResult) -> dict[str, Any]:
     return out
 
 
+def _staging(zstore: Any) -> str | None:
+    """A temporary Zarr group beside an on-disk store (same file system), or None."""
+    if not isinstance(zstore, str):
+        return None
+    parent = os.path.dirname(os.path.abspath(zstore))
+    name = os.path.basename(os.path.abspath(zstore))
+    return tempfile.mkdtemp(prefix=f".{name}.classify.", suffix=".partial", dir=parent)
+
+
+def _swap_in(staging: str, zstore: str, attrs: dict[str, Any]) -> None:
+    """Put the arrays written under ``staging`` in place of the store's (renames, which need
+    no space), then its attributes (one atomic write)."""
+    for name in sorted(os.listdir(staging)):
+        new = os.path.join(staging, name)
+        if name.startswith(".") or not os.path.isdir(new):
+            continue
+        old = os.path.join(zstore, name)
+        if os.path.isdir(old):
+            os.rename(old, os.path.join(staging, f".old-{name}"))
+        os.rename(new, old)
+    path = os.path.join(zstore, ".zattrs")
+    with open(path, encoding="utf-8") as f:
+        current = json.load(f)
+    current.update(attrs)
+    write_file(path, json.dumps(current, indent=4).encode("utf-8"), what="store attributes")
+
+
 def classify_store(
     store: str | os.PathLike[str] | Any,
     *,
@@ -213,52 +243,74 @@ def classify_store(
             f"{zstore!r} is not a readable sweep store ({type(exc).__name__}: {exc})"
         ) from None
     res = classify_dataset(ds, period_rtol=period_rtol, max_period=max_period)
-    g = zarr.open_group(zstore, mode="a", use_consolidated=False)
-    dims = list(res["dims"])
-    for mesh, label in (("sp", "sun–planet"), ("rp", "planet–ring")):
-        name = f"contact_{mesh}"
-        if name not in res:
-            continue
-        arr = g.create_array(
-            name,
-            shape=res[name].shape,
-            chunks=res[name].shape,
-            dtype="int8",
-            fill_value=None,
-            attributes={
-                "long_name": f"contact regime of each {label} mesh over the recorded window",
-                "flag_values": [-1, 0, 1, 2],
-                "flag_meanings": "unknown none single_sided double_sided",
-                "_ARRAY_DIMENSIONS": [*dims, "planet_all"],
-            },
-            overwrite=True,
+    # on disk the new arrays are written beside the store first and swapped in by renames,
+    # so a full disk or a kill leaves the store as it was, never half rewritten
+    try:
+        staging = _staging(zstore)
+    except OSError as exc:
+        raise write_error(exc, "sweep store", str(zstore)) from None
+    try:
+        g = (
+            zarr.open_group(staging, mode="w", zarr_format=2)
+            if staging
+            else zarr.open_group(zstore, mode="a", use_consolidated=False)
         )
-        arr[...] = res[name]
-    docs = {
-        "motion": ("1T…nT, QP, chaos, unresolved or failed", ""),
-        "period": ("period n of the section sequence (0: none ≤ max_period)", 0),
-        "k01": ("0–1 test for chaos K (Gottwald & Melbourne)", np.nan),
-        "indicators_agree": ("whether every available indicator agrees with the label", False),
-    }
-    verdicts = "verdict" in ds.data_vars
-    for name, (doc, fill) in docs.items():
-        if verdicts and name in ("motion", "k01"):
-            continue  # written by every task with its verdict: never rewritten in place
-        values = res[name]
-        arr = g.create_array(
-            name,
-            shape=values.shape,
-            chunks=values.shape if values.size else "auto",
-            dtype=values.dtype,
-            # only floats carry a fill value (NaN): xarray would mask a bool False or a
-            # period 0 equal to the fill value as missing (the array is written whole)
-            fill_value=fill if values.dtype.kind == "f" else None,
-            attributes={"long_name": doc, "_ARRAY_DIMENSIONS": dims},
-            overwrite=True,
-        )
-        arr[...] = values
-    g.attrs["regime_table"] = json.dumps(res["regime_table"])
-    g.attrs["classification_rtol"] = float(period_rtol)
+        dims = list(res["dims"])
+        for mesh, label in (("sp", "sun–planet"), ("rp", "planet–ring")):
+            name = f"contact_{mesh}"
+            if name not in res:
+                continue
+            arr = g.create_array(
+                name,
+                shape=res[name].shape,
+                chunks=res[name].shape,
+                dtype="int8",
+                fill_value=None,
+                attributes={
+                    "long_name": f"contact regime of each {label} mesh over the recorded window",
+                    "flag_values": [-1, 0, 1, 2],
+                    "flag_meanings": "unknown none single_sided double_sided",
+                    "_ARRAY_DIMENSIONS": [*dims, "planet_all"],
+                },
+                overwrite=True,
+            )
+            arr[...] = res[name]
+        docs = {
+            "motion": ("1T…nT, QP, chaos, unresolved or failed", ""),
+            "period": ("period n of the section sequence (0: none ≤ max_period)", 0),
+            "k01": ("0–1 test for chaos K (Gottwald & Melbourne)", np.nan),
+            "indicators_agree": ("whether every available indicator agrees with the label", False),
+        }
+        verdicts = "verdict" in ds.data_vars
+        for name, (doc, fill) in docs.items():
+            if verdicts and name in ("motion", "k01"):
+                continue  # written by every task with its verdict: never rewritten in place
+            values = res[name]
+            arr = g.create_array(
+                name,
+                shape=values.shape,
+                chunks=values.shape if values.size else "auto",
+                dtype=values.dtype,
+                # only floats carry a fill value (NaN): xarray would mask a bool False or a
+                # period 0 equal to the fill value as missing (the array is written whole)
+                fill_value=fill if values.dtype.kind == "f" else None,
+                attributes={"long_name": doc, "_ARRAY_DIMENSIONS": dims},
+                overwrite=True,
+            )
+            arr[...] = values
+        attrs: dict[str, Any] = {
+            "regime_table": json.dumps(res["regime_table"]),
+            "classification_rtol": float(period_rtol),
+        }
+        if staging is None:
+            g.attrs.update(attrs)
+        else:
+            _swap_in(staging, str(zstore), attrs)
+    except OSError as exc:
+        raise write_error(exc, "sweep store", str(zstore)) from None
+    finally:
+        if staging is not None:
+            shutil.rmtree(staging, ignore_errors=True)
     consolidate(zstore)
     if isinstance(zstore, str):
         SweepStore(zstore).refresh_manifest()

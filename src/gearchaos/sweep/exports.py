@@ -26,6 +26,8 @@ from typing import Any
 import numpy as np
 
 from .._files import check_output_file, check_path
+from .._output import check_replaceable, file_has_mark, staged_file
+from .._version import __version__
 from ..errors import ParameterError, StoreError
 
 __all__ = ["FORMATS", "export", "open_result", "table"]
@@ -162,8 +164,10 @@ def export(source: Any, path: str | os.PathLike[str], *, to: str | None = None) 
         raise ParameterError(f"the output must be a file: {str(out)!r} is a directory")
     ds = open_result(source)
     out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = out.with_name(f".{out.name}.partial-{os.getpid()}")
-    try:
+    # an existing export is replaced only if gearchaos wrote it (its header, the .mat's text)
+    check_replaceable(str(out), what="export", ours=file_has_mark)
+    with staged_file(str(out), what="export") as staged:
+        tmp = Path(staged)
         if fmt == "csv":
             df = table(ds)
             header = [f"# {k} = {ds.attrs[k]}" for k in _HEADER_ATTRS if k in ds.attrs]
@@ -171,13 +175,10 @@ def export(source: Any, path: str | os.PathLike[str], *, to: str | None = None) 
                 name = re.search(r'^name = "(.*)"', str(ds.attrs["gearset_toml"]), re.M)
                 if name:
                     header.insert(0, f"# gearset = {name.group(1)}")
+            header.insert(0, f"# gearchaos {__version__} export of {os.fspath(source)}")
             with open(tmp, "w", encoding="utf-8", newline="") as f:
                 f.write("\n".join(header) + ("\n" if header else ""))
                 df.to_csv(f, index=False)  # floats as repr: the shortest exact text
         else:
             _write_mat(ds, os.fspath(tmp))
-        os.replace(tmp, out)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
     return out

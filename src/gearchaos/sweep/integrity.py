@@ -14,15 +14,19 @@
 from __future__ import annotations
 
 import contextlib
+import errno
 import json
 import math
 import os
 import socket
+import stat
+import tempfile
 import time
 import zlib
 from collections.abc import Iterable, Iterator, Mapping
 from typing import Any
 
+from .._output import write_file
 from ..errors import StoreError
 
 __all__ = [
@@ -58,7 +62,10 @@ class StoreLock:
 
     def __init__(self, store_path: str):
         self.store_path = store_path
-        self.path = f"{store_path}.lock"
+        # one lock per store whatever the spelling: a symbolic-link alias, a trailing slash or
+        # a relative path name the same directory, and so the same lock
+        real = os.path.realpath(os.path.abspath(store_path).rstrip(os.sep) or os.sep)
+        self.path = f"{real}.lock"
         self._held = False
 
     def _owner(self) -> dict[str, Any] | None:
@@ -75,19 +82,16 @@ class StoreLock:
         pid, host = owner.get("pid"), owner.get("host")
         if host == socket.gethostname() and isinstance(pid, int):
             return not _alive(pid)
-        if not owner:  # unreadable (a writer killed while writing it): stale after a minute
-            try:
-                return time.time() - os.stat(self.path).st_mtime > 60.0
-            except FileNotFoundError:
-                return True
-        return False
+        # a lock appears with its owner written (a hard link of a finished file), so one that
+        # names no owner (empty, torn: left by an older version or a full disk) holds nothing
+        return not isinstance(pid, int) or not isinstance(host, str)
 
     def acquire(self) -> None:
         parent = os.path.dirname(os.path.abspath(self.path))
         os.makedirs(parent, exist_ok=True)
         for _ in range(3):
             try:
-                fd = os.open(self.path, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+                self._create()
             except FileExistsError:
                 owner = self._owner()
                 if owner is None:
@@ -107,13 +111,41 @@ class StoreLock:
                     f"host {owner.get('host', '?')} since {when}; wait for it to finish, or "
                     f"remove {self.path} if that process no longer runs"
                 ) from None
-            with os.fdopen(fd, "w", encoding="utf-8") as f:
-                json.dump(
-                    {"pid": os.getpid(), "host": socket.gethostname(), "started": time.time()}, f
-                )
             self._held = True
             return
         raise StoreError(f"cannot take the lock {self.path} (it keeps changing)")
+
+    def _create(self) -> None:
+        """Create the lock file with its owner in one step: written and flushed under a
+        unique name, then hard-linked to the lock's name (which fails if it exists)."""
+        owner = {"pid": os.getpid(), "host": socket.gethostname(), "started": time.time()}
+        parent = os.path.dirname(self.path)
+        try:
+            os.makedirs(parent, exist_ok=True)
+            fd, tmp = tempfile.mkstemp(prefix=".lock.", suffix=".partial", dir=parent)
+        except OSError as exc:
+            raise StoreError(f"cannot create the lock {self.path}: {exc.strerror or exc}") from None
+        try:
+            with os.fdopen(fd, "w", encoding="utf-8") as f:
+                json.dump(owner, f)
+                f.flush()
+                os.fsync(f.fileno())
+            try:
+                os.link(tmp, self.path)
+            except OSError as exc:
+                if exc.errno not in (errno.EPERM, errno.EOPNOTSUPP, errno.ENOTSUP, errno.EXDEV):
+                    raise
+                # no hard links on this file system: create exclusively, then write
+                fd2 = os.open(self.path, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+                with os.fdopen(fd2, "w", encoding="utf-8") as f:
+                    json.dump(owner, f)
+        except FileExistsError:
+            raise
+        except OSError as exc:
+            raise StoreError(f"cannot create the lock {self.path}: {exc.strerror or exc}") from None
+        finally:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
 
     def release(self) -> None:
         if self._held:
@@ -132,11 +164,32 @@ class StoreLock:
 
 
 # ------------------------------------------------------------------------------- checksums
-def file_digest(path: str) -> tuple[int, int]:
-    """(size in bytes, CRC-32) of a file."""
-    with open(path, "rb") as f:
-        data = f.read()
-    return len(data), zlib.crc32(data)
+def file_digest(path: str, max_bytes: int = 1 << 31) -> tuple[int, int]:
+    """(size in bytes, CRC-32) of a regular file of at most ``max_bytes`` bytes: a symbolic
+    link, a FIFO or a device is refused (``OSError``) before anything is read, and at most
+    ``max_bytes`` + 1 bytes are read, so ``/dev/zero`` or a huge file never exhausts memory."""
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOFOLLOW", 0)
+    try:
+        fd = os.open(path, flags)
+    except OSError as exc:
+        if exc.errno == errno.ELOOP:  # O_NOFOLLOW met a symbolic link
+            raise OSError(errno.ELOOP, "a symbolic link, not a chunk file") from None
+        raise
+    try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            raise OSError(errno.EINVAL, "not a regular file")
+        crc, size = 0, 0
+        while size <= max_bytes:
+            block = os.read(fd, min(1 << 20, max_bytes + 1 - size))
+            if not block:
+                break
+            crc = zlib.crc32(block, crc)
+            size += len(block)
+        if size > max_bytes:
+            raise OSError(errno.EFBIG, f"larger than the {max_bytes} bytes written")
+        return size, crc
+    finally:
+        os.close(fd)
 
 
 def chunk_keys(
@@ -207,7 +260,7 @@ def verify_chunks(root: str, chunks: Mapping[str, Any]) -> list[str]:
                 problems.append(f"chunk {rel} appeared after it was written as empty")
             continue
         try:
-            size, crc = file_digest(path)
+            size, crc = file_digest(path, max_bytes=expected[0])
         except FileNotFoundError:
             problems.append(f"chunk {rel} is missing")
             continue
@@ -220,13 +273,9 @@ def verify_chunks(root: str, chunks: Mapping[str, Any]) -> list[str]:
 
 
 def write_json_atomic(path: str, data: Any) -> None:
-    """Write JSON to a temporary file, flush it to disk and rename it into place."""
-    tmp = f"{path}.partial-{os.getpid()}"
-    with open(tmp, "w", encoding="utf-8") as f:
-        json.dump(data, f, separators=(",", ":"))
-        f.flush()
-        os.fsync(f.fileno())
-    os.replace(tmp, path)
+    """Write JSON through the package's one staged write (unique temporary name, flushed to
+    disk, renamed into place; a full disk is a clear error)."""
+    write_file(path, json.dumps(data, separators=(",", ":")).encode("utf-8"), what="record")
 
 
 def read_manifest(root: str) -> dict[str, Any] | None:

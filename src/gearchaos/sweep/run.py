@@ -20,7 +20,7 @@ import numpy as np
 
 from .._checks import check_bool
 from .._version import provenance
-from ..errors import ParameterError, Status
+from ..errors import ParameterError, Status, StoreError
 from ..integrate._chains import ChainOutput, ChainRun
 from ..model.target import scale_attrs
 from ._response_store import response_extract, response_variables
@@ -312,14 +312,11 @@ def _run_locked(
         if st.attrs().get("complete"):
             st.clear_stale_progress()
             return st.open()
-    elif st.path is not None and os.path.exists(st.path):
-        if overwrite:
-            st.remove()
-        else:
-            raise ParameterError(
-                f"{st.path} exists and is not a gearchaos sweep store; "
-                "choose another path or pass overwrite=True (--overwrite)"
-            )
+    elif st.path is not None and os.path.lexists(st.path):
+        raise StoreError(
+            f"{st.path!r} exists and is not a gearchaos sweep store: it is never replaced, "
+            "not even with overwrite=True (--overwrite); move it away or choose another path"
+        )
     if not st.exists():
         variables, chunks = layout.variables()
         _check_sizes(grid, variables, st.path)

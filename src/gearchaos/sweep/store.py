@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from .._files import check_path
+from .._output import check_replaceable, is_own_zarr, write_file
 from ..errors import StoreError
 from ..gearset.mapping import flatten
 from .integrity import (
@@ -43,6 +44,16 @@ __all__ = ["SweepStore", "open_sweep"]
 PROGRESS = "_progress"
 
 
+def is_sweep_store(path: str) -> bool:
+    """Whether ``path`` is a directory gearchaos wrote as a sweep store and nothing else
+    (:func:`~gearchaos._output.is_own_zarr`: its attributes name the sweep and the package
+    version; it holds only Zarr metadata, the manifest, the task markers and arrays of chunks —
+    a file a user put inside makes it no longer only a store, so ``overwrite`` refuses it)."""
+    return is_own_zarr(
+        path, keys=("sweep_toml", "version"), files=frozenset({MANIFEST}), markers=PROGRESS
+    )
+
+
 @contextlib.contextmanager
 def foreign_files_ignored() -> Iterator[None]:
     """Silence Zarr's warning about the files of a store that are no Zarr nodes (the task
@@ -53,11 +64,25 @@ def foreign_files_ignored() -> Iterator[None]:
 
 
 def consolidate(store: Any) -> None:
-    """Consolidate a store's metadata."""
+    """Consolidate a store's metadata. On disk the ``.zmetadata`` file is built from the
+    metadata files and written in one atomic step (Zarr's own writer truncates it first, so a
+    full disk or a kill would leave a store that no longer opens)."""
     import zarr
 
-    with foreign_files_ignored():
-        zarr.consolidate_metadata(store)
+    if not isinstance(store, str):
+        with foreign_files_ignored():
+            zarr.consolidate_metadata(store)
+        return
+    meta: dict[str, Any] = {}
+    for dirpath, dirnames, files in os.walk(store):
+        dirnames[:] = sorted(d for d in dirnames if d != PROGRESS)
+        rel = os.path.relpath(dirpath, store).replace(os.sep, "/")
+        for name in (".zgroup", ".zattrs", ".zarray"):
+            if name in files and not (rel == "." and name == ".zmetadata"):
+                with open(os.path.join(dirpath, name), encoding="utf-8") as f:
+                    meta[name if rel == "." else f"{rel}/{name}"] = json.load(f)
+    text = json.dumps({"metadata": meta, "zarr_consolidated_format": 1}, indent=4)
+    write_file(os.path.join(store, ".zmetadata"), text.encode("utf-8"), what="store metadata")
 
 
 def open_sweep(path: str | os.PathLike[str], *, verify: bool = True) -> Any:
@@ -148,9 +173,10 @@ class SweepStore:
             )
 
     def remove(self) -> None:
-        if self.path is not None and os.path.exists(self.path):
-            if not os.path.isdir(self.path):
-                raise StoreError(f"{self.path} exists and is not a directory")
+        """Delete the store (``overwrite``): only a gearchaos sweep store that holds nothing
+        else (:func:`is_sweep_store`); any other path is refused with its name."""
+        if self.path is not None and os.path.lexists(self.path):
+            check_replaceable(self.path, what="sweep store", ours=is_sweep_store)
             shutil.rmtree(self.path)
 
     # ------------------------------------------------------------------ creation

@@ -1,0 +1,277 @@
+"""Writing results safely: one overwrite rule and one way to put a file or directory in place.
+
+**The overwrite rule.** A path that already exists is replaced only when it is gearchaos's own
+output of the same kind, recognised by its own metadata (:func:`check_replaceable`, with the
+writer's test ``ours``): a sweep store whose attributes name its sweep and which holds nothing
+else, a branch file with its ``parameter`` attribute, a figure or export carrying the
+``gearchaos`` mark. Anything else — a user's directory, a thesis, a file of another program, a
+symbolic link — is refused with :class:`~gearchaos.errors.StoreError` naming the path.
+
+**The one way to write.** :func:`staged_file` and :func:`staged_dir` give the writer a
+temporary path beside the target with a unique name, created exclusively (``O_EXCL``: a
+symbolic link planted under any name is never followed), and on success flush it to disk and
+rename it over the target in one step; on every error path the temporary is removed. An
+``ENOSPC`` becomes "no space left on device … N bytes free" instead of a crash or a truncated
+file; writers whose libraries crash on a full disk (HDF5) serialise to memory first and write
+the bytes with :func:`write_file`.
+
+A leaf module: it imports nothing from the package but :mod:`gearchaos.errors`.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import errno
+import json
+import os
+import re
+import shutil
+import stat
+import tempfile
+from collections.abc import Callable, Iterator
+
+from .errors import StoreError
+
+__all__ = [
+    "MARK",
+    "check_replaceable",
+    "file_has_mark",
+    "is_own_zarr",
+    "staged_dir",
+    "staged_file",
+    "write_error",
+    "write_file",
+]
+
+#: The bytes that identify a file gearchaos wrote (figure metadata, CSV and TOML headers).
+MARK = b"gearchaos"
+
+#: How much of a file :func:`file_has_mark` reads at most (figures and exports are small).
+_MARK_SCAN = 64 * 1024 * 1024
+
+
+def _umask() -> int:
+    old = os.umask(0o022)
+    os.umask(old)
+    return old
+
+
+#: The mode of a new file (a temporary file is created 0600): what ``open`` would give.
+_FILE_MODE = 0o666 & ~_umask()
+
+
+def _free(directory: str) -> int | None:
+    try:
+        st = os.statvfs(directory)
+    except (OSError, AttributeError):
+        return None
+    return int(st.f_bavail * st.f_frsize)
+
+
+def write_error(exc: OSError, what: str, path: str, needed: int | None = None) -> StoreError:
+    """A clear error for a failed write of ``what`` at ``path`` (a full disk says so, with
+    the bytes free and, when known, needed)."""
+    if exc.errno in (errno.ENOSPC, errno.EDQUOT):
+        free = _free(os.path.dirname(os.path.abspath(path)) or ".")
+        need = f"{needed} bytes needed, " if needed is not None else ""
+        have = f"{free} bytes free" if free is not None else "free space unknown"
+        return StoreError(f"no space left on device for {what} {path!r}: {need}{have}")
+    return StoreError(f"cannot write {what} {path!r}: {exc.strerror or exc}")
+
+
+def _fsync_dir(directory: str) -> None:
+    with contextlib.suppress(OSError):
+        fd = os.open(directory, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+
+
+def _remove(path: str) -> None:
+    with contextlib.suppress(OSError):
+        if os.path.isdir(path) and not os.path.islink(path):
+            shutil.rmtree(path, ignore_errors=True)
+        else:
+            os.unlink(path)
+
+
+def _parent(path: str) -> tuple[str, str]:
+    full = os.path.abspath(path)
+    return os.path.dirname(full), os.path.basename(full.rstrip(os.sep)) or "output"
+
+
+@contextlib.contextmanager
+def staged_file(path: str, *, what: str, needed: int | None = None) -> Iterator[str]:
+    """A temporary file path beside ``path`` for a writer to fill; renamed over ``path`` when
+    the block ends without error, removed otherwise. ``needed`` (bytes), when known, goes
+    into the message of a full disk."""
+    parent, name = _parent(path)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=".partial", dir=parent)
+    except OSError as exc:
+        raise write_error(exc, what, path, needed) from None
+    done = False
+    try:
+        # a replaced file keeps its permissions, a new one gets the usual ones
+        try:
+            mode = stat.S_IMODE(os.stat(path).st_mode)
+        except OSError:
+            mode = _FILE_MODE
+        os.fchmod(fd, mode)
+        os.close(fd)
+        fd = -1
+        yield tmp
+        with open(tmp, "rb") as f:  # the writer closed it: flush its blocks to the disk
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+        done = True
+        _fsync_dir(parent)
+    except OSError as exc:
+        raise write_error(exc, what, path, needed) from None
+    finally:
+        if fd >= 0:
+            os.close(fd)
+        if not done:
+            _remove(tmp)
+
+
+def write_file(path: str, data: bytes | memoryview, *, what: str) -> str:
+    """Write ``data`` to ``path`` through :func:`staged_file`; returns ``path``."""
+    view = memoryview(data).cast("B")
+    with staged_file(path, what=what, needed=view.nbytes) as tmp:
+        flags = os.O_WRONLY | os.O_TRUNC | getattr(os, "O_NOFOLLOW", 0)
+        fd = os.open(tmp, flags)
+        try:
+            done = 0
+            while done < view.nbytes:
+                done += os.write(fd, view[done:])
+        finally:
+            os.close(fd)
+    return path
+
+
+@contextlib.contextmanager
+def staged_dir(path: str, *, what: str) -> Iterator[str]:
+    """A temporary directory beside ``path`` for a writer to fill; put in place of ``path``
+    when the block ends without error (an existing ``path`` — which the caller has checked
+    with :func:`check_replaceable` — is moved aside first and removed after), removed
+    otherwise."""
+    parent, name = _parent(path)
+    try:
+        os.makedirs(parent, exist_ok=True)
+        tmp = tempfile.mkdtemp(prefix=f".{name}.", suffix=".partial", dir=parent)
+    except OSError as exc:
+        raise write_error(exc, what, path) from None
+    done = False
+    try:
+        yield tmp
+        if os.path.lexists(path):
+            trash = tempfile.mkdtemp(prefix=f".{name}.", suffix=".old", dir=parent)
+            os.rename(path, os.path.join(trash, name))
+            os.rename(tmp, path)
+            done = True
+            shutil.rmtree(trash, ignore_errors=True)
+        else:
+            os.rename(tmp, path)
+            done = True
+        _fsync_dir(parent)
+    except OSError as exc:
+        raise write_error(exc, what, path) from None
+    finally:
+        if not done:
+            _remove(tmp)
+
+
+def file_has_mark(path: str) -> bool:
+    """Whether the regular file ``path`` holds :data:`MARK` within its first 64 MiB (a figure's
+    metadata, an export's header); never follows a symbolic link or opens a FIFO."""
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOFOLLOW", 0)
+    try:
+        fd = os.open(path, flags)
+    except OSError:
+        return False
+    try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            return False
+        tail = b""
+        left = _MARK_SCAN
+        while left > 0:
+            block = os.read(fd, min(1 << 20, left))
+            if not block:
+                return False
+            if MARK in tail + block:
+                return True
+            tail = block[-len(MARK) :]
+            left -= len(block)
+        return False
+    except OSError:
+        return False
+    finally:
+        os.close(fd)
+
+
+def check_replaceable(path: str, *, what: str, ours: Callable[[str], bool]) -> None:
+    """Refuse to replace ``path`` unless nothing is there or it is gearchaos's own ``what``
+    (``ours(path)`` true): never a symbolic link, a foreign file or directory."""
+    if not os.path.lexists(path):
+        return
+    if os.path.islink(path):
+        raise StoreError(
+            f"{path!r} is a symbolic link: a {what} is never written through one; "
+            "choose another path"
+        )
+    if not ours(path):
+        kind = "directory" if os.path.isdir(path) else "file"
+        raise StoreError(
+            f"{path!r} exists and is not a {what} gearchaos wrote (a {kind} of something "
+            "else): it is not replaced; move it away or choose another path"
+        )
+
+
+_CHUNK = re.compile(r"[0-9]+(\.[0-9]+)*")
+#: The temporary files of an interrupted atomic write (``x.partial-PID``, ``.x.abc.partial``).
+_OWN_TEMP = re.compile(r"\.partial(-[0-9]+)?$")
+
+
+def is_own_zarr(
+    path: str,
+    *,
+    keys: tuple[str, ...],
+    files: frozenset[str] = frozenset(),
+    markers: str | None = None,
+) -> bool:
+    """Whether ``path`` is a Zarr (format 2) directory gearchaos wrote and nothing else: its
+    ``.zattrs`` holds every attribute in ``keys``; its top level holds only Zarr metadata,
+    the named ``files``, the ``markers`` directory of ``*.done`` files, temporaries of an
+    interrupted write, and arrays (directories of ``.zarray``, ``.zattrs`` and chunk files).
+    A file or directory a user put inside makes it no longer only gearchaos's."""
+    if os.path.islink(path) or not os.path.isdir(path):
+        return False
+    try:
+        with open(os.path.join(path, ".zattrs"), encoding="utf-8") as f:
+            attrs = json.loads(f.read(1 << 24))
+        entries = list(os.scandir(path))
+    except (OSError, ValueError):
+        return False
+    if not isinstance(attrs, dict) or not all(k in attrs for k in keys):
+        return False
+    top = {".zattrs", ".zgroup", ".zmetadata", *files}
+    for e in entries:
+        if e.is_file(follow_symlinks=False) and (e.name in top or _OWN_TEMP.search(e.name)):
+            continue
+        if not e.is_dir(follow_symlinks=False):
+            return False
+        try:
+            inner = os.listdir(e.path)
+        except OSError:
+            return False
+        if e.name == markers:
+            if not all(n.endswith(".done") or _OWN_TEMP.search(n) for n in inner):
+                return False
+            continue
+        if ".zarray" not in inner:
+            return False
+        if not all(n in (".zarray", ".zattrs") or _CHUNK.fullmatch(n) for n in inner):
+            return False
+    return True

@@ -1,0 +1,296 @@
+"""Never lose a user's file, never store wrong data as valid (issue 23): the overwrite rule,
+the one staged write, full disks, planted links, the store lock and hostile chunk files.
+
+Full-disk cases mount a small tmpfs, which needs root; they are skipped cleanly elsewhere.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import shutil
+import subprocess
+import threading
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import gearchaos as gc
+from gearchaos._output import file_has_mark, staged_file, write_file
+from gearchaos.analysis import open_branch, save_branch
+from gearchaos.errors import StoreError
+from gearchaos.sweep.integrity import StoreLock
+from gearchaos.sweep.store import is_sweep_store
+
+OSC = gc.backlash_oscillator(1.0, zeta=0.05, b=1.0, f_mean=0.1, f_alt=0.2)
+QUICK = {"transient_periods": 5, "periods": 4, "progress": False}
+
+
+def _sweep(path: Path, overwrite: bool = False):
+    return gc.bifurcation(OSC, "omega=0.8:1.2:3", store=path, overwrite=overwrite, **QUICK)
+
+
+def _branch():
+    return gc.continuation(OSC, ("omega", 1.5, 1.6), max_points=4)
+
+
+@contextlib.contextmanager
+def _small_disk(tmp_path: Path, size: str) -> Iterator[Path]:
+    """A tmpfs of ``size`` mounted under tmp_path (root only; skipped otherwise)."""
+    mnt = tmp_path / "disk"
+    mnt.mkdir()
+    if os.geteuid() != 0 or shutil.which("mount") is None:
+        pytest.skip("a small tmpfs needs root")
+    r = subprocess.run(["mount", "-t", "tmpfs", "-o", f"size={size}", "tmpfs", str(mnt)])
+    if r.returncode != 0:
+        pytest.skip("this machine cannot mount a tmpfs")
+    try:
+        yield mnt
+    finally:
+        subprocess.run(["umount", "-l", str(mnt)], check=False)
+
+
+def _fill(disk: Path, leave: int) -> None:
+    """Fill ``disk`` until about ``leave`` bytes are free."""
+    free = os.statvfs(disk).f_bavail * os.statvfs(disk).f_frsize
+    if free > leave:
+        with contextlib.suppress(OSError), open(disk / "ballast", "wb") as f:
+            f.write(b"\0" * (free - leave))
+
+
+# ------------------------------------------------------------------------- overwrite rule
+def test_overwrite_never_deletes_a_directory_gearchaos_did_not_write(tmp_path: Path) -> None:
+    # `bifurcation -o results_dir --overwrite` deleted results_dir/sub/notes.txt
+    foreign = tmp_path / "results_dir"
+    (foreign / "sub").mkdir(parents=True)
+    (foreign / "sub" / "notes.txt").write_text("a month of notes")
+    with pytest.raises(StoreError, match="not a gearchaos sweep store: it is never replaced"):
+        _sweep(foreign, overwrite=True)
+    assert (foreign / "sub" / "notes.txt").read_text() == "a month of notes"
+    # a store the user put a file into is no longer only gearchaos's: refused too
+    store = tmp_path / "run.zarr"
+    _sweep(store)
+    assert is_sweep_store(str(store))
+    (store / "chapter1").mkdir()
+    (store / "chapter1" / "draft.tex").write_text(r"\chapter{}")
+    assert not is_sweep_store(str(store))
+    with pytest.raises(StoreError, match="not a sweep store gearchaos wrote"):
+        _sweep(store, overwrite=True)
+    assert (store / "chapter1" / "draft.tex").exists()
+    # a genuine store is replaced
+    (store / "chapter1" / "draft.tex").unlink()
+    (store / "chapter1").rmdir()
+    ds = _sweep(store, overwrite=True)
+    assert ds.sizes["omega"] == 3
+    # and a symbolic link to a store is never written through
+    link = tmp_path / "alias.zarr"
+    link.symlink_to(store)
+    with pytest.raises(StoreError, match="symbolic link"):
+        _sweep(link, overwrite=True)
+    assert is_sweep_store(str(store))
+
+
+def test_a_branch_overwrite_replaces_only_a_branch(tmp_path: Path) -> None:
+    # `continue -o thesis.zarr --overwrite` deleted thesis.zarr/chapter1/draft.tex
+    br = _branch()
+    thesis = tmp_path / "thesis.zarr"
+    (thesis / "chapter1").mkdir(parents=True)
+    (thesis / "chapter1" / "draft.tex").write_text("text")
+    with pytest.raises(StoreError, match="not a zarr branch file gearchaos wrote"):
+        save_branch(br, thesis, overwrite=True)
+    assert (thesis / "chapter1" / "draft.tex").read_text() == "text"
+    paper = tmp_path / "paper.nc"
+    paper.write_bytes(b"\x89HDF\r\n\x1a\n someone else's data")
+    with pytest.raises(StoreError, match="not a netcdf branch file gearchaos wrote"):
+        save_branch(br, paper, overwrite=True)
+    assert paper.read_bytes().endswith(b"someone else's data")
+    for name in ("b.nc", "b.zarr"):
+        save_branch(br, tmp_path / name)
+        save_branch(br, tmp_path / name, overwrite=True)  # its own: replaced
+        assert open_branch(tmp_path / name).sizes == br.sizes
+    assert not [p for p in tmp_path.iterdir() if "partial" in p.name]
+
+
+def test_concurrent_branch_writers_leave_one_complete_branch(tmp_path: Path) -> None:
+    # two `continue -o b.nc --overwrite` at once left a b.nc with omega and every multiplier
+    # 0 (both used the fixed name b.nc.partial): each writer now has its own temporary
+    short, long = _branch(), gc.continuation(OSC, ("omega", 1.5, 1.7), max_points=6)
+    target = tmp_path / "b.nc"
+    errors: list[BaseException] = []
+
+    def write(ds) -> None:
+        try:
+            for _ in range(5):
+                save_branch(ds, target, overwrite=True)
+        except BaseException as exc:  # pragma: no cover - reported below
+            errors.append(exc)
+
+    threads = [threading.Thread(target=write, args=(ds,)) for ds in (short, long)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert not errors
+    got = open_branch(target)
+    assert any(got.sizes == ds.sizes for ds in (short, long))
+    omega = got[str(got.attrs["parameter"])].values
+    assert np.all(omega >= 1.5) and np.all(np.isfinite(got.multiplier_re.values))
+    assert [p.name for p in tmp_path.iterdir()] == ["b.nc"]
+
+
+def test_figures_and_exports_replace_only_their_own_files(tmp_path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from gearchaos.plot import savefig
+
+    fig = plt.figure()
+    for suffix in (".png", ".pdf", ".svg"):
+        out = tmp_path / f"f{suffix}"
+        savefig(fig, out)
+        assert file_has_mark(str(out))
+        savefig(fig, out)  # its own figure: replaced
+        photo = tmp_path / f"holiday{suffix}"
+        photo.write_bytes(b"not drawn by us")
+        with pytest.raises(StoreError, match="not a figure gearchaos wrote"):
+            savefig(fig, photo)
+        assert photo.read_bytes() == b"not drawn by us"
+    plt.close(fig)
+    store = tmp_path / "run.zarr"
+    _sweep(store)
+    csv = tmp_path / "run.csv"
+    gc.export(store, csv)
+    gc.export(store, csv)  # its own export: replaced
+    sheet = tmp_path / "budget.csv"
+    sheet.write_text("a,b\n1,2\n")
+    with pytest.raises(StoreError, match="not a export gearchaos wrote"):
+        gc.export(store, sheet)
+    assert sheet.read_text() == "a,b\n1,2\n"
+
+
+def test_a_planted_link_at_the_old_temporary_names_is_never_followed(tmp_path: Path) -> None:
+    # a symlink at out/simulation.nc.partial or f.png.partial made simulate/plot overwrite
+    # the link's target
+    victim = tmp_path / "victim.txt"
+    victim.write_text("precious")
+    out = tmp_path / "out"
+    out.mkdir()
+    for name in ("simulation.nc.partial", ".simulation.nc.partial"):
+        (out / name).symlink_to(victim)
+    res = gc.simulate(OSC, omega=1.0, transient_periods=2, periods=2)
+    res.save(out / "simulation.nc")
+    res.save(out / "simulation.nc")  # its own file: replaced
+    assert victim.read_text() == "precious"
+    assert gc.open_simulation(out / "simulation.nc").attrs["title"].startswith("gearchaos")
+    # and a branch file is not a simulation file
+    save_branch(_branch(), tmp_path / "b.nc")
+    with pytest.raises(StoreError, match=r"not a gearchaos simulation file.*open_branch"):
+        gc.open_simulation(tmp_path / "b.nc")
+
+
+def test_a_failed_write_leaves_the_old_file_and_no_temporary(tmp_path: Path) -> None:
+    target = tmp_path / "x.json"
+    target.write_text("old")
+    with pytest.raises(RuntimeError), staged_file(str(target), what="record") as tmp:
+        Path(tmp).write_text("half")
+        raise RuntimeError("killed")
+    assert target.read_text() == "old"
+    assert [p.name for p in tmp_path.iterdir()] == ["x.json"]
+    write_file(str(target), b"new", what="record")
+    assert target.read_text() == "new"
+    assert (target.stat().st_mode & 0o777) == 0o644 or os.geteuid() != 0
+
+
+# ----------------------------------------------------------------------------- full disk
+def test_a_full_disk_is_a_clear_error_that_loses_nothing(tmp_path: Path) -> None:
+    with _small_disk(tmp_path, "256k") as disk:
+        # a simulation file (netCDF writers crashed here) and a branch
+        res = gc.simulate(OSC, omega=1.0, transient_periods=2, periods=400)
+        out = disk / "out"
+        out.mkdir()
+        keep = out / "simulation.nc"
+        small = gc.simulate(OSC, omega=1.0, transient_periods=2, periods=2)
+        small.save(keep)
+        before = keep.read_bytes()
+        _fill(disk, 16 * 1024)
+        with pytest.raises(StoreError, match="no space left on device"):
+            res.save(keep)
+        assert keep.read_bytes() == before  # the old file is intact
+        with pytest.raises(StoreError, match="no space left on device"):
+            save_branch(gc.continuation(OSC, ("omega", 1.5, 1.9), max_points=40), disk / "b.nc")
+        assert not [p for p in disk.rglob("*") if "partial" in p.name]
+        # init-gearset --force keeps the user's file whole
+        (disk / "ballast").unlink()
+        gs_file = disk / "g.toml"
+        gs_file.write_text("# my gear set\n")
+        _fill(disk, 1024)
+        from typer.testing import CliRunner
+
+        from gearchaos.cli import app
+
+        r = CliRunner().invoke(app, ["init-gearset", str(gs_file), "--force"])
+        assert r.exit_code != 0 and "no space left on device" in r.output
+        assert gs_file.read_text() == "# my gear set\n"
+
+
+def test_classify_on_a_full_disk_leaves_the_store_whole(tmp_path: Path) -> None:
+    with _small_disk(tmp_path, "2m") as disk:
+        store = disk / "run.zarr"
+        _sweep(store)
+        want = gc.open_sweep(store)
+        _fill(disk, 0)
+        with pytest.raises(StoreError):
+            gc.sweep.classify_store(store)
+        again = gc.open_sweep(store)  # every chunk still there, every check passes
+        np.testing.assert_array_equal(again.motion.values, want.motion.values)
+        (disk / "ballast").unlink()
+        gc.sweep.classify_store(store)  # and it can be classified once there is space
+        assert not [p for p in disk.iterdir() if "partial" in p.name]
+
+
+# ---------------------------------------------------------------------------------- lock
+def test_one_lock_per_store_whatever_its_spelling(tmp_path: Path) -> None:
+    store = tmp_path / "run.zarr"
+    store.mkdir()
+    alias = tmp_path / "alias.zarr"
+    alias.symlink_to(store)
+    with StoreLock(str(store)):
+        for spelling in (str(alias), str(store) + "/", os.path.relpath(store)):
+            with pytest.raises(StoreError, match="is being written by process"):
+                StoreLock(spelling).acquire()
+
+
+def test_an_empty_lock_left_by_a_full_disk_does_not_block(tmp_path: Path) -> None:
+    store = tmp_path / "run.zarr"
+    lock = StoreLock(str(store))
+    Path(lock.path).write_text("")  # what a full disk left behind (an owner never written)
+    with lock:
+        owner = json.loads(Path(lock.path).read_text())
+        assert owner["pid"] == os.getpid()
+    assert not Path(lock.path).exists()
+    assert not [p for p in tmp_path.iterdir() if "partial" in p.name]
+
+
+# ------------------------------------------------------------------------ hostile chunks
+@pytest.mark.parametrize("kind", ["dev_zero", "fifo", "link"])
+def test_a_chunk_that_is_no_regular_file_is_damage(tmp_path: Path, kind: str) -> None:
+    # a chunk linked to /dev/zero got every reader OOM-killed; a FIFO hung them
+    store = tmp_path / "run.zarr"
+    _sweep(store)
+    chunk = next(p for p in sorted((store / "x").iterdir()) if not p.name.startswith("."))
+    chunk.unlink()
+    if kind == "dev_zero":
+        chunk.symlink_to("/dev/zero")
+    elif kind == "fifo":
+        os.mkfifo(chunk)
+    else:
+        other = tmp_path / "elsewhere"
+        other.write_bytes(b"\0" * 64)
+        chunk.symlink_to(other)
+    with pytest.raises(StoreError, match=r"chunk x/\S+ cannot be read"):
+        gc.open_sweep(store)
