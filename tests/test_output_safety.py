@@ -238,6 +238,22 @@ def test_a_full_disk_is_a_clear_error_that_loses_nothing(tmp_path: Path) -> None
         assert gs_file.read_text() == "# my gear set\n"
 
 
+def test_a_sweep_on_a_full_disk_leaves_no_lock_and_no_half_store(tmp_path: Path) -> None:
+    # after running out of disk an empty r.zarr.lock blocked the next sweep for 60 s and
+    # *.creating-PID directories were left behind
+    with _small_disk(tmp_path, "4m") as disk:
+        _fill(disk, 64 * 1024)
+        with pytest.raises(StoreError, match="no space left on device"):
+            _sweep(disk / "r.zarr")
+        # what is left is the store (resumable: a task without its marker is recomputed),
+        # no lock and no temporary
+        assert sorted(p.name for p in disk.iterdir()) in (["ballast"], ["ballast", "r.zarr"])
+        (disk / "ballast").unlink()
+        done = _sweep(disk / "r.zarr")  # at once, no stale lock
+        want = _sweep(tmp_path / "ref.zarr")
+        np.testing.assert_array_equal(done.x.values, want.x.values)
+
+
 def test_classify_on_a_full_disk_leaves_the_store_whole(tmp_path: Path) -> None:
     with _small_disk(tmp_path, "2m") as disk:
         store = disk / "run.zarr"

@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from .._files import check_path
-from .._output import check_replaceable, is_own_zarr, write_file
+from .._output import check_replaceable, is_own_zarr, write_error, write_file
 from ..errors import StoreError
 from ..gearset.mapping import flatten
 from .integrity import (
@@ -209,31 +209,38 @@ class SweepStore:
                     shutil.rmtree(os.path.join(parent, stale), ignore_errors=True)
             tmp = f"{self.path}.creating-{os.getpid()}"
             target = tmp
-        ds = xr.Dataset(coords={k: (d, v) for k, (d, v) in coords.items()})
-        ds.attrs.update(attrs)
-        ds.attrs["complete"] = False
-        # Zarr format 2: consolidated metadata and string coordinates are part of its
-        # specification (format 3 still flags both as unstable)
-        ds.to_zarr(target, mode="w", consolidated=False, zarr_format=2)
-        g = zarr.open_group(target, mode="a", zarr_format=2)
-        for name, (dims, shape_dtype, fill, vattrs) in variables.items():
-            shape, dtype = shape_dtype
-            # integers and strings (labels) carry no fill value, so xarray keeps their type
-            written = np.issubdtype(np.dtype(dtype), np.integer) or np.dtype(dtype).kind == "U"
-            arr = g.create_array(
-                name,
-                shape=shape,
-                chunks=chunks[name],
-                dtype=dtype,
-                fill_value=None if written else fill,
-                attributes={**vattrs, "_ARRAY_DIMENSIONS": list(dims)},
-            )
-            if written:
-                arr[...] = np.full(shape, fill, dtype=dtype)
-        consolidate(target)
-        if tmp is not None and self.path is not None:
-            os.makedirs(os.path.join(tmp, PROGRESS), exist_ok=True)
-            os.rename(tmp, self.path)
+        try:
+            ds = xr.Dataset(coords={k: (d, v) for k, (d, v) in coords.items()})
+            ds.attrs.update(attrs)
+            ds.attrs["complete"] = False
+            # Zarr format 2: consolidated metadata and string coordinates are part of its
+            # specification (format 3 still flags both as unstable)
+            ds.to_zarr(target, mode="w", consolidated=False, zarr_format=2)
+            g = zarr.open_group(target, mode="a", zarr_format=2)
+            for name, (dims, shape_dtype, fill, vattrs) in variables.items():
+                shape, dtype = shape_dtype
+                # integers and strings (labels) carry no fill value, so xarray keeps their type
+                written = np.issubdtype(np.dtype(dtype), np.integer) or np.dtype(dtype).kind == "U"
+                arr = g.create_array(
+                    name,
+                    shape=shape,
+                    chunks=chunks[name],
+                    dtype=dtype,
+                    fill_value=None if written else fill,
+                    attributes={**vattrs, "_ARRAY_DIMENSIONS": list(dims)},
+                )
+                if written:
+                    arr[...] = np.full(shape, fill, dtype=dtype)
+            consolidate(target)
+            if tmp is not None and self.path is not None:
+                os.makedirs(os.path.join(tmp, PROGRESS), exist_ok=True)
+                os.rename(tmp, self.path)
+        except BaseException as exc:  # a full disk or an interrupt: no half-built store left
+            if tmp is not None:
+                shutil.rmtree(tmp, ignore_errors=True)
+            if isinstance(exc, OSError) and self.path is not None:
+                raise write_error(exc, "sweep store", self.path) from None
+            raise
 
     # ------------------------------------------------------------------ progress
     def done_tasks(self) -> set[int]:
@@ -272,11 +279,14 @@ class SweepStore:
                 self._arrays[name] = arr
         keys: list[str] = []
         # status last: a point whose status says it ran has every other variable written
-        for name, values in sorted(data.items(), key=lambda item: item[0] == "status"):
-            arr = self._arrays[name]
-            sl = block + (slice(None),) * (arr.ndim - len(block))
-            arr[sl] = values
-            keys += chunk_keys(name, arr.shape, arr.chunks, block)
+        try:
+            for name, values in sorted(data.items(), key=lambda item: item[0] == "status"):
+                arr = self._arrays[name]
+                sl = block + (slice(None),) * (arr.ndim - len(block))
+                arr[sl] = values
+                keys += chunk_keys(name, arr.shape, arr.chunks, block)
+        except OSError as exc:  # the task has no marker: a resume computes it again
+            raise write_error(exc, "sweep store", str(self.path)) from None
         if self.path is not None:
             d = os.path.join(self.path, PROGRESS)
             os.makedirs(d, exist_ok=True)
