@@ -19,14 +19,15 @@ from gearchaos.analysis.modal import Mode, mass_stiffness, modes_table, natural_
 
 RTOL = 1e-9
 
-# Valid standard tooth numbers: z_r = z_s + 2 z_p and (z_s + z_r)/N an integer.
+# Valid standard tooth numbers: z_r = z_s + 2 z_p, (z_s + z_r)/N an integer, and N planets
+# that clear each other, (z_s + z_p)·sin(π/N) > z_p + 2.
 TEETH = {
     1: (34, 31, 96),  # 130/1
     2: (34, 31, 96),  # 130/2 = 65
     3: (30, 33, 96),  # 126/3 = 42
     4: (34, 30, 94),  # 128/4 = 32
     5: (34, 31, 96),  # 130/5 = 26 (the hindawi2021 preset, MODEL.md §9)
-    6: (30, 33, 96),  # 126/6 = 21
+    6: (42, 27, 96),  # 138/6 = 23; (42 + 27)·sin(π/6) = 34.5 > 29
 }
 
 

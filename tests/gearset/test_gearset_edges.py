@@ -117,7 +117,14 @@ def test_plausible_ranges(
         changes["geometry.planets"] = 4  # (9936 + 10000)/4 = 4984
         inside = 9_936
     if name == "geometry.planets":
-        changes = {"geometry.planets": 100, "teeth.sun": 19, "teeth.ring": 81}  # 100/100
+        # (980 + 1020)/100 = 20, and 100 planets of 20 teeth clear each other around a sun
+        # of 980: (980 + 20)·sin(π/100) = 31.4 > 22 modules
+        changes = {
+            "geometry.planets": 100,
+            "teeth.sun": 980,
+            "teeth.planet": 20,
+            "teeth.ring": 1020,
+        }
     assert get_value(evolve(base, changes), name) == inside
     with raises_exactly(f"{name} must lie in the plausible range {range_text}: got {outside!r}"):
         evolve(base, {name: outside})
@@ -208,7 +215,9 @@ def _limits(name: str) -> tuple[float, float]:
 
 
 #: (z_s, z_p, N): the extreme tooth numbers and planet counts that the relations allow.
-TEETH_CORNERS = [(1, 1, 1), (1, 1, 2), (1, 4_999, 100), (9_998, 1, 2), (34, 31, 5), (2, 4_999, 1)]
+#: (z_s, z_p, N) at the ends of the ranges whose planets still clear each other:
+#: (z_s + z_p)·sin(π/N) > z_p + 2 — e.g. 100 planets of 50 teeth around a sun of 9900
+TEETH_CORNERS = [(1, 1, 1), (3, 1, 2), (9_900, 50, 100), (9_998, 1, 2), (34, 31, 5), (2, 4_999, 1)]
 
 
 @st.composite
@@ -278,3 +287,17 @@ def test_every_derived_quantity_is_finite_at_the_corners(gs: GearSet, omega: flo
         assert getattr(par, name) > 0.0, name
     assert all(math.isfinite(x) and x > 0 for x in dataclasses.astuple(scales))
     assert np.isfinite(pack_planetary(par, omega)).all()
+
+
+def test_planets_that_overlap_are_refused_with_the_numbers() -> None:
+    # issue 23: `simulate --set geometry.planets=13` ran; so did teeth 10/40/90 with 10 planets
+    # (centres 15.5 modules apart against tip diameters of 42 modules)
+    sheng = preset("sheng2016")  # 33/32/97: (33 + 32)·sin(π/13) = 15.6 < 34 modules
+    with pytest.raises(ParameterError, match=r"geometry.planets = 13: the planets do not fit"):
+        sheng.evolve({"geometry.planets": 13})
+    with pytest.raises(ParameterError, match=r"= 15\.45 modules .* = 42 modules"):
+        sheng.evolve(
+            {"teeth.sun": 10, "teeth.planet": 40, "teeth.ring": 90, "geometry.planets": 10}
+        )
+    # the largest count that fits is accepted: (33 + 32)·sin(π/5) = 38.2 > 34
+    assert sheng.evolve({"geometry.planets": 5}).geometry.planets == 5

@@ -127,8 +127,10 @@ def gear_sets(draw: st.DrawFn) -> GearSet:
     n = draw(st.integers(1, 12))
     zs = draw(st.integers(1, 400))
     zp = draw(st.integers(1, 400))
-    while (2 * (zs + zp)) % n:  # (z_s + z_r)/N = 2(z_s + z_p)/N must be an integer
-        zp += 1
+    # (z_s + z_r)/N = 2(z_s + z_p)/N must be an integer, and N ≥ 2 planets must clear
+    # each other: (z_s + z_p)·sin(π/N) > z_p + 2
+    while (2 * (zs + zp)) % n or (n > 1 and (zs + zp) * math.sin(math.pi / n) <= zp + 2):
+        zs += 1
     module = draw(_plausible("geometry.module"))
     bc = draw(_plausible("clearance.characteristic_length"))
     changes: dict[str, object] = {

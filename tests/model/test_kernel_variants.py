@@ -9,6 +9,8 @@ stiffness harmonics) too.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -35,7 +37,12 @@ def _gearset(n: int, rare: bool) -> gc.GearSet:
     base = gc.preset("hindawi2021")
     changes: dict[str, object] = {}
     if n != base.n_planets:
-        changes = {"geometry.planets": n, "teeth.sun": 35, "teeth.ring": 97}
+        # the smallest sun from 35 teeth around which n planets of 31 are equally spaced
+        # ((z_s + z_r)/N whole) and clear each other ((z_s + z_p)·sin(π/N) > z_p + 2)
+        zs = 35
+        while (2 * (zs + 31)) % n or (zs + 31) * math.sin(math.pi / n) <= 33:
+            zs += 1
+        changes = {"geometry.planets": n, "teeth.sun": zs, "teeth.ring": zs + 62}
     if rare:
         changes.update(RARE)
     return base.evolve(changes) if changes else base

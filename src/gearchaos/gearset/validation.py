@@ -323,7 +323,9 @@ def validate(gs: Any) -> None:
              ``clearance.units`` in {dimensionless, m}; ``mesh_phasing.model`` in
              {parker, in_phase};
         3. relations: z_r = z_s + 2 z_p (standard gears); (z_s + z_r)/N an integer (equally
-           spaced planets); k_a + Σ_h |k_h| < k_m for each mesh (positive mesh stiffness);
+           spaced planets); N ≥ 2 planets clear each other, (z_s + z_p)·sin(π/N) > z_p + 2
+           (centre spacing beyond the tip diameter, in modules); k_a + Σ_h |k_h| < k_m for
+           each mesh (positive mesh stiffness);
            b_sp, b_rp, b_s, A_sp, A_rp, E_s, E_p, E_r, converted to metres (× b_c when their
            ``units`` is ``dimensionless``), at most one module m — the addendum of a standard
            tooth: a larger clearance or error disengages the teeth;
@@ -331,10 +333,6 @@ def validate(gs: Any) -> None:
            T_L and the dimensionless groups μ, κ, T̄_D, T̄_L, b̄, Ā, Ē, mesh phases — is finite,
            and positive where the model divides by it. The ranges above guarantee this; the
            check guards against a rule relaxed later.
-
-        Not checked: that neighbouring planets clear each other ((z_s + z_p) sin(π/N) >
-        z_p + 2): the lumped model has no tip circles, and the modal theory holds for any N
-        (the calibration's search space enforces it, ``paper/calibrate.py``).
     """
     if not all(hasattr(gs, t) for t in (*RECORD_CLASSES, *META)):
         raise TypeError(f"validate() expects a GearSet: got {type(gs).__name__}")
@@ -361,10 +359,30 @@ def validate(gs: Any) -> None:
             "(teeth.sun + teeth.ring)/geometry.planets must be an integer: "
             f"got ({z.sun} + {z.ring})/{n} = {(z.sun + z.ring) / n:g}"
         )
+    _check_planets_fit(gs)
     _check_stiffness_positive(gs, "sun_planet")
     _check_stiffness_positive(gs, "planet_ring")
     _check_within_module(gs)
     _check_derived(gs)
+
+
+def _check_planets_fit(gs: Any) -> None:
+    """N ≥ 2 equally spaced planets must clear each other: their centres, on the circle of
+    radius a = m (z_s + z_p)/2, lie 2a·sin(π/N) apart, which must exceed a planet's tip
+    diameter m (z_p + 2) (standard addendum m)."""
+    z, n, m = gs.teeth, gs.geometry.planets, gs.geometry.module
+    if n < 2:
+        return
+    apart = (z.sun + z.planet) * math.sin(math.pi / n)
+    tip = z.planet + 2
+    if apart <= tip:
+        raise ParameterError(
+            f"geometry.planets = {n}: the planets do not fit around the sun: neighbouring "
+            f"planet centres are (teeth.sun + teeth.planet)·m·sin(π/N) = {apart:.4g} modules "
+            f"= {apart * m * 1e3:.4g} mm apart, not more than a planet's tip diameter "
+            f"(teeth.planet + 2)·m = {tip} modules = {tip * m * 1e3:.4g} mm (teeth.sun = "
+            f"{z.sun}, teeth.planet = {z.planet}); use fewer planets or other teeth"
+        )
 
 
 #: Analyses that sample the response at the mesh-period section t_k = kT (case-insensitive;
