@@ -23,9 +23,11 @@ from gearchaos.sweep import SweepSpec
 INVALID = [
     ("rtol", -1.0, "rtol must be a finite number >= 1e-14: got -1.0"),
     ("rtol", 0.0, "rtol must be a finite number >= 1e-14: got 0.0"),
-    ("rtol", math.nan, "rtol must be a finite number in [1e-14, 1]: got nan"),
-    ("rtol", 2.0, "rtol must be a finite number <= 1: got 2.0"),
-    ("rtol", "1e-8", "rtol must be a finite number in [1e-14, 1]: got '1e-8' (str)"),
+    ("rtol", math.nan, "rtol must be a finite number in [1e-14, 0.1]: got nan"),
+    ("rtol", 2.0, "rtol must be a finite number <= 0.1: got 2.0"),
+    # issue 23: 0.5 ran and flipped the contact regime; the docstring's limit is 0.1
+    ("rtol", 0.5, "rtol must be a finite number <= 0.1: got 0.5"),
+    ("rtol", "1e-8", "rtol must be a finite number in [1e-14, 0.1]: got '1e-8' (str)"),
     ("atol", math.nan, "atol must be a finite number in (0, 1]: got nan"),
     ("atol", 0.0, "atol must be a finite number > 0: got 0.0"),
     ("atol", -1.0, "atol must be a finite number > 0: got -1.0"),
@@ -69,7 +71,7 @@ def test_python_entry_points_refuse_identically(
 
 CLI_INVALID = [
     ("--rtol", "-1", "--rtol: rtol must be a finite number >= 1e-14: got -1.0"),
-    ("--rtol", "nan", "--rtol: rtol must be a finite number in [1e-14, 1]: got nan"),
+    ("--rtol", "nan", "--rtol: rtol must be a finite number in [1e-14, 0.1]: got nan"),
     ("--rtol", "0", "--rtol: rtol must be a finite number >= 1e-14: got 0.0"),
     ("--atol", "nan", "--atol: atol must be a finite number in (0, 1]: got nan"),
     ("--atol", "-1", "--atol: atol must be a finite number > 0: got -1.0"),

@@ -241,8 +241,15 @@ def test_stops_cleanly_with_the_reason() -> None:
     assert ds.sizes["point"] == 3
     assert "max_points" in ds.attrs["stop_reason"]
     # a corrector that may take two map evaluations cannot converge: the reason is kept
+    # (min_step <= step <= max_step is required since issue 23)
     ds = gc.continuation(
-        backlash(), "omega=0.6:0.7", max_corrector=2, step=0.05, min_step=0.02, **TIGHT
+        backlash(),
+        "omega=0.6:0.7",
+        max_corrector=2,
+        step=0.05,
+        min_step=0.02,
+        max_step=0.05,
+        **TIGHT,
     )
     assert ds.attrs["stop_reason"].startswith("stopped at omega=0.6")
     assert ds.sizes["point"] == 1

@@ -496,6 +496,15 @@ def continuation(
         max_corrector=check_int("max_corrector", max_corrector, lo=2, hi=1000),
         event_tol=_pos("event_tol", event_tol, span * 1e-6),
     )
+    if steps.minimum > steps.maximum or (
+        step is not None and not steps.minimum <= steps.initial <= steps.maximum
+    ):
+        raise ParameterError(
+            "the steps must satisfy min_step <= step <= max_step: got min_step = "
+            f"{steps.minimum:g}, step = {steps.initial:g}, max_step = {steps.maximum:g}"
+        )
+    if step is None:  # the default first step inside the bounds given
+        steps = replace(steps, initial=min(max(steps.initial, steps.minimum), steps.maximum))
     eps = check_tol(tol, cfg)
 
     n, lam0, guess, switch = _start(start, period, name, a)

@@ -316,8 +316,20 @@ def save_branch(ds: Any, path: str | os.PathLike[str], *, overwrite: bool = Fals
     """Write a branch to ``path``: ``*.nc`` as netCDF-4 (h5netcdf), ``*.zarr`` as a Zarr store.
 
     An existing path is refused unless ``overwrite``; the file appears under its name only
-    when complete.
+    when complete. Only a branch (a dataset of :func:`~gearchaos.continuation`, with its
+    ``parameter`` attribute and multipliers) is written.
     """
+    import xarray as xr
+
+    if not isinstance(ds, xr.Dataset):
+        raise ParameterError(
+            f"save_branch needs a branch dataset (from continuation): got {type(ds).__name__}"
+        )
+    if "parameter" not in ds.attrs or "multiplier_re" not in ds:
+        raise ParameterError(
+            "save_branch needs a branch dataset (from continuation): this dataset has no "
+            "'parameter' attribute or no 'multiplier_re' variable"
+        )
     kind = check_store(path, overwrite)
     path = os.fspath(path)
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)

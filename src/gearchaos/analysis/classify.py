@@ -348,7 +348,13 @@ def _resolve_threshold(
 
 
 def _as_points(points: Any) -> np.ndarray:
-    p = np.asarray(points, dtype=np.float64)
+    try:
+        p = np.asarray(points, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ParameterError(
+            "points must be section points, numbers of shape (m,) or (m, d): got "
+            f"{type(points).__name__} {str(points)[:40]!r}"
+        ) from None
     if p.ndim == 1:
         p = p[:, None]
     elif p.ndim != 2:

@@ -54,6 +54,7 @@ from typing import Any
 import numpy as np
 import scipy.linalg
 
+from .._checks import check_real
 from ..gearset import GearSet
 
 __all__ = [
@@ -304,6 +305,7 @@ def natural_frequencies(gs: GearSet, *, rtol: float = 1e-8) -> list[Mode]:
 
     and the planet modes sit at λ = (k_sp + k_rp)/m_p* (MODEL.md §10.3).
     """
+    check_real("rtol", rtol, lo=0.0, hi=1.0, lo_open=True, hi_open=True)
     M, K, names = mass_stiffness(gs)
     me = gs.equivalent_mass_mesh
     ksp = gs.stiffness.sun_planet_mean

@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Annotated, Any, NoReturn
 
 import numpy as np
 import typer
+import typer.core
 from rich.console import Console
 from rich.text import Text
 
@@ -43,8 +44,41 @@ INTERRUPTED_MESSAGE = (
     "interrupted: the store keeps every finished chunk; run the same command again to resume"
 )
 
+
+class _Commands(typer.core.TyperGroup):
+    """The command group: refuses a single-valued option given twice (Click would keep the
+    last silently: ``response --vary omega=1:2:3 --vary xi=0.03,0.05`` swept ξ only)."""
+
+    def resolve_command(self, ctx: Any, args: list[str]) -> Any:
+        name, cmd, rest = super().resolve_command(ctx, args)
+        if cmd is not None:
+            problem = repeated_option(cmd, rest)
+            if problem:
+                ctx.fail(problem)
+        return name, cmd, rest
+
+
+def repeated_option(cmd: Any, args: list[str]) -> str | None:
+    """What is wrong when an option that takes one value appears more than once in ``args``
+    (the command's arguments), or None."""
+    tokens = args[: args.index("--")] if "--" in args else args
+    for param in cmd.params:
+        if getattr(param, "param_type_name", "") != "option" or param.multiple or param.count:
+            continue
+        names = [*param.opts, *param.secondary_opts]
+        longs = [n for n in names if n.startswith("--")]
+        hits = [t for t in tokens if t in names or any(t.startswith(n + "=") for n in longs)]
+        if len(hits) > 1:
+            return (
+                f"{names[0]} was given {len(hits)} times ({', '.join(hits)}); "
+                f"'{cmd.name}' takes it once"
+            )
+    return None
+
+
 app = typer.Typer(
     name="gearchaos",
+    cls=_Commands,
     help=(
         "Nonlinear dynamics of planetary gear trains with backlash and bearing clearance: "
         "simulate a gear set at a mesh frequency, sweep any parameter into bifurcation "

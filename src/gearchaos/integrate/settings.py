@@ -23,7 +23,7 @@ from ..errors import ParameterError
 __all__ = ["PERTURBATION", "SIMULATION", "SampleTimes", "SolverSettings", "rest_direction"]
 
 #: Bounds of the settings (see :meth:`SolverSettings.check`).
-RTOL_RANGE = (1e-14, 1.0)
+RTOL_RANGE = (1e-14, 0.1)
 ATOL_MAX = 1.0
 MAX_PERIODS = 10**9
 MAX_SAMPLES_PER_PERIOD = 10**6

@@ -30,6 +30,11 @@ __all__ = ["phase_portrait", "poincare_map", "sun_orbit"]
 
 
 def _with_dot(result: Any, var: str | None, planet: int) -> VarInfo:
+    if not (hasattr(result, "section") and hasattr(result, "system")):
+        raise ParameterError(
+            "result must be a simulation result (gearchaos.simulate(...)): got "
+            f"{type(result).__name__}"
+        )
     info = variable(result, var, planet)
     if info.dot is None:
         raise ParameterError(

@@ -24,7 +24,7 @@ import numpy as np
 
 from .._checks import check_int, check_real
 from .._output import write_error, write_file
-from ..errors import ParameterError, StoreError
+from ..errors import ParameterError, Status, StoreError
 from .result import SweepResult
 from .store import SweepStore, consolidate, foreign_files_ignored, open_sweep
 
@@ -80,7 +80,7 @@ def classify_dataset(
     agree = np.ones(shape, dtype=bool)
     for idx in np.ndindex(*shape):
         mc: Any = details[idx]
-        labels[idx] = "failed" if status[idx] != 0 else mc.label
+        labels[idx] = _status_label(int(status[idx])) or mc.label
         period[idx] = mc.period or 0
         k01[idx] = np.nan if mc.k01 is None else mc.k01
         agree[idx] = bool(mc.agree)
@@ -95,13 +95,23 @@ def classify_dataset(
     }
 
 
+def _status_label(status: int) -> str | None:
+    """The label a point's integration status imposes: ``failed`` for a failed integration,
+    ``not run`` for a point an interrupted sweep has not computed (never "failed": nothing
+    failed), None for a point that ran."""
+    if status == int(Status.NOT_RUN):
+        return "not run"
+    return "failed" if status != 0 else None
+
+
 def _from_verdicts(res: SweepResult) -> dict[str, Any]:
     """The stored verdicts' labels (:mod:`gearchaos.sweep.verdicts`): nothing is re-decided;
     the period follows from the label, and the contact regimes and regime table are added."""
     ds = res.ds
     labels = np.asarray(ds["motion"].transpose(*res.lead_dims).values).astype(LABEL_DTYPE)
     status = res.status()
-    labels = np.where(status != 0, "failed", labels).astype(LABEL_DTYPE)
+    for idx in np.ndindex(*labels.shape):
+        labels[idx] = _status_label(int(status[idx])) or labels[idx]
     period = np.zeros(labels.shape, dtype=np.int16)
     for idx in np.ndindex(*labels.shape):
         lab = str(labels[idx])
@@ -119,7 +129,8 @@ def _from_verdicts(res: SweepResult) -> dict[str, Any]:
 
 
 def _regime_table(res: SweepResult, labels: np.ndarray) -> dict[str, Any]:
-    """Fraction of the points in each regime, per family value when there is a family."""
+    """Fraction of the points in each regime, per family value when there is a family (of the
+    points computed: an interrupted sweep's points not run yet are left out)."""
     from ..analysis.classify import regime_table
 
     ds, lead_dims = res.ds, res.lead_dims
@@ -128,12 +139,16 @@ def _regime_table(res: SweepResult, labels: np.ndarray) -> dict[str, Any]:
     if fam is not None and fam in lead_dims:
         ax = lead_dims.index(fam)
         table = {
-            f"{fam}={float(v):g}": regime_table(np.take(labels, i, axis=ax).ravel())
+            f"{fam}={float(v):g}": regime_table(_ran(np.take(labels, i, axis=ax).ravel()))
             for i, v in enumerate(ds[fam].values)
         }
     else:
-        table = {"all": regime_table(labels.ravel())}
+        table = {"all": regime_table(_ran(labels.ravel()))}
     return table
+
+
+def _ran(labels: np.ndarray) -> np.ndarray:
+    return labels[labels != "not run"]
 
 
 def label_periods(

@@ -26,7 +26,7 @@ import numpy as np
 
 from .._files import check_path
 from .._output import check_replaceable, is_own_zarr, write_error, write_file
-from ..errors import StoreError
+from ..errors import Status, StoreError
 from ..gearset.mapping import flatten
 from .integrity import (
     MANIFEST,
@@ -123,6 +123,16 @@ def open_sweep(path: str | os.PathLike[str], *, verify: bool = True) -> Any:
         verify_attributes(root, ds)
         if ds.attrs.get("complete") is not True:
             verify_progress(root, PROGRESS)
+    if ds.attrs.get("complete") is not True:
+        status = np.asarray(ds["status"].values)
+        left = int(np.sum(status == int(Status.NOT_RUN)))
+        if left:
+            warnings.warn(
+                f"{root!r} is an interrupted sweep: {left} of {status.size} points are not "
+                "computed yet (shown as 'not run'); run the same command again to resume it",
+                UserWarning,
+                stacklevel=2,
+            )
     return ds
 
 

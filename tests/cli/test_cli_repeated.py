@@ -1,0 +1,50 @@
+"""An option that takes one value, given twice, is refused (issue 23, item 8): Click kept the
+last one silently, so `response --vary omega=1:2:3 --vary xi=0.03,0.05` swept ξ only."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from gearchaos.cli import EXIT_INVALID, app
+
+
+@pytest.mark.parametrize(
+    ("args", "option"),
+    [
+        (["response", "--vary", "omega=1:2:3", "--vary", "xi=0.03,0.05"], "--vary"),
+        (["poincare", "--vary", "omega=1,2", "--vary=xi=0.03,0.05"], "--vary"),
+        (["continue", "--vary", "omega=1.5:1.6", "-v", "omega=1.5:1.7"], "--vary"),
+        (
+            ["bifurcation", "-v", "omega=1:2:3", "--family", "xi=0.03", "--family", "xi=1"],
+            "--family",
+        ),
+        (
+            ["simulate", "--set", "omega=1.5", "--transient", "10", "--transient", "20"],
+            "--transient",
+        ),
+    ],
+)
+def test_a_single_valued_option_given_twice_is_refused(
+    args: list[str], option: str, tmp_path: Path
+) -> None:
+    r = CliRunner().invoke(app, [*args, "-o", str(tmp_path / "out.zarr")])
+    assert r.exit_code == EXIT_INVALID, r.output
+    assert f"{option} was given 2 times" in r.output
+    assert not list(tmp_path.iterdir())  # refused before anything ran
+
+
+def test_options_that_may_repeat_still_do(tmp_path: Path) -> None:
+    # --set and a 2-D map's two --vary are lists
+    out = tmp_path / "m.zarr"
+    r = CliRunner().invoke(
+        app,
+        [
+            "bifurcation", "-v", "omega=1:1.2:2", "-v", "xi=0.03,0.05", "--set", "teeth.sun=33",
+            "--set", "backlash.sun_planet=3", "--transient", "2", "--periods", "2", "-o", str(out),
+        ],
+    )  # fmt: skip
+    assert r.exit_code == 0, r.output
+    assert out.exists()
