@@ -48,3 +48,15 @@ def test_options_that_may_repeat_still_do(tmp_path: Path) -> None:
     )  # fmt: skip
     assert r.exit_code == 0, r.output
     assert out.exists()
+
+
+def test_control_characters_of_a_gear_set_never_reach_the_terminal(tmp_path: Path) -> None:
+    # issue 23: `info` printed the ANSI escape sequences of a gear-set name as they were
+    from gearchaos.gearset import preset
+
+    f = tmp_path / "g.toml"
+    f.write_text(preset("sheng2016").evolve({"name": "gear\x1b[2J\x1b[31mset"}).to_toml())
+    r = CliRunner().invoke(app, ["info", "--gearset", str(f)])
+    assert r.exit_code == EXIT_INVALID
+    assert "name contains the control character 0x1b" in r.output
+    assert "\x1b[2J" not in r.output

@@ -13,6 +13,7 @@ from __future__ import annotations
 import contextlib
 import json
 import math
+import unicodedata
 import warnings
 from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
@@ -239,7 +240,17 @@ def load_gearset(
         gs = GearSet.from_toml(gearset_file)
     else:
         gs = load_preset(preset if preset is not None else DEFAULT_PRESET)
-    return gs.evolve(dict(changes)) if changes else gs
+    gs = gs.evolve(dict(changes)) if changes else gs
+    for field, keep in (("name", ""), ("description", "\t\n")):
+        text = getattr(gs, field)
+        bad = next((ch for ch in text if unicodedata.category(ch) == "Cc" and ch not in keep), None)
+        if bad is not None:  # an ESC would start an escape sequence in the user's terminal
+            raise ParameterError(
+                f"the gear set's {field} contains the control character {ord(bad):#04x}, "
+                "which would reach the terminal and every title as it is; remove it "
+                f"(got {text!r})"
+            )
+    return gs
 
 
 def default_omega_note(quiet: bool, what: str = "swept") -> None:

@@ -133,7 +133,10 @@ def bifurcation(
         str | None,
         typer.Option(
             "--scheduler",
-            help="Address of a running dask.distributed scheduler, e.g. tcp://HOST:8786.",
+            help=(
+                "Address of a running dask.distributed scheduler, e.g. tcp://HOST:8786 — one "
+                "you trust: Dask exchanges pickles, which run code when read."
+            ),
             show_default=False,
         ),
     ] = None,
