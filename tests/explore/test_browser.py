@@ -115,9 +115,16 @@ def _start(store: Path) -> dict[str, Any]:
 
 
 def _stop(server: dict[str, Any]) -> None:
-    if server["proc"].poll() is None:
-        server["proc"].kill()
-        server["proc"].wait(timeout=30)
+    """SIGTERM (the explorer then ends its worker processes), SIGKILL only if it hangs: a
+    killed server left its spawned workers running after the tests."""
+    proc = server["proc"]
+    if proc.poll() is None:
+        proc.terminate()
+        try:
+            proc.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait(timeout=30)
 
 
 def _open(browser: Any, url: str) -> Any:
@@ -238,3 +245,33 @@ def test_the_server_stops_cleanly(gear_store: Path, browser: Any) -> None:
             assert s.connect_ex(("localhost", port)) != 0, "the port still accepts connections"
     finally:
         _stop(server)
+
+
+def _get(url: str, path: str, host: str) -> tuple[int, str]:
+    import http.client
+
+    u = urlparse(url)
+    conn = http.client.HTTPConnection(u.hostname or "localhost", u.port, timeout=30)
+    try:
+        conn.request("GET", path, headers={"Host": host})
+        r = conn.getresponse()
+        return r.status, r.read().decode("utf-8", "replace")
+    finally:
+        conn.close()
+
+
+def test_the_server_answers_only_its_own_host_names(server: dict[str, Any]) -> None:
+    # issue 23: any Host: header was served (DNS rebinding), and /components/<module>/ imported
+    # any installed module (`this` printed the Zen of Python in the server log)
+    port = urlparse(server["url"]).port
+    for host in (f"localhost:{port}", f"127.0.0.1:{port}"):
+        assert _get(server["url"], "/", host)[0] == 200, host
+    for host in (f"evil.example:{port}", "attacker.test", f"127.0.0.1.nip.io:{port}"):
+        assert _get(server["url"], "/", host)[0] == 403, host
+    status, _ = _get(server["url"], "/components/this/Zen/_css/x.css", f"localhost:{port}")
+    assert status == 403
+    time.sleep(0.5)
+    seen = []
+    while not server["lines"].empty():
+        seen.append(server["lines"].get_nowait())
+    assert not any("Beautiful is better than ugly" in line for line in seen)

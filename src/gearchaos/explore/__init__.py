@@ -17,9 +17,10 @@ import sys
 import types
 from typing import Any
 
-from .app import Explorer, Workers, explore, serve
+from .app import Explorer, Workers, explore
 from .compute import compute_point, run_zoom, zoom_path
 from .model import ExploreModel, Point
+from .server import serve
 
 __all__ = [
     "ExploreModel",

@@ -1,4 +1,4 @@
-"""The explorer's web page (Panel on Bokeh) and its server.
+"""The explorer's web page (Panel on Bokeh); its server is :mod:`.server`.
 
 One :class:`Explorer` per browser session (or notebook cell) shows a sweep store: the
 bifurcation diagram (every stored section value X̄_k against the swept value) with its band of
@@ -16,8 +16,6 @@ from __future__ import annotations
 import concurrent.futures as cf
 import multiprocessing
 import os
-import signal
-import sys
 import threading
 from collections.abc import Callable, Mapping
 from pathlib import Path
@@ -37,7 +35,7 @@ from ..sweep.result import open_result
 from .compute import compute_point, run_zoom
 from .model import ExploreModel, Point, parameter_axis_label, parameter_label
 
-__all__ = ["Explorer", "Workers", "explore", "serve"]
+__all__ = ["Explorer", "Workers", "explore"]
 
 #: Milliseconds between two looks at the background jobs.
 POLL_MS = 250
@@ -523,49 +521,3 @@ def explore(store: str | os.PathLike[str], *, var: str | None = None, planet: in
         For a missing, damaged or foreign store, as ``gearchaos plot``.
     """
     return Explorer(store, var=var, planet=planet)
-
-
-def serve(
-    store: str | os.PathLike[str],
-    *,
-    port: int = 0,
-    show: bool = True,
-    var: str | None = None,
-    planet: int = 1,
-    ready: Callable[[str], None] | None = None,
-) -> None:
-    """Serve the explorer of ``store`` on ``localhost:port`` (0: a free port) until Ctrl-C or
-    SIGTERM; ``ready(url)`` is called once it listens. Returns after a clean stop: the server
-    closed and the worker processes ended."""
-    open_result(store)  # a bad store fails here, before anything listens
-    ExploreModel(open_result(store), var=var, planet=planet)
-    workers = Workers()
-    server = pn.serve(
-        {"/": lambda: Explorer(store, var=var, planet=planet, workers=workers)},
-        port=port,
-        address="localhost",
-        show=False,
-        start=False,
-        title=f"gearchaos explore · {Path(store).name}",
-        verbose=False,
-    )
-    url = f"http://localhost:{server.port}/"
-    loop = server.io_loop
-
-    def stop(*_: Any) -> None:
-        loop.add_callback_from_signal(loop.stop)
-
-    old = {s: signal.signal(s, stop) for s in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        server.start()
-        if ready is not None:
-            ready(url)
-        if show:
-            loop.add_callback(lambda: server.show("/"))
-        loop.start()
-    finally:
-        for s, h in old.items():
-            signal.signal(s, h)
-        server.stop()
-        workers.shutdown()
-        sys.stdout.flush()
