@@ -310,3 +310,73 @@ def test_a_chunk_that_is_no_regular_file_is_damage(tmp_path: Path, kind: str) ->
         chunk.symlink_to(other)
     with pytest.raises(StoreError, match=r"chunk x/\S+ cannot be read"):
         gc.open_sweep(store)
+
+
+# --------------------------------------------------------------- damage read as data (4, 14)
+def _edit_array_meta(store: Path, name: str, **changes: object) -> None:
+    """Edit an array's metadata consistently in .zarray and .zmetadata (a careful forger)."""
+    zarray = store / name / ".zarray"
+    meta = {**json.loads(zarray.read_text()), **changes}
+    zarray.write_text(json.dumps(meta))
+    zmeta = json.loads((store / ".zmetadata").read_text())
+    zmeta["metadata"][f"{name}/.zarray"] = meta
+    (store / ".zmetadata").write_text(json.dumps(zmeta))
+
+
+@pytest.mark.parametrize(
+    ("changes", "words"),
+    [
+        ({"dtype": ">f8"}, "element type '>f8'"),
+        ({"order": "F"}, "memory order 'F'"),
+        ({"fill_value": 0.0}, "fill value 0.0"),
+        ({"compressor": None}, "compressor None"),
+    ],
+)
+def test_consistently_edited_metadata_is_damage(
+    tmp_path: Path, changes: dict[str, object], words: str
+) -> None:
+    # plot, export and explore wrote garbage with exit 0 from such a store
+    store = tmp_path / "run.zarr"
+    _sweep(store)
+    _edit_array_meta(store, "x", **changes)
+    with pytest.raises(StoreError, match=f"the array x has the {words}"):
+        gc.open_sweep(store)
+    with pytest.raises(StoreError, match=f"the array x has the {words}"):
+        _sweep(store)  # never resumed into
+
+
+def test_a_complete_store_without_its_manifest_is_damage(tmp_path: Path) -> None:
+    # deleting _manifest.json switched chunk verification off: a deleted chunk was then
+    # plotted and exported as NaN with exit 0
+    store = tmp_path / "run.zarr"
+    _sweep(store)
+    (store / "_manifest.json").unlink()
+    with pytest.raises(StoreError, match=r"chunk manifest _manifest\.json is missing"):
+        gc.open_sweep(store)
+    with pytest.raises(StoreError, match=r"chunk manifest _manifest\.json is missing"):
+        _sweep(store)
+    assert _sweep(store, overwrite=True).sizes["omega"] == 3  # a damaged store of ours
+
+
+def test_junk_metadata_is_reported_not_a_traceback(tmp_path: Path) -> None:
+    # resume into a store with junk .zattrs/.zmetadata ended in a JSONDecodeError
+    for name in (".zattrs", ".zmetadata"):
+        store = tmp_path / f"run{name}.zarr"
+        _sweep(store)
+        (store / name).write_text("{not json")
+        with pytest.raises(StoreError, match="not readable"):
+            _sweep(store)
+
+
+def test_command_line_paths_that_failed_with_a_traceback(tmp_path: Path) -> None:
+    from typer.testing import CliRunner
+
+    from gearchaos.cli import app
+
+    r = CliRunner().invoke(app, ["simulate", "--set", "omega=1.5", "--transient", "1e-320"])
+    assert r.exit_code != 0 and "transient_periods must be 0 or at least 1e-06" in r.output
+    assert isinstance(r.exception, SystemExit)  # a clean exit, not a traceback
+    long = tmp_path / ("a" * 305 + ".toml")
+    r = CliRunner().invoke(app, ["init-gearset", str(long)])
+    assert r.exit_code != 0 and "File name too long" in r.output
+    assert isinstance(r.exception, SystemExit)

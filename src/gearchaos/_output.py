@@ -234,6 +234,11 @@ _CHUNK = re.compile(r"[0-9]+(\.[0-9]+)*")
 _OWN_TEMP = re.compile(r"\.partial(-[0-9]+)?$")
 
 
+def _consolidated_root(meta: dict[str, object]) -> object:
+    inner = meta.get("metadata")
+    return inner.get(".zattrs") if isinstance(inner, dict) else None
+
+
 def is_own_zarr(
     path: str,
     *,
@@ -249,12 +254,21 @@ def is_own_zarr(
     if os.path.islink(path) or not os.path.isdir(path):
         return False
     try:
-        with open(os.path.join(path, ".zattrs"), encoding="utf-8") as f:
-            attrs = json.loads(f.read(1 << 24))
         entries = list(os.scandir(path))
-    except (OSError, ValueError):
+    except OSError:
         return False
-    if not isinstance(attrs, dict) or not all(k in attrs for k in keys):
+    # its attributes, or their consolidated copy when a damaged store lost the first
+    found = False
+    for name, pick in ((".zattrs", lambda d: d), (".zmetadata", _consolidated_root)):
+        try:
+            with open(os.path.join(path, name), encoding="utf-8") as f:
+                attrs = pick(json.loads(f.read(1 << 24)))
+        except (OSError, ValueError, AttributeError, TypeError):
+            continue
+        if isinstance(attrs, dict) and all(k in attrs for k in keys):
+            found = True
+            break
+    if not found:
         return False
     top = {".zattrs", ".zgroup", ".zmetadata", *files}
     for e in entries:

@@ -50,6 +50,12 @@ class _Commands(typer.core.TyperGroup):
     """The command group: refuses a single-valued option given twice (Click would keep the
     last silently: ``response --vary omega=1:2:3 --vary xi=0.03,0.05`` swept ξ only)."""
 
+    def invoke(self, ctx: Any) -> Any:
+        # every command's errors, also those outside its own reported_errors() block (an
+        # over-long or unreadable path met while checking its arguments), are one line
+        with reported_errors():
+            return super().invoke(ctx)
+
     def resolve_command(self, ctx: Any, args: list[str]) -> Any:
         name, cmd, rest = super().resolve_command(ctx, args)
         if cmd is not None:

@@ -26,6 +26,8 @@ __all__ = ["PERTURBATION", "SIMULATION", "SampleTimes", "SolverSettings", "rest_
 RTOL_RANGE = (1e-14, 0.1)
 ATOL_MAX = 1.0
 MAX_PERIODS = 10**9
+#: The shortest transient other than none, in forcing periods.
+MIN_TRANSIENT = 1e-6
 MAX_SAMPLES_PER_PERIOD = 10**6
 MAX_STEP_BUDGET = 2**62
 #: Values of ``settle``.
@@ -122,7 +124,7 @@ class SolverSettings:
     def check(self) -> None:
         """Raise :class:`~gearchaos.errors.ParameterError` at the first invalid setting.
 
-        Rules: ``transient_periods`` a number in [0, 1e9]; ``periods`` an integer in
+        Rules: ``transient_periods`` 0 or a number in [1e-6, 1e9]; ``periods`` an integer in
         [1, 1e9]; ``samples_per_period`` an integer in [1, 1e6]; ``section_phase`` a finite
         number; ``rtol`` a number in [1e-14, 0.1] (below 1e-14 the floating-point resolution
         of the time variable is reached); ``atol`` a number in (0, 1] (states are of order one:
@@ -130,6 +132,11 @@ class SolverSettings:
         "auto". Booleans and strings are not numbers.
         """
         check_real("transient_periods", self.transient_periods, lo=0.0, hi=float(MAX_PERIODS))
+        if 0 < self.transient_periods < MIN_TRANSIENT:
+            raise ParameterError(
+                f"transient_periods must be 0 or at least {MIN_TRANSIENT:g} (a shorter "
+                f"transient is below any step of the integrator): got {self.transient_periods!r}"
+            )
         check_int("periods", self.periods, lo=1, hi=MAX_PERIODS)
         check_int("samples_per_period", self.samples_per_period, lo=1, hi=MAX_SAMPLES_PER_PERIOD)
         check_real("section_phase", self.section_phase)

@@ -23,10 +23,10 @@ from typing import Any
 import numpy as np
 
 from .._checks import check_int, check_real
-from .._output import write_error, write_file
+from .._output import write_error
 from ..errors import ParameterError, Status, StoreError
 from .result import SweepResult
-from .store import SweepStore, consolidate, foreign_files_ignored, open_sweep
+from .store import SweepStore, consolidate, foreign_files_ignored, open_sweep, set_attributes
 
 __all__ = ["classify_dataset", "classify_store"]
 
@@ -216,11 +216,7 @@ def _swap_in(staging: str, zstore: str, attrs: dict[str, Any]) -> None:
         if os.path.isdir(old):
             os.rename(old, os.path.join(staging, f".old-{name}"))
         os.rename(new, old)
-    path = os.path.join(zstore, ".zattrs")
-    with open(path, encoding="utf-8") as f:
-        current = json.load(f)
-    current.update(attrs)
-    write_file(path, json.dumps(current, indent=4).encode("utf-8"), what="store attributes")
+    set_attributes(zstore, attrs)
 
 
 def classify_store(

@@ -297,6 +297,19 @@ def verify_manifest(root: str, arrays: Iterable[str] | None = None) -> None:
     """Raise :class:`StoreError` naming every missing or damaged chunk of a complete store."""
     manifest = read_manifest(root)
     if manifest is None:
+        # a store is complete only with its manifest (written first): without it no chunk
+        # could be checked, so a complete store that lost it is damage, not an older store
+        try:
+            with open(os.path.join(root, ".zattrs"), encoding="utf-8") as f:
+                complete = json.loads(f.read(1 << 24)).get("complete") is True
+        except (OSError, ValueError, AttributeError):
+            complete = False
+        if complete:
+            raise StoreError(
+                f"{root} is damaged: its chunk manifest {MANIFEST} is missing, so no chunk can "
+                "be checked. Its data cannot be trusted; run the sweep again with --overwrite "
+                "(overwrite=True)"
+            )
         return
     listed: dict[str, Any] = manifest["chunks"]
     problems = []

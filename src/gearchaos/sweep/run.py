@@ -308,6 +308,7 @@ def _run_locked(
     if st.exists() and overwrite:
         st.remove()
     if st.exists():
+        st.verify()  # damaged metadata or chunks are reported, never resumed into
         st.check_same(identity)
         if st.attrs().get("complete"):
             st.clear_stale_progress()

@@ -63,6 +63,16 @@ def foreign_files_ignored() -> Iterator[None]:
         yield
 
 
+def set_attributes(root: str, updates: dict[str, Any]) -> None:
+    """Update the root attributes (``.zattrs``) of an on-disk store in one atomic write (Zarr
+    rewrites the file in place: a kill or a full disk would leave it torn)."""
+    path = os.path.join(root, ".zattrs")
+    with open(path, encoding="utf-8") as f:
+        attrs = json.load(f)
+    attrs.update(updates)
+    write_file(path, json.dumps(attrs, indent=4).encode("utf-8"), what="store attributes")
+
+
 def consolidate(store: Any) -> None:
     """Consolidate a store's metadata. On disk the ``.zmetadata`` file is built from the
     metadata files and written in one atomic step (Zarr's own writer truncates it first, so a
@@ -162,6 +172,14 @@ class SweepStore:
         import zarr
 
         return dict(zarr.open_group(self.zarr_store, mode="r").attrs)
+
+    def verify(self) -> None:
+        """The checks of :func:`open_sweep` before a store is resumed: its metadata (every
+        file equal to its consolidated copy, every array of the schema gearchaos writes)
+        and, when complete, every chunk against the manifest."""
+        if self.path is not None:
+            verify_metadata(self.path)
+            verify_manifest(self.path)
 
     def check_same(self, identity: dict[str, Any]) -> None:
         """Refuse to resume a store made with other settings (name what differs)."""
@@ -331,8 +349,11 @@ class SweepStore:
                 os.path.join(self.path, MANIFEST),
                 {"chunks": digest_chunks(self.path, all_chunks(self.path))},
             )
-        g = zarr.open_group(self.zarr_store, mode="a", use_consolidated=False)
-        g.attrs["complete"] = True
+        if self.path is not None:
+            set_attributes(self.path, {"complete": True})
+        else:
+            g = zarr.open_group(self.zarr_store, mode="a", use_consolidated=False)
+            g.attrs["complete"] = True
         consolidate(self.zarr_store)
         if self.path is not None:
             shutil.rmtree(os.path.join(self.path, PROGRESS), ignore_errors=True)

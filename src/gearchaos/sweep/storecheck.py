@@ -20,6 +20,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 from typing import Any
 
 import numpy as np
@@ -86,11 +87,46 @@ def verify_metadata(root: str) -> None:
             raise _damaged(root, f"the metadata file {key} is not readable JSON") from None
         if actual != consolidated and not _classification_left(key, actual, consolidated):
             raise _damaged(root, f"the metadata file {key} differs from .zmetadata")
+        if key.endswith("/.zarray"):
+            problem = array_schema_problem(actual)
+            if problem:
+                raise _damaged(root, f"the array {key[: -len('/.zarray')]} {problem}")
     for entry in sorted(os.listdir(root)):
         if os.path.exists(os.path.join(root, entry, ".zarray")) and (
             f"{entry}/.zarray" not in listed and entry not in CLASSIFY_ARRAYS
         ):
             raise _damaged(root, f"the array {entry} is not in the consolidated metadata")
+
+
+#: The element types gearchaos writes: little-endian (or byte-order-free) floats, integers,
+#: booleans and Unicode labels.
+_DTYPES = re.compile(r"(<f8|\|i1|<i2|<i4|<i8|\|b1|<U[0-9]{1,3})")
+
+
+def array_schema_problem(meta: Any) -> str | None:
+    """What is wrong with an array's ``.zarray`` against what gearchaos writes, or None:
+    the element type (``dtype``), the memory ``order`` C, no ``filters``, a ``fill_value``
+    of NaN for floats and none otherwise, the Blosc compressor. Edited consistently in
+    ``.zarray`` and ``.zmetadata``, any of these would make every reader decode garbage."""
+    if not isinstance(meta, dict):
+        return "has no readable metadata"
+    dtype = meta.get("dtype")
+    if not isinstance(dtype, str) or not _DTYPES.fullmatch(dtype):
+        return f"has the element type {dtype!r}, which gearchaos never writes"
+    if meta.get("order") != "C":
+        return f"has the memory order {meta.get('order')!r} (gearchaos writes 'C')"
+    if meta.get("filters") is not None:
+        return "has filters gearchaos never writes"
+    fill = meta.get("fill_value")
+    if dtype == "<f8":
+        if fill != "NaN":
+            return f"has the fill value {fill!r} (a float array's is NaN)"
+    elif fill is not None:
+        return f"has the fill value {fill!r} (only float arrays have one)"
+    comp = meta.get("compressor")
+    if not (isinstance(comp, dict) and comp.get("id") == "blosc"):
+        return f"has the compressor {comp!r} (gearchaos writes Blosc)"
+    return None
 
 
 def _same(got: Any, want: Any) -> bool:
