@@ -60,3 +60,27 @@ def test_control_characters_of_a_gear_set_never_reach_the_terminal(tmp_path: Pat
     assert r.exit_code == EXIT_INVALID
     assert "name contains the control character 0x1b" in r.output
     assert "\x1b[2J" not in r.output
+
+
+def test_plot_options_that_a_figure_does_not_use_are_refused(tmp_path: Path) -> None:
+    # issue 23: `plot resp.zarr --var nope` and `--planet 9` on a response store and on a 2-D
+    # store exited 0, ignoring the option
+    runner = CliRunner()
+    resp, grid = tmp_path / "resp.zarr", tmp_path / "map.zarr"
+    quick = ["--transient", "2", "--periods", "2"]
+    assert (
+        runner.invoke(app, ["response", "-v", "omega=1:2:3", *quick, "-o", str(resp)]).exit_code
+        == 0
+    )
+    r = runner.invoke(
+        app, ["bifurcation", "-v", "omega=1:2:2", "-v", "xi=0.03,0.05", *quick, "-o", str(grid)]
+    )
+    assert r.exit_code == 0, r.output
+    for args, words in (
+        ([str(resp), "--var", "nope"], "--var does not apply to the frequency-response figure"),
+        ([str(resp), "--planet", "9"], "--planet does not apply"),
+        ([str(grid), "--planet", "9"], "planet must be one of the observed planets [1]: got 9"),
+    ):
+        r = runner.invoke(app, ["plot", *args, "-o", str(tmp_path / "f.png")])
+        assert r.exit_code == EXIT_INVALID and words in r.output, r.output
+    assert not (tmp_path / "f.png").exists()

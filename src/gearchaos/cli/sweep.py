@@ -296,12 +296,20 @@ def plot(
         typer.Option("--output", "-o", help="Figure file: .png, .pdf or .svg.", show_default=False),
     ],
     var: Annotated[
-        str,
+        str | None,
         typer.Option(
-            "--var", help="Section variable: delta_sp (X̄_sp), delta_sp_dot, delta_rp, x_s, ..."
+            "--var",
+            help="Section variable: delta_sp (X̄_sp), delta_sp_dot, delta_rp, x_s, ... "
+            "[default: delta_sp]",
+            show_default=False,
         ),
-    ] = "delta_sp",
-    planet: Annotated[int, typer.Option("--planet", help="Planet of per-planet variables.")] = 1,
+    ] = None,
+    planet: Annotated[
+        int | None,
+        typer.Option(
+            "--planet", help="Planet of per-planet variables. [default: 1]", show_default=False
+        ),
+    ] = None,
     clearance: Annotated[
         bool,
         typer.Option("--clearance-lines", help="Dashed lines at ±b̄ of the variable's clearance."),
@@ -358,6 +366,14 @@ def plot(
         if res.ds.attrs.get("kind") == "response" and not sections:
             from ..plot import response_figure
 
+            given = [o for o, v in (("--var", var), ("--planet", planet)) if v is not None]
+            if given:  # the response curves draw every mesh's contact force, no section
+                raise ParameterError(
+                    f"{' and '.join(given)} {'does' if len(given) == 1 else 'do'} not apply to "
+                    "the frequency-response figure of "
+                    f"{store}; add --sections to draw its bifurcation diagram of one variable"
+                )
+
             fig = response_figure(res)
             if output.parent != Path(""):
                 output.parent.mkdir(parents=True, exist_ok=True)
@@ -366,8 +382,8 @@ def plot(
             return
         fig = sweep_figure(
             res,
-            var=var,
-            planet=planet,
+            var="delta_sp" if var is None else var,
+            planet=1 if planet is None else planet,
             clearance_lines=clearance,
             resonances=resonances,
             branches=branches,

@@ -223,6 +223,8 @@ def sweep_figure(
     ds = res.ds
     var = resolve_var(ds, var)
     lay = res.layout(var)
+    if var is not None and "planet" in ds[var].dims:
+        _planet_sel(ds[var], planet)  # an unobserved planet is refused, whatever the figure
     if len(lay.vary) == 1:
         return bifurcation_figure(
             res,
