@@ -76,6 +76,16 @@ def open_result(source: Any) -> Any:
 
     try:
         return open_simulation(path)
+    except StoreError as exc:
+        if "open_branch" in str(exc):  # a branch file of `gearchaos continue`
+            raise StoreError(
+                f"{path!r} is a branch of `gearchaos continue`, not a sweep store or a "
+                "simulation file: draw it with `gearchaos plot STORE --branch` or read it with "
+                "gearchaos.analysis.open_branch"
+            ) from None
+        raise StoreError(
+            f"{path!r} is neither a sweep store nor a simulation file: {exc}"
+        ) from None
     except Exception as exc:  # h5netcdf / h5py raise many types for a file that is no netCDF
         raise StoreError(
             f"{path!r} is neither a sweep store nor a simulation file ({type(exc).__name__})"
