@@ -20,6 +20,7 @@ from .._numba import entry_point
 from ..errors import ParameterError, Status
 from ..model.system import System
 from .settings import SampleTimes, SolverSettings
+from .threads import pool, wait_all
 
 __all__ = ["ChainOutput", "ChainRun", "SampleArrays", "run_chains"]
 
@@ -324,31 +325,21 @@ _CHAIN_OUTPUTS = (
     "tau", "states", "observables", "obs_min", "obs_max", "final_state", "info", "status",
     "log_sums",
 )  # fmt: skip
-_POOLS: dict[tuple[int, int], Any] = {}
 
 
 def run_threaded(call: Any, n: int, threads: int) -> None:
-    """``call(lo, hi)`` over blocks that cover ``range(n)``, on ``threads`` threads that take
-    the blocks in turn (``call`` must release the GIL: a ``nogil`` kernel). A block is about an
-    eighth of a thread's share, so an uneven load still spreads. An interrupt cancels the blocks
-    not yet started; the running ones finish (compiled code cannot be stopped)."""
-    import concurrent.futures as cf
-    import os
+    """``call(lo, hi)`` over blocks that cover ``range(n)``, on ``threads`` daemon threads that
+    take the blocks in turn (``call`` must release the GIL: a ``nogil`` kernel). A block is
+    about an eighth of a thread's share, so an uneven load still spreads. From the main thread
+    even one block runs on a worker, so that Ctrl-C or SIGTERM interrupts the wait at once
+    (:mod:`.threads`); an interrupt cancels the blocks not yet started, and the running ones
+    finish in the background (compiled code cannot be stopped) without holding the process."""
+    import threading
 
     threads = max(1, min(int(threads), n))
-    if threads == 1:
-        call(0, n)
+    if threads == 1 and threading.current_thread() is not threading.main_thread():
+        call(0, n)  # a sweep driver's single block runs where it is
         return
-    key = (os.getpid(), threads)  # a pool does not survive a fork
-    pool = _POOLS.get(key)
-    if pool is None:
-        pool = _POOLS[key] = cf.ThreadPoolExecutor(threads, thread_name_prefix="gearchaos")
+    workers = pool(threads)
     size = max(1, n // (8 * threads))
-    futures = [pool.submit(call, lo, min(lo + size, n)) for lo in range(0, n, size)]
-    try:
-        for f in futures:
-            f.result()
-    except BaseException:
-        for f in futures:
-            f.cancel()
-        raise
+    wait_all([workers.submit(call, lo, min(lo + size, n)) for lo in range(0, n, size)])

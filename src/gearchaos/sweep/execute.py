@@ -86,8 +86,17 @@ def executor(execution: Execution | None = None) -> Iterator[tuple[Any, Any, str
     if ex_.workers is not None:
         n = int(ex_.workers)
         ctx = multiprocessing.get_context("spawn")
-        with cf.ProcessPoolExecutor(max_workers=n, mp_context=ctx, initializer=_init_worker) as ex:
+        ex = cf.ProcessPoolExecutor(max_workers=n, mp_context=ctx, initializer=_init_worker)
+        try:
             yield ex, run_chains, f"{n} local processes"
+        except BaseException:
+            # interrupted or failed: end the workers now (a clean shutdown would wait for the
+            # blocks they compute, seconds of compiled code whose result nobody reads)
+            for proc in list(getattr(ex, "_processes", {}).values()):
+                proc.terminate()
+            ex.shutdown(wait=False, cancel_futures=True)
+            raise
+        ex.shutdown(wait=True)
         return
     if ex_.scheduler is not None or ex_.dask_local is not None:
         try:

@@ -22,6 +22,7 @@ from .._checks import check_bool
 from .._version import provenance
 from ..errors import ParameterError, Status, StoreError
 from ..integrate._chains import ChainOutput, ChainRun
+from ..integrate.threads import abandon, resume
 from ..model.target import scale_attrs
 from ._response_store import response_extract, response_variables
 from .execute import EXECUTION_OPTIONS, Execution, InProcess, executor
@@ -423,6 +424,7 @@ def _run_in_process(
     width = _DRIVERS
     driver = cf.ThreadPoolExecutor(width, thread_name_prefix="gearchaos-sweep")
     pending: collections.deque[cf.Future[Any]] = collections.deque()
+    resume()
     try:
         for group in itertools.islice(groups, width):
             pending.append(driver.submit(compute, group))
@@ -434,6 +436,9 @@ def _run_in_process(
             for t, data, failed in done:
                 st.write(t.index, t.block, data)
                 bar.advance(t.n_points, failed)
+    except BaseException:
+        abandon()  # the drivers stop waiting for their blocks: the process can exit at once
+        raise
     finally:
         driver.shutdown(wait=False, cancel_futures=True)
 
