@@ -52,9 +52,16 @@ class _Commands(typer.core.TyperGroup):
 
     def invoke(self, ctx: Any) -> Any:
         # every command's errors, also those outside its own reported_errors() block (an
-        # over-long or unreadable path met while checking its arguments), are one line
-        with reported_errors():
-            return super().invoke(ctx)
+        # over-long or unreadable path met while checking its arguments), are one line, and
+        # so is each distinct warning (an interrupted store read by plot or export)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("default")
+            try:
+                with reported_errors():
+                    return super().invoke(ctx)
+            finally:
+                for message in dict.fromkeys(str(w.message) for w in caught):
+                    warn(message)
 
     def resolve_command(self, ctx: Any, args: list[str]) -> Any:
         name, cmd, rest = super().resolve_command(ctx, args)
