@@ -155,6 +155,15 @@ def periodic_orbits(
     messages = [f"no convergence in {iters} iterations"] * K
     history: list[np.ndarray] = []  # best max|G| of every point after each evaluation
 
+    def monodromies(idx: np.ndarray, states: np.ndarray) -> tuple[Shot, np.ndarray]:
+        """The map with tangents of the points ``idx`` at ``states``, and its monodromy
+        matrices."""
+        shot = shoot(
+            [systems[k] for k in idx], states[idx], n, cfg, tangents=True, tangent_tol=tangent_tol
+        )
+        assert shot.monodromy is not None
+        return shot, shot.monodromy
+
     def step(k: int, g: np.ndarray, r: float) -> None:
         """The Newton (or chord) step from y[k] = best_y[k], or convergence."""
         M = mono[k]
@@ -178,19 +187,11 @@ def periodic_orbits(
         fresh = active[refresh[active]] if chord else active
         mapped = active[~redo[active]]
         if fresh.size:
-            tang = shoot(
-                [systems[k] for k in fresh],
-                y[fresh],
-                n,
-                cfg,
-                tangents=True,
-                tangent_tol=tangent_tol,
-            )
-            assert tang.monodromy is not None
+            tang, tang_m = monodromies(fresh, y)
             for j, k in enumerate(fresh.tolist()):
                 evals[k] += 1
                 ok_j = tang.ok(j)
-                mono[k] = tang.monodromy[j] if ok_j else None
+                mono[k] = tang_m[j] if ok_j else None
                 mono_at[k], refresh[k] = y[k], False
         plain = (
             shoot([systems[k] for k in mapped], y[mapped], n, cfg, tangents=False)
@@ -250,18 +251,10 @@ def periodic_orbits(
         )
     ]
     if stale:
-        t = shoot(
-            [systems[k] for k in stale],
-            best_y[stale],
-            n,
-            cfg,
-            tangents=True,
-            tangent_tol=tangent_tol,
-        )
-        assert t.monodromy is not None
+        t, t_m = monodromies(np.array(stale), best_y)
         for j, k in enumerate(stale):
             evals[k] += 1
-            mono[k] = t.monodromy[j] if t.ok(j) else None
+            mono[k] = t_m[j] if t.ok(j) else None
     out = []
     for k in range(K):
         ok = best_r[k] <= eps and best[k] is not None and mono[k] is not None
