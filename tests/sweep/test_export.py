@@ -109,3 +109,29 @@ def test_cli_export_and_refusals(store: Path, tmp_path: Path) -> None:
         gc.export(store, tmp_path / "x.parquet")
     with pytest.raises(StoreError):
         gc.export(tmp_path / "a.txt", tmp_path / "y.csv")
+
+
+def test_a_csv_stands_alone(tmp_path: Path, sheng: gc.GearSet) -> None:
+    # issue 24: a backlash-sweep CSV named only `gearset = sheng2016`: not the changed
+    # planet-ring backlash, not Ω; status and orbit codes came without a legend
+    path = tmp_path / "b.zarr"
+    gc.bifurcation(
+        sheng.evolve({"backlash.planet_ring": 2.0}),
+        "backlash.sun_planet=1:2:2",
+        fixed={"omega": 1.5},
+        store=path,
+        progress=False,
+        **SHORT,
+    )
+    out = gc.export(path, tmp_path / "b.csv")
+    header = [ln for ln in out.read_text().splitlines() if ln.startswith("#")]
+    text = "\n".join(header)
+    assert "#   planet_ring = 2.0" in text  # the changed value, in the gear set's own TOML
+    assert '"omega" = 1.5' in text  # the sweep's fixed values
+    assert "# status: 0 = ok, 1 = max_steps" in text and "4 = not_run" in text
+    assert "# verdict: " in text and "0 = floquet" in text
+    # and the rows still read back with pandas
+    import pandas as pd
+
+    df = pd.read_csv(out, comment="#")
+    assert len(df) > 0 and "status" in df.columns

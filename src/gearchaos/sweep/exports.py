@@ -92,6 +92,31 @@ def open_result(source: Any) -> Any:
         ) from None
 
 
+def _provenance_lines(ds: Any, columns: list[str]) -> list[str]:
+    """The header lines that make a CSV stand alone: the legend of every coded column
+    (``status``, ``verdict``, ``record``, ``orbit_status`` …: code = meaning, from the
+    variable's ``flag_values``/``flag_meanings``), then the whole gear set and sweep
+    specification as TOML — every parameter value, the changed ones too."""
+    lines = []
+    for name in columns:
+        if name not in ds.variables:
+            continue
+        attrs = ds[name].attrs
+        values, meanings = attrs.get("flag_values"), attrs.get("flag_meanings")
+        if values is None or not isinstance(meanings, str):
+            continue
+        pairs = ", ".join(
+            f"{int(v)} = {m}" for v, m in zip(np.ravel(values), meanings.split(), strict=False)
+        )
+        lines.append(f"# {name}: {pairs}")
+    for key, title in (("gearset_toml", "gear set"), ("sweep_toml", "sweep")):
+        text = ds.attrs.get(key)
+        if isinstance(text, str) and text.strip():
+            lines.append(f"# {title} (TOML, every value):")
+            lines += [f"#   {ln}" if ln else "#" for ln in text.strip().splitlines()]
+    return lines
+
+
 def _is_sweep(ds: Any) -> bool:
     return "status" in ds.data_vars and "section" in ds.dims and "tau" not in ds.coords
 
@@ -186,6 +211,7 @@ def export(source: Any, path: str | os.PathLike[str], *, to: str | None = None) 
                 if name:
                     header.insert(0, f"# gearset = {name.group(1)}")
             header.insert(0, f"# gearchaos {__version__} export of {os.fspath(source)}")
+            header += _provenance_lines(ds, [str(c) for c in df.columns])
             with open(tmp, "w", encoding="utf-8", newline="") as f:
                 f.write("\n".join(header) + ("\n" if header else ""))
                 df.to_csv(f, index=False)  # floats as repr: the shortest exact text
