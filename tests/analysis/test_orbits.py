@@ -201,8 +201,11 @@ def test_orbit_api_section_values_contacts_and_summary(sheng: gc.GearSet) -> Non
     }
     summary = orbit.summary()
     assert list(summary) == [
-        "period", "converged", "residual", "stable", "multipliers", "x_sp1", "contact",
+        "period", "minimal_period", "converged", "max_multiplier", "residual", "stable",
+        "multipliers", "x_sp1", "contact",
     ]  # fmt: skip
+    assert summary["minimal_period"] == 1  # issue 24: the JSON says the orbit's own period
+    assert summary["max_multiplier"] == pytest.approx(max(m["abs"] for m in summary["multipliers"]))
     assert summary["x_sp1"] == pytest.approx([float(x[0, 0])])
     assert len(summary["multipliers"]) == 16
     m0 = summary["multipliers"][0]

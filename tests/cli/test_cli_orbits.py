@@ -16,7 +16,17 @@ from typer.testing import CliRunner
 
 from gearchaos.cli import app
 
-KEYS = {"period", "converged", "residual", "stable", "multipliers", "x_sp1", "contact"}
+KEYS = {
+    "period",
+    "minimal_period",
+    "converged",
+    "residual",
+    "stable",
+    "max_multiplier",
+    "multipliers",
+    "x_sp1",
+    "contact",
+}
 
 
 @pytest.fixture(scope="module")

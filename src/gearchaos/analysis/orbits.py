@@ -192,13 +192,17 @@ class PeriodicOrbit:
         return ob.take(self.sections, self.section_obs)
 
     def summary(self) -> dict[str, Any]:
-        """A JSON-serialisable summary: ``period``, ``converged``, ``residual``, ``stable``,
-        ``multipliers`` ([{re, im, abs}]), ``x_sp1`` (the section values of X̄_sp1, or of the
-        first tracked observable of a reference system) and ``contact`` ([{contact, regime}])."""
+        """A JSON-serialisable summary: ``period`` (the one shot), ``minimal_period`` (the
+        orbit's own: a period-2 shooting may converge on a 1T orbit), ``converged``,
+        ``residual``, ``stable``, ``max_multiplier``, ``multipliers`` ([{re, im, abs}]),
+        ``x_sp1`` (the section values of X̄_sp1, or of the first tracked observable of a
+        reference system) and ``contact`` ([{contact, regime}])."""
         first = self.system.obs_names[0]
         return {
             "period": int(self.period),
+            "minimal_period": int(self.minimal_period),
             "converged": bool(self.converged),
+            "max_multiplier": float(self.max_multiplier),
             "residual": float(self.residual),
             "stable": bool(self.stable),
             "multipliers": [

@@ -50,8 +50,9 @@ def orbit(
     and contact regimes.
 
     The multipliers μ are the eigenvalues of the monodromy matrix; the orbit is stable when
-    every |μ| < 1. **--json** prints exactly {period, converged, residual, stable,
-    multipliers: [{re, im, abs}], x_sp1: [...], contact: [...]}.
+    every |μ| < 1. **--json** prints exactly {period, minimal_period, converged, residual,
+    stable, max_multiplier, multipliers: [{re, im, abs}], x_sp1: [...], contact: [...]}; a
+    period-2 shooting that converges on a 1T orbit says minimal_period 1.
 
     Example: **gearchaos orbit --set omega=1.5 --period 1**
     """
@@ -69,7 +70,17 @@ def orbit(
                 orb = periodic_orbit(gs, period=period, omega=omega, settings=settings)
         summary = orb.summary()
     if json_out:
-        keys = ("period", "converged", "residual", "stable", "multipliers", "x_sp1", "contact")
+        keys = (
+            "period",
+            "minimal_period",
+            "converged",
+            "residual",
+            "stable",
+            "max_multiplier",
+            "multipliers",
+            "x_sp1",
+            "contact",
+        )
         c.print_json({k: summary[k] for k in keys})
         return
     out = c.stdout()
