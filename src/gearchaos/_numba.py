@@ -39,14 +39,14 @@ def on_first_compile(callback: Any) -> None:
         _FIRST_COMPILE.append(callback)
 
 
-def _in_disk_cache(dispatcher: Any) -> bool:
-    """Whether numba's cache index of ``dispatcher`` exists (its kernels were compiled and
-    saved before); True where that cannot be told."""
-    import os
-
+def _in_disk_cache(dispatcher: Any, sig: tuple[Any, ...]) -> bool:
+    """Whether numba's on-disk cache of ``dispatcher`` holds the specialisation ``sig`` (a new
+    planet count, say, is compiled although others are cached); True where that cannot be
+    told."""
     try:
-        return bool(os.path.exists(dispatcher._cache._cache_file._index_path))
-    except AttributeError:
+        index = dispatcher._cache._cache_file._load_index()
+        return any(key[0] == sig for key in index)
+    except Exception:  # numba's internals changed: assume cached, print nothing
         return True
 
 
@@ -72,9 +72,9 @@ def entry_point(dispatcher: Any, kind: int, *args: Any) -> Any:
     fast = (dispatcher, kind, *(_type_key(a) for a in args))
     entry = _ENTRIES.get(fast)
     if entry is None:
-        if _FIRST_COMPILE and not _in_disk_cache(dispatcher):
-            _FIRST_COMPILE.pop()()
         sig = (types.literal(kind), *(typeof(a) for a in args))
+        if _FIRST_COMPILE and not _in_disk_cache(dispatcher, sig):
+            _FIRST_COMPILE.pop()()
         with warnings.catch_warnings():
             # numba's IR inliner emits an internal "pedantic" NumbaIRAssumptionWarning for the
             # inlined dispatch of the right-hand side; it is harmless and not actionable

@@ -139,8 +139,9 @@ def reported_errors() -> Iterator[None]:
 
     on_first_compile(
         lambda: stderr().print(
-            "compiling numerical kernels (once per planet count and analysis, about 15 "
-            "seconds; later runs load them from the cache)…"
+            "compiling numerical kernels for this model (once per planet count and "
+            "analysis: from a few seconds to a minute or two on a small machine; later runs "
+            "load them from the cache)…"
         )
     )
     try:
