@@ -18,7 +18,7 @@ def test_notice_once_and_only_before_a_compilation(
     monkeypatch: pytest.MonkeyPatch, cached: bool
 ) -> None:
     calls: list[int] = []
-    monkeypatch.setattr(_numba, "_in_disk_cache", lambda dispatcher: cached)
+    monkeypatch.setattr(_numba, "_in_disk_cache", lambda dispatcher, sig: cached)
     monkeypatch.setattr(_numba, "_ENTRIES", {})  # as in a fresh process
     _numba.on_first_compile(lambda: calls.append(1))
     try:
@@ -30,8 +30,14 @@ def test_notice_once_and_only_before_a_compilation(
 
 
 def test_disk_cache_is_read_from_the_dispatcher() -> None:
+    from numba import types
+
     from gearchaos.integrate.dopri import dopri_chains
 
     _run()  # compiled or loaded: either way the index is on disk now
-    assert _numba._in_disk_cache(dopri_chains) is True
-    assert _numba._in_disk_cache(object()) is True  # cannot be told: no notice
+    index = dopri_chains._cache._cache_file._load_index()
+    cached_sig = next(iter(index))[0]
+    assert _numba._in_disk_cache(dopri_chains, cached_sig) is True
+    # a specialisation the cache does not hold (a new planet count, say): the notice is due
+    assert _numba._in_disk_cache(dopri_chains, (types.literal(987654),)) is False
+    assert _numba._in_disk_cache(object(), cached_sig) is True  # cannot be told: no notice
