@@ -70,18 +70,7 @@ def orbit(
                 orb = periodic_orbit(gs, period=period, omega=omega, settings=settings)
         summary = orb.summary()
     if json_out:
-        keys = (
-            "period",
-            "minimal_period",
-            "converged",
-            "residual",
-            "stable",
-            "max_multiplier",
-            "multipliers",
-            "x_sp1",
-            "contact",
-        )
-        c.print_json({k: summary[k] for k in keys})
+        c.print_json(summary)  # exactly the keys of PeriodicOrbit.summary()
         return
     out = c.stdout()
     table = pairs_table(f"period-{period} orbit of {gs.name} at Ω = {omega:g}")
