@@ -38,6 +38,14 @@ class Status(enum.IntEnum):
     NON_FINITE = 3
     NOT_RUN = 4  # a sweep point not computed yet (an interrupted store); never a kernel result
 
+    def __str__(self) -> str:
+        """The name a person reads (``ok``, ``max_steps``), not the code ``0``."""
+        return self.name.lower()
+
+    def __format__(self, spec: str) -> str:
+        # f"{status}" reads as its name; a numeric format (f"{status:d}") gives the code
+        return str(self) if not spec else format(int(self), spec)
+
     @property
     def message(self) -> str:
         return _MESSAGES[self]

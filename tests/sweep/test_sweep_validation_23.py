@@ -83,3 +83,11 @@ def test_errors_name_what_was_wrong() -> None:
         classify_motion("abc")
     with pytest.raises(ParameterError, match="result must be a simulation result"):
         poincare_map(None)
+
+
+def test_a_status_reads_as_its_name() -> None:
+    # issue 24: `res.status` formatted as `0`
+    res = gc.simulate(OSC, omega=1.0, transient_periods=2, periods=2)
+    assert f"{res.status}" == str(res.status) == "ok"
+    assert f"{res.status:d}" == "0" and int(res.status) == 0  # the code where asked for
+    assert str(gc.Status.NOT_RUN) == "not_run"
