@@ -1,5 +1,5 @@
-"""Progress outside a terminal (a log file, a pipe, a batch job): readable plain lines, one per
-5 % of the points and one at the end, never a truncated bar."""
+"""Progress outside a terminal (a log file, a pipe, a batch job): readable plain lines, at most
+one per 5 % of the points and per 10 s, and one at the end, never a truncated bar."""
 
 from __future__ import annotations
 
@@ -36,3 +36,17 @@ def test_progress_outside_a_terminal_is_plain_lines(capsys: pytest.CaptureFixtur
     assert done == sorted(done) and done[-1] == 40
     assert len(lines) <= 21  # at most one line per 5 % (and the last)
     assert "━" not in err  # no bar characters in a log
+
+
+def test_a_short_sweep_in_a_log_writes_one_line(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # issue 24: outside a terminal a 100-point sweep printed about 20 lines; lines are now
+    # also at least EVERY seconds apart (set very long here: only the final line remains)
+    from gearchaos.sweep.progress import _Bar
+
+    monkeypatch.setattr(_Bar, "EVERY", 1e9)
+    system = gc.backlash_oscillator(1.0, zeta=0.05, b=1.0, f_mean=0.1, f_alt=0.5)
+    gc.bifurcation(system, {"omega": "0.6:1.2:100"}, transient_periods=2, periods=2)
+    lines = [ln for ln in capsys.readouterr().err.splitlines() if ln.startswith("sweep")]
+    assert len(lines) == 1 and " 100 of 100 points (100 %)" in lines[0]

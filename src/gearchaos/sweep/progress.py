@@ -12,10 +12,12 @@ __all__: list[str] = []
 
 class _Bar:
     """Rich progress bar (points done, points/s, ETA) on stderr in a terminal; elsewhere (a
-    log file, a pipe, a batch job) one plain line per 5 % of the points; silent when
-    disabled."""
+    log file, a pipe, a batch job) a plain line when at least 5 % of the points and
+    :attr:`EVERY` seconds have passed since the last one, and one at the end (a short sweep
+    writes one line, an hour-long one at most twenty); silent when disabled."""
 
     STEP = 0.05  # fraction of the points between two plain lines
+    EVERY = 10.0  # seconds between two plain lines
 
     def __init__(self, enabled: bool, total: int, done: int):
         self.enabled = enabled
@@ -25,6 +27,7 @@ class _Bar:
         self._p: Any = None
         self._plain = False
         self._next_line = 0.0
+        self._last_line = time.perf_counter()
         self._what = ""
 
     def __enter__(self) -> _Bar:
@@ -85,10 +88,13 @@ class _Bar:
     def advance(self, n: int, failed: int) -> None:
         self.done += n
         self.failed += failed
-        if self._plain and (
-            self.done / max(self.total, 1) >= self._next_line or self.done >= self.total
-        ):
+        now = time.perf_counter()
+        due = self.done / max(self.total, 1) >= self._next_line and now - self._last_line >= (
+            self.EVERY
+        )
+        if self._plain and (due or self.done >= self.total):
             print(self._line(), file=sys.stderr, flush=True)
+            self._last_line = now
             while self._next_line <= self.done / max(self.total, 1):
                 self._next_line += self.STEP
         if self._p is not None:
