@@ -84,3 +84,11 @@ def test_plot_options_that_a_figure_does_not_use_are_refused(tmp_path: Path) -> 
         r = runner.invoke(app, ["plot", *args, "-o", str(tmp_path / "f.png")])
         assert r.exit_code == EXIT_INVALID and words in r.output, r.output
     assert not (tmp_path / "f.png").exists()
+
+
+@pytest.mark.parametrize("command", ["simulate", "bifurcation", "plot", "continue", "explore"])
+def test_flags_show_no_value_placeholder_in_help(command: str) -> None:
+    # issue 24: every flag showed a `<bool>` placeholder in --help, as if it took a value
+    r = CliRunner().invoke(app, [command, "--help"], env={"COLUMNS": "120"})
+    assert r.exit_code == 0
+    assert "<bool>" not in r.output and "--help" in r.output

@@ -66,6 +66,10 @@ class _Commands(typer.core.TyperGroup):
     def resolve_command(self, ctx: Any, args: list[str]) -> Any:
         name, cmd, rest = super().resolve_command(ctx, args)
         if cmd is not None:
+            # a flag takes no value: no "<bool>" beside it in --help
+            for param in [*cmd.params, cmd.get_help_option(ctx)]:
+                if param is not None and getattr(param, "is_flag", False) and not param.metavar:
+                    param.metavar = ""
             problem = repeated_option(cmd, rest)
             if problem:
                 ctx.fail(problem)
