@@ -123,7 +123,14 @@ def test_set_changes_the_gear_set_and_files_are_written(runner: CliRunner, tmp_p
         gs = GearSet.from_toml_string(ds.attrs["gearset_toml"])
         assert "delta_sp" in ds and ds.delta_sp.sizes["section"] == 20
         assert np.all(np.isfinite(ds.delta_sp.sel(planet=1).values))
-    expected = preset("sheng2016").evolve({"xi": 0.05, "backlash.sun_planet": 2.5})
+    # every value as set, and a name that says the gear set is not plain sheng2016 (issue 24)
+    expected = preset("sheng2016").evolve(
+        {
+            "xi": 0.05,
+            "backlash.sun_planet": 2.5,
+            "name": "sheng2016 (modified: xi, backlash.sun_planet)",
+        }
+    )
     assert gs == expected
 
 

@@ -258,7 +258,13 @@ def load_gearset(
         gs = GearSet.from_toml(gearset_file)
     else:
         gs = load_preset(preset if preset is not None else DEFAULT_PRESET)
-    gs = gs.evolve(dict(changes)) if changes else gs
+    if changes:
+        # a changed gear set is no longer the named one: its name says so (and which
+        # parameters), so titles and result files never call it plain "sheng2016"
+        names = [k for k in changes if k not in ("name", "description")]
+        label = ", ".join(names) if len(names) <= 3 else f"{len(names)} parameters"
+        renamed = {"name": f"{gs.name} (modified: {label})"} if names else {}
+        gs = gs.evolve({**dict(changes), **renamed})
     for field, keep in (("name", ""), ("description", "\t\n")):
         text = getattr(gs, field)
         bad = next((ch for ch in text if unicodedata.category(ch) == "Cc" and ch not in keep), None)
