@@ -30,6 +30,7 @@ __all__ = [
     "check_output_file",
     "check_path",
     "check_regular_file",
+    "open_regular_nofollow",
     "read_text_file",
 ]
 
@@ -108,6 +109,29 @@ def _open_regular(path: object, what: str) -> tuple[int, str, str]:
         os.close(fd)
         raise StoreError(f"{what} '{shown}' is {_kind(mode)}, not a regular file")
     return fd, name, shown
+
+
+def open_regular_nofollow(path: str) -> int:
+    """A read descriptor of the regular file at ``path`` itself, for files gearchaos wrote
+    (chunks, figures it may replace): a symbolic link is never followed (``OSError`` ELOOP), a
+    FIFO, device or directory is refused (``OSError`` EINVAL) before anything is read, and
+    the open never blocks. The caller closes the descriptor."""
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOFOLLOW", 0)
+    try:
+        fd = os.open(path, flags)
+    except OSError as exc:
+        if exc.errno == errno.ELOOP:
+            raise OSError(errno.ELOOP, "a symbolic link, not a regular file") from None
+        raise
+    try:
+        mode = os.fstat(fd).st_mode
+    except OSError:
+        os.close(fd)
+        raise
+    if not stat.S_ISREG(mode):
+        os.close(fd)
+        raise OSError(errno.EINVAL, f"{_kind(mode)}, not a regular file")
+    return fd
 
 
 def check_regular_file(path: object, *, what: str) -> str:

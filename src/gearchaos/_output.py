@@ -15,7 +15,8 @@ rename it over the target in one step; on every error path the temporary is remo
 file; writers whose libraries crash on a full disk (HDF5) serialise to memory first and write
 the bytes with :func:`write_file`.
 
-A leaf module: it imports nothing from the package but :mod:`gearchaos.errors`.
+A leaf module: it imports nothing from the package but :mod:`gearchaos.errors` and
+:mod:`gearchaos._files`.
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ import stat
 import tempfile
 from collections.abc import Callable, Iterator
 
+from ._files import open_regular_nofollow
 from .errors import StoreError
 
 __all__ = [
@@ -186,14 +188,11 @@ def staged_dir(path: str, *, what: str) -> Iterator[str]:
 def file_has_mark(path: str) -> bool:
     """Whether the regular file ``path`` holds :data:`MARK` within its first 64 MiB (a figure's
     metadata, an export's header); never follows a symbolic link or opens a FIFO."""
-    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOFOLLOW", 0)
     try:
-        fd = os.open(path, flags)
+        fd = open_regular_nofollow(path)
     except OSError:
         return False
     try:
-        if not stat.S_ISREG(os.fstat(fd).st_mode):
-            return False
         tail = b""
         left = _MARK_SCAN
         while left > 0:

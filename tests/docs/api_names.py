@@ -13,17 +13,14 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
+import pkgutil
 
-SUBPACKAGES = (
-    "gearset",
-    "model",
-    "integrate",
-    "analysis",
-    "dynamics",
-    "sweep",
-    "plot",
-    "paper",
-    "explore",
+import gearchaos
+
+#: Every subpackage but the command line, read from the package (a new one must be documented;
+#: the layer order is test_architecture's).
+SUBPACKAGES = tuple(
+    m.name for m in pkgutil.iter_modules(gearchaos.__path__) if m.ispkg and m.name != "cli"
 )
 PACKAGES = ("gearchaos", *(f"gearchaos.{p}" for p in SUBPACKAGES))
 NOT_DOCUMENTABLE = {"__version__"}  # a plain string, described in the page's text

@@ -74,13 +74,12 @@ def periods_of(
     if p.ndim < 2:
         raise ParameterError(f"points must have shape (..., m, d): got shape {p.shape}")
     lead = p.shape[:-2]
-    atols = np.asarray(atol, dtype=np.float64) if not isinstance(atol, str) else atol
-    if isinstance(atols, np.ndarray) and atols.ndim > 0:
+    if np.ndim(atol) > 0:  # one absolute tolerance per sequence
         try:
-            atols = np.broadcast_to(atols, lead).reshape(-1)
-        except ValueError:
+            atols = np.broadcast_to(np.asarray(atol, dtype=np.float64), lead).reshape(-1)
+        except (TypeError, ValueError):
             raise ParameterError(
-                f"atol must be a number or one per sequence ({lead}): got shape {atols.shape}"
+                f"atol must be a number or one per sequence ({lead}): got shape {np.shape(atol)}"
             ) from None
         if not np.all(np.isfinite(atols) & (atols >= 0)):
             raise ParameterError("atol must be finite numbers >= 0: got a negative or NaN value")

@@ -96,10 +96,10 @@ def split_omega(values: Mapping[str, Any]) -> tuple[float | None, dict[str, Any]
     return check_omega(rest.pop(OMEGA)), rest
 
 
-def _gearset_model(gs: GearSet, changes: tuple[tuple[str, Any], ...], key: Any = None) -> Any:
-    """The planetary model of ``gs`` evolved by ``changes`` (validated); ``key`` identifies
-    ``changes`` for the cache."""
-    return PlanetaryModel.from_gearset(gs.evolve(dict(changes)) if changes else gs)
+def _gearset_model(gs: GearSet, changes: tuple[tuple[str, str, Any], ...]) -> Any:
+    """The planetary model of ``gs`` evolved by ``changes`` ((name, type name, value), the
+    cache's key; validated)."""
+    return PlanetaryModel.from_gearset(gs.evolve({k: v for k, _, v in changes}) if changes else gs)
 
 
 #: The models of the last gear sets and changes asked for: a continuation or a Newton
@@ -117,14 +117,13 @@ def model_for(target: Any, changes: Mapping[str, Any]) -> Any:
     """
     _check_target(target)
     if isinstance(target, GearSet):
-        items = tuple(changes.items())
         # the values' types are part of the key: True == 1, but a bool is never a count
-        key = tuple(sorted((k, type(v).__name__, v) for k, v in items))
+        key = tuple(sorted((k, type(v).__name__, v) for k, v in changes.items()))
         try:
             hash(key)
         except TypeError:  # an unhashable value (a list of harmonics): no cache
-            return _gearset_model(target, items)
-        return _cached_gearset_model(target, items, key)
+            return _gearset_model(target, key)
+        return _cached_gearset_model(target, key)
     if not changes:
         return target.model
     check_names(target, changes)

@@ -19,13 +19,13 @@ import json
 import math
 import os
 import socket
-import stat
 import tempfile
 import time
 import zlib
 from collections.abc import Iterable, Iterator, Mapping
 from typing import Any
 
+from .._files import open_regular_nofollow
 from .._output import write_file
 from ..errors import StoreError
 
@@ -168,16 +168,8 @@ def file_digest(path: str, max_bytes: int = 1 << 31) -> tuple[int, int]:
     """(size in bytes, CRC-32) of a regular file of at most ``max_bytes`` bytes: a symbolic
     link, a FIFO or a device is refused (``OSError``) before anything is read, and at most
     ``max_bytes`` + 1 bytes are read, so ``/dev/zero`` or a huge file never exhausts memory."""
-    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOFOLLOW", 0)
+    fd = open_regular_nofollow(path)
     try:
-        fd = os.open(path, flags)
-    except OSError as exc:
-        if exc.errno == errno.ELOOP:  # O_NOFOLLOW met a symbolic link
-            raise OSError(errno.ELOOP, "a symbolic link, not a chunk file") from None
-        raise
-    try:
-        if not stat.S_ISREG(os.fstat(fd).st_mode):
-            raise OSError(errno.EINVAL, "not a regular file")
         crc, size = 0, 0
         while size <= max_bytes:
             block = os.read(fd, min(1 << 20, max_bytes + 1 - size))

@@ -88,7 +88,7 @@ def consolidate(store: Any) -> None:
         dirnames[:] = sorted(d for d in dirnames if d != PROGRESS)
         rel = os.path.relpath(dirpath, store).replace(os.sep, "/")
         for name in (".zgroup", ".zattrs", ".zarray"):
-            if name in files and not (rel == "." and name == ".zmetadata"):
+            if name in files:
                 with open(os.path.join(dirpath, name), encoding="utf-8") as f:
                     meta[name if rel == "." else f"{rel}/{name}"] = json.load(f)
     text = json.dumps({"metadata": meta, "zarr_consolidated_format": 1}, indent=4)
