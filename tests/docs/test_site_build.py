@@ -3,7 +3,8 @@
 The inventory the build writes (``objects.inv``, Sphinx format) lists every object the API
 reference rendered; every name of ``gearchaos.__all__`` and of each documented subpackage's
 ``__all__`` must be in it. The pages load nothing from the network (no CDN scripts, styles or
-fonts) and the model's equations are rendered as MathML.
+fonts) and the model's equations are rendered as MathML. The API reference's tables show types
+in their Type column and no unresolved ``<autoref>`` tag (``reference_tables.py``).
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import zlib
 from pathlib import Path
 
 from api_names import PACKAGES, directive_target, public_names
+from reference_tables import defects, is_type
 
 ROOT = Path(__file__).resolve().parents[2]
 REMOTE_ASSET = re.compile(r"<(?:script|link|img)\b[^>]*(?:src|href)=\"(?:https?:)?//", re.I)
@@ -63,6 +65,7 @@ def test_site_builds_offline_and_renders_the_public_api(tmp_path: Path) -> None:
     _build(tmp_path)
     _check_pages(tmp_path)
     _check_api_reference(tmp_path)
+    _check_reference_tables(tmp_path)
     _check_no_network_assets(tmp_path)
     _check_mathml(tmp_path)
 
@@ -104,6 +107,57 @@ def _check_api_reference(site: Path) -> None:
                 wrong.append(f"{target} ({sorted(roles[target])}, expected {role})")
     assert not missing, f"public names the API reference does not render: {missing}"
     assert not wrong, f"public names rendered as the wrong kind of object: {wrong}"
+
+
+def _check_reference_tables(site: Path) -> None:
+    """No page shows a raw ``<autoref>`` tag, and every Type cell of the API reference's
+    tables is a type (a numpydoc ``name : sentence`` puts the sentence there)."""
+    found = {
+        str(page.relative_to(site)): bad
+        for page in sorted(site.rglob("*.html"))
+        if (bad := defects(page.read_text(encoding="utf-8")))
+    }
+    assert not found, (
+        "API reference tables with a sentence or a raw autoref in the Type column (write "
+        f"'name' alone, the description indented below it, for an annotated field): {found}"
+    )
+
+
+#: What mkdocstrings rendered for ``Event`` when its docstring read ``kind : one of
+#: :data:`EVENT_KINDS`.`` (issue 24): the sentence in the Type column, the role escaped.
+_BROKEN_ROWS = """<table><thead><tr><th>Name</th><th>Type</th><th>Description</th></tr></thead>
+<tbody><tr class="doc-section-item"><td><code>kind</code></td>
+<td><code>one of &lt;autoref identifier=&#34;gearchaos.analysis.branch_events.EVENT_KINDS&#34;
+optional&gt;&lt;code&gt;EVENT_KINDS&lt;/code&gt;&lt;/autoref&gt;.</code></td><td></td></tr>
+<tr><td><code>arclength</code></td><td><code>the branch&#39;s arclength at the event.</code></td>
+<td></td></tr><tr><td><code>value</code></td><td><code>float</code></td><td>The value.</td></tr>
+</tbody></table>"""
+
+
+def test_reference_table_check_finds_sentences_and_raw_autorefs() -> None:
+    found = defects(_BROKEN_ROWS)
+    assert sum("raw autoref" in f for f in found) == 2
+    assert [f.split(":")[0] for f in found if "Type cell" in f] == ["kind", "arclength"]
+    for good in (
+        "float",
+        "dict[str, Any]",
+        "int | None",
+        "Sequence[dict[str, Any] | None] | None",
+        "numpy.ndarray",
+        "tuple of str",
+        "list of (str, str)",
+        "mapping of str to object",
+        "str or os.PathLike",
+        "(figure, rows)",
+        "",
+    ):
+        assert is_type(good), good
+    for bad in (
+        "n, in forcing periods T = 2π/Ω.",
+        "(n_state,) the state at the end",
+        "how it ended",
+    ):
+        assert not is_type(bad), bad
 
 
 def _check_no_network_assets(site: Path) -> None:

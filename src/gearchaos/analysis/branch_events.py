@@ -63,19 +63,32 @@ class Event:
 
     Attributes
     ----------
-    kind : one of :data:`EVENT_KINDS`.
-    parameter : the continued parameter's name.
-    value : the parameter value where the test function vanishes.
-    point : index of the branch point just before the event.
-    arclength : the branch's arclength at the event.
-    multiplier : the critical multiplier (+1, −1 or the complex one at the unit circle);
+    kind
+        One of :data:`EVENT_KINDS`.
+    parameter
+        The continued parameter's name.
+    value
+        The parameter value where the test function vanishes.
+    point
+        Index of the branch point just before the event.
+    arclength
+        The branch's arclength at the event.
+    multiplier
+        The critical multiplier (+1, −1 or the complex one at the unit circle);
         NaN for grazing.
-    state : the orbit's section state at the event.
-    vector : a real eigenvector of the monodromy matrix for the critical multiplier (the real
+    state
+        The orbit's section state at the event.
+    vector
+        A real eigenvector of the monodromy matrix for the critical multiplier (the real
         part of the complex one for Neimark–Sacker; zeros for grazing).
-    period : the period n of the branch (in forcing periods).
-    detail : contacts and regimes that change (grazing), or remarks.
-    located : whether the location converged to the tolerance.
+    period
+        The period n of the branch (in forcing periods).
+    detail
+        Contacts and regimes that change (grazing), or remarks.
+    located
+        Whether the location converged to the tolerance.
+    values
+        The branch's fixed numeric parameter values by dotted name (its store's ``fixed``).
     """
 
     kind: str

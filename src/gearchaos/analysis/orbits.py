@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -115,23 +115,41 @@ class PeriodicOrbit:
 
     Attributes
     ----------
-    system : the :class:`~gearchaos.model.System` (model and Ω) of the orbit.
-    state : (n_state,) the orbit's state y* at the section time τ_s (``section_tau``).
-    period : n, in forcing periods T = 2π/Ω.
-    multipliers : complex (n_state,) eigenvalues of the monodromy matrix, by modulus, descending.
-    residual : ‖Pⁿ(y*) − y*‖_∞ / max(1, ‖y*‖_∞) at the returned state.
-    converged : whether the residual fell below ``tol``.
-    iterations : map evaluations of the Newton iteration (with and without tangents, trial
+    system
+        The :class:`~gearchaos.model.System` (model and Ω) of the orbit.
+    state
+        (n_state,) the orbit's state y* at the section time τ_s (``section_tau``).
+    period
+        n, in forcing periods T = 2π/Ω.
+    multipliers
+        (n_state,) complex eigenvalues of the monodromy matrix, by modulus, descending.
+    residual
+        ‖Pⁿ(y*) − y*‖_∞ / max(1, ‖y*‖_∞) at the returned state.
+    converged
+        Whether the residual fell below ``tol``.
+    iterations
+        Map evaluations of the Newton iteration (with and without tangents, trial
         steps included).
-    monodromy : (n_state, n_state) M = DPⁿ(y*).
-    sections : (n, n_state) the states at τ_s + kT, k = 0 … n−1.
-    section_obs : (n, n_obs) the observables there.
-    obs_min, obs_max : (n_track,) extrema of the tracked observables over the orbit.
-    settings : the solver settings of the shooting.
-    status : the integration status of the last map evaluation.
-    message : why the iteration stopped.
-    tol : the residual tolerance.
-    values : the parameter values by name it was computed at.
+    monodromy
+        (n_state, n_state) M = DPⁿ(y*).
+    sections
+        (n, n_state) the states at τ_s + kT, k = 0 … n−1.
+    section_obs
+        (n, n_obs) the observables there.
+    obs_min
+        (n_track,) minima of the tracked observables over the orbit.
+    obs_max
+        (n_track,) maxima of the tracked observables over the orbit.
+    settings
+        The solver settings of the shooting.
+    status
+        The integration status of the last map evaluation.
+    message
+        Why the iteration stopped.
+    tol
+        The residual tolerance.
+    values
+        The parameter values by name it was computed at.
     """
 
     system: System
@@ -379,6 +397,7 @@ def periodic_orbit(
     params: Mapping[str, Any] | None = None,
     tol: float | None = None,
     max_iterations: int = 40,
+    settle: float | None = None,
     **values_and_settings: Any,
 ) -> PeriodicOrbit:
     """A period-n orbit by shooting, with its Floquet multipliers.
@@ -399,8 +418,9 @@ def periodic_orbit(
         n, the orbit's period in forcing periods.
     guess
         The Newton start: ``None`` (simulate ``transient_periods`` from rest, then take the
-        section point that best repeats after n periods), a state, a :class:`PeriodicOrbit`,
-        or a simulation result (:func:`gearchaos.simulate`, same section).
+        section point that best repeats after n periods; see ``settle``), a state, a
+        :class:`PeriodicOrbit`, or a simulation result (:func:`gearchaos.simulate`, same
+        section).
     settings, **values_and_settings
         Parameter values by name (``omega=1.2``, ``xi=0.05``; names that are not Python
         identifiers go in ``params={"backlash.sun_planet": 2.4}``) and solver settings
@@ -413,6 +433,14 @@ def periodic_orbit(
         (relative to max(1, ‖y‖_∞)); default rtol/10, at least 1e-12.
     max_iterations
         Map evaluations allowed (with and without tangents, trial steps included).
+    settle
+        With ``guess=None``: the most mesh periods simulated from rest for the guess (default
+        16 × ``transient_periods``). While the shooting ends on no orbit or on an unstable one
+        (a record that had not settled yet: the motion from rest is still leaving an unstable
+        orbit), the guess simulation runs twice as long again, up to ``settle``; the first
+        stable orbit found is returned, else the first converged one. ``settle =
+        transient_periods`` shoots once. The orbit's ``settings.transient_periods`` says which
+        settle gave its guess.
 
     Returns
     -------
@@ -436,8 +464,72 @@ def periodic_orbit(
         warn_if_eccentric(gs, "Poincaré section")
     eps = check_tol(tol, cfg)
     iters = check_int("max_iterations", max_iterations, lo=1, hi=10_000)
+    if guess is None:
+        return settled_orbit(system, n, cfg, eps, iters, values=values, settle=settle)
+    if settle is not None:
+        raise ParameterError(f"settle applies to guess=None only: got settle={settle!r}")
     y = initial_guess(system, guess, n, cfg)
     return solve_orbit(system, y, n, cfg, eps, iters, values=values)
+
+
+#: Default longest settle of the guess simulation, in multiples of ``transient_periods``.
+SETTLE_FACTOR = 16
+
+
+def settled_orbit(
+    system: System,
+    n: int,
+    cfg: SolverSettings,
+    tol: float,
+    max_iterations: int,
+    *,
+    values: Mapping[str, Any] | None = None,
+    settle: float | None = None,
+    want_stable: bool = True,
+) -> PeriodicOrbit:
+    """The period-n orbit from simulations from rest of growing length (see ``settle`` of
+    :func:`periodic_orbit`): transients T0, T0 + m, T0 + 3m, T0 + 7m, … (m = ⌈T0⌉, so the
+    section phase stays that of T0) until the shooting converges (on a stable orbit when
+    ``want_stable``) or the next transient would exceed ``settle``."""
+    first = float(cfg.transient_periods)
+    most = SETTLE_FACTOR * max(first, 1.0) if settle is None else settle
+    most = check_real("settle", most, lo=first)
+    step = max(1, math.ceil(first))
+    tried: list[PeriodicOrbit] = []
+    extra = 0
+    while True:
+        c = cfg.replace(transient_periods=first + extra)
+        orbit = solve_orbit(
+            system, initial_guess(system, None, n, c), n, c, tol, max_iterations, values=values
+        )
+        tried.append(orbit)
+        done = orbit.stable if want_stable else orbit.converged
+        extra = 2 * extra + step
+        if done or first + extra > most:
+            break
+    if len(tried) == 1 or tried[-1].stable or (tried[-1].converged and not want_stable):
+        return _settled_note(tried[-1], tried)
+    converged = [o for o in tried if o.converged]
+    return _settled_note(converged[0] if converged else tried[0], tried)
+
+
+def _settled_note(orbit: PeriodicOrbit, tried: Sequence[PeriodicOrbit]) -> PeriodicOrbit:
+    """``orbit`` with its message saying how long the guess settled (several tries)."""
+    if len(tried) == 1:
+        return orbit
+    lo = tried[0].settings.transient_periods
+    hi = tried[-1].settings.transient_periods
+    used = orbit.settings.transient_periods
+    if orbit.stable:
+        why = f"guess after {used:g} mesh periods from rest (tried {lo:g}–{hi:g})"
+    elif orbit.converged:
+        why = (
+            f"no stable period-{orbit.period} orbit reached from rest in {lo:g}–{hi:g} mesh "
+            f"periods; this unstable one is from the {used:g}-period guess"
+        )
+    else:
+        why = f"{orbit.message} (guesses after {lo:g}–{hi:g} mesh periods from rest)"
+    return replace(orbit, message=(f"converged; {why}" if orbit.converged else why))
 
 
 def solve_orbit(

@@ -53,18 +53,31 @@ class Attractor:
 
     Attributes
     ----------
-    label : motion verdict (``1T`` … ``nT``, ``QP``, ``chaos``, ``unresolved``).
-    period : n for an nT label, else 0.
-    lle : largest Lyapunov exponent λ₁ per unit τ of its first run (the verdict's: exactly
+    label
+        Motion verdict (``1T`` … ``nT``, ``QP``, ``chaos``, ``unresolved``).
+    period
+        n for an nT label, else 0.
+    lle
+        Largest Lyapunov exponent λ₁ per unit τ of its first run (the verdict's: exactly
         ln max|μ|/(nT) for a confirmed orbit).
-    starts : indices of the starts that reached it (0 is the start at rest).
-    initial_states : (len(starts), n_state) those starts.
-    final_state : the state at the end of its first run (on the section).
-    section_states : (periods, n_state) the states at the section points of its first run.
-    sections : (periods, n_obs) the observables there.
-    system : the :class:`~gearchaos.model.System` (model and Ω).
-    orbit : the period-n orbit shot from ``final_state`` (periodic attractors), else None.
-    verdict : the :class:`~gearchaos.dynamics.verdict.Verdict` of its first run (evidence,
+    starts
+        Indices of the starts that reached it (0 is the start at rest).
+    initial_states
+        (len(starts), n_state) those starts.
+    final_state
+        The state at the end of its first run (on the section).
+    section_states
+        (periods, n_state) the states at the section points of its first run.
+    sections
+        (periods, n_obs) the observables there.
+    system
+        The :class:`~gearchaos.model.System` (model and Ω).
+    orbit
+        The period-n orbit shot from ``final_state`` (periodic attractors), else None.
+    values
+        The parameter values by name it was computed at.
+    verdict
+        The :class:`~gearchaos.dynamics.verdict.Verdict` of its first run (evidence,
         λ₁'s error, the reason).
     """
 

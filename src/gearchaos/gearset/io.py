@@ -123,7 +123,7 @@ def from_toml(path: str | os.PathLike[str]) -> GearSet:
 
     Parameters
     ----------
-    path : str or path-like
+    path : str or os.PathLike
         The file (``gearchaos init-gearset`` writes a commented template). It must be a regular
         file (a symbolic link to one is followed) of at most 1 MiB
         (:data:`gearchaos.gearset.records.MAX_FILE_BYTES`).

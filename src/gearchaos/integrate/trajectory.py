@@ -20,16 +20,30 @@ class Trajectory(SampleArrays):
 
     Attributes
     ----------
-    tau : (m,) sample times; every ``samples_per_period``-th one is a Poincaré section time.
-    states : (m, n_state) states at ``tau``.
-    observables : (m, n_obs) observables (``system.obs_names``) at ``tau``.
-    obs_min, obs_max : (n_track,) extrema of the tracked observables over the recorded window.
-    final_state : (n_state,) the state at the end.
-    system : the integrated system.
-    status : how the integration ended.
-    solver : the :class:`~gearchaos.integrate.settings.SolverSettings` of the run.
-    t0, y0 : start time and initial state (``None``: the zero state).
-    tau_reached : where the integration stopped (the end time when it succeeded).
+    tau
+        (m,) sample times; every ``samples_per_period``-th one is a Poincaré section time.
+    states
+        (m, n_state) states at ``tau``.
+    observables
+        (m, n_obs) observables (``system.obs_names``) at ``tau``.
+    obs_min
+        (n_track,) minima of the tracked observables over the recorded window.
+    obs_max
+        (n_track,) maxima of the tracked observables over the recorded window.
+    final_state
+        (n_state,) the state at the end.
+    system
+        The integrated system.
+    status
+        How the integration ended.
+    solver
+        The :class:`~gearchaos.integrate.settings.SolverSettings` of the run.
+    t0
+        Start time.
+    y0
+        Initial state (``None``: the zero state).
+    tau_reached
+        Where the integration stopped (the end time when it succeeded).
     """
 
     system: System
