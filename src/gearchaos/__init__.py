@@ -30,6 +30,7 @@ from .sweep import bifurcation, open_sweep, response
 from .sweep.exports import export
 
 __all__ = [
+    "Event",
     "GearSet",
     "IntegrationError",
     "ParameterError",
@@ -49,18 +50,27 @@ __all__ = [
     "linear_oscillator",
     "linear_system",
     "lorenz",
+    "lyapunov_spectrum",
+    "max_lyapunov",
     "nondimensionalise",
+    "open_branch",
     "open_simulation",
     "open_sweep",
     "periodic_orbit",
+    "periodic_orbits",
     "planetary_system",
     "preset",
     "response",
+    "save_branch",
     "simulate",
 ]
 
 if TYPE_CHECKING:
     from .analysis.arclength import continuation
+    from .analysis.branch import open_branch, save_branch
+    from .analysis.branch_events import Event
+    from .analysis.lyapunov import lyapunov_spectrum, max_lyapunov
+    from .analysis.orbit_batch import periodic_orbits
     from .analysis.orbits import PeriodicOrbit, periodic_orbit
     from .dynamics.coexistence import attractors
     from .explore import explore
@@ -71,6 +81,12 @@ _LAZY_ATTRIBUTES = {
     "PeriodicOrbit": "analysis.orbits",
     "periodic_orbit": "analysis.orbits",
     "continuation": "analysis.arclength",
+    "Event": "analysis.branch_events",
+    "open_branch": "analysis.branch",
+    "save_branch": "analysis.branch",
+    "lyapunov_spectrum": "analysis.lyapunov",
+    "max_lyapunov": "analysis.lyapunov",
+    "periodic_orbits": "analysis.orbit_batch",
     "attractors": "dynamics.coexistence",
 }
 
@@ -78,8 +94,8 @@ _LAZY_ATTRIBUTES = {
 def __getattr__(name: str) -> object:
     """``gearchaos.plot`` etc. import on first use (matplotlib only when plotting; Panel only
     for ``gearchaos.explore``, a callable package: ``gearchaos.explore(store)``), and so do
-    the periodic-orbit front doors (``gc.periodic_orbit``, ``gc.continuation``,
-    ``gc.attractors``)."""
+    the periodic-orbit, branch and Lyapunov front doors (``gc.periodic_orbit``,
+    ``gc.continuation``, ``gc.max_lyapunov``, ``gc.attractors`` …)."""
     import importlib
 
     if name in _LAZY_SUBPACKAGES:

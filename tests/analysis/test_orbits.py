@@ -202,7 +202,7 @@ def test_orbit_api_section_values_contacts_and_summary(sheng: gc.GearSet) -> Non
     summary = orbit.summary()
     assert list(summary) == [
         "period", "minimal_period", "converged", "max_multiplier", "residual", "stable",
-        "multipliers", "x_sp1", "contact",
+        "multipliers", "x_sp1", "contact", "message",
     ]  # fmt: skip
     assert summary["minimal_period"] == 1  # issue 24: the JSON says the orbit's own period
     assert summary["max_multiplier"] == pytest.approx(max(m["abs"] for m in summary["multipliers"]))

@@ -26,6 +26,7 @@ KEYS = {
     "multipliers",
     "x_sp1",
     "contact",
+    "message",
 }
 
 

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -28,6 +29,7 @@ from ..errors import ParameterError, Status
 from ..integrate.settings import MAX_SAMPLES_PER_PERIOD, SolverSettings
 from ..integrate.simulate import integrate
 from ..model.system import System
+from ..model.target import resolve
 
 __all__ = [
     "LYAPUNOV_BLOCKS",
@@ -121,25 +123,29 @@ LYAPUNOV_SETTINGS = SolverSettings(periods=500)
 
 
 def lyapunov_spectrum(
-    system: System,
+    system: Any,
     settings: SolverSettings | None = None,
     *,
     n_exponents: int | None = None,
     renormalizations_per_period: int = 1,
     y0: np.ndarray | None = None,
     seed: int | None = TANGENT_SEED,
-    **solver: Any,
+    params: Mapping[str, Any] | None = None,
+    **values_and_settings: Any,
 ) -> LyapunovResult:
     """The ``n_exponents`` largest Lyapunov exponents (all by default) of ``system``.
 
     Parameters
     ----------
     system
-        Any :class:`~gearchaos.model.System`; its forcing period T = 2π/Ω sets the
+        A :class:`~gearchaos.gearset.GearSet` (with ``omega=``) or any
+        :class:`~gearchaos.model.System`; its forcing period T = 2π/Ω sets the
         renormalisation interval T / ``renormalizations_per_period``.
-    settings, **solver
-        :class:`~gearchaos.integrate.settings.SolverSettings` (default: 100 transient periods,
-        500 periods averaged over) and/or its fields by name: ``transient_periods``,
+    settings, params, **values_and_settings
+        Parameter values by name, as for :func:`~gearchaos.analysis.orbits.periodic_orbit`
+        (``omega=1.7``, ``xi=0.05``; dotted names in ``params={"backlash.sun_planet": 2}``),
+        and :class:`~gearchaos.integrate.settings.SolverSettings` (default: 100 transient
+        periods, 500 periods averaged over) and/or its fields by name: ``transient_periods``,
         ``periods`` (the statistical error of a chaotic estimate decays like 1/√(periods); a
         regular orbit's like log(·)/periods), ``rtol`` and ``atol`` (of the state and of the
         normalised tangent vectors), ``max_steps``, ``perturbation`` (of the start from
@@ -164,8 +170,17 @@ def lyapunov_spectrum(
         When the state does not move over the recorded window (an equilibrium): the exponents
         are then those of the equilibrium, not of an attractor.
     """
-    if not isinstance(system, System):
-        raise ParameterError(f"system must be a System: got {type(system).__name__}")
+    names = set(SolverSettings.field_names())
+    solver = {k: v for k, v in values_and_settings.items() if k in names}
+    values = {k: v for k, v in values_and_settings.items() if k not in names}
+    if params is not None and not isinstance(params, Mapping):
+        raise ParameterError(f"params must be a mapping of names to values: got {params!r}")
+    for key, value in (params or {}).items():
+        if key in values:
+            raise ParameterError(f"parameter {key!r} is given twice (keyword and params)")
+        values[key] = value
+    if not isinstance(system, System) or values:
+        system = resolve(system, values)
     per_period = check_int(
         "renormalizations_per_period", renormalizations_per_period, lo=1, hi=MAX_SAMPLES_PER_PERIOD
     )
@@ -222,6 +237,7 @@ def format_exponent(value: float | None, error: float | None) -> str:
     return f"{value:.4g} ± {error:.2g}"
 
 
-def max_lyapunov(system: System, **kwargs: object) -> float:
-    """Largest Lyapunov exponent (per unit τ) of ``system``; see :func:`lyapunov_spectrum`."""
+def max_lyapunov(system: Any, **kwargs: object) -> float:
+    """Largest Lyapunov exponent (per unit τ) of a gear set at ``omega=`` or of any system;
+    see :func:`lyapunov_spectrum` (``gc.max_lyapunov(gs, omega=1.7)``)."""
     return lyapunov_spectrum(system, n_exponents=1, **kwargs).largest  # type: ignore[arg-type]

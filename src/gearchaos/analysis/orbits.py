@@ -214,7 +214,8 @@ class PeriodicOrbit:
         orbit's own: a period-2 shooting may converge on a 1T orbit), ``converged``,
         ``residual``, ``stable``, ``max_multiplier``, ``multipliers`` ([{re, im, abs}]),
         ``x_sp1`` (the section values of X̄_sp1, or of the first tracked observable of a
-        reference system) and ``contact`` ([{contact, regime}])."""
+        reference system), ``contact`` ([{contact, regime}]) and ``message`` (how it converged
+        or why not; how long the guess settled)."""
         first = self.system.obs_names[0]
         return {
             "period": int(self.period),
@@ -229,7 +230,15 @@ class PeriodicOrbit:
             ],
             "x_sp1": [float(v) for v in self.section(first)],
             "contact": [{"contact": k, "regime": v} for k, v in self.contact.items()],
+            "message": self.message,
         }
+
+    def save(self, path: Any) -> str:
+        """Write the orbit to a netCDF-4 orbit file, the start ``gearchaos continue --from``
+        reads (:func:`~gearchaos.analysis.orbit_file.save_orbit`); returns the path."""
+        from .orbit_file import save_orbit
+
+        return save_orbit(self, path)
 
     # -- xarray --------------------------------------------------------------------
     def attrs(self) -> dict[str, Any]:

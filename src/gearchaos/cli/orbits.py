@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import math
 import time
 from pathlib import Path
 from typing import Annotated, Any
@@ -12,21 +13,87 @@ from rich.markup import escape
 from rich.table import Table
 from rich.text import Text
 
-from ..errors import ParameterError
+from ..errors import IntegrationError, ParameterError
 from . import _common as c
 from ._render import pairs_table
 
 PeriodOpt = Annotated[
-    int, typer.Option("--period", "-n", help="Period n of the orbit, in mesh periods.")
+    int | None,
+    typer.Option(
+        "--period",
+        "-n",
+        help="Period n of the orbit, in mesh periods (default: the period --from knows, else 1).",
+        show_default=False,
+    ),
 ]
 
 GuessOpt = Annotated[
     float,
     typer.Option(
         "--transient",
-        help="Mesh periods simulated from rest for the first guess of the (starting) orbit.",
+        help="Mesh periods simulated from rest for the first guess of the (starting) orbit; "
+        "while the shooting then finds no orbit (or, for orbit, an unstable one), the guess "
+        "settles longer, up to 16 times as long.",
     ),
 ]
+
+FromOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--from",
+        help="Start from a file instead of from rest: a sweep store (the state a point ended "
+        "in; pick it with --at), a branch file (its point at --at NAME=VALUE) or an orbit file "
+        "(gearchaos orbit -o ORBIT.nc). The gear set and the point's values come with it.",
+        show_default=False,
+    ),
+]
+
+AtOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--at",
+        help="The point of --from: NAME=VALUE[,NAME=VALUE…], e.g. --at omega=1.5 (a store "
+        "point's swept values; a branch's parameter).",
+        show_default=False,
+    ),
+]
+
+
+def _period(period: int | None, start: Any) -> int:
+    """--period, else the period the start knows, else 1."""
+    if period is not None:
+        return period
+    return (start.period if start is not None else None) or 1
+
+
+def _start_values(
+    from_: str | None,
+    at: str | None,
+    preset: str | None,
+    gearset: Path | None,
+    sets: list[str],
+) -> tuple[Any, dict[str, Any], Any]:
+    """(gear set, parameter values, start or None) of ``orbit`` and ``continue``: from
+    ``--from``/``--at`` when given (its gear set and values, ``--set`` on top), else the gear
+    set of ``--preset``/``--gearset`` changed by ``--set`` and Ω alone as a value."""
+    from ._start import OMEGA, load_start
+
+    omega, changes = c.parse_sets(sets)
+    if from_ is None:
+        if at is not None:
+            raise ParameterError(f"--at picks a point of --from, which is missing: got --at {at}")
+        values: dict[str, Any] = {} if omega is None else {OMEGA: omega}
+        return c.load_gearset(preset, gearset, changes), values, None
+    if preset is not None or gearset is not None:
+        raise ParameterError(
+            "--from brings the gear set it was computed for: drop --preset/--gearset (change "
+            "values with --set)"
+        )
+    start = load_start(from_, at)
+    values = {**start.values, **changes}
+    if omega is not None:
+        values[OMEGA] = omega
+    return start.gearset, values, start
 
 
 def _spinner(text: str, quiet: bool) -> contextlib.AbstractContextManager[Any]:
@@ -39,8 +106,20 @@ def orbit(
     preset: c.PresetOpt = None,
     gearset: c.GearsetOpt = None,
     set_: c.SetOpt = None,
-    period: PeriodOpt = 1,
+    period: PeriodOpt = None,
     transient: GuessOpt = 50.0,
+    from_: FromOpt = None,
+    at: AtOpt = None,
+    output: Annotated[
+        str | None,
+        typer.Option(
+            "--output",
+            "-o",
+            help="Also write the orbit to ORBIT.nc (state, multipliers, monodromy, gear set, "
+            "values, settings): a start for gearchaos continue --from ORBIT.nc.",
+            show_default=False,
+        ),
+    ] = None,
     rtol: c.RtolOpt = 1e-8,
     atol: c.AtolOpt = 1e-10,
     json_out: c.JsonOpt = False,
@@ -51,29 +130,46 @@ def orbit(
 
     The multipliers μ are the eigenvalues of the monodromy matrix; the orbit is stable when
     every |μ| < 1. **--json** prints exactly {period, minimal_period, converged, residual,
-    stable, max_multiplier, multipliers: [{re, im, abs}], x_sp1: [...], contact: [...]}; a
-    period-2 shooting that converges on a 1T orbit says minimal_period 1.
+    stable, max_multiplier, multipliers: [{re, im, abs}], x_sp1: [...], contact: [...],
+    message}; a period-2 shooting that converges on a 1T orbit says minimal_period 1.
+
+    The guess is a simulation from rest of --transient mesh periods, settled longer (up to
+    16 times) while the shooting lands on no orbit or an unstable one; or the state of a
+    sweep point, branch point or orbit file (**--from FILE --at NAME=VALUE**).
 
     Example: **gearchaos orbit --set omega=1.5 --period 1**
     """
     from ..analysis.orbits import periodic_orbit
 
     with c.reported_errors():
-        omega, changes = c.parse_sets(set_ or [])
-        gs = c.load_gearset(preset, gearset, changes)
-        omega = c.DEFAULT_OMEGA if omega is None else omega
+        gs, values, start = _start_values(from_, at, preset, gearset, set_ or [])
+        values.setdefault("omega", c.DEFAULT_OMEGA)
+        omega = values["omega"]
         settings = c.solver_settings(transient, 1, rtol, atol)
+        period = _period(period, start)
         if period < 1 or period > 64:
             raise ParameterError(f"--period must be an integer in [1, 64]: got {period}")
+        path = c.output_path(output)
+        if path is not None and path.suffix.lower() != ".nc":
+            raise ParameterError(f"--output must end in .nc (an orbit file): got {output!r}")
+        guess = None
+        if start is not None:
+            settings = settings.replace(**start.section)
+            guess = start.state
         with _spinner(f"shooting the period-{period} orbit at Ω = {omega:g}…", json_out):
             with c.warnings_to_stderr():
-                orb = periodic_orbit(gs, period=period, omega=omega, settings=settings)
+                orb = periodic_orbit(
+                    gs, period=period, guess=guess, settings=settings, params=values
+                )
         summary = orb.summary()
+        if path is not None:
+            orb.save(path)
     if json_out:
         c.print_json(summary)  # exactly the keys of PeriodicOrbit.summary()
         return
     out = c.stdout()
-    table = pairs_table(f"period-{period} orbit of {gs.name} at Ω = {omega:g}")
+    title = f"period-{period} orbit of {gs.name} at Ω = {omega:g}"
+    table = pairs_table(title + ("" if start is None else f", from {start.source}"))
     table.add_row(
         "converged",
         Text("yes" if orb.converged else "no", style="" if orb.converged else "bold red"),
@@ -95,6 +191,10 @@ def orbit(
     out.print(mult)
     if not orb.converged:
         out.print(Text(f"not converged: {orb.message}", style="bold red"))
+    elif orb.message != "converged":
+        out.print(Text(orb.message, style="dim"))
+    if path is not None:
+        c.wrote(path)
 
 
 @c.app.command("continue")
@@ -121,8 +221,10 @@ def continue_(
     preset: c.PresetOpt = None,
     gearset: c.GearsetOpt = None,
     set_: c.SetOpt = None,
-    period: PeriodOpt = 1,
+    period: PeriodOpt = None,
     transient: GuessOpt = 50.0,
+    from_: FromOpt = None,
+    at: AtOpt = None,
     rtol: c.RtolOpt = 1e-8,
     atol: c.AtolOpt = 1e-10,
     max_points: Annotated[
@@ -155,20 +257,41 @@ def continue_(
         assert path is not None
         if path.suffix.lower() not in (".nc", ".zarr"):
             raise ParameterError(f"--output must end in .nc or .zarr: got {output!r}")
-        omega, changes = c.parse_sets(set_ or [])
-        gs = c.load_gearset(preset, gearset)
         name = vary.partition("=")[0].strip()
-        values: dict[str, Any] = dict(changes)
-        if name in values:
+        set_names = {item.partition("=")[0].strip() for item in set_ or []}
+        if name in set_names:
             raise ParameterError(f"{name} is both continued and set with --set; choose one")
-        if name != "omega":
-            if omega is None:
-                omega = c.DEFAULT_OMEGA
-                c.default_omega_note(quiet or json_out, "continued")
-            values["omega"] = omega
-        elif omega is not None:
-            raise ParameterError("omega is both continued and set with --set; choose one")
+        if from_ is None:
+            omega, changes = c.parse_sets(set_ or [])
+            gs = c.load_gearset(preset, gearset)
+            values: dict[str, Any] = dict(changes)
+            start = None
+            if name != "omega":
+                if omega is None:
+                    omega = c.DEFAULT_OMEGA
+                    c.default_omega_note(quiet or json_out, "continued")
+                values["omega"] = omega
+        else:
+            gs, values, start = _start_values(from_, at, preset, gearset, set_ or [])
         settings = c.solver_settings(transient, 1, rtol, atol)
+        period = _period(period, start)
+        first = None
+        if start is not None:  # the orbit at the file's point: the branch starts there
+            from ..analysis.orbits import periodic_orbit
+
+            if name not in values:
+                values[name] = gs[name]
+            settings = settings.replace(**start.section)
+            with c.warnings_to_stderr():
+                first = periodic_orbit(
+                    gs, period=period, guess=start.state, settings=settings, params=values
+                )
+            if not first.converged:
+                raise IntegrationError(
+                    f"no period-{period} orbit near the start, {start.source} ({first.message}, "
+                    f"residual {first.residual:.3g}): pick a point whose motion is periodic"
+                )
+            values.pop(name)
         t0 = time.perf_counter()
         with _spinner(f"continuing the period-{period} branch in {name}…", quiet or json_out):
             with c.warnings_to_stderr():
@@ -176,6 +299,7 @@ def continue_(
                     gs,
                     vary,
                     period=period,
+                    start=first,
                     settings=settings,
                     params=values,
                     max_points=max_points,
@@ -202,19 +326,37 @@ def continue_(
         )
     out.print(table)
     events = Table(title="events along the branch", title_justify="left")
-    for col in ("kind", name, "multiplier", "detail"):
+    for col in ("kind", f"{name} ± uncertainty", "multiplier", "detail"):
         events.add_column(escape(col))
     for e in summary["events"]:
         mu = e.get("multiplier")
         mu_text = "—" if mu is None else f"{mu['re']:.4g}{mu['im']:+.4g}i (|μ| {mu['abs']:.4g})"
         events.add_row(
             escape(e["kind"]),
-            f"{e['value']:.6g}",
+            _with_uncertainty(e["value"], e.get("uncertainty")),
             escape(mu_text),
             escape(str(e.get("detail", ""))),
         )
     out.print(events)
+    if summary["events"]:
+        out.print(
+            Text(
+                "± is half the final bracket of the location plus the integrator's error of "
+                "the event's test function (checked at rtol/100); a smaller --rtol locates "
+                "the events more precisely",
+                style="dim",
+            )
+        )
     c.wrote(Path(path))
+
+
+def _with_uncertainty(value: float, u: float | None) -> str:
+    """``value ± u``: the value to the decimal of the uncertainty's first significant digit
+    (six significant digits without an uncertainty)."""
+    if u is None or not math.isfinite(u) or u <= 0:
+        return f"{value:.6g}"
+    digits = max(0, -math.floor(math.log10(u)))
+    return f"{value:.{digits}f} ± {u:.1g}" if digits <= 15 else f"{value:.15g} ± {u:.1g}"
 
 
 @c.app.command()

@@ -29,7 +29,7 @@ from typing import Final
 
 from .._files import read_text_file
 from ..errors import ParameterError
-from .mapping import apply_changes, check_changes, records_from_data, to_dict
+from .mapping import apply_changes, check_changes, get_value, records_from_data, to_dict
 from .schema import UNITS
 from .tables import (
     RECORD_CLASSES,
@@ -261,6 +261,13 @@ class GearSet:
         return any(v != 0.0 for v in (e.sun, e.planet, e.ring))
 
     # ------------------------------------------------------------------ copies and I/O
+    def __getitem__(self, name: str) -> object:
+        """One parameter by the dotted name :meth:`evolve` and ``--set`` take:
+        ``gs["backlash.sun_planet"]``, ``gs["xi"]`` (while the three damping ratios are
+        equal), ``gs["name"]``. Unknown names raise :class:`~gearchaos.errors.ParameterError`
+        with the closest valid name."""
+        return get_value(self, name)
+
     def evolve(self, changes: Mapping[str, object] = _NO_CHANGES, /, **kwargs: object) -> GearSet:
         """A validated copy with some parameters changed.
 
