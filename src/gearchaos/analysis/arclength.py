@@ -47,13 +47,13 @@ from ..integrate.settings import SolverSettings
 from ..model.system import System
 from ..model.target import OMEGA, resolve
 from . import branch_events as ev
+from .branch_locate import detect
 from .orbits import (
     ORBIT_SETTINGS,
     PeriodicOrbit,
     check_tol,
     contact_levels,
     initial_guess,
-    orbit_contacts,
     solve_orbit,
     split_values,
 )
@@ -313,93 +313,9 @@ class _Branch:
 
     # -- events -------------------------------------------------------------------------
     def detect(self, p: Solution, q: Solution, index: int) -> None:
-        """Find, locate and record the events between consecutive points p and q."""
-        assert p.tangent is not None and q.tangent is not None
-        span = q.s - p.s  # q's coordinate along p's tangent
-        found = []
-        ta = self.contact_tests(p)
-        tb = self.contact_tests(q)
-        grazing = ev.contact_changes(ta, tb)
-        for group in grazing:
-            key = group[0]
-
-            def fn(pt: Solution | None, key: tuple[str, str] = key) -> float | None:
-                if pt is None:
-                    return None
-                return self.contact_tests(pt)[key]
-
-            names = ",".join(k[0] for k in group)
-            detail = f"{names}: {self._regime(p, key)} → {self._regime(q, key)}"
-            found.append(self._locate("grazing", fn, p, span, ta[key], tb[key], detail))
-        changes = ev.multiplier_changes(p.mu, q.mu, float(p.tangent[-1]), float(q.tangent[-1]))
-        if self.switched and index == 0:
-            # a branch switched at a bifurcation starts where a multiplier is +1 (μ² of the
-            # period-n orbit's −1, or the branch point's +1): that is where it came from
-            changes = [c for c in changes if c[1] != "fold"]
-        for kind, test in changes:
-
-            def mfn(pt: Solution | None, test: str = test) -> float | None:
-                if pt is None:
-                    return None
-                return ev.multiplier_tests(pt.mu)[test]
-
-            fa = ev.multiplier_tests(p.mu)[test]
-            fb = ev.multiplier_tests(q.mu)[test]
-            note = "in the same step as a grazing" if grazing else ""
-            found.append(self._locate(kind, mfn, p, span, fa, fb, note))
-        for e in found:
-            self.found.append(ev.Event(**{**e, "point": index}))
-
-    def contact_tests(self, p: Solution) -> dict[tuple[str, str], float]:
-        """Grazing test functions at p, against the clearances at p's parameter value (the
-        continued parameter may be a clearance)."""
-        levels = contact_levels(self.system(p.lam))
-        return ev.contact_tests(levels, p.shot.obs_min[0], p.shot.obs_max[0])
-
-    def _regime(self, p: Solution, key: tuple[str, str]) -> str:
-        regimes = orbit_contacts(self.system(p.lam), p.shot.obs_min[0], p.shot.obs_max[0])
-        return regimes[key[0]]
-
-    def _locate(
-        self, kind: str, fn: Any, p: Solution, span: float, fa: float, fb: float, detail: str
-    ) -> dict[str, Any]:
-        cache: dict[float, Solution | None] = {}
-
-        def g(sigma: float) -> float | None:
-            pt = self.at_arclength(p, sigma)
-            cache[sigma] = pt
-            return fn(pt)
-
-        sigma, ok = ev.illinois(g, 0.0, span, fa, fb, self.steps.event_tol)
-        pt = self.at_arclength(p, sigma)
-        if pt is None:  # fall back to the nearest corrected trial point
-            good = {s: v for s, v in cache.items() if v is not None}
-            if not good:
-                pt, sigma, ok = p, 0.0, False
-            else:
-                sigma = min(good, key=lambda s: abs(s - sigma))
-                pt = good[sigma]
-                ok = False
-        assert pt is not None
-        mu_c = ev.critical_multiplier(kind, pt.mu)
-        vec = ev.eigenvector(pt.monodromy, mu_c) if kind != "grazing" else np.zeros(pt.y.size)
-        return {
-            "kind": kind,
-            "parameter": self.name,
-            "value": pt.lam,
-            "arclength": p.s + sigma,
-            "multiplier": mu_c,
-            "state": pt.y.copy(),
-            "vector": vec,
-            "period": self.n,
-            "detail": detail,
-            "located": ok,
-            "values": {k: float(v) for k, v in self.fixed.items() if _is_number(v)},
-        }
-
-
-def _is_number(v: Any) -> bool:
-    return isinstance(v, int | float) and not isinstance(v, bool)
+        """Find, locate and record the events between consecutive points p and q
+        (:func:`gearchaos.analysis.branch_locate.detect`)."""
+        self.found.extend(detect(self, p, q, index))
 
 
 # ------------------------------------------------------------------------------ front door
@@ -457,7 +373,11 @@ def continuation(
     tol
         Residual tolerance of every point (default 100·rtol, at least 1e-10).
     event_tol
-        Arclength tolerance of the event location (default range·1e-6).
+        Arclength tolerance of the event location (default range·``tol``: a state change of
+        relative size ``tol``, what the corrector resolves, counts as that much arclength).
+        Every event reports its location uncertainty in the parameter (the final bracket
+        and the integrator's error of its test function, see
+        :mod:`gearchaos.analysis.branch_locate`).
     grid
         Parameter values to land on: every time the branch passes one, a branch point is
         computed exactly there (flagged ``on_grid``), e.g. a sweep's grid, to compare
@@ -494,7 +414,7 @@ def continuation(
         maximum=_pos("max_step", max_step, span / 100.0),
         max_points=check_int("max_points", max_points, lo=2, hi=1_000_000),
         max_corrector=check_int("max_corrector", max_corrector, lo=2, hi=1000),
-        event_tol=_pos("event_tol", event_tol, span * 1e-6),
+        event_tol=_pos("event_tol", event_tol, math.nan),
     )
     if steps.minimum > steps.maximum or (
         step is not None and not steps.minimum <= steps.initial <= steps.maximum
@@ -506,6 +426,8 @@ def continuation(
     if step is None:  # the default first step inside the bounds given
         steps = replace(steps, initial=min(max(steps.initial, steps.minimum), steps.maximum))
     eps = check_tol(tol, cfg)
+    if event_tol is None:  # what the corrector resolves, above the arclength's round-off
+        steps = replace(steps, event_tol=span * max(eps, 1e-14))
 
     n, lam0, guess, switch = _start(start, period, name, a)
     if not lo <= lam0 <= hi:

@@ -24,7 +24,8 @@ events
     ``event_kind``, ``event_value`` (parameter value), ``event_point`` (index of the point
     before it), ``event_arclength``, ``event_multiplier_re``, ``event_multiplier_im``,
     ``event_state`` (event, state), ``event_vector`` (event, state), ``event_detail``,
-    ``event_located`` (int8).
+    ``event_located`` (int8), ``event_uncertainty`` (the location uncertainty in the
+    parameter, :mod:`gearchaos.analysis.branch_locate`).
 attributes
     ``parameter``, ``period``, ``range_start``, ``range_stop``, ``vary``, ``fixed`` (JSON of the
     fixed values), ``stop_reason``, ``start`` (how the branch started), ``tol``, the step
@@ -36,6 +37,7 @@ attributes
 from __future__ import annotations
 
 import json
+import math
 import os
 from collections.abc import Mapping
 from typing import Any
@@ -227,6 +229,11 @@ def _put_events(ds: Any, events: list[Any], m: int) -> None:
     width = max([len(e.detail) for e in events] + [1])
     ds["event_detail"] = ("event", np.array([e.detail for e in events], dtype=f"U{width}"))
     ds["event_located"] = ("event", np.array([e.located for e in events], dtype=np.int8))
+    ds["event_uncertainty"] = ("event", np.array([e.uncertainty for e in events], dtype=float))
+    ds["event_uncertainty"].attrs["long_name"] = (
+        "location uncertainty of event_value: the final bracket's half-width plus the shift "
+        "the integrator's error of the test function causes (its rtol/100 check)"
+    )
 
 
 def fixed_json(values: Mapping[str, Any]) -> str:
@@ -239,8 +246,9 @@ def branch_summary(ds: Any) -> dict[str, Any]:
     """A JSON-serialisable summary of a branch: ``parameter``, ``period``, ``range``,
     ``points``, ``stop_reason``, ``segments`` (maximal runs of consecutive points of equal
     stability: ``from``/``to`` parameter values, ``stable``, ``points``) and ``events``
-    (``kind``, ``value``, ``point``, ``multiplier`` {re, im, abs} or None for grazing,
-    ``detail``, ``located``), in arclength order."""
+    (``kind``, ``value``, ``uncertainty`` (of ``value``; None for files without it),
+    ``point``, ``multiplier`` {re, im, abs} or None for grazing, ``detail``, ``located``),
+    in arclength order."""
     name = str(ds.attrs["parameter"])
     lam = np.asarray(ds[name].values, dtype=float)
     stable = np.asarray(ds["stable"].values, dtype=bool)
@@ -261,10 +269,12 @@ def branch_summary(ds: Any) -> dict[str, Any]:
     for k in range(ds.sizes.get("event", 0)):
         re, im = float(ds.event_multiplier_re[k]), float(ds.event_multiplier_im[k])
         kind = str(ds.event_kind.values[k])
+        unc = float(ds.event_uncertainty[k]) if "event_uncertainty" in ds else math.nan
         events.append(
             {
                 "kind": kind,
                 "value": float(ds.event_value[k]),
+                "uncertainty": unc if math.isfinite(unc) else None,
                 "point": int(ds.event_point[k]),
                 "multiplier": None
                 if kind == "grazing"

@@ -24,7 +24,8 @@ kind                   test function                               meaning
 
 Each sign change is located by the Illinois (modified regula falsi) iteration on the arclength
 between the two points, every trial point corrected onto the branch
-(:func:`gearchaos.analysis.continuation` does that), to a tolerance in arclength.
+(:mod:`gearchaos.analysis.branch_locate` does that), to a tolerance in arclength; every event
+carries its location uncertainty in the parameter.
 Grazing makes the stroboscopic map only C¹, so the multipliers may change steeply (not
 smoothly) across a grazing event; a multiplier test that changes sign in the same step as a
 grazing is still reported, with ``detail`` saying so.
@@ -87,6 +88,11 @@ class Event:
         Contacts and regimes that change (grazing), or remarks.
     located
         Whether the location converged to the tolerance.
+    uncertainty
+        The location uncertainty in the parameter: the final bracket's half-width and the
+        shift the integrator's error of the test function causes
+        (:mod:`gearchaos.analysis.branch_locate`); NaN for branch files written before it was
+        stored.
     values
         The branch's fixed numeric parameter values by dotted name (its store's ``fixed``).
     """
@@ -102,13 +108,15 @@ class Event:
     period: int
     detail: str = ""
     located: bool = True
+    uncertainty: float = math.nan
     values: dict[str, float] = field(default_factory=dict)
 
     def __repr__(self) -> str:
         mu = "" if self.kind == "grazing" else f", μ={self.multiplier:.4g}"
         extra = f", {self.detail}" if self.detail else ""
+        pm = f" ± {self.uncertainty:.1g}" if math.isfinite(self.uncertainty) else ""
         return (
-            f"Event({self.kind} at {self.parameter}={self.value:.8g}, "
+            f"Event({self.kind} at {self.parameter}={self.value:.10g}{pm}, "
             f"period {self.period}{mu}{extra})"
         )
 
@@ -237,14 +245,15 @@ def illinois(
     f_hi: float,
     tol: float,
     max_evaluations: int = 40,
-) -> tuple[float, bool]:
+) -> tuple[float, bool, tuple[float, float]]:
     """A root of ``fn`` in [lo, hi] (f_lo·f_hi < 0) by the Illinois iteration, stopping when
     the bracket is shorter than ``tol``; ``fn`` returning None (a failed evaluation) falls
-    back to bisection. Returns (root, converged)."""
+    back to bisection. Returns (root, converged, final bracket): the root is the bracket's
+    midpoint, or a trial point where ``fn`` is exactly 0."""
     side = 0
     for _ in range(max_evaluations):
         if hi - lo <= tol:
-            return 0.5 * (lo + hi), True
+            return 0.5 * (lo + hi), True, (lo, hi)
         if f_hi != f_lo and math.isfinite(f_hi - f_lo):
             x = (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
         else:
@@ -255,10 +264,10 @@ def illinois(
         if fx is None or not math.isfinite(fx):
             fx2 = fn(0.5 * (lo + hi))
             if fx2 is None or not math.isfinite(fx2):
-                return 0.5 * (lo + hi), False
+                return 0.5 * (lo + hi), False, (lo, hi)
             x, fx = 0.5 * (lo + hi), fx2
         if fx == 0.0:
-            return x, True
+            return x, True, (x, x)
         if (fx > 0) == (f_hi > 0):
             hi, f_hi = x, fx
             if side == -1:
@@ -269,7 +278,7 @@ def illinois(
             if side == 1:
                 f_hi *= 0.5
             side = 1
-    return 0.5 * (lo + hi), hi - lo <= tol
+    return 0.5 * (lo + hi), hi - lo <= tol, (lo, hi)
 
 
 # ------------------------------------------------------------------------------ reading
@@ -301,6 +310,11 @@ def events(ds: Any) -> list[Event]:
                 period=int(ds.attrs.get("period", 1)),
                 detail=str(row["event_detail"].values),
                 located=bool(int(row["event_located"].values)),
+                uncertainty=(
+                    float(row["event_uncertainty"].values)
+                    if "event_uncertainty" in ds
+                    else math.nan
+                ),
                 values=_fixed_values(ds),
             )
         )
