@@ -32,7 +32,8 @@ VERSION_ATTRS = frozenset({"version", "numba_version", "numpy_version", "scipy_v
 
 #: The reference was last regenerated for issue 13 (Newton's method for the predicted switch
 #: time, which moves step ends by less than 1e-9 of a step); it holds the contact forces and
-#: the load factor as issue 12 defined them.
+#: the load factor as issue 12 defined them; issue 24's redefinition of the contact force (its
+#: compressive part) is applied to it by _contact_forces_issue_24.
 
 
 def _same_attrs(a: dict[str, object], b: dict[str, object], where: str) -> None:
@@ -58,6 +59,36 @@ def _model_repr_issue_12(attrs: dict[str, object]) -> dict[str, object]:
     text = out.get("model_parameters")
     if isinstance(text, str) and text.startswith("BacklashOscillator(") and ", kind=" in text:
         out["model_parameters"] = text.split(", kind=")[0] + ")"
+    return out
+
+
+def _contact_forces_issue_24(ref: xr.Dataset, widths: dict[str, float]) -> xr.Dataset:
+    """Issue 24 redefined the reported contact force as the compressive part of the mesh
+    force (the damping's pull just before release is no contact force): apply that to the
+    reference — samples F̄ where F̄ δ̄ > 0, else 0; extrema of a window that touched one flank
+    clipped at 0 on that flank's side — and its new descriptions. ``widths``: b̄ per mesh."""
+    out = ref.copy(deep=True)
+    for m, b in widths.items():
+        for tail in ("", "_history"):
+            f = ref[f"contact_force_{m}{tail}"]
+            d = ref[f"delta_{m}{tail}"].values
+            out[f"contact_force_{m}{tail}"].values[...] = np.where(f.values * d > 0, f.values, 0)
+            out[f"contact_force_{m}{tail}"].attrs["long_name"] = f.attrs["long_name"].replace(
+                "in contact, 0 while apart",
+                "where it presses the flanks in contact together, 0 while apart or pulling",
+            )
+        drive = ref[f"delta_{m}_max"].values > b
+        back = ref[f"delta_{m}_min"].values < -b
+        assert np.all(drive & ~back)  # one flank: the clipped extrema are exact
+        for which in ("min", "max"):
+            out[f"contact_force_{m}_{which}"].values[...] = np.maximum(
+                ref[f"contact_force_{m}_{which}"].values, 0.0
+            )
+        out[f"load_factor_{m}"].attrs["note"] = (
+            ref[f"load_factor_{m}"]
+            .attrs["note"]
+            .replace("apart)", "apart or the damping would pull)")
+        )
     return out
 
 
@@ -97,6 +128,9 @@ def test_simulate_result_is_bitwise_equal_to_reference(tmp_path: Path) -> None:
     res.save(tmp_path / "simulate.nc")
     new = xr.load_dataset(tmp_path / "simulate.nc", engine="h5netcdf")
     ref = xr.load_dataset(REF / "simulate.nc", engine="h5netcdf")
+    bl = gearset().backlash
+    assert bl.units == "dimensionless"
+    ref = _contact_forces_issue_24(ref, {"sp": bl.sun_planet, "rp": bl.planet_ring})
     _same_attrs(new.attrs, ref.attrs, "simulate.nc")
     assert sorted(new.variables) == sorted(ref.variables)
     for name in ref.variables:

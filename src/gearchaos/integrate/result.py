@@ -5,7 +5,9 @@ dimension ``section`` (coordinate ``tau``) and ``planet`` (1..N); variables ``de
 ``delta_rp``, ``delta_sp_dot``, ``delta_rp_dot`` (section, planet), ``x_s``, ``y_s``,
 ``x_s_dot``, ``y_s_dot`` (section), ``delta_sp_min``, ``delta_sp_max``, ``delta_rp_min``,
 ``delta_rp_max`` (planet), ``contact_force_sp``, ``contact_force_rp`` (section, planet: the
-mesh contact forces, 0 while the teeth are apart) with their ``_min``/``_max`` (planet) and
+mesh contact forces, 0 while the teeth are apart and where the mesh force would pull,
+:func:`gearchaos.model.response.compressive_contact_forces`) with their ``_min``/``_max``
+(planet) and
 ``load_factor_sp``, ``load_factor_rp`` (planet: max |F̄ᶜ| over T̄_D/N); attributes
 ``gearset_toml``, ``omega``, ``rtol``, ``atol``, ``transient_periods``, ``periods``,
 ``status``, ``version``. With ``samples_per_period > 1``
@@ -175,7 +177,8 @@ class SimulationResult(Trajectory):
             put(
                 f"contact_force_{mesh}",
                 ("section", "planet"),
-                f"F̄ᶜ_{mesh}, {what} contact force: κ f(X̄; b̄) + c̄ X̄' in contact, 0 while apart",
+                f"F̄ᶜ_{mesh}, {what} contact force: κ f(X̄; b̄) + c̄ X̄' where it presses the "
+                "flanks in contact together, 0 while apart or pulling",
                 _DIMLESS,
             )
         put("x_s", ("section",), "x̄_s, sun centre displacement", _DIMLESS, **lu)
@@ -228,7 +231,8 @@ class SimulationResult(Trajectory):
                     attrs={
                         "long_name": f"dynamic load factor max |F_{mesh}ᶜ|/(T_D/(N r_bs))",
                         "units": _DIMLESS,
-                        "note": "contact force (0 while the teeth are apart), extrema tracked "
+                        "note": "contact force (0 while the teeth are apart or the damping would "
+                        "pull), extrema tracked "
                         "inside every integration step: independent of the sampling",
                     },
                 )

@@ -16,6 +16,7 @@ import numpy as np
 
 from .._checks import check_bool, check_int, check_real
 from ..errors import IntegrationError, ParameterError
+from ..model.response import compressive_contact_forces
 from ..model.system import System
 from ..model.target import resolve
 from ._chains import ChainRun, run_chains
@@ -95,13 +96,17 @@ def integrate(
         tangent_start=None if k == 0 else tangent_start,
     )
     out = run_chains(run)
+    # contact forces as the flanks carry them: no tension (model.response)
+    observables, obs_min, obs_max = compressive_contact_forces(
+        system, out.observables[0, 0], out.obs_min[0, 0], out.obs_max[0, 0]
+    )
     return Trajectory(
         system=system,
         tau=out.tau[0, 0],
         states=out.states[0, 0, :, :n],
-        observables=out.observables[0, 0],
-        obs_min=out.obs_min[0, 0],
-        obs_max=out.obs_max[0, 0],
+        observables=observables,
+        obs_min=obs_min,
+        obs_max=obs_max,
         final_state=out.final_state[0, 0, :n],
         status=out.statuses()[0],
         steps_accepted=int(out.info[0, 0, 0]),

@@ -3,9 +3,16 @@
 For every mesh type of a model (``sp`` and ``rp`` of the planetary model, one per planet;
 ``mesh`` of the backlash oscillator) this module turns the kernel's outputs into
 
-* the **contact force** F̄ᶜ = κ(τ) f(δ̄; b̄) + c̄ δ̄' while the teeth touch (|δ̄| > b̄) and
-  exactly 0 while they are apart (MODEL.md §4 applies the damping c̄ δ̄' inside the clearance
-  too, so the vector field is continuous, but no force is transmitted through a gap);
+* the **contact force** F̄ᶜ: the mesh force F̄ = κ(τ) f(δ̄; b̄) + c̄ δ̄' of MODEL.md §4 while the
+  teeth touch (|δ̄| > b̄) and it presses them together (F̄ δ̄ > 0: F̄ > 0 on the drive flank,
+  F̄ < 0 on the back flank), else exactly 0 (:func:`compressive_contact_forces`). Two parts
+  of the model's mesh force are not a contact force: the damping c̄ δ̄' that MODEL.md §4
+  applies inside the clearance too (it keeps the vector field continuous, but no force passes
+  through a gap), and the *tension* of the viscous term just before the teeth release, where
+  c̄ δ̄' < 0 outweighs κ f(δ̄; b̄) → 0 (a Kelvin–Voigt contact pulls; real flanks cannot — on
+  ``sheng2016`` at Ω = 1.5 the sun–planet mesh force reaches −0.018 against a peak of 0.25).
+  The equations of motion keep that force as MODEL.md writes it; only what is *reported* as a
+  contact force leaves it out;
 * its **peak** max_τ |F̄ᶜ(τ)| over the recorded window, from the running extrema that the
   integrator tracks inside every step (so it does not depend on the sampling rate);
 * its **RMS** √(⟨F̄ᶜ²⟩), the mean over the recorded samples (uniform over whole forcing
@@ -28,7 +35,13 @@ import numpy as np
 
 from .system import Observable, System
 
-__all__ = ["MeshGroup", "mesh_groups", "response_quantities", "static_mesh_force"]
+__all__ = [
+    "MeshGroup",
+    "compressive_contact_forces",
+    "mesh_groups",
+    "response_quantities",
+    "static_mesh_force",
+]
 
 #: Names of the response quantities per mesh type ``m`` (``sp``, ``rp`` or ``mesh``).
 QUANTITIES = {
@@ -59,7 +72,70 @@ def mesh_groups(system: System) -> list[MeshGroup]:
             MeshGroup(m, system.observable(f"contact_force_{m}"), system.observable(f"delta_{m}"))
             for m in ("sp", "rp")
         ]
-    return [MeshGroup("mesh", system.observable("contact_force"), system.observable("x"))]
+    # the deflection as the tracked observable x (also a state: the same values)
+    x = Observable("x", "obs", np.array([system.obs_names.index("x")]), False)
+    return [MeshGroup("mesh", system.observable("contact_force"), x)]
+
+
+def compressive_contact_forces(
+    system: System,
+    observables: np.ndarray,
+    obs_min: np.ndarray,
+    obs_max: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The kernel's outputs with every contact force reduced to what the flanks carry.
+
+    The kernel tracks, as ``contact_force_*``, the mesh force F̄ = κ f(δ̄; b̄) + c̄ δ̄' while
+    |δ̄| > b̄ and 0 in the gap. Teeth can only push, so the contact force is
+
+        F̄ᶜ = F̄ where F̄ δ̄ > 0 (compression on the flank in contact), else 0,
+
+    and this function applies that to the samples and to the tracked extrema (copies; the
+    other columns unchanged; applying it twice changes nothing). The equations of motion are
+    not affected: they use MODEL.md §4's mesh force, tension included.
+
+    The extrema are exact when the window touched one flank only (the usual case: then every
+    negative value on the drive flank is tension, so F̄ᶜ_min = max(F̄_min, 0) and
+    F̄ᶜ_max = max(F̄_max, 0); the back flank alike, mirrored): which flanks touched comes from
+    the tracked extrema of δ̄ against ±b̄. Where both flanks touched, the tracked extrema
+    cannot tell the tension of one flank from the compression of the other; they are kept
+    (with 0 inside [F̄ᶜ_min, F̄ᶜ_max], which a passage through the gap reaches) and are exact
+    unless a tension exceeded the opposite flank's largest compression.
+
+    Parameters
+    ----------
+    system
+        The system that ran (no contact forces: the arrays come back unchanged).
+    observables
+        (..., n_obs) observables at the samples.
+    obs_min, obs_max
+        (..., n_track) extrema of the tracked observables over the window.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``observables``, ``obs_min``, ``obs_max`` with the contact-force columns replaced.
+    """
+    groups = mesh_groups(system)
+    if not groups:
+        return observables, obs_min, obs_max
+    obs = np.array(observables, dtype=np.float64, copy=True)
+    lo = np.array(obs_min, dtype=np.float64, copy=True)
+    hi = np.array(obs_max, dtype=np.float64, copy=True)
+    widths = system.switch_widths
+    for g in groups:
+        fc, dc = g.force.columns, g.deflection.columns
+        f = obs[..., fc]
+        obs[..., fc] = np.where(f * obs[..., dc] > 0.0, f, 0.0)
+        drive = hi[..., dc] > widths[dc]
+        back = lo[..., dc] < -widths[dc]
+        flo, fhi = lo[..., fc], hi[..., fc]
+        lo[..., fc] = np.where(back, np.minimum(flo, 0.0), np.maximum(flo, 0.0))
+        hi[..., fc] = np.where(drive, np.maximum(fhi, 0.0), np.minimum(fhi, 0.0))
+        none = ~drive & ~back
+        lo[..., fc] = np.where(none, 0.0, lo[..., fc])
+        hi[..., fc] = np.where(none, 0.0, hi[..., fc])
+    return obs, lo, hi
 
 
 def static_mesh_force(system: System) -> float:
@@ -89,6 +165,7 @@ def response_quantities(
         (n_track,) running extrema of the tracked observables over the recorded window.
     observables
         (s, n_obs) observables at the recorded samples (uniform over whole forcing periods).
+        The contact forces are taken as :func:`compressive_contact_forces` gives them.
 
     Returns
     -------
@@ -99,6 +176,9 @@ def response_quantities(
         With F̄ᶜ the contact force and δ̄ the mesh deflection:
         force_rms = √⟨F̄ᶜ²⟩, force_peak = max |F̄ᶜ|, dte_rms = √⟨(δ̄ − ⟨δ̄⟩)²⟩.
     """
+    observables, obs_min, obs_max = compressive_contact_forces(
+        system, observables, obs_min, obs_max
+    )
     static = static_mesh_force(system)
     out: dict[str, np.ndarray] = {}
     for g in mesh_groups(system):

@@ -112,9 +112,11 @@ def mesh_force_history(
     """Plot the mesh contact forces of one planet against time in mesh periods, with the
     separations shaded.
 
-    The contact force is F̄ᶜ = κ(τ) f(δ̄; b̄) + c̄ δ̄' while the teeth touch (|δ̄| > b̄) and
-    exactly 0 while they are apart (MODEL.md §4; the damping term alone is not a contact
-    force). For planetary results both meshes of ``planet`` are drawn (sun–planet F̄ᶜ_spi and
+    The contact force is the mesh force κ(τ) f(δ̄; b̄) + c̄ δ̄' of MODEL.md §4 while the teeth
+    touch (|δ̄| > b̄) and it presses them together, and exactly 0 while they are apart (the
+    damping term alone is not a contact force) or where the damping would pull them just
+    before release (flanks cannot; :func:`gearchaos.model.response.compressive_contact_forces`).
+    For planetary results both meshes of ``planet`` are drawn (sun–planet F̄ᶜ_spi and
     planet–ring F̄ᶜ_rpi) with the static mesh force T̄_D/N dotted; for the backlash oscillator
     its single mesh (static force F_m). Intervals where a mesh is separated are shaded in its
     colour.
@@ -153,8 +155,12 @@ def mesh_force_history(
         sub = f"{g.mesh}{planet}" if g.force.per_planet else ""
         label = rf"$\bar F^c_{{{sub}}}$ {names[g.mesh]}" if sub else r"$\bar F^c$"
         ax.plot(t, y, lw=0.9, color=colours[g.mesh], label=label)
+        # apart: inside the clearance (the force is also 0 where the damping would pull)
+        dcol = g.deflection.columns[planet - 1 if g.force.per_planet else 0]
+        delta = result.observables[sl, dcol]
+        apart = np.abs(delta) <= result.system.switch_widths[dcol]
         first = True
-        for a, b in _spans(y == 0.0):
+        for a, b in _spans(apart):
             lo = t[max(a - 1, 0)] if a > 0 else t[a]
             hi = t[min(b + 1, t.size - 1)]
             ax.axvspan(

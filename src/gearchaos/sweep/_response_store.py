@@ -7,7 +7,12 @@ from typing import Any
 
 import numpy as np
 
-from ..model.response import QUANTITIES, mesh_groups, response_quantities
+from ..model.response import (
+    QUANTITIES,
+    compressive_contact_forces,
+    mesh_groups,
+    response_quantities,
+)
 
 __all__ = ["response_extract", "response_variables"]
 
@@ -60,6 +65,9 @@ def response_extract(
     """Fill one point's response quantities into the block arrays ``data`` (created here on
     the first call with the shape ``data["status"]`` has); NaN where the point failed."""
     bshape = data["status"].shape
+    observables, obs_min, obs_max = compressive_contact_forces(
+        system, observables, obs_min, obs_max
+    )
     values = response_quantities(system, obs_min, obs_max, observables)
     for g in mesh_groups(system):
         cols = g.force.columns

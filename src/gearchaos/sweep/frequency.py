@@ -7,7 +7,9 @@ point and mesh type ``m`` (``sp``, ``rp``; ``mesh`` for the backlash oscillator)
 besides the sections and extrema of every sweep (:mod:`gearchaos.model.response`):
 
 * ``force_rms_m``, ``force_peak_m`` (per planet): √⟨F̄ᶜ²⟩ and max |F̄ᶜ| of the contact force
-  F̄ᶜ = κ f(δ̄; b̄) + c̄ δ̄' (0 while the teeth are apart), in k_m,sp b_c;
+  F̄ᶜ = κ f(δ̄; b̄) + c̄ δ̄' where it presses the flanks together (0 while the teeth are apart
+  or the damping would pull them, :func:`~gearchaos.model.response.compressive_contact_forces`),
+  in k_m,sp b_c;
 * ``load_factor_m``: max over the planets of max |F̄ᶜ| / (T̄_D/N), the dynamic load factor;
 * ``dte_rms_m`` (per planet): √⟨(δ̄ − ⟨δ̄⟩)²⟩, the RMS dynamic transmission error, in b_c;
 * ``contact_force_m_min``/``_max`` (per planet): the tracked extrema of F̄ᶜ.
