@@ -128,9 +128,9 @@ def test_response_figure_axes_follow_the_gear_set(tmp_path) -> None:
     omega_n = math.sqrt(gs.stiffness.sun_planet_mean / (ms * mp / (ms + mp)))
     rpm_per_omega = omega_n * (z.sun + z.ring) / (z.sun * z.ring) * 60 / (2 * math.pi)
     hz_per_omega = omega_n / (2 * math.pi)
-    top, bottom = fig.axes[0], fig.axes[3]
+    top = fig.axes[0]
     labels = {}
-    for ax in (top, bottom):
+    for ax in fig.axes:
         for child in ax.child_axes:
             labels[child.get_xlabel()] = (child, ax)
     omegas = np.array([0.6, 0.8, 1.0])
@@ -148,3 +148,107 @@ def test_response_figure_axes_follow_the_gear_set(tmp_path) -> None:
     assert right
     np.testing.assert_allclose(right[0]._functions[0](1.0), force_n, rtol=1e-9)
     fig.savefig(tmp_path / "response.png")
+
+
+def _jump_and_shade_positions(fig) -> tuple[list[float], list[tuple[float, float]]]:
+    """x of every jump arrow and x extent of every hysteresis patch of a response figure."""
+    jumps, shades = [], []
+    for ax in fig.axes:
+        for child in ax.get_children():
+            gid = child.get_gid() or ""
+            if gid == "jump":
+                jumps.append(float(child.xy[0]))
+            elif gid == "hysteresis":
+                for path in child.get_paths():
+                    v = path.vertices[:, 0]
+                    shades.append((float(v.min()), float(v.max())))
+    return jumps, shades
+
+
+def test_response_figure_marks_jumps_and_hysteresis_only_between_periodic_states() -> None:
+    """`gearchaos response --preset sheng2016` over Ω = 0.6–0.9: sweeping up, the 1T orbit
+    gives way to a chaotic motion near Ω ≈ 0.75 (λ₁ > 0), sweeping down the chaotic motion
+    persists down to Ω ≈ 0.68. The curves step there, but a step between 1T and chaos is no
+    jump between coexisting periodic states, and 1T beside chaos is no periodic hysteresis:
+    the figure drew arrows and shading across it. Marks are allowed only where the store's
+    own verdicts say both ends are periodic."""
+    from gearchaos.plot import response_figure
+    from gearchaos.plot.regimes import REGIME_GID
+
+    grid = np.round(np.linspace(0.6, 0.9, 7), 12)
+    ds = gc.response(gc.preset("sheng2016"), {"omega": grid}, progress=False)
+    motion = {d: ds.motion.sel(direction=d).values.astype(str) for d in ("up", "down")}
+    periodic = {d: np.char.endswith(m, "T") for d, m in motion.items()}
+    # the case: a large step of the up branch between a periodic and a non-periodic point
+    up = ds.force_peak_sp.sel(direction="up").max("planet_all").values
+    steps = find_jumps(grid, up)
+    assert steps, "the up branch should step"
+    mixed = [j for j in steps if not periodic["up"][np.searchsorted(grid, j) - 1 :][:2].all()]
+    assert mixed, "the step should join a periodic and a non-periodic point"
+    fig = response_figure(ds)
+    jumps, shades = _jump_and_shade_positions(fig)
+    for xj in jumps:
+        k = int(np.searchsorted(grid, xj))
+        assert any(periodic[d][k - 1] and periodic[d][k] for d in periodic), xj
+    for lo, hi in shades:
+        inside = (grid >= lo - 1e-12) & (grid <= hi + 1e-12)
+        assert np.all(periodic["up"][inside] & periodic["down"][inside]), (lo, hi)
+    assert not any(abs(xj - j) < 1e-12 for xj in jumps for j in mixed)
+    # the motion band: one row per direction, the verdicts' categories, a legend of them
+    band = next(a for a in fig.axes if any(
+        (c.get_gid() or "").startswith(REGIME_GID) for c in a.get_children()
+    ))  # fmt: skip
+    drawn = {(c.get_gid() or "").split(":", 1)[1] for c in band.get_children()
+             if (c.get_gid() or "").startswith(REGIME_GID)}  # fmt: skip
+    assert drawn == set(motion["up"]) | set(motion["down"])
+    assert [t.get_text() for t in band.get_yticklabels()] == ["up", "down"]
+    legend = fig.legends[0]
+    assert {t.get_text() for t in legend.get_texts()} == drawn
+
+
+def test_response_figure_keeps_the_oscillators_periodic_jump_and_hysteresis() -> None:
+    """The backlash oscillator (see the scipy test above): sweeping down, its high 2T branch
+    drops onto the low 2T one near Ω ≈ 0.78 — a jump between periodic states, drawn, with
+    the two periodic branches shaded between them where both coexist. Sweeping up, the low
+    branch leaves near Ω ≈ 1.0 for a chaotic motion (the verdict's λ₁ > 0): not drawn."""
+    from gearchaos.plot import response_figure
+
+    grid = np.round(np.linspace(0.7, 1.1, 9), 12)
+    ds = gc.response(
+        _oscillator(), {"omega": grid}, transient_periods=40, periods=6, progress=False
+    )
+    motion = {d: ds.motion.sel(direction=d).values.astype(str) for d in ("up", "down")}
+    periodic = {d: np.char.endswith(m, "T") for d, m in motion.items()}
+    fig = response_figure(ds)
+    jumps, shades = _jump_and_shade_positions(fig)
+    drawn = 0
+    for d in ("up", "down"):
+        y = ds.force_peak_mesh.sel(direction=d).values
+        k = int(np.argmax(np.abs(np.diff(y))))
+        ends = bool(periodic[d][k] and periodic[d][k + 1])
+        assert (_largest_jump(grid, y) in [pytest.approx(j) for j in jumps]) == ends, d
+        drawn += ends
+    assert drawn >= 1  # the down branch's periodic jump
+    up = ds.force_peak_mesh.sel(direction="up").values
+    down = ds.force_peak_mesh.sel(direction="down").values
+    both = periodic["up"] & periodic["down"]
+    differ = np.abs(up - down) > 0.1 * np.ptp(np.r_[up, down])
+    pairs = np.nonzero((both & differ)[:-1] & (both & differ)[1:])[0]
+    assert pairs.size  # two neighbouring values with coexisting, different periodic motions
+    for i in pairs:
+        assert any(lo <= grid[i] and grid[i + 1] <= hi for lo, hi in shades), grid[i]
+
+
+def test_find_jumps_only_between_allowed_neighbours() -> None:
+    x = np.linspace(0, 1, 11)
+    y = np.where(x < 0.45, 1.0, 3.0)
+    assert find_jumps(x, y, where=np.ones(11, bool)) == [pytest.approx(0.45)]
+    chaotic = x > 0.45  # the point after the step is not periodic: no jump
+    assert find_jumps(x, y, where=~chaotic) == []
+    # a non-allowed point breaks the curve rather than being skipped
+    where = np.ones(11, bool)
+    where[5] = False
+    y2 = np.where(x < 0.55, 1.0, 3.0)
+    assert find_jumps(x, y2, where=where) == []
+    with pytest.raises(gc.ParameterError, match="where"):
+        find_jumps(x, y, where=np.ones(3, bool))

@@ -1,11 +1,21 @@
 """Frequency-response curves of a response sweep (:func:`gearchaos.response`).
 
 Four panels over the swept parameter (usually Ω): peak and RMS contact force of each mesh type,
-dynamic load factor and RMS dynamic transmission error. The up branch is drawn solid, the down
-branch dashed; jumps (:func:`~gearchaos.sweep.frequency.find_jumps`) are marked with arrows in the
-direction of the sweep, and where the branches differ the band between them is shaded. Over Ω
-the top axis shows the sun speed in rpm and the mesh frequency in Hz, and the force and DTE
-panels a physical axis (N, µm) on the right, where the gear set defines them.
+dynamic load factor and RMS dynamic transmission error, and under them the motion band of the
+bifurcation diagram (:func:`~gearchaos.plot.regimes.regime_band`: the verdict of every point,
+one row per sweep direction) with a legend of the labels. The up branch is drawn solid, the
+down branch dashed. The curves' own marks follow the verdicts, so that none contradicts them:
+
+* a **jump** (an arrow in the direction of the sweep,
+  :func:`~gearchaos.sweep.frequency.find_jumps`) joins two neighbouring points of one branch
+  that are both periodic (nT) — a chaotic curve scatters from point to point without jumping;
+* **hysteresis** is shaded between the branches only where both directions are periodic at
+  the same value and their responses differ: two coexisting periodic motions. Where either
+  branch is QP, chaotic, unresolved or failed, nothing is shaded.
+
+A store without motion labels gets neither marks nor band. Over Ω the top axis shows the sun
+speed in rpm and the mesh frequency in Hz, and the force and DTE panels a physical axis (N,
+µm) on the right, where the gear set defines them.
 """
 
 from __future__ import annotations
@@ -16,6 +26,7 @@ import numpy as np
 
 from ..sweep import SweepResult
 from ..sweep.frequency import find_jumps
+from .regimes import regime_band, regime_categories, regime_category, regime_legend_below
 from .units import PhysicalScales, fit_to_data, linear_axis
 
 __all__ = ["response_figure"]
@@ -32,11 +43,25 @@ PANELS = (
     ),
 )
 MESH_LABEL = {"sp": "sun–planet", "rp": "planet–ring", "mesh": "mesh"}
-MESH_COLOR = {"sp": "C0", "rp": "C3", "mesh": "C0"}
+#: Mesh colours outside the regime palette (whose blue is 1T and red chaos).
+MESH_COLOR = {"sp": "0.1", "rp": "#9467bd", "mesh": "0.1"}
+#: Relative difference of the branches (to the panel's range) shaded as hysteresis.
+HYSTERESIS_REL = 0.02
 
 
 def _meshes(ds: Any) -> list[str]:
     return [m for m in ("sp", "rp", "mesh") if f"force_peak_{m}" in ds]
+
+
+def _periodic(ds: Any, direction: str | None) -> np.ndarray | None:
+    """Per swept value, whether the verdict of ``direction`` is periodic (nT); None without
+    motion labels."""
+    if "motion" not in ds.data_vars:
+        return None
+    cats = regime_categories(ds)
+    if direction is not None:
+        cats = cats.sel(direction=direction)
+    return np.array([regime_category(c).endswith("T") for c in np.ravel(cats.values)])
 
 
 def _branch(ds: Any, name: str, direction: str | None) -> np.ndarray:
@@ -60,12 +85,16 @@ def response_figure(
     rel_jump
         Jump threshold as a fraction of a curve's range (:func:`find_jumps`).
     figsize
-        Figure size in inches (default 7 × 9).
+        Figure size in inches (default 7 × 10 with the motion band, 7 × 9 without).
 
     Returns
     -------
     matplotlib.figure.Figure
         Per-planet quantities are drawn for the most loaded planet (max over the planets).
+        Jumps (``gid="jump"``) join periodic neighbours only, hysteresis (``gid="hysteresis"``)
+        is shaded only where both branches are periodic and differ by more than
+        :data:`HYSTERESIS_REL` of the panel's range (module docstring); the last axes is the
+        motion band when the store has motion labels.
     """
     from matplotlib.figure import Figure
 
@@ -85,9 +114,19 @@ def response_figure(
     xname = lead[0]
     x = np.asarray(ds[xname].values, dtype=float)
     directions = list(ds["direction"].values) if "direction" in ds.dims else [None]
+    periodic = {d: _periodic(ds, d) for d in directions}
+    labelled = all(p is not None for p in periodic.values())
     scales = PhysicalScales.of_sweep(res)
-    fig = Figure(figsize=figsize or (7.0, 9.0), layout="constrained")
-    axes = fig.subplots(len(PANELS), 1, sharex=True)
+    fig = Figure(figsize=figsize or (7.0, 10.0 if labelled else 9.0), layout="constrained")
+    if labelled:
+        band_h = 0.12 * len(directions)
+        grid = fig.add_gridspec(len(PANELS) + 1, 1, height_ratios=[1.0] * len(PANELS) + [band_h])
+        axes = [fig.add_subplot(grid[0, 0])]
+        axes += [fig.add_subplot(grid[k, 0], sharex=axes[0]) for k in range(1, len(PANELS))]
+        band = fig.add_subplot(grid[len(PANELS), 0], sharex=axes[0])
+    else:
+        axes = list(fig.subplots(len(PANELS), 1, sharex=True))
+        band = None
     for ax, (q, ylabel, phys) in zip(axes, PANELS, strict=True):
         ys: list[np.ndarray] = []
         for m in meshes:
@@ -100,7 +139,9 @@ def response_figure(
                 ax.plot(
                     x, y, style, color=MESH_COLOR[m], marker=marker, ms=2.5, lw=1.0, label=label
                 )
-                for xj in find_jumps(x, y, rel=rel_jump):
+                if periodic[d] is None:
+                    continue
+                for xj in find_jumps(x, y, rel=rel_jump, where=periodic[d]):
                     k = int(np.searchsorted(x, xj))
                     y0, y1 = y[k - 1], y[k]
                     if d == "down":
@@ -112,22 +153,25 @@ def response_figure(
                         arrowprops={"arrowstyle": "->", "color": MESH_COLOR[m], "lw": 1.2},
                         gid="jump",
                     )
-            if len(branches) == 2:
+            if len(branches) == 2 and labelled:
                 up, down = branches["up"], branches["down"]
+                both = np.asarray(periodic["up"]) & np.asarray(periodic["down"])
                 span = np.nanmax([np.nanmax(up), np.nanmax(down)]) - np.nanmin(
                     [np.nanmin(up), np.nanmin(down)]
                 )
-                differ = np.abs(up - down) > 0.02 * span if span > 0 else np.zeros_like(up, bool)
-                ax.fill_between(
-                    x,
-                    np.fmin(up, down),
-                    np.fmax(up, down),
-                    where=differ,
-                    color=MESH_COLOR[m],
-                    alpha=0.12,
-                    lw=0,
-                    gid="hysteresis",
-                )
+                differ = np.abs(up - down) > HYSTERESIS_REL * span if span > 0 else both & False
+                shade = both & differ
+                if shade.any():
+                    ax.fill_between(
+                        x,
+                        np.fmin(up, down),
+                        np.fmax(up, down),
+                        where=shade,
+                        color=MESH_COLOR[m],
+                        alpha=0.15,
+                        lw=0,
+                        gid="hysteresis",
+                    )
         ax.set_ylabel(ylabel, fontsize="small")
         fit_to_data(ax, x, np.concatenate(ys))
         if phys is not None:
@@ -138,16 +182,28 @@ def response_figure(
         ax.grid(alpha=0.3, lw=0.5)
     axes[0].legend(fontsize="x-small", ncol=2, loc="best")
     xlabel = r"$\Omega = \omega/\omega_n$" if xname == "omega" else xname
-    axes[-1].set_xlabel(xlabel)
+    bottom = axes[-1]
+    if band is not None:
+        limits = axes[0].get_xlim()
+        regime_band(res, band)
+        band.set_xlim(*limits)  # the panels' limits, not the band's outer cells
+        for ax in axes:
+            ax.tick_params(axis="x", labelbottom=False)
+        cats = np.asarray(regime_categories(res).values, dtype=object).ravel()
+        regime_legend_below(fig, cats)
+        bottom = band
+    bottom.set_xlabel(xlabel)
     if xname == "omega":
         rpm = scales.factor("omega")
         if rpm is not None:
             linear_axis(axes[0], "x", rpm[0], rpm[1])
         hz = scales.factor("mesh_hz")
         if hz is not None:
-            sec = axes[-1].secondary_xaxis(
-                -0.32, functions=(lambda v: np.asarray(v) * hz[0], lambda v: np.asarray(v) / hz[0])
+            sec = bottom.secondary_xaxis(
+                "bottom",
+                functions=(lambda v: np.asarray(v) * hz[0], lambda v: np.asarray(v) / hz[0]),
             )
+            sec.spines["bottom"].set_position(("outward", 34))
             sec.set_xlabel(f"mesh frequency $f_m$ {hz[1]}", fontsize="small")
             sec.tick_params(labelsize="small")
     title = ds.attrs.get("title", "").replace("sweep", "frequency response")

@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from .._checks import check_real
+from ..errors import ParameterError
 from .run import bifurcation
 
 __all__ = ["find_jumps", "response"]
@@ -81,7 +82,7 @@ def response(
     )
 
 
-def find_jumps(x: Any, y: Any, *, rel: float = 0.25) -> list[float]:
+def find_jumps(x: Any, y: Any, *, rel: float = 0.25, where: Any = None) -> list[float]:
     """Where a response curve jumps: the midpoints (x_k + x_{k+1})/2 of the neighbouring
     points whose values differ by more than ``rel`` times the curve's range max y − min y.
 
@@ -92,6 +93,12 @@ def find_jumps(x: Any, y: Any, *, rel: float = 0.25) -> list[float]:
         ``up`` or ``down``); NaN points (failed) are skipped.
     rel
         Threshold as a fraction of the range (default 0.25).
+    where
+        Optional booleans, one per point: the points a jump may join. A jump is a jump between
+        two *periodic* states (a chaotic curve scatters from point to point without jumping
+        anywhere), so a response figure passes the points whose motion verdict is nT. With
+        ``where`` only neighbours in the grid count — a point outside it (or NaN) breaks the
+        curve instead of being skipped — and the range is still the whole curve's.
 
     Returns
     -------
@@ -102,6 +109,23 @@ def find_jumps(x: Any, y: Any, *, rel: float = 0.25) -> list[float]:
     xa = np.asarray(x, dtype=float)
     ya = np.asarray(y, dtype=float)
     ok = np.isfinite(ya)
+    if where is not None:
+        allowed = np.asarray(where, dtype=bool)
+        if allowed.shape != ya.shape:
+            raise ParameterError(
+                f"where must have one entry per point ({ya.shape}): got shape {allowed.shape}"
+            )
+        order = np.argsort(xa, kind="stable")
+        xs, ys, fine = xa[order], ya[order], (ok & allowed)[order]
+        if not ok.any():
+            return []
+        span = float(np.nanmax(ya) - np.nanmin(ya))
+        if span <= 0.0:
+            return []
+        pair = fine[:-1] & fine[1:]
+        big = np.zeros(pair.shape, dtype=bool)
+        big[pair] = np.abs(np.diff(ys))[pair] > rel * span
+        return [float(0.5 * (xs[i] + xs[i + 1])) for i in np.nonzero(big)[0]]
     xa, ya = xa[ok], ya[ok]
     if ya.size < 2:
         return []
