@@ -5,7 +5,7 @@ Run from the repository root with the project's environment:
 block of ``docs/tutorial/index.md`` in its Full variant, in order, in WORKDIR (default
 ``tutorial-run/``, kept so that a rerun resumes the sweeps), exactly as a reader would after
 ``source .venv/bin/activate``, and copies the figures the page shows into ``docs/tutorial/``,
-resized and palette-quantised to stay under 300 kB each. About five minutes on 2 cores.
+resized and palette-quantised to stay under 300 kB each.
 """
 
 from __future__ import annotations

@@ -191,6 +191,6 @@ def test_quick_tutorial_prints_what_the_page_shows(quick_run: Path) -> None:
 
 @pytest.mark.slow
 def test_full_tutorial(tmp_path: Path) -> None:
-    """The Full variant (the figures' commands), about five minutes on 2 cores."""
+    """The Full variant (the figures' commands)."""
     _run_tutorial(tmp_path, "full")
     _check_outputs(tmp_path, "full")

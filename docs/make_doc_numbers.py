@@ -1,0 +1,395 @@
+"""Rewrite the numbers of the docs that a program printed, from the programs themselves.
+
+Run from the repository root with the project's environment:
+``.venv/bin/python docs/make_doc_numbers.py [--check] [--fast]``. Every number of README.md,
+the tutorial and the reproduce how-to that a command printed (or that the committed report
+holds) sits between markers, and this script rewrites what is between them::
+
+    |μ| ≈ <!-- gen:gallery.mu-3.5 -->0.97<!-- /gen --> per two periods
+
+    <!-- gen:chaos-point.excerpt -->
+
+    ```text
+    │ motion │ chaos │
+    ```
+
+    <!-- /gen -->
+
+A marker's name is ``SOURCE.KEY``. Each source (:data:`SOURCES`) runs one command, shown
+verbatim in a code block or in inline code of every page that quotes it (checked), in a fresh
+directory with ``COLUMNS=100`` (the width of the excerpts), and reads its output; the
+``report`` source reads ``docs/report/report.json`` instead, which ``gearchaos reproduce --all
+-o docs/report`` wrote. Window keys of the tutorial's Full sweep are ``fig4a.wN.LABEL.lo|hi``
+(the N-th window the page's Python block prints, which must carry LABEL, so that the prose
+around it stays true) with an optional format after ``|``.
+
+A source whose output no longer supports the prose around its numbers (the README's two
+attractors at Ω = 1.5, say) raises :class:`ProseOutOfDate` with what to rewrite.
+``--check`` rewrites nothing and exits 1 listing the stale numbers; ``--fast`` leaves out the
+sources marked slow (the tutorial's 800-point sweep). ``tests/docs/test_doc_numbers.py``
+runs the fast sources and the report in CI and the slow one under ``-m slow``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import shlex
+import subprocess
+import sys
+import tempfile
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tests" / "docs"))
+
+from tutorial_blocks import TUTORIAL, runnable  # noqa: E402
+
+PAGES = (ROOT / "README.md", TUTORIAL, ROOT / "docs" / "howto" / "reproduce.md")
+REPORT = ROOT / "docs" / "report" / "report.json"
+MARK = re.compile(r"<!-- gen:(?P<name>[^ ]+) -->(?P<body>.*?)<!-- /gen -->", re.S)
+COLUMNS = 100
+
+
+class ProseOutOfDate(RuntimeError):
+    """The program's output no longer says what the prose around its numbers says."""
+
+
+class Block(str):
+    """A value shown as a ``text`` code block (an excerpt of what a command printed)."""
+
+
+# ---------------------------------------------------------------------- running commands
+def _gearchaos() -> list[str]:
+    exe = Path(sys.executable).parent / "gearchaos"
+    return [str(exe)] if exe.exists() else [sys.executable, "-m", "gearchaos"]
+
+
+def run(command: str, cwd: Path) -> str:
+    """Run a ``gearchaos …`` command of a page (``.venv/bin/`` prefix or none) in ``cwd``;
+    its stdout."""
+    argv = shlex.split(command)
+    if Path(argv[0]).name != "gearchaos":
+        raise ValueError(f"not a gearchaos command: {command!r}")
+    env = {**os.environ, "COLUMNS": str(COLUMNS), "MPLBACKEND": "Agg", "NO_COLOR": "1"}
+    env.pop("FORCE_COLOR", None)
+    proc = subprocess.run(
+        [*_gearchaos(), *argv[1:]], cwd=cwd, env=env, capture_output=True, text=True
+    )
+    if proc.returncode != 0:
+        raise RuntimeError(f"{command!r} failed ({proc.returncode}):\n{proc.stderr[-3000:]}")
+    return proc.stdout
+
+
+def table_rows(text: str) -> dict[str, list[str]]:
+    """The body rows of the (first) two-column rich table in ``text``: quantity → its printed
+    lines (a wrapped value continues on lines with an empty first cell)."""
+    rows: dict[str, list[str]] = {}
+    last: list[str] | None = None
+    for line in text.splitlines():
+        if not line.startswith("│"):
+            continue
+        cells = [c.strip() for c in line.strip("│").split("│")]
+        if cells[0]:
+            last = rows.setdefault(cells[0], [])
+        if last is not None:
+            last.append(line.rstrip())
+    return rows
+
+
+def cell(rows: dict[str, list[str]], name: str, column: int = 1) -> str:
+    if name not in rows:
+        raise ProseOutOfDate(f"the command no longer prints a {name!r} row")
+    return " ".join(line.strip("│").split("│")[column].strip() for line in rows[name]).strip()
+
+
+def excerpt(rows: dict[str, list[str]], names: tuple[str, ...]) -> Block:
+    missing = [n for n in names if n not in rows]
+    if missing:
+        raise ProseOutOfDate(f"the command no longer prints the rows {missing}")
+    return Block("\n".join(line for n in names for line in rows[n]) + "\n")
+
+
+def printed_table(text: str) -> Block:
+    """The first table of ``text`` with its title, as printed."""
+    lines = text.splitlines()
+    start = next(i for i, line in enumerate(lines) if line.startswith(("┏", "┌")))
+    end = next(i for i in range(start, len(lines)) if lines[i].startswith(("└", "┗")))
+    return Block("\n".join(line.rstrip() for line in lines[max(start - 1, 0) : end + 1]) + "\n")
+
+
+# ---------------------------------------------------------------------- the sources
+@dataclass(frozen=True)
+class Source:
+    """One command and the values read from its output (``produce(work dir) → values``)."""
+
+    command: str | None
+    produce: Callable[[Path], dict[str, str]]
+    slow: bool = False
+
+
+QUICKSTART_ROWS = (
+    "distinct section points",
+    "motion",
+    "X̄_sp1 section min",
+    "X̄_sp1 section max",
+    "contact sun_planet_1",
+)
+LYAPUNOV_ROWS = (
+    "motion",
+    "decided by",
+    "λ₁ [1/τ]",
+    "periods added to finish the transient",
+    "0–1 test K",
+    "indicators agree",
+    "motion note",
+)
+
+
+def _quickstart(work: Path) -> dict[str, str]:
+    rows = table_rows(run(SOURCES["quickstart"].command or "", work))
+    if cell(rows, "motion") != "1T" or "still converging" not in cell(rows, "motion note"):
+        raise ProseOutOfDate(
+            "the quick start is no longer a 1T orbit the record still converges onto "
+            "(README 'Quick start', tutorial step 2)"
+        )
+    shown, recorded = cell(rows, "distinct section points").split(" of ")
+    return {
+        "excerpt": excerpt(rows, QUICKSTART_ROWS),
+        "distinct": shown,
+        "recorded": recorded,
+        "mu": f"{float(cell(rows, 'max |μ| (Floquet)')):.3f}",
+    }
+
+
+def _lyapunov(work: Path) -> dict[str, str]:
+    rows = table_rows(run(SOURCES["chaos-point"].command or "", work))
+    if cell(rows, "motion") != "chaos":
+        raise ProseOutOfDate("Ω = 2.0 (xi = 0.03) is no longer chaos (tutorial step 6)")
+    return {"excerpt": excerpt(rows, LYAPUNOV_ROWS)}
+
+
+def _gallery(work: Path) -> dict[str, str]:
+    out = run(SOURCES["gallery"].command or "", work)
+    table = printed_table(out)
+    labels: dict[str, tuple[str, str]] = {}
+    for line in table.splitlines():
+        if line.startswith("│"):
+            cells = [c.strip() for c in line.strip("│").split("│")]
+            labels[cells[0]] = (cells[1].lstrip("■ "), cells[3])
+    expected = {"0.5": "1T", "1.1": "2T", "2": "chaos", "3.5": "2T"}
+    if {k: v[0] for k, v in labels.items()} != expected:
+        raise ProseOutOfDate(
+            f"the tutorial's gallery (step 5) describes {expected}; the command now labels "
+            f"{ {k: v[0] for k, v in labels.items()} }"
+        )
+    return {"table": table, "mu-3.5": f"{float(labels['3.5'][1]):.2f}"}
+
+
+_SEGMENT = re.compile(r"│ (stable|unstable) ([\d.]+) … ([\d.]+)")
+_EVENT = re.compile(r"│ (\w+) +│ ([\d.]+) ±")
+
+
+def _continuation(work: Path) -> dict[str, str]:
+    out = run(SOURCES["continue"].command or "", work)
+    stable = [(float(a), float(b)) for kind, a, b in _SEGMENT.findall(out) if kind == "stable"]
+    events = [(kind, float(v)) for kind, v in _EVENT.findall(out)]
+    kinds = [k for k, _ in events]
+    if len(stable) != 1 or kinds != ["neimark_sacker", "period_doubling"]:
+        raise ProseOutOfDate(
+            "the README says the 1T branch near Ω = 1.5 is stable on one stretch between a "
+            f"Neimark–Sacker bifurcation and a period doubling; now: stable {stable}, "
+            f"events {kinds}"
+        )
+    (lo, hi), (ns, pd) = stable[0], (events[0][1], events[1][1])
+    if not ns <= lo <= hi <= pd:
+        raise ProseOutOfDate(f"the stable stretch {lo}–{hi} is not between {ns} and {pd}")
+    return {"ns": f"{ns:.3f}", "pd": f"{pd:.3f}"}
+
+
+def _attractors(work: Path) -> dict[str, str]:
+    out = run(SOURCES["attractors"].command or "", work)
+    found = []
+    for line in out.splitlines():
+        if line.startswith("│"):
+            cells = [c.strip() for c in line.strip("│").split("│")]
+            found.append((cells[0], cells[2], cells[4]))
+    shape = [(label, starts) for label, starts, _ in found]
+    if shape != [("1T", "0"), ("chaos", "1, 2, 3, 4, 5, 6, 7")]:
+        raise ProseOutOfDate(
+            "the README says 'gearchaos attractors --set omega=1.5' finds the 1T orbit from "
+            f"rest and chaos from the seven other starts; it now finds {shape}"
+        )
+    mu = re.search(r"max \|μ\| = ([\d.]+), stable", found[0][2])
+    if mu is None:
+        raise ProseOutOfDate(f"the 1T attractor's orbit is no longer stable: {found[0][2]!r}")
+    return {"mu": f"{float(mu.group(1)):.3f}"}
+
+
+def _windows_block() -> str:
+    (block,) = [b for b in runnable("full") if b.lang == "python" and "fig4a.zarr" in b.code]
+    return block.code
+
+
+def _fig4a(work: Path) -> dict[str, str]:
+    """The tutorial's Full Ω sweep, and what the page's Python block prints about it."""
+    run(SOURCES["fig4a"].command or "", work)
+    proc = subprocess.run(
+        [sys.executable, "-c", _windows_block()],
+        cwd=work,
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    values: dict[str, str] = {"windows": Block(proc.stdout)}
+    line = re.compile(r"^Ω = ([\d.]+) … ([\d.]+): (\S+)$")
+    for i, text in enumerate(proc.stdout.splitlines(), start=1):
+        m = line.match(text)
+        if m is None:
+            raise ProseOutOfDate(f"unexpected line of the window listing: {text!r}")
+        values[f"w{i}.{m.group(3)}.lo"], values[f"w{i}.{m.group(3)}.hi"] = m.group(1, 2)
+    import gearchaos as gc
+
+    ds = gc.open_sweep(work / "fig4a.zarr")
+    x = ds["delta_sp"].sel(planet=1)
+    values["static"] = repr(float(x.isel(omega=0).mean()))
+    for key in [k for k in values if k.endswith(".1T.lo")]:
+        lo, hi = float(values[key]), float(values[key.replace(".lo", ".hi")])
+        values[key.replace(".lo", ".mean")] = repr(float(x.sel(omega=slice(lo, hi)).mean()))
+    return values
+
+
+def _report(_: Path) -> dict[str, str]:
+    """Counts and run time of the committed report (``docs/report/report.json``)."""
+    report = json.loads(REPORT.read_text(encoding="utf-8"))
+    values: dict[str, str] = {"seconds": f"{report['seconds']:.0f}"}
+    for part in ("landmarks", "conclusions"):
+        verdicts = [item["verdict"] for item in report[part]]
+        values[f"{part}.total"] = str(len(verdicts))
+        for verdict in ("holds", "partly", "does not hold"):
+            values[f"{part}.{verdict.replace(' ', '-')}"] = str(verdicts.count(verdict))
+        values[f"{part}.not-ids"] = ", ".join(
+            str(item["id"]) for item in report[part] if item["verdict"] == "does not hold"
+        )
+    return values
+
+
+#: Source name → the command whose output it reads (None: a committed file).
+SOURCES: dict[str, Source] = {
+    "quickstart": Source(
+        "gearchaos simulate --preset sheng2016 --set omega=1.5 -o out/", _quickstart
+    ),
+    "chaos-point": Source("gearchaos simulate --set xi=0.03 --set omega=2.0", _lyapunov),
+    "gallery": Source(
+        "gearchaos poincare --set xi=0.03 --vary omega=0.5,1.1,2.0,3.5 --with phase -o gallery.png",
+        _gallery,
+    ),
+    "continue": Source("gearchaos continue --vary omega=1.45:1.56 -o branch.nc", _continuation),
+    "attractors": Source("gearchaos attractors --set omega=1.5", _attractors),
+    "fig4a": Source(
+        "gearchaos bifurcation --vary omega=0.05:4:800 --set xi=0.03 -o fig4a.zarr",
+        _fig4a,
+        slow=True,
+    ),
+    "report": Source(None, _report),
+}
+
+
+# ---------------------------------------------------------------------- the pages
+def markers(text: str) -> list[tuple[str, str, str]]:
+    """``(source, key, format)`` of every marker of a page, in order."""
+    out = []
+    for m in MARK.finditer(text):
+        name, _, fmt = m["name"].partition("|")
+        source, _, key = name.partition(".")
+        out.append((source, key, fmt))
+    return out
+
+
+def shows_command(text: str, command: str) -> bool:
+    """Whether the page shows ``command`` verbatim (in a code block or inline code, with or
+    without the ``.venv/bin/`` prefix)."""
+    pattern = rf"(?:^|`)(?:\s*)(?:\.venv/bin/)?{re.escape(command)}(?:$|`)"
+    return re.search(pattern, text, flags=re.M) is not None
+
+
+def compute(sources: list[str]) -> dict[str, dict[str, str]]:
+    """Run each source once (in its own temporary directory); source → key → value."""
+    values = {}
+    for name in sources:
+        with tempfile.TemporaryDirectory(prefix=f"doc-numbers-{name}-") as tmp:
+            values[name] = SOURCES[name].produce(Path(tmp))
+    return values
+
+
+def _formatted(value: str, fmt: str) -> str:
+    return format(float(value), fmt) if fmt else value
+
+
+def render(text: str, values: dict[str, dict[str, str]]) -> str:
+    """``text`` with every marker of a computed source filled in."""
+
+    def fill(m: re.Match[str]) -> str:
+        name, _, fmt = m["name"].partition("|")
+        source, _, key = name.partition(".")
+        if source not in values:
+            return m.group(0)
+        if key not in values[source]:
+            raise ProseOutOfDate(
+                f"gen:{m['name']}: {source} gives no {key!r} (it gives {sorted(values[source])})"
+            )
+        value = values[source][key]
+        if isinstance(value, Block):
+            body = f"\n\n```text\n{value}```\n\n"
+        else:
+            body = _formatted(value, fmt)
+        return f"<!-- gen:{m['name']} -->{body}<!-- /gen -->"
+
+    return MARK.sub(fill, text)
+
+
+def problems(page: Path, text: str, values: dict[str, dict[str, str]]) -> list[str]:
+    """Unknown sources, commands the page does not show, and numbers that differ from
+    what the code gives now."""
+    found = []
+    for source, key, _ in markers(text):
+        if source not in SOURCES:
+            found.append(f"{page.name}: gen:{source}.{key}: no such source")
+        elif (cmd := SOURCES[source].command) and not shows_command(text, cmd):
+            found.append(f"{page.name}: gen:{source}.{key}: the page does not show {cmd!r}")
+    want = render(text, values)
+    old = {m.start(): m.group(0) for m in MARK.finditer(text)}
+    new = [m.group(0) for m in MARK.finditer(want)]
+    for (_, before), after in zip(sorted(old.items()), new, strict=True):
+        if before != after:
+            found.append(f"{page.name}: shows {before!r}, the code gives {after!r}")
+    return found
+
+
+def used_sources(pages: tuple[Path, ...] = PAGES) -> list[str]:
+    names = {s for page in pages for s, _, _ in markers(page.read_text(encoding="utf-8"))}
+    return [name for name in SOURCES if name in names]
+
+
+def main(argv: list[str]) -> int:
+    check, fast = "--check" in argv, "--fast" in argv
+    names = [n for n in used_sources() if not (fast and SOURCES[n].slow)]
+    values = compute(names)
+    stale = []
+    for page in PAGES:
+        text = page.read_text(encoding="utf-8")
+        stale += problems(page, text, values)
+        if not check and (new := render(text, values)) != text:
+            page.write_text(new, encoding="utf-8")
+            print(f"rewrote {page.relative_to(ROOT)}")
+    if check:
+        print("\n".join(stale) or "every generated number is current")
+        return 1 if stale else 0
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
