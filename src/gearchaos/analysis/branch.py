@@ -396,6 +396,7 @@ def open_branch(path: str | os.PathLike[str]) -> Any:
         ) from None
     if "parameter" not in ds.attrs or "multiplier_re" not in ds:
         raise StoreError(f"{path} is not a gearchaos branch (no 'parameter' attribute)")
+    ds.encoding["source"] = path  # figures name a branch by its file
     return ds
 
 

@@ -13,7 +13,7 @@ Every event carries its location **uncertainty** in the parameter,
 
 h the half-width of the final bracket (the root-finding error), δs the shift of the root
 that the integrator's error of the test function f causes: f at the event is evaluated again
-from the event point corrected onto the same parameter value with rtol and atol a hundred
+from the event point corrected onto the same hyperplane with rtol and atol a hundred
 times smaller (the integrator's error there is then about 1 % of that at rtol), and divided by
 the slope of f between the two branch points. The factor 2 covers the check's own error and a
 secant slope that differs from the slope at the event. |dλ/ds| is bounded by the larger
@@ -119,7 +119,7 @@ def locate(
             pt = good[sigma]
             ok, lo, hi = False, min(lo, sigma), max(hi, sigma)
     assert pt is not None
-    check = check_point(br, pt)
+    check = check_point(br, p, pt)
     f_e = fn(pt)
     f_check = fn(check) if check is not None else None
     dlam_ds = max(abs(float(p.tangent[-1])), abs(float(q.tangent[-1])))
@@ -148,8 +148,9 @@ def locate(
     }
 
 
-def check_point(br: Any, pt: Solution) -> Solution | None:
-    """``pt`` corrected again at its parameter value with rtol and atol divided by
+def check_point(br: Any, p: Solution, pt: Solution) -> Solution | None:
+    """``pt`` corrected again on its hyperplane (normal to p's tangent: well posed at a fold,
+    where a fixed parameter value is not) with rtol and atol divided by
     :data:`CHECK_FACTOR` (None when that fails; ``pt`` itself when rtol is already at its
     floor)."""
     cfg = br.cfg
@@ -157,10 +158,11 @@ def check_point(br: Any, pt: Solution) -> Solution | None:
     if rtol >= float(cfg.rtol):
         return pt
     fine = replace(cfg, rtol=rtol, atol=float(cfg.atol) / CHECK_FACTOR)
-    prob = replace(br.prob, settings=fine, tol=default_tol(fine), fd_step=0.0)
-    e_lam = np.zeros(pt.y.size + 1)
-    e_lam[-1] = 1.0
-    sol, _ = correct(prob, pt.z, e_lam, pt.lam, monodromy=pt.monodromy, g_lam=pt.g_lam)
+    prob = replace(br.prob, settings=fine, tol=default_tol(fine))
+    assert p.tangent is not None
+    normal = br.weight(p.tangent)
+    z = pt.z
+    sol, _ = correct(prob, z, normal, float(normal @ z), monodromy=pt.monodromy, g_lam=pt.g_lam)
     if sol is not None:
         br.evals += sol.evals
         br.jacobians += sol.jacobians

@@ -288,9 +288,26 @@ def bifurcation(
     out.print(Text(f"next: gearchaos plot {output} -o {output.stem}.png", style="dim"))
 
 
+def _is_branch(path: Path) -> bool:
+    """Whether ``path`` names a branch file of `gearchaos continue` (netCDF, or a Zarr branch
+    with its chunk manifest) rather than a sweep store."""
+    from ..analysis.branch import MANIFEST
+
+    if path.suffix.lower() in (".nc", ".nc4", ".h5"):
+        return True
+    return path.is_dir() and (path / MANIFEST).is_file()
+
+
 @c.app.command()
 def plot(
-    store: StoreArg,
+    stores: Annotated[
+        list[Path],
+        typer.Argument(
+            help="A sweep store of `gearchaos bifurcation` or `response`, or one or more branch "
+            "files of `gearchaos continue` (drawn on their own).",
+            show_default=False,
+        ),
+    ],
     output: Annotated[
         Path,
         typer.Option("--output", "-o", help="Figure file: .png, .pdf or .svg.", show_default=False),
@@ -344,9 +361,12 @@ def plot(
     motion labels under each) for a 1-D sweep, maps coloured by motion label (1T, 2T, …, QP,
     chaos) for a 2-D sweep, frequency-response curves (peak and RMS contact force, load
     factor, RMS DTE; up and down branches, jumps marked; Ω with sun rpm and mesh Hz) for a
-    store of `gearchaos response`.
+    store of `gearchaos response`. Branch files of `gearchaos continue` are drawn on their own
+    (section values against the continued parameter, stable solid, unstable dashed, events
+    named), or over a sweep's diagram with --branch.
 
-    Example: **gearchaos plot fig4.zarr -o fig4.png --clearance-lines**
+    Example: **gearchaos plot fig4.zarr -o fig4.png --clearance-lines**, **gearchaos plot
+    branch.nc -o branch.png**
     """
     from ..plot.figure import SAVE_FORMATS
 
@@ -355,13 +375,37 @@ def plot(
             raise ParameterError(
                 f"--output must end in one of {', '.join(SAVE_FORMATS)}: got {str(output)!r}"
             )
-        res = open_store(store)
         import matplotlib
 
         matplotlib.use("Agg")
         from ..analysis.branch import open_branch
         from ..plot import savefig, sweep_figure
 
+        if all(_is_branch(p) for p in stores):
+            if sections:
+                raise ParameterError("--sections applies to response stores, not branch files")
+            from ..plot.branch import branch_figure
+
+            fig = branch_figure(
+                [open_branch(b) for b in [*stores, *(branch or [])]],
+                var=var,
+                planet=1 if planet is None else planet,
+                clearance_lines=clearance,
+                resonances=resonances,
+            )
+            if output.parent != Path(""):
+                output.parent.mkdir(parents=True, exist_ok=True)
+            savefig(fig, output)
+            c.wrote(output)
+            return
+        if len(stores) > 1:
+            raise ParameterError(
+                "STORE must be one sweep store, or branch files only: got "
+                f"{', '.join(str(p) for p in stores)}; draw branches over a sweep with "
+                "--branch BRANCH.nc"
+            )
+        store = stores[0]
+        res = open_store(store)
         branches = [open_branch(b) for b in branch or []]
         if res.ds.attrs.get("kind") == "response" and not sections:
             from ..plot import response_figure

@@ -38,7 +38,7 @@ from ._common import (
     resonance_lines,
     var_symbol,
 )
-from .branch import branch_matches, branch_overlay
+from .branch import BRANCH_COLOURS, branch_labels, branch_matches, branch_overlay
 from .regimes import regime_band, regime_categories, regime_legend_below
 from .units import (
     PhysicalScales,
@@ -160,14 +160,15 @@ def bifurcation(
         Continued branches of periodic orbits (:func:`gearchaos.continuation`) to overlay:
         those of the x-axis parameter whose fixed values agree with ``select`` are drawn,
         stable solid, unstable dashed, with their events marked and named
-        (:func:`~gearchaos.plot.branch.branch_overlay`).
+        (:func:`~gearchaos.plot.branch.branch_overlay`), in the quantity the diagram shows
+        (X̄ − b̄ when ``relative``); each named in the legend by its file (or its start).
     physical
         Physical axes opposite the dimensionless ones: the variable in µm (mm/s, N) on the
         right, and when the x axis is Ω the sun speed in rpm on top (gear sets only).
     relative
         Draw X̄ − b̄ (the deflection beyond the drive-flank edge of the clearance) instead of
         X̄. ``None`` (default) does so exactly when the swept parameter is the clearance of
-        ``var`` itself (b̄_sp for X̄_sp …) and no branches are overlaid: X̄ then grows with b̄
+        ``var`` itself (b̄_sp for X̄_sp …): X̄ then grows with b̄
         and the attractor would be a thin band along the diagonal X̄ = b̄; the clearance edges
         become X̄ − b̄ = 0 (drive flank) and −2b̄ (back flank).
 
@@ -197,10 +198,7 @@ def bifurcation(
         clear_sym = found[1]
     if relative is None:
         relative = bool(
-            found is not None
-            and b_line.size == x.size > 1
-            and not np.all(b_line == b_line[0])
-            and not branches
+            found is not None and b_line.size == x.size > 1 and not np.all(b_line == b_line[0])
         )
     if relative and (found is None or b_line.size != x.size):
         raise ParameterError(
@@ -270,8 +268,14 @@ def bifurcation(
 
     if resonances and x_name == "omega" and x.size:
         resonance_lines(ax, res.gearset, float(np.min(x)), float(np.max(x)))
-    for k, branch in enumerate(b for b in branches if branch_matches(b, x_name, select)):
-        branch_overlay(branch, ax, var=var, planet=planet, color=f"C{(k + 4) % 10}")
+    shown = [b for b in branches if branch_matches(b, x_name, select)]
+    named: set[str] = set()
+    for k, (branch, text) in enumerate(zip(shown, branch_labels(shown), strict=True)):
+        colour = BRANCH_COLOURS[(k + 2) % len(BRANCH_COLOURS)]
+        branch_overlay(
+            branch, ax, var=var, planet=planet, color=colour, label=text, relative=relative,
+            named=named,
+        )  # fmt: skip
 
     notes = []
     if n_failed:

@@ -4,21 +4,39 @@ A branch (:func:`gearchaos.continuation`) holds, per point, the parameter value,
 section values and its stability. :func:`branch_overlay` draws the section values of one
 variable against the parameter — stable stretches solid, unstable ones dashed — and marks each
 event (fold, period doubling, Neimark–Sacker, grazing) with a symbol and its name, so a reader
-sees *why* the brute-force diagram underneath changes where it does.
+sees *why* the brute-force diagram underneath changes where it does. :func:`branch_figure`
+draws one or several branch files on their own (``gearchaos plot BRANCH.nc``).
+
+When the continued parameter is the clearance of the drawn variable (b̄_sp for X̄_sp …), the
+branch is drawn as X̄ − b̄ (``relative``), as the bifurcation diagrams of such sweeps are: X̄
+grows with b̄ and the branch would otherwise be a line along the diagonal.
 """
 
 from __future__ import annotations
 
 import json
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ..errors import ParameterError
-from ._common import get_ax
+from ..gearset.schema import CLEARANCES, FIELDS
+from ._common import axis_label, axis_symbol, fmt, get_ax, resonance_lines, var_symbol
+from .units import PhysicalScales, clearance_notes, fit_to_data, secondary_axis, var_quantity
 
-__all__ = ["BRANCH_GID", "EVENT_STYLE", "branch_matches", "branch_overlay"]
+__all__ = [
+    "BRANCH_COLOURS",
+    "BRANCH_GID",
+    "EVENT_NAMES",
+    "EVENT_STYLE",
+    "branch_clearance",
+    "branch_figure",
+    "branch_labels",
+    "branch_matches",
+    "branch_overlay",
+]
 
 #: ``gid`` prefix of the artists drawn by :func:`branch_overlay`.
 BRANCH_GID = "branch"
@@ -32,6 +50,19 @@ EVENT_STYLE: dict[str, tuple[str, str, str]] = {
     "grazing": ("x", "0.35", "graze"),
 }
 
+#: Colours of the branches of :func:`branch_figure`, none an event's (over a sweep's diagram
+#: from the third on: the first two are the up and down sweeps' colours).
+BRANCH_COLOURS = ("tab:blue", "tab:red", "tab:cyan", "tab:pink", "tab:olive", "navy", "darkred")
+
+#: The legend entry of each event kind.
+EVENT_NAMES: dict[str, str] = {
+    "fold": "fold (μ = +1)",
+    "period_doubling": "period doubling PD (μ = −1)",
+    "neimark_sacker": "Neimark–Sacker NS (|μ| = 1)",
+    "branch_point": "branch point BP (μ = +1)",
+    "grazing": "grazing (contact starts/ends)",
+}
+
 
 def _fixed(branch: Any) -> dict[str, Any]:
     raw = branch.attrs.get("fixed", "{}")
@@ -40,6 +71,74 @@ def _fixed(branch: Any) -> dict[str, Any]:
     except (TypeError, ValueError):
         return {}
     return data if isinstance(data, dict) else {}
+
+
+def _gearset(branch: Any) -> Any:
+    """The gear set of a branch (at its start, with its fixed values), or ``None``."""
+    text = str(branch.attrs.get("gearset_toml", "") or "")
+    if not text:
+        return None
+    from ..gearset.io import from_toml_string
+
+    return from_toml_string(text)
+
+
+def branch_clearance(branch: Any, var: str) -> np.ndarray | None:
+    """b̄ of the clearance acting on ``var`` at every point of ``branch`` — the continued
+    value when the clearance itself is continued, else the gear set's (or the reference
+    system's) — or ``None`` for variables without a clearance."""
+    if var.endswith("_dot"):
+        return None
+    name = str(branch.attrs.get("parameter", ""))
+    lam = np.asarray(branch[name].values, dtype=np.float64)
+    if var in CLEARANCES:
+        parameter, _, key = CLEARANCES[var]
+        gs = _gearset(branch)
+        if gs is None:
+            return None
+        if name == parameter:
+            units = gs.backlash.units if parameter.startswith("backlash.") else gs.clearance.units
+            return lam / gs.clearance.characteristic_length if units == "m" else lam.copy()
+        bsp, brp = gs.backlash_bar()
+        b = {"sun_planet": bsp, "planet_ring": brp}.get(key, gs.sun_bearing_clearance_bar())
+        return np.full(lam.shape, float(b))
+    if f"clearance_{var}" in branch.attrs:  # reference systems: x of the backlash oscillator
+        if name == "b":
+            return lam.copy()
+        return np.full(lam.shape, float(branch.attrs[f"clearance_{var}"]))
+    return None
+
+
+def _clearance_symbol(var: str) -> str:
+    if var in CLEARANCES:
+        return FIELDS[CLEARANCES[var][0]].tex
+    return "b"
+
+
+def branch_labels(branches: Sequence[Any]) -> list[str]:
+    """Legend labels that tell the branches apart: the file name (when the branch was opened
+    from one), the period and the start (``from a period doubling at Ω = 1.95``), numbered
+    where two would still read the same."""
+    labels = []
+    for br in branches:
+        n = int(br.attrs.get("period", 1))
+        source = str(getattr(br, "encoding", {}).get("source", "") or "")
+        start = str(br.attrs.get("start", ""))
+        text = f"period-{n} branch"
+        if source:
+            text = f"{Path(source).name}: {text}"
+        elif " at " in start:  # switched at an event: say where
+            kind, _, where = start.partition(" at ")
+            text += f" from {kind.replace('_', ' ')} at {where.split(' (')[0]}"
+        labels.append(text)
+    for text in set(labels):
+        same = [k for k, t in enumerate(labels) if t == text]
+        if len(same) > 1:
+            for j, k in enumerate(same):
+                lo, hi = (br := branches[k]).attrs.get("range_start"), br.attrs.get("range_stop")
+                extra = f" ({fmt(lo)} → {fmt(hi)})" if lo is not None and hi is not None else ""
+                labels[k] = f"{text}{extra} #{j + 1}"
+    return labels
 
 
 def branch_matches(branch: Any, x_name: str, select: Mapping[str, Any] | None) -> bool:
@@ -56,6 +155,20 @@ def branch_matches(branch: Any, x_name: str, select: Mapping[str, Any] | None) -
     return True
 
 
+def _section_values(branch: Any, var: str, planet: int) -> np.ndarray:
+    name = str(branch.attrs.get("parameter", ""))
+    if name not in branch.coords or var not in branch.data_vars:
+        have = ", ".join(str(v) for v in branch.data_vars if "section" in branch[v].dims)
+        raise ParameterError(f"var must be a section variable of the branch ({have}): got {var!r}")
+    da = branch[var]
+    if "planet" in da.dims:
+        planets = [int(p) for p in np.asarray(branch["planet"].values)]
+        if planet not in planets:
+            raise ParameterError(f"planet must be one of the branch's {planets}: got {planet!r}")
+        da = da.sel(planet=planet)
+    return np.asarray(da.transpose("point", "section").values, dtype=np.float64)
+
+
 def branch_overlay(
     branch: Any,
     ax: Any = None,
@@ -65,6 +178,8 @@ def branch_overlay(
     color: str = "tab:blue",
     events: bool = True,
     label: str | None = None,
+    relative: bool = False,
+    named: set[str] | None = None,
 ) -> Any:
     """Draw a continued branch over a bifurcation diagram of the same parameter.
 
@@ -79,9 +194,16 @@ def branch_overlay(
     color
         Colour of the branch; stable stretches are solid, unstable ones dashed.
     events
-        Mark the events with a symbol each and name them (``PD``, ``NS``, ``fold``, ``graze``).
+        Mark the events with a symbol each at the branch's section values there (interpolated
+        in arclength between the two branch points around it), write its short name (``PD``,
+        ``NS``, ``fold``, ``graze``) beside it and its full name in the legend.
     label
         Legend label (default: ``period-n branch``).
+    relative
+        Draw X̄ − b̄ (:func:`branch_clearance`), as the diagram underneath does when its swept
+        parameter is the clearance of ``var``.
+    named
+        Event kinds already in the legend (updated): each kind is named once per axes.
 
     Returns
     -------
@@ -89,19 +211,15 @@ def branch_overlay(
         The artists carry ``gid`` ``branch:stable``, ``branch:unstable`` and
         ``branch:event:<kind>``.
     """
+    y = _section_values(branch, var, planet)
     name = str(branch.attrs.get("parameter", ""))
-    if name not in branch.coords or var not in branch.data_vars:
-        have = ", ".join(str(v) for v in branch.data_vars if "section" in branch[v].dims)
-        raise ParameterError(f"var must be a section variable of the branch ({have}): got {var!r}")
     ax = get_ax(ax)
     lam = np.asarray(branch[name].values, dtype=np.float64)
-    da = branch[var]
-    if "planet" in da.dims:
-        planets = [int(p) for p in np.asarray(branch["planet"].values)]
-        if planet not in planets:
-            raise ParameterError(f"planet must be one of the branch's {planets}: got {planet!r}")
-        da = da.sel(planet=planet)
-    y = np.asarray(da.transpose("point", "section").values, dtype=np.float64)
+    if relative:
+        b = branch_clearance(branch, var)
+        if b is None:
+            raise ParameterError(f"relative=True needs a clearance of {var!r}: it has none")
+        y = y - b[:, None]
     stable = np.asarray(branch["stable"].values, dtype=bool)
     n = int(branch.attrs.get("period", 1))
     text = label or f"period-{n} branch"
@@ -119,41 +237,220 @@ def branch_overlay(
                 yy,
                 style,
                 color=color,
-                lw=1.1 if which else 0.9,
+                lw=1.3 if which else 1.0,
                 zorder=3,
                 gid=f"{BRANCH_GID}:{'stable' if which else 'unstable'}",
                 label=(f"{text} ({'stable' if which else 'unstable'})" if j == 0 else None),
             )
     if events and branch.sizes.get("event", 0):
-        seen: set[str] = set()
-        for k in range(branch.sizes["event"]):
-            kind = str(branch.event_kind.values[k])
-            marker, colour, short = EVENT_STYLE.get(kind, ("o", "k", kind))
-            value = float(branch.event_value.values[k])
-            i = int(branch.event_point.values[k])
-            i = min(max(i, 0), y.shape[0] - 1)
-            ys = y[i]
-            ax.scatter(
-                np.full(ys.size, value),
-                ys,
-                marker=marker,
-                s=36,
-                facecolors="none" if marker not in ("x", "P") else colour,
-                edgecolors=colour,
-                linewidths=1.2,
-                zorder=4,
-                gid=f"{BRANCH_GID}:event:{kind}",
-                label=short if short not in seen else None,
-            )
-            seen.add(short)
-            ax.annotate(
-                short,
-                (value, float(np.nanmax(ys))),
-                xytext=(0, 6),
-                textcoords="offset points",
-                ha="center",
-                fontsize="x-small",
-                color=colour,
-                gid=f"{BRANCH_GID}:event-label",
-            )
+        _draw_events(ax, branch, y, set() if named is None else named)
     return ax
+
+
+def _draw_events(ax: Any, branch: Any, y: np.ndarray, named: set[str]) -> None:
+    s = np.asarray(branch["arclength"].values, dtype=np.float64)
+    for k in range(branch.sizes["event"]):
+        kind = str(branch.event_kind.values[k])
+        marker, colour, short = EVENT_STYLE.get(kind, ("o", "k", kind))
+        value = float(branch.event_value.values[k])
+        i = min(max(int(branch.event_point.values[k]), 0), y.shape[0] - 1)
+        ys = y[i]
+        if i + 1 < y.shape[0] and s[i + 1] > s[i]:  # between the two points, in arclength
+            f = (float(branch.event_arclength.values[k]) - s[i]) / (s[i + 1] - s[i])
+            ys = y[i] + min(max(f, 0.0), 1.0) * (y[i + 1] - y[i])
+        filled = marker in ("x", "P")  # line markers take one colour, the others a rim
+        ax.scatter(
+            np.full(ys.size, value),
+            ys,
+            marker=marker,
+            s=40,
+            **({"c": colour} if filled else {"facecolors": "none", "edgecolors": colour}),
+            linewidths=1.3,
+            zorder=4,
+            gid=f"{BRANCH_GID}:event:{kind}",
+            label=EVENT_NAMES.get(kind, kind) if kind not in named else None,
+        )
+        named.add(kind)
+        ax.annotate(
+            short,
+            (value, float(np.nanmax(ys))),
+            xytext=(0, 6),
+            textcoords="offset points",
+            ha="center",
+            fontsize="x-small",
+            color=colour,
+            gid=f"{BRANCH_GID}:event-label",
+        )
+
+
+def _given(branch: Any) -> list[str]:
+    """``symbol = value`` of the values the branch holds fixed: its fixed values, then b̄_sp,
+    b̄_rp, b̄_s and ξ of its gear set, leaving out the continued parameter."""
+    name = str(branch.attrs.get("parameter", ""))
+    out, shown = [], {name}
+    for k, v in _fixed(branch).items():
+        if isinstance(v, int | float) and not isinstance(v, bool) and k not in shown:
+            out.append(f"{axis_symbol(k)} = {fmt(v)}")
+            shown.add(k)
+    gs = _gearset(branch)
+    if gs is None:  # a reference system: its parameters with a symbol, from its repr
+        import re
+
+        text = str(branch.attrs.get("model_parameters", ""))
+        for k, v in re.findall(r"(\w+)=([-+0-9.eE]+)[,)]", text):
+            if k not in shown and axis_symbol(k) != k:
+                out.append(f"{axis_symbol(k)} = {fmt(float(v))}")
+        return out
+    bsp, brp = gs.backlash_bar()
+    for key, value in (
+        ("backlash.sun_planet", bsp),
+        ("backlash.planet_ring", brp),
+        ("clearance.sun_bearing", gs.sun_bearing_clearance_bar()),
+    ):
+        if key not in shown:
+            out.append(f"{axis_symbol(key)} = {fmt(value)}")
+    d = gs.damping
+    damping = {"xi", "damping.sun_planet", "damping.planet_ring", "damping.sun_bearing"}
+    if not damping & shown and d.sun_planet == d.planet_ring == d.sun_bearing:
+        out.append(f"{axis_symbol('xi')} = {fmt(d.sun_planet)}")
+    return out
+
+
+def branch_figure(
+    branches: Sequence[Any],
+    *,
+    var: str | None = None,
+    planet: int = 1,
+    relative: bool | None = None,
+    clearance_lines: bool = False,
+    resonances: bool = False,
+    physical: bool = True,
+    figsize: tuple[float, float] | None = None,
+) -> Any:
+    """One or several continued branches on their own: the section values of ``var`` of each
+    periodic orbit against the continued parameter, stable stretches solid, unstable ones
+    dashed, the events marked and named in the legend; the gear set and the values it holds
+    fixed in the title.
+
+    Parameters
+    ----------
+    branches
+        Branch datasets of one parameter (:func:`gearchaos.analysis.open_branch`).
+    var, planet
+        Section variable (default ``delta_sp``, else the first one the branches observed) and
+        planet.
+    relative
+        Draw X̄ − b̄ (default: when the continued parameter is the clearance of ``var``).
+    clearance_lines
+        Dashed lines at ±b̄ of the variable's clearance (0 and −2b̄, the flank edges, when
+        ``relative``).
+    resonances
+        When the parameter is Ω: the mesh-harmonic resonances of the gear set, as in
+        :func:`~gearchaos.plot.bifurcation.bifurcation`.
+    physical
+        Physical axes opposite the dimensionless ones (µm, mm/s; sun speed in rpm).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from matplotlib.figure import Figure
+
+    branches = list(branches)
+    if not branches:
+        raise ParameterError("branches must hold at least one branch: got none")
+    names = [str(br.attrs.get("parameter", "")) for br in branches]
+    if len(set(names)) > 1:
+        raise ParameterError(
+            f"branches must continue one parameter to share an axis: got {', '.join(names)}"
+        )
+    name = names[0]
+    if var is None:
+        have = [str(v) for v in branches[0].data_vars if "section" in branches[0][v].dims]
+        if not have:
+            raise ParameterError("the branch holds no section variable (dimension 'section')")
+        var = "delta_sp" if "delta_sp" in have else have[0]
+    clearances = [branch_clearance(br, var) for br in branches]
+    if relative is None:
+        relative = all(b is not None and np.ptp(b) > 0 for b in clearances)
+    fig = Figure(figsize=figsize or (7.0, 4.8), layout="constrained")
+    ax = fig.add_subplot()
+    labels = branch_labels(branches) if len(branches) > 1 else [None]
+    named: set[str] = set()
+    ys = []
+    for k, br in enumerate(branches):
+        colour = BRANCH_COLOURS[k % len(BRANCH_COLOURS)]
+        branch_overlay(
+            br, ax, var=var, planet=planet, color=colour, label=labels[k], relative=relative,
+            named=named,
+        )  # fmt: skip
+        y = _section_values(br, var, planet)
+        b = clearances[k]
+        ys.append(y - b[:, None] if relative and b is not None else y)
+    lam = np.concatenate([np.asarray(br[name].values, dtype=float) for br in branches])
+    ax.set_xlim(*_padded(lam))
+    fit_to_data(ax, None, np.concatenate([y.ravel() for y in ys]))
+    sym = _clearance_symbol(var)
+    b0 = clearances[0]
+    if clearance_lines and b0 is not None:
+        levels = [0.0] if relative else [float(b0[0]), -float(b0[0])]
+        for level in levels:
+            ax.axhline(level, color="0.35", ls=":", lw=0.9, zorder=1, gid="clearance")
+        clearance_notes(ax, "y", levels, sym)
+        if relative:
+            for br, b in zip(branches, clearances, strict=True):
+                if b is not None:
+                    x = np.asarray(br[name].values, dtype=float)
+                    ax.plot(x, -2.0 * b, color="0.35", ls=":", lw=0.9, zorder=1, gid="clearance")
+    gs = _gearset(branches[0])
+    if resonances and name == "omega":
+        resonance_lines(ax, gs, *ax.get_xlim())
+    ax.set_xlabel(axis_label(name))
+    ylabel = var_symbol(var, planet if "planet" in branches[0][var].dims else None)
+    ax.set_ylabel(f"${ylabel} - {sym}$" if relative else f"${ylabel}$")
+    if physical and gs is not None:
+        from ..model.planetary import PlanetaryModel
+
+        scales = PhysicalScales.of_model(PlanetaryModel.from_gearset(gs))
+        secondary_axis(ax, "y", var_quantity(var), scales)
+        if name == "omega":
+            secondary_axis(ax, "x", "omega", scales)
+    ax.legend(loc="best", fontsize="small")
+    fig.suptitle(_title(branches, var, planet), fontsize="medium")
+    return fig
+
+
+def _padded(v: np.ndarray) -> tuple[float, float]:
+    lo, hi = float(np.nanmin(v)), float(np.nanmax(v))
+    pad = 0.02 * (hi - lo) if hi > lo else 0.05 * max(abs(lo), 1.0)
+    return lo - pad, hi + pad
+
+
+def _title(branches: list[Any], var: str, planet: int) -> str:
+    first = branches[0]
+    gs = _gearset(first)
+    model = gs.name if gs is not None else str(first.attrs.get("model", ""))
+    periods = sorted({int(br.attrs.get("period", 1)) for br in branches})
+    what = (
+        f"continued period-{periods[0]} orbit"
+        if len(branches) == 1
+        else "continued branches of period " + ", ".join(str(n) for n in periods)
+    )
+    lines = [f"{model}: {what}, section values against {axis_symbol(first.attrs['parameter'])}"]
+    given = _given(first)
+    if given:
+        lines.append("at " + ", ".join(given))
+    rtol = first.attrs.get("rtol")
+    u = [
+        float(x)
+        for br in branches
+        if "event_uncertainty" in br
+        for x in np.asarray(br["event_uncertainty"].values)
+        if np.isfinite(x)
+    ]
+    solver = f"shooting + pseudo-arclength continuation, rtol {fmt(rtol)}" if rtol else ""
+    if u:
+        solver += f"; events located to ±{max(u):.0e} or better"
+    if solver:
+        lines.append(solver)
+    return "\n".join(lines)
