@@ -144,6 +144,15 @@ def poincare_map(
     return ax
 
 
+def _equal_spans(ax: Any) -> None:
+    """Widen the shorter of the two axis ranges about its centre to the longer one."""
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    half = max(x1 - x0, y1 - y0) / 2
+    cx, cy = (x0 + x1) / 2, (y0 + y1) / 2
+    ax.set_xlim(cx - half, cx + half)
+    ax.set_ylim(cy - half, cy + half)
+
+
 def sun_orbit(result: Any, ax: Any = None, periods: float | None = None) -> Any:
     """Plot the sun-centre orbit ȳ_s against x̄_s with the bearing clearance square.
 
@@ -202,9 +211,12 @@ def sun_orbit(result: Any, ax: Any = None, periods: float | None = None) -> Any:
         )
     else:
         fit_to_data(ax, data_x, data_y, joint=True)
+        _equal_spans(ax)
         if b is not None and b > 0:
             clearance_notes(ax, "x", (-b, b), r"\bar{b}_s")
-    ax.set_aspect("equal", adjustable="datalim")
+    # square limits in a square box: equal aspect without overruling the fixed limits at
+    # every draw ("datalim" did, and matplotlib logged "Ignoring fixed y limits …" each time)
+    ax.set_aspect("equal", adjustable="box")
     ax.set_xlabel(xi.label)
     ax.set_ylabel(yi.label)
     return ax
