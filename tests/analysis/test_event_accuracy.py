@@ -2,7 +2,8 @@
 accurately (issue 24).
 
 The backlash oscillator (MODEL.md §10.5) with F_a = F_m grazes where Ω² = 1/(2 − 4ζ²) (closed
-form; see tests/analysis/test_continuation.py) and has a period doubling near Ω ≈ 1.95. With
+form; see tests/analysis/test_continuation.py), folds at Ω ≈ 0.731 and has a period doubling
+near Ω ≈ 1.95. With
 the default settings (rtol 1e-8) each event's stated uncertainty must
 
 * cover the distance to the same event located with a much tighter event tolerance (the
@@ -40,7 +41,12 @@ def one_event(ds, kind: str):
 
 
 @pytest.mark.parametrize(
-    ("vary", "kind"), [("omega=2.1:1.8", "period_doubling"), ("omega=0.6:0.72", "grazing")]
+    ("vary", "kind"),
+    [
+        ("omega=2.1:1.8", "period_doubling"),
+        ("omega=0.6:0.72", "grazing"),
+        ("omega=0.6:0.8", "fold"),  # the branch turns back at Ω ≈ 0.731, after grazing
+    ],
 )
 def test_default_event_location_is_within_its_stated_uncertainty(vary, kind, tmp_path) -> None:
     path = tmp_path / "branch.nc"

@@ -9,16 +9,16 @@ resolve nothing the corrector resolves).
 
 Every event carries its location **uncertainty** in the parameter,
 
-    u = |dλ/ds| (h + 2 δs),    δs = |f(z_e; rtol/100) − f(z_e; rtol)| / |df/ds|,
+    u = |dλ/ds| (h + 2 δs) + 2 |λ_c − λ_e|,    δs = |f(z_c) − f(z_e)| / |df/ds|,
 
-h the half-width of the final bracket (the root-finding error), δs the shift of the root
-that the integrator's error of the test function f causes: f at the event is evaluated again
-from the event point corrected onto the same hyperplane with rtol and atol a hundred
-times smaller (the integrator's error there is then about 1 % of that at rtol), and divided by
-the slope of f between the two branch points. The factor 2 covers the check's own error and a
-secant slope that differs from the slope at the event. |dλ/ds| is bounded by the larger
-|dλ/ds| of the two points (at a fold it is small: λ is extremal there and barely moves with
-the arclength).
+h the half-width of the final bracket (the root-finding error); z_c = (y_c, λ_c) the event
+point z_e corrected again onto the same hyperplane (normal to the tangent) with rtol and atol a
+hundred times smaller, where the integrator's error is about 1 % of that at rtol. The
+integrator's error moves the event two ways: along the branch, δs, the change of the test
+function f divided by its slope between the two branch points; and the branch itself, λ_c −
+λ_e (at a fold, where the hyperplane leaves λ free, this is the whole error: dλ/ds = 0 there).
+The factors 2 cover the check's own error and a secant slope that differs from the slope at
+the event. |dλ/ds| is bounded by the larger |dλ/ds| of the two points.
 """
 
 from __future__ import annotations
@@ -129,7 +129,7 @@ def locate(
         abs(fb - fa) / span if span > 0 else math.nan,
         dlam_ds,
         span,
-    )
+    ) + (2.0 * abs(check.lam - pt.lam) if check is not None else 0.0)
     mu_c = ev.critical_multiplier(kind, pt.mu)
     vec = ev.eigenvector(pt.monodromy, mu_c) if kind != "grazing" else np.zeros(pt.y.size)
     return {
@@ -158,7 +158,7 @@ def check_point(br: Any, p: Solution, pt: Solution) -> Solution | None:
     if rtol >= float(cfg.rtol):
         return pt
     fine = replace(cfg, rtol=rtol, atol=float(cfg.atol) / CHECK_FACTOR)
-    prob = replace(br.prob, settings=fine, tol=default_tol(fine))
+    prob = replace(br.prob, settings=fine, tol=default_tol(fine), fd_step=0.0)  # G_λ: pt's
     assert p.tangent is not None
     normal = br.weight(p.tangent)
     z = pt.z
