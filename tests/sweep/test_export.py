@@ -135,3 +135,40 @@ def test_a_csv_stands_alone(tmp_path: Path, sheng: gc.GearSet) -> None:
 
     df = pd.read_csv(out, comment="#")
     assert len(df) > 0 and "status" in df.columns
+
+
+def test_csv_has_every_planets_extrema_and_contact_regimes(store: Path, tmp_path: Path) -> None:
+    """Issue 24: the per-planet extrema, the contact regimes (``contact_sp``) and the final
+    state were left out of the CSV although its help says one column per variable; they are
+    one column per planet (or state), equal to the store's values on every row of the point."""
+    out = gc.export(store, tmp_path / "wide.csv")
+    text = out.read_text(encoding="utf-8")
+    df = pd.read_csv(out, comment="#")
+    ds = gc.open_sweep(store).load()
+    wide = [n for n, v in ds.data_vars.items() if "planet_all" in v.dims or "state" in v.dims]
+    assert {"contact_sp", "contact_rp", "delta_sp_min", "delta_rp_max", "final_state"} <= set(wide)
+    for name in wide:
+        dim = "planet_all" if "planet_all" in ds[name].dims else "state"
+        labels = [f"p{p}" if dim == "planet_all" else str(p) for p in ds[dim].values]
+        for label, coord in zip(labels, ds[dim].values, strict=True):
+            col = f"{name}_{label}"
+            assert col in df.columns, col
+            for _, row in df.sample(10, random_state=1).iterrows():
+                want = ds[name].sel({"xi": row["xi"], "omega": row["omega"], dim: coord})
+                assert row[col] == want.item(), (col, row["xi"], row["omega"])
+    # five planets, though only planets 1 and 3 were observed at the section
+    assert [c for c in df.columns if c.startswith("contact_sp_")] == [
+        f"contact_sp_p{p}" for p in range(1, 6)
+    ]
+    # the coded regime columns come with their legend
+    assert "# contact_sp: -1 = unknown, 0 = none, 1 = single_sided, 2 = double_sided" in text
+
+
+def test_simulation_csv_has_the_extrema_of_every_planet(simulation: Path, tmp_path: Path) -> None:
+    out = gc.export(simulation, tmp_path / "sim.csv")
+    df = pd.read_csv(out, comment="#")
+    ds = gc.open_simulation(simulation)
+    for p in range(1, 6):
+        assert (df[f"delta_sp_min_p{p}"] == ds["delta_sp_min"].sel(planet=p).item()).all()
+    # the time samples stay rows, never columns
+    assert len(df.columns) < 120

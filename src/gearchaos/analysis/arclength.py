@@ -54,6 +54,7 @@ from .orbits import (
     check_tol,
     contact_levels,
     initial_guess,
+    settled_orbit,
     solve_orbit,
     split_values,
 )
@@ -453,18 +454,24 @@ def continuation(
 
         warn_if_eccentric(gs, "Poincaré section")
     br.levels = contact_levels(system0)
-    if guess is None or (isinstance(guess, PeriodicOrbit) and guess.period != n):
-        y0 = initial_guess(system0, None, n, cfg)
-    else:
-        y0 = initial_guess(system0, guess, n, cfg, what="start")
     if switch is None:
-        orbit = solve_orbit(system0, y0, n, cfg, eps, 40)
+        if guess is None or (isinstance(guess, PeriodicOrbit) and guess.period != n):
+            # from rest, settled longer while the shooting does not converge
+            orbit = settled_orbit(system0, n, cfg, eps, 40, want_stable=False)
+        else:
+            orbit = solve_orbit(
+                system0, initial_guess(system0, guess, n, cfg, what="start"), n, cfg, eps, 40
+            )
         if not orbit.converged:
             raise IntegrationError(
                 f"no period-{n} orbit converged at {name}={lam0:g} ({orbit.message}, residual "
-                f"{orbit.residual:.3g}); pass a better start (a state or a PeriodicOrbit)"
+                f"{orbit.residual:.3g}); start from a better state: start= a state or a "
+                "PeriodicOrbit (gearchaos continue --from STORE --at NAME=VALUE, a branch or "
+                "an orbit file), or settle longer (transient_periods, --transient)"
             )
         y0 = orbit.state
+    else:
+        y0 = initial_guess(system0, guess, n, cfg, what="start")
     br.kappa = span / (max(1.0, float(np.max(np.abs(y0)))) * math.sqrt(y0.size))
     e_lam = np.zeros(y0.size + 1)
     e_lam[-1] = 1.0

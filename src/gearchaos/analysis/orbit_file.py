@@ -15,7 +15,6 @@ from typing import Any
 from .._files import check_output_file, check_regular_file
 from .._output import check_replaceable, file_has_mark, write_file
 from ..errors import ParameterError, StoreError
-from .orbits import PeriodicOrbit
 
 __all__ = ["ORBIT_TITLE", "is_orbit_file", "open_orbit", "save_orbit"]
 
@@ -23,10 +22,11 @@ __all__ = ["ORBIT_TITLE", "is_orbit_file", "open_orbit", "save_orbit"]
 ORBIT_TITLE = "gearchaos periodic orbit"
 
 
-def save_orbit(orbit: PeriodicOrbit, path: str | os.PathLike[str]) -> str:
+def save_orbit(orbit: Any, path: str | os.PathLike[str]) -> str:
     """Write ``orbit`` to a netCDF-4 file (h5netcdf); returns the path. A file there is replaced
     only when gearchaos wrote it (else :class:`~gearchaos.errors.StoreError`)."""
-    if not isinstance(orbit, PeriodicOrbit):
+    # a PeriodicOrbit (checked by what it offers: orbits.py imports this module)
+    if not (hasattr(orbit, "to_dataset") and hasattr(orbit, "multipliers")):
         raise ParameterError(f"orbit must be a PeriodicOrbit: got {type(orbit).__name__}")
     text = check_output_file(path, what="orbit file")
     check_replaceable(text, what="orbit file", ours=is_orbit_file)

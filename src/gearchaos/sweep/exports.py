@@ -6,8 +6,10 @@ open :class:`xarray.Dataset` of either kind and writes
 * ``csv`` — one row per point and section sample (a tidy table): the swept parameters, the
   section index (and ``tau`` for a simulation), the planet where a variable is per planet, then
   one column per variable; per-point variables (``status``, ``motion``, ``lle`` …) repeat on the
-  rows of their point. A header of ``#`` lines carries the provenance (gear set name, settings,
-  versions), which ``pandas.read_csv(..., comment="#")`` skips.
+  rows of their point, and those over every planet or state get one column per planet or state
+  (``contact_sp_p1`` … ``contact_sp_p5``, ``delta_sp_min_p1``, ``final_state_x_s``). A
+  header of ``#`` lines carries the provenance (gear set name, settings, versions), which
+  ``pandas.read_csv(..., comment="#")`` skips.
 * ``mat`` — every variable and coordinate as a MATLAB array (``scipy.io.savemat``, format 5),
   names with ``.`` turned into ``_`` (``backlash.sun_planet`` → ``backlash_sun_planet``), the
   dimension names of each variable in ``dims_<name>`` and the attributes in the struct
@@ -139,7 +141,48 @@ def table(source: Any) -> Any:
     df = sub.to_dataframe().reset_index()
     order = [*lead, "section", *(["tau"] if "tau" in df.columns else [])]
     order += [c for c in ("planet",) if c in df.columns]
-    return df[[*order, *(c for c in df.columns if c not in order)]]
+    df = df[[*order, *(c for c in df.columns if c not in order)]]
+    wide = _wide_columns(ds, lead, names)
+    if wide:
+        import pandas as pd
+
+        extra = pd.DataFrame(wide)
+        if lead:  # per point: repeated on the rows of the point, matched by its coordinates
+            keys = {d: np.asarray(ds[d].values) for d in lead}
+            grid = np.meshgrid(*keys.values(), indexing="ij")
+            for d, g in zip(keys, grid, strict=True):
+                extra[d] = g.reshape(-1)
+            df = df.merge(extra, on=lead, how="left", sort=False)
+        else:
+            for col, values in wide.items():
+                df[col] = values[0]
+    return df
+
+
+#: Dimensions spread over one column per value (planets, state components).
+_WIDE_DIMS = ("planet_all", "planet", "state")
+
+
+def _wide_columns(ds: Any, lead: list[str], skip: list[str]) -> dict[str, np.ndarray]:
+    """The per-point variables over one more dimension (the extrema and contact regimes of every
+    planet over ``planet_all``, the final state over ``state``) as one column per value of that
+    dimension: ``contact_sp_p3``, ``delta_sp_min_p1``, ``final_state_x_s``; values flattened in
+    the order of the lead dimensions."""
+    out: dict[str, np.ndarray] = {}
+    for name, var in ds.data_vars.items():
+        if name in skip or "section" in var.dims:
+            continue
+        extra = [d for d in var.dims if d not in lead]
+        if len(extra) != 1 or [d for d in var.dims if d in lead] != lead:
+            continue
+        (dim,) = extra
+        if dim not in _WIDE_DIMS:  # e.g. the time samples of a simulation: not one per column
+            continue
+        values = var.transpose(*lead, dim).values.reshape(-1, var.sizes[dim])
+        prefix = "p" if dim in ("planet_all", "planet") else ""
+        for k, label in enumerate(np.asarray(ds[dim].values)):
+            out[f"{name}_{prefix}{label}"] = values[:, k]
+    return out
 
 
 def _mat_name(name: str) -> str:
@@ -211,7 +254,7 @@ def export(source: Any, path: str | os.PathLike[str], *, to: str | None = None) 
                 if name:
                     header.insert(0, f"# gearset = {name.group(1)}")
             header.insert(0, f"# gearchaos {__version__} export of {os.fspath(source)}")
-            header += _provenance_lines(ds, [str(c) for c in df.columns])
+            header += _provenance_lines(ds, [*map(str, df.columns), *map(str, ds.data_vars)])
             with open(tmp, "w", encoding="utf-8", newline="") as f:
                 f.write("\n".join(header) + ("\n" if header else ""))
                 df.to_csv(f, index=False)  # floats as repr: the shortest exact text
