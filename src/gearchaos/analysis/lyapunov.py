@@ -26,6 +26,7 @@ import numpy as np
 
 from .._checks import check_int
 from ..errors import ParameterError, Status
+from ..gearset import GearSet
 from ..integrate.settings import MAX_SAMPLES_PER_PERIOD, SolverSettings
 from ..integrate.simulate import integrate
 from ..model.system import System
@@ -179,6 +180,10 @@ def lyapunov_spectrum(
         if key in values:
             raise ParameterError(f"parameter {key!r} is given twice (keyword and params)")
         values[key] = value
+    if not isinstance(system, System | GearSet):
+        raise ParameterError(
+            f"system must be a System or a GearSet (with omega=): got {type(system).__name__}"
+        )
     if not isinstance(system, System) or values:
         system = resolve(system, values)
     per_period = check_int(

@@ -17,6 +17,7 @@ import numpy as np
 
 from .._checks import check_real
 from ..errors import ParameterError, Status
+from ..model.response import compressive_contact_forces
 from ..model.system import System
 from ._chains import ChainRun, SampleArrays, run_chains
 from .settings import SolverSettings
@@ -93,13 +94,21 @@ def integrate_batch(
     cfg.check_memory(n + systems[0].n_obs + 1, points=m)
     run = ChainRun.from_systems([[s] for s in systems], cfg, y0=y0, max_step=max_step)
     out = run_chains(run)
+    # contact forces as the flanks carry them, each point with its own clearances (as simulate)
+    observables = np.array(out.observables[:, 0], dtype=np.float64)
+    obs_min = np.array(out.obs_min[:, 0], dtype=np.float64)
+    obs_max = np.array(out.obs_max[:, 0], dtype=np.float64)
+    for i, system in enumerate(systems):
+        observables[i], obs_min[i], obs_max[i] = compressive_contact_forces(
+            system, observables[i], obs_min[i], obs_max[i]
+        )
     return BatchResult(
         systems=systems,
         tau=out.tau[:, 0],
         states=out.states[:, 0],
-        observables=out.observables[:, 0],
-        obs_min=out.obs_min[:, 0],
-        obs_max=out.obs_max[:, 0],
+        observables=observables,
+        obs_min=obs_min,
+        obs_max=obs_max,
         final_state=out.final_state[:, 0],
         status=out.status[:, 0],
         steps_accepted=out.info[:, 0, 0].astype(np.int64),
