@@ -14,9 +14,11 @@ from typing import Any
 import numba
 import numpy as np
 from numba import typeof, types
+from numba.core import cgutils
 from numba.core.errors import NumbaIRAssumptionWarning
+from numba.extending import intrinsic
 
-__all__ = ["call_literal", "entry_point", "njit_noalloc", "on_first_compile"]
+__all__ = ["call_literal", "entry_point", "njit_noalloc", "on_first_compile", "stack_array"]
 
 #: ``@njit_noalloc``: a cached kernel compiled without numba's reference counting, for kernels
 #: that allocate nothing (right-hand sides, tangents, the integrator's switch helpers). A call
@@ -129,3 +131,33 @@ def guard_cache(dispatchers: list[Any], sources: list[str]) -> None:
                 f.write(digest)
         except Exception:  # best effort: never break an import
             continue
+
+
+def _stack_array(typingctx: Any, size: Any) -> Any:
+    """``stack_array(N)``: an uninitialised float64 work array of the compile-time constant
+    length N on the stack of the compiled function (allocated once, in its entry block): work
+    space for kernels compiled without numba's allocator (:data:`njit_noalloc`), such as the
+    finite-difference tangent of a model without its own."""
+    if not isinstance(size, types.IntegerLiteral):
+        return None
+    n = int(size.literal_value)
+    arr_t = types.Array(types.float64, 1, "C")
+
+    def codegen(context: Any, builder: Any, sig: Any, args: Any) -> Any:
+        length = context.get_constant(types.intp, n)
+        ptr = cgutils.alloca_once(builder, context.get_value_type(types.float64), size=length)
+        ary = context.make_array(arr_t)(context, builder)
+        context.populate_array(
+            ary,
+            data=ptr,
+            shape=cgutils.pack_array(builder, [length]),
+            strides=cgutils.pack_array(builder, [context.get_constant(types.intp, 8)]),
+            itemsize=context.get_constant(types.intp, 8),
+            meminfo=None,
+        )
+        return ary._getvalue()
+
+    return arr_t(size), codegen
+
+
+stack_array: Any = intrinsic(_stack_array)

@@ -277,6 +277,25 @@ def load_gearset(
     return gs
 
 
+def load_target(
+    preset: str | None,
+    gearset_file: Path | None,
+    model: str | None,
+    changes: Mapping[str, object] | None = None,
+) -> Any:
+    """The gear set of ``--preset``/``--gearset`` with ``changes`` (:func:`load_gearset`), or,
+    with ``--model``, a :class:`~gearchaos.model.System` of that model class with ``changes``
+    as its parameters (at Ω = DEFAULT_OMEGA until a command sets Ω)."""
+    if model is None:
+        return load_gearset(preset, gearset_file, changes)
+    if preset is not None or gearset_file is not None:
+        raise ParameterError("--model excludes --preset and --gearset: give one of them")
+    from ..model import System
+    from ..model.contract import build_model, load_model_class
+
+    return System(build_model(load_model_class(model), dict(changes or {})), DEFAULT_OMEGA)
+
+
 def default_omega_note(quiet: bool, what: str = "swept") -> None:
     """Tell the user which Ω a command uses when it is neither swept nor set."""
     if not quiet:
@@ -364,6 +383,17 @@ GearsetOpt = Annotated[
         "-g",
         help="Gear-set TOML file (start from `gearchaos init-gearset`). Excludes --preset.",
         dir_okay=False,
+        show_default=False,
+    ),
+]
+ModelOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--model",
+        "-m",
+        help="Your own model instead of a gear set: FILE.py:CLASS, MODULE:CLASS or an installed "
+        "name (see docs/howto/own-model.md); --set NAME=VALUE sets its parameters. Excludes "
+        "--preset and --gearset.",
         show_default=False,
     ),
 ]

@@ -72,6 +72,7 @@ def _start_values(
     preset: str | None,
     gearset: Path | None,
     sets: list[str],
+    model: str | None = None,
 ) -> tuple[Any, dict[str, Any], Any]:
     """(gear set, parameter values, start or None) of ``orbit`` and ``continue``: from
     ``--from``/``--at`` when given (its gear set and values, ``--set`` on top), else the gear
@@ -83,7 +84,9 @@ def _start_values(
         if at is not None:
             raise ParameterError(f"--at picks a point of --from, which is missing: got --at {at}")
         values: dict[str, Any] = {} if omega is None else {OMEGA: omega}
-        return c.load_gearset(preset, gearset, changes), values, None
+        return c.load_target(preset, gearset, model, changes), values, None
+    if model is not None:
+        raise ParameterError("--from brings the model it was computed for: drop --model")
     if preset is not None or gearset is not None:
         raise ParameterError(
             "--from brings the gear set it was computed for: drop --preset/--gearset (change "
@@ -105,6 +108,7 @@ def _spinner(text: str, quiet: bool) -> contextlib.AbstractContextManager[Any]:
 def orbit(
     preset: c.PresetOpt = None,
     gearset: c.GearsetOpt = None,
+    model: c.ModelOpt = None,
     set_: c.SetOpt = None,
     period: PeriodOpt = None,
     transient: GuessOpt = 50.0,
@@ -142,7 +146,7 @@ def orbit(
     from ..analysis.orbits import periodic_orbit
 
     with c.reported_errors():
-        gs, values, start = _start_values(from_, at, preset, gearset, set_ or [])
+        gs, values, start = _start_values(from_, at, preset, gearset, set_ or [], model)
         values.setdefault("omega", c.DEFAULT_OMEGA)
         omega = values["omega"]
         settings = c.solver_settings(transient, 1, rtol, atol)
@@ -220,6 +224,7 @@ def continue_(
     ] = None,
     preset: c.PresetOpt = None,
     gearset: c.GearsetOpt = None,
+    model: c.ModelOpt = None,
     set_: c.SetOpt = None,
     period: PeriodOpt = None,
     transient: GuessOpt = 50.0,
@@ -263,7 +268,11 @@ def continue_(
             raise ParameterError(f"{name} is both continued and set with --set; choose one")
         if from_ is None:
             omega, changes = c.parse_sets(set_ or [])
-            gs = c.load_gearset(preset, gearset)
+            if model is not None:  # the model's parameters are set on it
+                gs = c.load_target(preset, gearset, model, changes)
+                changes = {}
+            else:
+                gs = c.load_gearset(preset, gearset)
             values: dict[str, Any] = dict(changes)
             start = None
             if name != "omega":
@@ -272,7 +281,7 @@ def continue_(
                     c.default_omega_note(quiet or json_out, "continued")
                 values["omega"] = omega
         else:
-            gs, values, start = _start_values(from_, at, preset, gearset, set_ or [])
+            gs, values, start = _start_values(from_, at, preset, gearset, set_ or [], model)
         settings = c.solver_settings(transient, 1, rtol, atol)
         period = _period(period, start)
         first = None
@@ -363,6 +372,7 @@ def _with_uncertainty(value: float, u: float | None) -> str:
 def attractors(
     preset: c.PresetOpt = None,
     gearset: c.GearsetOpt = None,
+    model: c.ModelOpt = None,
     set_: c.SetOpt = None,
     starts: Annotated[
         int,
@@ -395,7 +405,7 @@ def attractors(
 
     with c.reported_errors():
         omega, changes = c.parse_sets(set_ or [])
-        gs = c.load_gearset(preset, gearset, changes)
+        gs = c.load_target(preset, gearset, model, changes)
         if omega is None:
             omega = c.DEFAULT_OMEGA
             c.default_omega_note(json_out, "set")

@@ -77,8 +77,8 @@ def reproduce(
     b̄_rp ∈ [1, 9] at Ω = 1.5, ξ = 0.05, at the values the seed's text names.
 
     --all runs every figure into OUTPUT, checks the conclusions of the seed's Section 4 and its
-    landmarks against the runs and writes the report OUTPUT/index.html (resumable; 4–8 minutes
-    on 2 cores, --quick about a minute).
+    landmarks against the runs and writes the report OUTPUT/index.html (resumable, with
+    progress; the report records its own run time; --quick is a coarse version for CI).
 
     Example: **gearchaos reproduce fig4 -o paper/ --quick**;
     **gearchaos reproduce --all -o report/**

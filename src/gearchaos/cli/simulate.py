@@ -19,6 +19,7 @@ from ._render import add_motion_rows
 def simulate(
     preset: c.PresetOpt = None,
     gearset: c.GearsetOpt = None,
+    model: c.ModelOpt = None,
     set_: c.SetOpt = None,
     transient: c.TransientOpt = SIMULATION.transient_periods,
     settle: c.SettleOpt = "off",
@@ -90,7 +91,7 @@ def simulate(
         if output is not None and output.exists() and not output.is_dir():
             raise ParameterError(f"--output must be a directory: {str(output)!r} is a file")
         omega, changes = c.parse_sets(set_ or [])
-        gs = c.load_gearset(preset, gearset, changes)
+        gs = c.load_target(preset, gearset, model, changes)
         omega = c.DEFAULT_OMEGA if omega is None else omega
         settings = c.solver_settings(
             transient, periods, rtol, atol, samples_per_period, settle, perturbation

@@ -84,6 +84,7 @@ def bifurcation(
     ] = None,
     preset: c.PresetOpt = None,
     gearset: c.GearsetOpt = None,
+    model: c.ModelOpt = None,
     set_: c.SetOpt = None,
     observe: Annotated[
         list[str] | None,
@@ -222,9 +223,13 @@ def bifurcation(
             transient, periods, rtol, atol, settle=settle, perturbation=perturbation
         )
         omega, changes = c.parse_sets(set_ or [])
-        gs = c.load_gearset(preset, gearset)
         swept = {_axis_name(v) for v in vary} | ({_axis_name(family)} if family else set())
-        fixed = c.sweep_fixed(swept, omega, changes, quiet or json_out)
+        if model is not None:  # the model's own parameters are set on it, not fixed
+            gs = c.load_target(preset, gearset, model, changes)
+            fixed = c.sweep_fixed(swept, omega, {}, quiet or json_out)
+        else:
+            gs = c.load_gearset(preset, gearset)
+            fixed = c.sweep_fixed(swept, omega, changes, quiet or json_out)
 
         from .. import sweep
 

@@ -15,9 +15,8 @@ periodic labels confirmed by shooting with their Floquet multipliers, chaos and 
 its standard error over an extension of the run, transients finished.
 
 Cost: the full run is 6 700 sweep points of 200 mesh periods plus 38 gallery values of 600
-periods; on the 2-core reference machine 4–8 minutes in all (3 min 46 s for ``sheng2016``,
-5–8 min for ``hindawi2021``, whose chaotic points take more steps), within the 30-minute target.
-``quick`` (CI) takes about a minute.
+periods; the report records its own wall time (``seconds`` in ``report.json``), and
+``benchmarks/bench_verdicts.py`` measures the verdicts' share against plain sweeps.
 """
 
 from __future__ import annotations

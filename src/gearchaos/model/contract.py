@@ -1,0 +1,378 @@
+"""The model contract: what a model gives gearchaos, and models written outside the package.
+
+Every analysis of gearchaos — simulations, sweeps and stores, motion verdicts, periodic orbits,
+continuation, Lyapunov exponents, attractors, plots, the explorer and the command line — works on
+a :class:`~gearchaos.model.System`, a model at one forcing frequency Ω. A *model* is a frozen
+description of a dimensionless system that provides (:class:`Model`):
+
+``name``
+    A short name (titles, store attributes).
+``state_names``, ``n_state``
+    The state components y, in order.
+``obs_names``, ``n_track``
+    The observables the right-hand side writes, in order: first the ``n_track`` *tracked* ones
+    (the integrator records their extrema over every run and lands steps on their switches),
+    then their τ-derivatives (``n_track`` more), then any others (forces, stiffness …).
+``pack(omega)``
+    The float64 parameter vector ``p`` the compiled right-hand side reads, at Ω.
+``kind``
+    The integer that selects the compiled right-hand side (built-in models have fixed kinds;
+    models from outside get theirs from :func:`register_kernels`).
+``switch_widths`` (optional, default: none)
+    Half clearance b_k of the dead zone acting on each tracked observable (``inf``: smooth):
+    the integrator lands a step where a tracked observable crosses ±b_k, where the vector field
+    has a kink.
+``clearances`` (optional)
+    Half clearances by name (store attributes, figures).
+``contacts`` (optional)
+    The :class:`Contact` s whose regime (no impact, single-sided, double-sided) analyses
+    report: a name, the tracked observable it is judged on, its half clearance and its kind.
+``n_contact_forces`` (optional, default 0)
+    How many tracked observables, at the end of the tracked ones, are contact forces (their
+    extrema give peak forces; they have no switch).
+``default_observables`` (optional)
+    The pair of variables sections and labels use (default: the first tracked observable and
+    its derivative).
+``scales`` (optional)
+    Physical scales (``omega_n``, ``length`` …) for axes in SI units.
+
+The right-hand side is a compiled function ``rhs(t, y, p, dydt, obs, level)`` writing dy/dτ
+into ``dydt[:n_state]`` and the observables into ``obs`` (at least the first ``2 n_track``;
+``level`` says whether all are needed, :data:`~gearchaos.model.kernels.OBS_ALL`); the optional
+tangent ``tangent(t, y, p, obs, dydt, n, k)`` writes J(τ, y[:n]) applied to the ``k`` vectors
+stored after the state in ``y`` into ``dydt[n:]``. A model without a tangent gets a central
+finite-difference one (:func:`~gearchaos.model.kernels.tangent`).
+
+A model defined outside the package subclasses :class:`UserModel` (a frozen dataclass whose
+fields are its parameters) and names its compiled functions ``rhs`` (and ``tangent``); see the
+how-to *Your own gear model* (``docs/howto/own-model.md``) and ``examples/kahraman_singh_1991.py``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import inspect
+from dataclasses import dataclass
+from typing import Any, ClassVar, Protocol, runtime_checkable
+
+import numpy as np
+
+from ..errors import ParameterError
+
+__all__ = [
+    "Contact",
+    "Model",
+    "UserModel",
+    "contacts_of",
+    "default_observables",
+    "register_kernels",
+]
+
+#: Kinds of models from outside the package start here (built-in kinds are below 1000).
+EXTERNAL_KIND_BASE = 1 << 24
+#: The largest state and observable counts a model without its own tangent may have (the
+#: finite-difference tangent keeps its work arrays on the stack).
+FD_MAX_STATE = 256
+FD_MAX_OBS = 1024
+
+
+@dataclass(frozen=True)
+class Contact:
+    """A contact whose regime analyses report: ``name``, the index ``column`` of the tracked
+    observable (a deflection) it is judged on, its half clearance b̄ and its ``kind``
+    (``mesh``: teeth meet at δ = ±b̄, regime from min δ; ``bearing``: a journal touches the
+    bearing at ±b̄, regime from both extrema)."""
+
+    name: str
+    column: int
+    clearance: float
+    kind: str = "mesh"
+
+
+@runtime_checkable
+class Model(Protocol):
+    """What a dimensionless model provides to build a :class:`~gearchaos.model.System` (see
+    the module docstring for the optional members)."""
+
+    name: str
+
+    @property
+    def kind(self) -> int: ...
+
+    @property
+    def n_state(self) -> int: ...
+
+    @property
+    def state_names(self) -> tuple[str, ...]: ...
+
+    @property
+    def obs_names(self) -> tuple[str, ...]: ...
+
+    @property
+    def n_track(self) -> int: ...
+
+    def pack(self, omega: float) -> np.ndarray: ...
+
+
+def contacts_of(model: Any) -> tuple[Contact, ...]:
+    """The model's contacts: its ``contacts``, else none."""
+    return tuple(getattr(model, "contacts", ()))
+
+
+def default_observables(model: Any) -> tuple[str, str]:
+    """The (variable, derivative) pair a model's sections and labels use by default."""
+    pair = getattr(model, "default_observables", None)
+    if pair is not None:
+        return (str(pair[0]), str(pair[1]))
+    names = tuple(model.obs_names)
+    n_track = int(model.n_track)
+    if n_track >= 1 and len(names) >= 2 * n_track:
+        return (names[0], names[n_track])
+    states = tuple(model.state_names)
+    return (states[0], states[1] if len(states) > 1 else states[0])
+
+
+# ------------------------------------------------------------------ models from outside
+_REGISTERED: dict[Any, int] = {}
+
+
+def _source_digest(cls: type, rhs: Any, tangent: Any) -> str:
+    """A digest of the code that defines the model: its module's source file (so an edit of
+    the model, or of a helper in the same file, gives a new kind and a new compilation), else
+    the functions' own source."""
+    h = hashlib.sha256(f"{cls.__module__}:{cls.__qualname__}".encode())
+    try:
+        path = inspect.getsourcefile(cls)
+        if path is None:
+            raise TypeError(cls)
+        with open(path, "rb") as f:
+            h.update(f.read())
+    except (OSError, TypeError):
+        for fn in (rhs, tangent):
+            if fn is not None:
+                try:
+                    h.update(inspect.getsource(getattr(fn, "py_func", fn)).encode())
+                except (OSError, TypeError):
+                    h.update(repr(id(fn)).encode())  # no source: this process only
+    return h.hexdigest()
+
+
+def _compiled(cls: type, attr: str) -> Any:
+    fn = inspect.getattr_static(cls, attr, None)
+    if fn is None:
+        return None
+    if isinstance(fn, staticmethod):
+        fn = fn.__func__
+    if not hasattr(fn, "py_func"):
+        raise ParameterError(
+            f"{cls.__name__}.{attr} must be a numba.njit function (decorate it with "
+            f"@numba.njit(cache=True)): got {type(fn).__name__}"
+        )
+    return fn
+
+
+def register_kernels(cls: type) -> int:
+    """The kernel kind of a model class defined outside the package, its ``rhs`` (and
+    ``tangent``, or the finite-difference tangent) registered with the integrator's dispatch
+    on first use. The kind is derived from the model's source, so that numba's on-disk cache
+    serves a second process without compiling again, and an edited model compiles afresh."""
+    kind = _REGISTERED.get(cls)
+    if kind is not None:
+        return kind
+    from .kernels import register_kernel
+
+    rhs = _compiled(cls, "rhs")
+    if rhs is None:
+        raise ParameterError(
+            f"{cls.__name__} needs a compiled right-hand side: rhs = numba.njit(cache=True)("
+            "function(t, y, p, dydt, obs, level))"
+        )
+    tangent = _compiled(cls, "tangent")
+    kind = EXTERNAL_KIND_BASE + int(_source_digest(cls, rhs, tangent)[:10], 16)
+    register_kernel(kind, rhs, tangent)
+    _REGISTERED[cls] = kind
+    return kind
+
+
+class UserModel:
+    """Base of a model written outside gearchaos: subclass it as a frozen dataclass whose
+    fields are the dimensionless parameters, and give it
+
+    * ``name``, ``state_names``, ``obs_names`` and ``n_track`` (class attributes),
+    * ``rhs`` (and optionally ``tangent``): ``numba.njit(cache=True)`` functions with the
+      signatures of the module docstring,
+    * ``pack(self, omega)``: the parameter vector ``rhs`` reads,
+    * optionally ``switch_widths``, ``clearances``, ``contacts``, ``n_contact_forces``,
+      ``default_observables``, ``scales``.
+
+    ``System(MyModel(...), omega)`` then runs in every analysis; parameters are changed by
+    field name (``params={"zeta": 0.1}``, ``--set zeta=0.1``).
+    """
+
+    name: ClassVar[str]
+    state_names: ClassVar[tuple[str, ...]]
+    obs_names: ClassVar[tuple[str, ...]]
+    n_track: ClassVar[int]
+    n_contact_forces: ClassVar[int] = 0
+
+    @property
+    def kind(self) -> int:
+        """The kernel kind (registered on first use, :func:`register_kernels`)."""
+        return register_kernels(type(self))
+
+    @property
+    def n_state(self) -> int:
+        return len(self.state_names)
+
+    @property
+    def switch_widths(self) -> np.ndarray:
+        """No switches unless the model says otherwise."""
+        return np.full(int(self.n_track), np.inf)
+
+    @property
+    def clearances(self) -> dict[str, float]:
+        return {c.name: c.clearance for c in contacts_of(self)}
+
+    def check(self) -> None:
+        """Refuse a model that breaks the contract (called by :func:`check_model`)."""
+        check_model(self)
+
+
+def check_model(model: Any) -> None:
+    """Raise :class:`~gearchaos.errors.ParameterError` naming the member of ``model`` that
+    breaks the contract (names, sizes, packed parameters, switch widths, contacts)."""
+    what = type(model).__name__
+    for attr in ("name", "state_names", "obs_names", "n_track", "pack", "kind"):
+        if not hasattr(model, attr):
+            raise ParameterError(f"{what} must define {attr} (the model contract)")
+    states, obs = tuple(model.state_names), tuple(model.obs_names)
+    if len(states) != int(model.n_state) or len(set(states)) != len(states) or not states:
+        raise ParameterError(f"{what}.state_names must be {model.n_state} distinct names")
+    if len(set(obs)) != len(obs):
+        raise ParameterError(f"{what}.obs_names must be distinct names: got {obs}")
+    n_track = int(model.n_track)
+    if not (0 <= n_track and 2 * n_track <= len(obs)):
+        raise ParameterError(
+            f"{what}.n_track must be in [0, len(obs_names)/2] (tracked observables and their "
+            f"derivatives come first): got {n_track} with {len(obs)} observables"
+        )
+    widths = np.asarray(getattr(model, "switch_widths", np.full(n_track, np.inf)), dtype=float)
+    if widths.shape != (n_track,) or np.any(np.isnan(widths)) or np.any(widths < 0):
+        raise ParameterError(
+            f"{what}.switch_widths must be {n_track} half clearances >= 0 (inf: no switch): "
+            f"got {widths.tolist()}"
+        )
+    for c in contacts_of(model):
+        if not 0 <= c.column < n_track or c.kind not in ("mesh", "bearing"):
+            raise ParameterError(
+                f"{what}.contacts: {c.name} must be judged on a tracked observable (column in "
+                f"[0, {n_track})) and be a mesh or a bearing: got {c}"
+            )
+    if getattr(model, "tangent", None) is None and (
+        len(states) > FD_MAX_STATE or len(obs) > FD_MAX_OBS
+    ):
+        raise ParameterError(
+            f"{what} has no tangent and {len(states)} states / {len(obs)} observables: the "
+            f"finite-difference tangent handles at most {FD_MAX_STATE} / {FD_MAX_OBS}; give "
+            "the model a tangent"
+        )
+
+
+# ------------------------------------------------------------------ loading a model by name
+#: The entry-point group under which installed packages offer models (``--model NAME``).
+ENTRY_POINT_GROUP = "gearchaos.models"
+
+
+def load_model_class(spec: str) -> type:
+    """The model class named by ``spec``: ``path/to/file.py:ClassName`` (the file's directory
+    joins ``sys.path`` and the file is imported under its stem, so worker processes import it
+    too), ``package.module:ClassName``, or the name of an entry point in the group
+    ``gearchaos.models``."""
+    import importlib
+    import importlib.util
+    import os
+    import sys
+
+    if not isinstance(spec, str) or not spec.strip():
+        raise ParameterError(f"--model must be FILE.py:CLASS, MODULE:CLASS or a name: got {spec!r}")
+    where, sep, attr = spec.rpartition(":")
+    if not sep:
+        from importlib.metadata import entry_points
+
+        found = [ep for ep in entry_points(group=ENTRY_POINT_GROUP) if ep.name == spec]
+        if not found:
+            known = sorted(ep.name for ep in entry_points(group=ENTRY_POINT_GROUP))
+            raise ParameterError(
+                f"--model {spec}: no model of that name is installed (entry points of "
+                f"{ENTRY_POINT_GROUP}: {', '.join(known) or 'none'}); or give FILE.py:CLASS"
+            )
+        cls = found[0].load()
+    else:
+        if where.endswith(".py"):
+            path = os.path.abspath(where)
+            if not os.path.isfile(path):
+                raise ParameterError(f"--model {spec}: no such file {where!r}")
+            folder, stem = os.path.split(path)[0], os.path.splitext(os.path.basename(path))[0]
+            if not stem.isidentifier():
+                raise ParameterError(
+                    f"--model {spec}: the file name must be a Python identifier (it is imported "
+                    f"as a module): got {stem!r}"
+                )
+            old = sys.modules.get(stem)
+            if old is not None and os.path.abspath(getattr(old, "__file__", "") or "") != path:
+                raise ParameterError(
+                    f"--model {spec}: a different module named {stem!r} is already imported; "
+                    "rename the file"
+                )
+            if folder not in sys.path:
+                sys.path.insert(0, folder)
+            module = importlib.import_module(stem)
+        else:
+            try:
+                module = importlib.import_module(where)
+            except ImportError as exc:
+                raise ParameterError(f"--model {spec}: cannot import {where!r} ({exc})") from None
+        cls = getattr(module, attr, None)
+        if cls is None:
+            raise ParameterError(f"--model {spec}: {where} defines no {attr!r}")
+    if not isinstance(cls, type):
+        raise ParameterError(f"--model {spec} must name a model class: got {type(cls).__name__}")
+    return cls
+
+
+def build_model(cls: type, changes: dict[str, Any] | None = None) -> Any:
+    """An instance of the dataclass model ``cls`` with ``changes`` by field name (text values,
+    as ``--set`` gives them, converted to the field's type), checked against the contract."""
+    import dataclasses
+
+    if not dataclasses.is_dataclass(cls):
+        raise ParameterError(f"{cls.__name__} must be a dataclass whose fields are its parameters")
+    fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
+    values: dict[str, Any] = {}
+    for key, value in (changes or {}).items():
+        field = fields.get(key)
+        if field is None:
+            import difflib
+
+            close = difflib.get_close_matches(key, list(fields), n=1)
+            hint = f"; did you mean {close[0]!r}?" if close else ""
+            raise ParameterError(
+                f"unknown parameter {key!r} of {cls.__name__} (its parameters: "
+                f"{', '.join(fields)}){hint}"
+            )
+        default = field.default
+        if isinstance(value, str) and not isinstance(default, str):
+            kind = int if isinstance(default, int) and not isinstance(default, bool) else float
+            try:
+                value = kind(value)
+            except ValueError:
+                raise ParameterError(
+                    f"{key} must be {'an integer' if kind is int else 'a number'}: got {value!r}"
+                ) from None
+        values[key] = value
+    try:
+        model = cls(**values)
+    except TypeError as exc:
+        raise ParameterError(f"{cls.__name__}: {exc}") from None
+    check_model(model)
+    return model
