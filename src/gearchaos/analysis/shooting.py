@@ -38,6 +38,7 @@ import numpy as np
 
 from ..errors import ParameterError, Status
 from ..integrate._chains import ChainRun, run_chains
+from ..integrate.interface import Info
 from ..integrate.settings import SampleTimes, SolverSettings
 from ..model.system import System
 
@@ -178,7 +179,7 @@ def shoot(
         obs_min=out.obs_min.min(axis=1),
         obs_max=out.obs_max.max(axis=1),
         status=status,
-        steps=out.info[:, :, 0].sum(axis=1).astype(np.int64),
+        steps=out.info[:, :, Info.ACCEPTED].sum(axis=1).astype(np.int64),
     )
 
 

@@ -5,7 +5,10 @@ a pool of threads, :func:`run_threaded`) of L points each (run in order, each op
 starting from its predecessor's final state). :class:`ChainRun` holds the numbers of such a
 job — packed parameters, switch widths, sample times, tolerances — and nothing else, so it can
 be shipped to another process or a Dask worker; :class:`ChainOutput` holds the kernel's raw outputs.
-The kernel's argument list is written here and nowhere else.
+The kernel's argument list is written here and nowhere else: the arrays of a :class:`ChainRun`
+(``_CHAIN_INPUTS``), its configuration record (:func:`config_record`, slots
+:class:`~gearchaos.integrate.interface.Config`) and the arrays of a :class:`ChainOutput`
+(``_CHAIN_OUTPUTS``).
 """
 
 from __future__ import annotations
@@ -19,10 +22,11 @@ import numpy as np
 from .._numba import entry_point
 from ..errors import ParameterError, Status
 from ..model.system import System
+from .interface import Config, Info
 from .settings import SampleTimes, SolverSettings
 from .threads import pool, wait_all
 
-__all__ = ["ChainOutput", "ChainRun", "SampleArrays", "run_chains"]
+__all__ = ["ChainOutput", "ChainRun", "SampleArrays", "config_record", "run_chains"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -217,8 +221,9 @@ class ChainOutput(SampleArrays):
 
     The :class:`SampleArrays` with shapes ``tau`` (C, L, s), ``states`` (C, L, s, n_full),
     ``observables`` (C, L, s, n_obs), ``obs_min``/``obs_max`` (C, L, n_track), ``final_state``
-    (C, L, n_full) with the tangent vectors; then ``info`` (C, L, 5): accepted steps, rejected
-    steps, time reached, next step size, transient periods skipped (``settle``); ``status`` (C, L)
+    (C, L, n_full) with the tangent vectors; then ``info`` (C, L, len(Info)): the columns of
+    :class:`~gearchaos.integrate.interface.Info` (accepted and rejected steps, time reached,
+    next step size, transient periods skipped by ``settle``); ``status`` (C, L)
     :class:`~gearchaos.errors.Status` codes; ``log_sums`` (C, L, k) accumulated log stretch
     factors of the tangent vectors.
     """
@@ -288,29 +293,18 @@ def run_chains(run: ChainRun, *, single_thread: bool = False) -> ChainOutput:
         obs_min=np.zeros((C, L, run.n_track)),
         obs_max=np.zeros((C, L, run.n_track)),
         final_state=np.zeros((C, L, n_full)),
-        info=np.zeros((C, L, 5)),
+        info=np.zeros((C, L, len(Info))),
         status=np.zeros((C, L), dtype=np.int64),
         log_sums=np.zeros((C, L, k)),
     )
     f64 = np.float64
     inputs = [np.ascontiguousarray(getattr(run, a), dtype=f64) for a in _CHAIN_INPUTS]
     outputs = [getattr(out, a) for a in _CHAIN_OUTPUTS]
-    numbers = (
-        int(ns), int(run.n_obs), int(run.n_track), int(run.n_state), float(run.rtol),
-        float(run.atol), float(run.h_init), float(run.max_step), int(run.max_steps),
-        bool(run.continuation), int(run.settle_spp), float(run.tangent_tol),
-    )  # fmt: skip
+    cfg = config_record(run)
 
     def args(lo: int, hi: int) -> tuple[Any, ...]:
         """The kernel's arguments for chains lo … hi − 1 (C-contiguous views)."""
-        Y0, P, SW, t0, t_rec, dt, t_end = (x[lo:hi] for x in inputs)
-        ns_, n_obs, n_track, n_state, rtol, atol, h_init, max_step, max_steps, cont, spp, ttol = (
-            numbers
-        )
-        return (
-            Y0, P, SW, t0, t_rec, dt, ns_, t_end, n_obs, n_track, n_state, rtol, atol, h_init,
-            max_step, max_steps, cont, *(x[lo:hi] for x in outputs), spp, ttol,
-        )  # fmt: skip
+        return (*(x[lo:hi] for x in inputs), cfg, *(x[lo:hi] for x in outputs))
 
     entry = entry_point(dopri_chains, run.kind, *args(0, C))
     kind = int(run.kind)
@@ -318,8 +312,15 @@ def run_chains(run: ChainRun, *, single_thread: bool = False) -> ChainOutput:
     return out
 
 
-#: the ChainRun arrays the kernel reads and the ChainOutput arrays it fills, chain axis first,
-#: in the kernel's argument order
+def config_record(run: ChainRun) -> np.ndarray:
+    """The configuration record of ``run`` for the kernel: slot ``s`` of
+    :class:`~gearchaos.integrate.interface.Config` holds the field of ``run`` named
+    ``s.name.lower()``, as a float64 (integers and flags exactly, up to 2⁵³)."""
+    return np.array([float(getattr(run, s.name.lower())) for s in Config], dtype=np.float64)
+
+
+#: the ChainRun arrays the kernel reads (then the configuration record) and the ChainOutput
+#: arrays it fills, chain axis first, in the kernel's argument order
 _CHAIN_INPUTS = ("Y0", "P", "SW", "t0", "t_rec", "dt", "t_end")
 _CHAIN_OUTPUTS = (
     "tau", "states", "observables", "obs_min", "obs_max", "final_state", "info", "status",

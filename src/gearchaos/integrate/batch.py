@@ -20,6 +20,7 @@ from ..errors import ParameterError, Status
 from ..model.response import compressive_contact_forces
 from ..model.system import System
 from ._chains import ChainRun, SampleArrays, run_chains
+from .interface import Info
 from .settings import SolverSettings
 
 __all__ = ["BatchResult", "integrate_batch"]
@@ -111,7 +112,7 @@ def integrate_batch(
         obs_max=obs_max,
         final_state=out.final_state[:, 0],
         status=out.status[:, 0],
-        steps_accepted=out.info[:, 0, 0].astype(np.int64),
-        steps_rejected=out.info[:, 0, 1].astype(np.int64),
+        steps_accepted=out.info[:, 0, Info.ACCEPTED].astype(np.int64),
+        steps_rejected=out.info[:, 0, Info.REJECTED].astype(np.int64),
         samples_per_period=cfg.samples_per_period,
     )

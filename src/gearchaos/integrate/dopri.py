@@ -38,8 +38,10 @@ import numba
 import numpy as np
 
 from .._numba import njit_noalloc
+from ..errors import Status
 from ..model.kernels import OBS_ALL, OBS_NONE, OBS_TRACK, rhs, tangent
 from ._switch import AIM, LAND, check_step, predict_switch, track
+from .interface import Config, Info
 from .tableau import DOPRI5
 
 __all__ = ["dopri_chains", "dopri_run"]
@@ -79,10 +81,10 @@ SETTLE_CYCLES = 3
 SETTLE_MIN_MATCHES = 8
 SETTLE_TOL = 1e-7
 
-ST_OK = 0
-ST_MAX_STEPS = 1
-ST_UNDERFLOW = 2
-ST_NON_FINITE = 3
+ST_OK = int(Status.OK)
+ST_MAX_STEPS = int(Status.MAX_STEPS)
+ST_UNDERFLOW = int(Status.STEP_UNDERFLOW)
+ST_NON_FINITE = int(Status.NON_FINITE)
 
 
 @numba.njit(cache=True, inline="always")
@@ -214,10 +216,11 @@ def dopri_run(
     kind, y0, p, sw, t0, t_rec, dt_sample, t_end, cfg, out, info, lsum, ws
 ):  # pragma: no cover - compiled
     """Integrate one system; fill the output arrays ``out`` = (out_t, out_y, out_obs,
-    obs_min, obs_max, y_final); return the status code. ``cfg`` = (n_samples, n_obs, n_track,
-    n_base, rtol, atol, h_init, max_step, max_steps, settle_spp, tan_tol): the numbers every
-    point of a run shares, one tuple so that their list is written once
-    (:func:`dopri_chains`). ``tan_tol`` scales the error tolerances of the tangent components.
+    obs_min, obs_max, y_final); return the status code. ``cfg`` is the configuration record
+    (float64, slots :class:`~gearchaos.integrate.interface.Config`): the numbers every point
+    of a run shares (n_samples, n_obs, n_track, n_base = n_state, rtol, atol, h_init, max_step,
+    max_steps, settle_spp, tan_tol = tangent_tol). ``tan_tol`` scales the error tolerances of
+    the tangent components.
 
     Samples are taken at τ_j = t_rec + j·dt_sample, j = 0 … n_samples−1 (t_rec ≥ t0), then the
     integration goes on to t_end ≥ τ_last. Extrema of obs[:n_track] are tracked over
@@ -225,9 +228,9 @@ def dopri_run(
     observables (``inf``: smooth); a step that crosses a switch obs_k = ±b_k is discarded and
     retried so that it ends on the switch, so no step straddles a kink of the vector field
     (DOPRI5's error estimate can miss a kink inside a step: 10–100× larger errors).
-    ``info`` (float64, length 5) receives accepted steps, rejected steps (including steps
-    discarded to land on a switch), the final time reached, the next step size and the
-    transient periods skipped by ``settle``.
+    ``info`` (float64, columns :class:`~gearchaos.integrate.interface.Info`) receives accepted
+    steps, rejected steps (including steps discarded to land on a switch), the final time
+    reached, the next step size and the transient periods skipped by ``settle``.
 
     Settling (``settle_spp`` > 0, the samples per period, so T = settle_spp·dt_sample): the
     steps also land on the transient section points τ_rec − mT, and once their sequence repeats
@@ -243,8 +246,17 @@ def dopri_run(
     so the state agrees with a plain run's to the tolerance — bitwise if ``tan_tol`` is inf.
     """
     numba.literally(kind)
-    (n_samples, n_obs, n_track, n_base, rtol, atol, h_init, max_step, max_steps, settle_spp,
-     tan_tol) = cfg  # fmt: skip
+    n_samples = int(cfg[Config.N_SAMPLES])
+    n_obs = int(cfg[Config.N_OBS])
+    n_track = int(cfg[Config.N_TRACK])
+    n_base = int(cfg[Config.N_STATE])
+    rtol = cfg[Config.RTOL]
+    atol = cfg[Config.ATOL]
+    h_init = cfg[Config.H_INIT]
+    max_step = cfg[Config.MAX_STEP]
+    max_steps = int(cfg[Config.MAX_STEPS])
+    settle_spp = int(cfg[Config.SETTLE_SPP])
+    tan_tol = cfg[Config.TANGENT_TOL]
     out_t, out_y, out_obs, obs_min, obs_max, y_final = out
     y, yt, K, obs, hist, t_hist, ring, runs, f1, o1 = ws
     n = y0.size
@@ -490,51 +502,28 @@ def dopri_run(
         t_hist[0] = t
 
     _copy(y_final, y, n)
-    info[0] = n_acc
-    info[1] = n_rej
-    info[2] = t
-    info[3] = h
-    info[4] = skipped
+    info[Info.ACCEPTED] = n_acc
+    info[Info.REJECTED] = n_rej
+    info[Info.TAU_REACHED] = t
+    info[Info.NEXT_STEP] = h
+    info[Info.SKIPPED] = skipped
     return status
 
 
 @numba.njit(cache=True, nogil=True)
 def dopri_chains(
-    kind,
-    Y0,
-    P,
-    SW,
-    t0,
-    t_rec,
-    dt_sample,
-    n_samples,
-    t_end,
-    n_obs,
-    n_track,
-    n_base,
-    rtol,
-    atol,
-    h_init,
-    max_step,
-    max_steps,
-    continuation,
-    out_t,
-    out_y,
-    out_obs,
-    obs_min,
-    obs_max,
-    y_final,
-    info,
-    status,
-    LSUM,
-    settle_spp,
-    tan_tol,
-):  # pragma: no cover - compiled
+    kind, Y0, P, SW, t0, t_rec, dt_sample, t_end, cfg, out_t, out_y, out_obs, obs_min, obs_max,
+    y_final, info, status, LSUM
+):  # pragma: no cover - compiled  # fmt: skip
     """Chains of integrations, one chain after another, points of a chain in order: the one
     compiled entry point of the integrator (single runs are chains of length one). It releases
     the GIL: :func:`~gearchaos.integrate._chains.run_chains` runs blocks of chains on several
     threads (a ``parallel=True`` kernel would cost seconds more to compile).
 
+    The arguments after ``kind`` are the arrays of a
+    :class:`~gearchaos.integrate._chains.ChainRun` (``_CHAIN_INPUTS``), its configuration
+    record ``cfg`` (:class:`~gearchaos.integrate.interface.Config`) and the arrays of a
+    :class:`~gearchaos.integrate._chains.ChainOutput` (``_CHAIN_OUTPUTS``), chain axis first.
     Point j of chain c has parameters ``P[c, j]`` and runs from τ = ``t0[c, j]``; it starts
     from ``Y0[c]`` (fresh) or, with ``continuation``, from the final state of point j−1 of the
     same chain (point 0 from ``Y0[c]``); a failed point restarts its successor from ``Y0[c]``.
@@ -547,11 +536,9 @@ def dopri_chains(
     numba.literally(kind)
     n_chains = P.shape[0]
     length = P.shape[1]
-    cfg = (
-        n_samples, n_obs, n_track, n_base, rtol, atol, h_init, max_step, max_steps, settle_spp,
-        tan_tol,
-    )  # fmt: skip
-    ws = workspace(Y0.shape[1], n_obs, n_track, n_base)
+    n_base = int(cfg[Config.N_STATE])
+    continuation = cfg[Config.CONTINUATION] != 0.0
+    ws = workspace(Y0.shape[1], int(cfg[Config.N_OBS]), int(cfg[Config.N_TRACK]), n_base)
     for c in range(n_chains):
         y = Y0[c].copy()
         for j in range(length):
@@ -593,6 +580,8 @@ def _guard() -> None:
         os.path.join(here, "dopri.py"),
         os.path.join(here, "_switch.py"),
         os.path.join(here, "tableau.py"),
+        os.path.join(here, "interface.py"),
+        os.path.join(os.path.dirname(here), "errors.py"),
     ]
     _numba.guard_cache([dopri_run, dopri_chains], sources)
 

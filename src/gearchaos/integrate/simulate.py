@@ -20,6 +20,7 @@ from ..model.response import compressive_contact_forces
 from ..model.system import System
 from ..model.target import resolve
 from ._chains import ChainRun, run_chains
+from .interface import Info
 from .result import SimulationResult
 from .settings import SIMULATION, SolverSettings
 from .trajectory import Trajectory
@@ -109,13 +110,13 @@ def integrate(
         obs_max=obs_max,
         final_state=out.final_state[0, 0, :n],
         status=out.statuses()[0],
-        steps_accepted=int(out.info[0, 0, 0]),
-        steps_rejected=int(out.info[0, 0, 1]),
+        steps_accepted=int(out.info[0, 0, Info.ACCEPTED]),
+        steps_rejected=int(out.info[0, 0, Info.REJECTED]),
         solver=cfg,
         t0=t_start,
         y0=None if y is None else y.copy(),
-        next_step=float(out.info[0, 0, 3]),
-        tau_reached=float(out.info[0, 0, 2]),
+        next_step=float(out.info[0, 0, Info.NEXT_STEP]),
+        tau_reached=float(out.info[0, 0, Info.TAU_REACHED]),
         tangent_log_sums=out.log_sums[0, 0],
         tangent_log_stretch=out.stretch(n)[0, 0] if k else np.empty(0),
     )

@@ -22,6 +22,7 @@ from .._checks import check_bool
 from .._version import provenance
 from ..errors import ParameterError, Status, StoreError
 from ..integrate._chains import ChainOutput, ChainRun
+from ..integrate.interface import Info
 from ..integrate.threads import abandon, resume
 from ..model.target import scale_attrs
 from ._response_store import response_extract, response_variables
@@ -177,10 +178,10 @@ class _Layout:
                 )
             self.put_extrema(data, pos, out.obs_min[c, j], out.obs_max[c, j])
             data["status"][pos] = out.status[c, j]
-            data["steps_accepted"][pos] = int(out.info[c, j, 0])
-            data["steps_rejected"][pos] = int(out.info[c, j, 1])
+            data["steps_accepted"][pos] = int(out.info[c, j, Info.ACCEPTED])
+            data["steps_rejected"][pos] = int(out.info[c, j, Info.REJECTED])
             if settle:
-                data[SKIPPED][pos] = int(out.info[c, j, 4])
+                data[SKIPPED][pos] = int(out.info[c, j, Info.SKIPPED])
             data["final_state"][pos] = out.final_state[c, j, :n_st]
             if spec.recorded_lyapunov:
                 data["lle"][pos] = lle[c, j, 0]
