@@ -31,6 +31,7 @@ from numba import types
 from numba.extending import overload
 
 from .._numba import njit_noalloc, stack_array
+from . import layout as L
 from .layout import (
     B_C,
     B_C_EPR,
@@ -130,6 +131,12 @@ def _sinusoid(a, w, s, c, ca, sa):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, inline="always")
+def _at(group, N):  # pragma: no cover - compiled
+    """Index of the first observable of a planetary group (``layout.PLANETARY_OBS``)."""
+    return group[0] * N + group[1]
+
+
+@numba.njit(cache=True, inline="always")
 def _planet_direction(p, N, i):  # pragma: no cover - compiled
     """(s_i, c_i): the sine and cosine of planet i's sun–planet line of action (the sun's
     translation enters the mesh deflection as −x s_i + y c_i)."""
@@ -218,7 +225,9 @@ def _planetary_rhs(n_fixed):
         State y = (x̄_s, ȳ_s, p̄_1..p̄_N, σ̄, then their τ-derivatives).
         obs = (δ̄_sp1..N, δ̄_rp1..N, x̄_s, ȳ_s, F̄ᶜ_sp1..N, F̄ᶜ_rp1..N, then the τ-derivatives of
         these T = 4N + 2 tracked observables, then F̄_sp1..N, F̄_rp1..N, then the mesh stiffnesses
-        κ_sp1..N, κ_rp1..N). The first 2N + 2 are the arguments of the dead zones (event-located);
+        κ_sp1..N, κ_rp1..N), at the offsets of ``layout.PLANETARY_OBS``, the table that also
+        names them (:func:`~gearchaos.model.layout.planetary_obs_names`).
+        The first 2N + 2 are the arguments of the dead zones (event-located);
         F̄ᶜ is the *contact* force of a mesh, κ f(δ̄; b̄) + c̄ δ̄' while the teeth touch
         (|δ̄| > b̄) and exactly 0 while they are apart; F̄ is the force of the equations of motion,
         κ f(δ̄; b̄) + c̄ δ̄' at all times (damping acts inside the clearance, MODEL.md §4). Their
@@ -227,7 +236,11 @@ def _planetary_rhs(n_fixed):
         """
         N = n_fixed if n_fixed > 0 else int(p[P_N])
         n = N + 3
-        nt = 4 * N + 2  # tracked observables (their derivatives follow them)
+        nt = _at(L.O_DOT, N)  # tracked observables (their derivatives follow them)
+        o_dsp = _at(L.O_DELTA_SP, N)
+        o_drp = _at(L.O_DELTA_RP, N)
+        o_csp = _at(L.O_CONTACT_SP, N)
+        o_crp = _at(L.O_CONTACT_RP, N)
         om = p[P_OMEGA]
         th = om * t
         c1 = math.cos(th)
@@ -296,27 +309,27 @@ def _planetary_rhs(n_fixed):
             dydt[n + 2 + i] = (frp - fsp) * inv_mup  # completed below
 
             if level >= OBS_TRACK:
-                obs[i] = dsp
-                obs[N + i] = drp
-                obs[nt + i] = dsp_d
-                obs[nt + N + i] = drp_d
+                obs[o_dsp + i] = dsp
+                obs[o_drp + i] = drp
+                obs[nt + o_dsp + i] = dsp_d
+                obs[nt + o_drp + i] = drp_d
                 # contact forces: zero while the teeth are apart; their derivatives without the
                 # c̄ δ̄'' term, which needs the accelerations (added after the loop)
                 on = in_contact(dsp, bsp)
                 sk = s1 * p[P_HEADER + B_CK_SP * N + i] + c1 * p[P_HEADER + B_SK_SP * N + i]
-                obs[2 * N + 2 + i] = fsp if on else 0.0
+                obs[o_csp + i] = fsp if on else 0.0
                 dfc = -om * sk * dksp * fzsp + ksp * dsp_d - csp * esp_dd
-                obs[nt + 2 * N + 2 + i] = dfc if on else 0.0
+                obs[nt + o_csp + i] = dfc if on else 0.0
                 on = in_contact(drp, brp)
                 sk = s1 * p[P_HEADER + B_CK_RP * N + i] + c1 * p[P_HEADER + B_SK_RP * N + i]
-                obs[3 * N + 2 + i] = frp if on else 0.0
+                obs[o_crp + i] = frp if on else 0.0
                 dfc = -om * sk * dkrp * fzrp + krp * drp_d - crp * erp_dd
-                obs[nt + 3 * N + 2 + i] = dfc if on else 0.0
+                obs[nt + o_crp + i] = dfc if on else 0.0
                 if level >= OBS_ALL:
-                    obs[2 * nt + i] = fsp
-                    obs[2 * nt + N + i] = frp
-                    obs[2 * nt + 2 * N + i] = ksp
-                    obs[2 * nt + 3 * N + i] = krp
+                    obs[_at(L.O_FORCE_SP, N) + i] = fsp
+                    obs[_at(L.O_FORCE_RP, N) + i] = frp
+                    obs[_at(L.O_STIFFNESS_SP, N) + i] = ksp
+                    obs[_at(L.O_STIFFNESS_RP, N) + i] = krp
             sum_fsp += fsp
             sum_frp += frp
             sum_fx += fsp * si
@@ -342,19 +355,19 @@ def _planetary_rhs(n_fixed):
             dydt[n + 2 + i] = qs + dydt[n + 2 + i] - qcp
         dydt[n + N + 2] = qs - (cas + car) * qc
         if level >= OBS_TRACK:
-            obs[2 * N] = x
-            obs[2 * N + 1] = yy
-            obs[nt + 2 * N] = xd
-            obs[nt + 2 * N + 1] = yd
+            obs[_at(L.O_X_S, N)] = x
+            obs[_at(L.O_Y_S, N)] = yy
+            obs[nt + _at(L.O_X_S, N)] = xd
+            obs[nt + _at(L.O_Y_S, N)] = yd
             # the c̄ δ̄'' terms of the contact-force derivatives: δ̄_sp'' = p̄_i'' + s_i'' − e_sp'',
             # δ̄_rp'' = σ̄'' − p̄_i'' − e_rp'' (the e'' parts were added in the loop)
             for i in range(N):
                 pdd = dydt[n + 2 + i]
-                if in_contact(obs[i], bsp):
+                if in_contact(obs[o_dsp + i], bsp):
                     si, ci = _planet_direction(p, N, i)
-                    obs[nt + 2 * N + 2 + i] += csp * (pdd - dydt[n] * si + dydt[n + 1] * ci)
-                if in_contact(obs[N + i], brp):
-                    obs[nt + 3 * N + 2 + i] += crp * (dydt[n + N + 2] - pdd)
+                    obs[nt + o_csp + i] += csp * (pdd - dydt[n] * si + dydt[n + 1] * ci)
+                if in_contact(obs[o_drp + i], brp):
+                    obs[nt + o_crp + i] += crp * (dydt[n + N + 2] - pdd)
 
     return planetary_rhs
 
@@ -387,8 +400,12 @@ def _planetary_tangent(n_fixed):
         inv_muc = p[P_INV_MUC]
         cas = p[P_COS_AS]
         car = p[P_COS_AR]
-        kb = p[P_KB] * engaged(obs[2 * N], p[P_BS])
-        kby = p[P_KB] * engaged(obs[2 * N + 1], p[P_BS])
+        o_dsp = _at(L.O_DELTA_SP, N)
+        o_drp = _at(L.O_DELTA_RP, N)
+        o_ksp = _at(L.O_STIFFNESS_SP, N)
+        o_krp = _at(L.O_STIFFNESS_RP, N)
+        kb = p[P_KB] * engaged(obs[_at(L.O_X_S, N)], p[P_BS])
+        kby = p[P_KB] * engaged(obs[_at(L.O_Y_S, N)], p[P_BS])
         cb = p[P_CS]
         inv_ms = p[P_INV_MU_S]
         for r in range(k):
@@ -411,8 +428,8 @@ def _planetary_tangent(n_fixed):
                 dsp_d = pdv - xdv * si + ydv * ci
                 drp = sv - pv
                 drp_d = sdv - pdv
-                fsp = obs[10 * N + 4 + i] * engaged(obs[i], bsp) * dsp + csp * dsp_d
-                frp = obs[11 * N + 4 + i] * engaged(obs[N + i], brp) * drp + crp * drp_d
+                fsp = obs[o_ksp + i] * engaged(obs[o_dsp + i], bsp) * dsp + csp * dsp_d
+                frp = obs[o_krp + i] * engaged(obs[o_drp + i], brp) * drp + crp * drp_d
                 dydt[o + nd + 2 + i] = (frp - fsp) * inv_mup  # completed below
                 sum_fsp += fsp
                 sum_frp += frp

@@ -83,6 +83,79 @@ B_S_ER = 17
 N_BLOCKS = 18
 # then NH_SP harmonic amplitudes (relative to k_m,sp) and NH_RP harmonic amplitudes
 
+# planetary observables: groups of one value per planet (True) or a single value (False), in
+# the order the kernel writes them. The tracked groups come first — the arguments of the dead
+# zones (δ̄_sp, δ̄_rp, x̄_s, ȳ_s: contact switches), then the contact forces F̄ᶜ_sp, F̄ᶜ_rp —, then
+# their τ-derivatives (``<group>_dot``), then the extras (mesh forces and stiffnesses). The
+# kernel's offsets and the names of the observables are both generated from this table.
+PLANETARY_TRACKED = (
+    ("delta_sp", True),
+    ("delta_rp", True),
+    ("x_s", False),
+    ("y_s", False),
+    ("contact_force_sp", True),
+    ("contact_force_rp", True),
+)
+PLANETARY_EXTRAS = (
+    ("force_sp", True),
+    ("force_rp", True),
+    ("stiffness_sp", True),
+    ("stiffness_rp", True),
+)
+PLANETARY_GROUPS = (
+    *PLANETARY_TRACKED,
+    *((f"{name}_dot", per_planet) for name, per_planet in PLANETARY_TRACKED),
+    *PLANETARY_EXTRAS,
+)
+
+
+def _offsets(groups: tuple[tuple[str, bool], ...]) -> dict[str, tuple[int, int]]:
+    """(a, b) for each group (and ``"size"`` after the last): it starts at index a N + b."""
+    out, a, b = {}, 0, 0
+    for name, per_planet in groups:
+        out[name] = (a, b)
+        a, b = (a + 1, b) if per_planet else (a, b + 1)
+    out["size"] = (a, b)
+    return out
+
+
+#: where each planetary observable group starts, as (a, b): index a N + b for N planets (global
+#: tuples of ints, which numba folds into the kernels as constants)
+PLANETARY_OBS = _offsets(PLANETARY_GROUPS)
+O_DELTA_SP = PLANETARY_OBS["delta_sp"]
+O_DELTA_RP = PLANETARY_OBS["delta_rp"]
+O_X_S = PLANETARY_OBS["x_s"]
+O_Y_S = PLANETARY_OBS["y_s"]
+O_CONTACT_SP = PLANETARY_OBS["contact_force_sp"]
+O_CONTACT_RP = PLANETARY_OBS["contact_force_rp"]
+O_DOT = PLANETARY_OBS["delta_sp_dot"]  # the derivatives: each group's offset plus this one's
+O_FORCE_SP = PLANETARY_OBS["force_sp"]
+O_FORCE_RP = PLANETARY_OBS["force_rp"]
+O_STIFFNESS_SP = PLANETARY_OBS["stiffness_sp"]
+O_STIFFNESS_RP = PLANETARY_OBS["stiffness_rp"]
+
+
+def planetary_offset(group: tuple[int, int], n_planets: int) -> int:
+    """Index of the first observable of a group (``PLANETARY_OBS``) for ``n_planets`` planets."""
+    return group[0] * n_planets + group[1]
+
+
+def planetary_obs_names(n_planets: int) -> tuple[str, ...]:
+    """Names of the planetary observables for ``n_planets`` planets, in the kernel's order:
+    ``<group>_<i>`` (planets from 1) for a group with one value per planet, else ``<group>``."""
+    planets = range(1, int(n_planets) + 1)
+    return tuple(
+        name_i
+        for name, per_planet in PLANETARY_GROUPS
+        for name_i in ((f"{name}_{i}" for i in planets) if per_planet else (name,))
+    )
+
+
+def planetary_n_track(n_planets: int) -> int:
+    """Number of tracked planetary observables (their derivatives follow them)."""
+    return planetary_offset(O_DOT, n_planets)
+
+
 # ---------- backlash oscillator (kind 1)
 BO_OMEGA = 0
 BO_ZETA = 1

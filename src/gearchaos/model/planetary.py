@@ -297,31 +297,15 @@ class PlanetaryModel:
 
     @property
     def obs_names(self) -> tuple[str, ...]:
-        N = range(1, self.n_planets + 1)
-        return (
-            *(f"delta_sp_{i}" for i in N),
-            *(f"delta_rp_{i}" for i in N),
-            "x_s",
-            "y_s",
-            *(f"contact_force_sp_{i}" for i in N),
-            *(f"contact_force_rp_{i}" for i in N),
-            *(f"delta_sp_dot_{i}" for i in N),
-            *(f"delta_rp_dot_{i}" for i in N),
-            "x_s_dot",
-            "y_s_dot",
-            *(f"contact_force_sp_dot_{i}" for i in N),
-            *(f"contact_force_rp_dot_{i}" for i in N),
-            *(f"force_sp_{i}" for i in N),
-            *(f"force_rp_{i}" for i in N),
-            *(f"stiffness_sp_{i}" for i in N),
-            *(f"stiffness_rp_{i}" for i in N),
-        )
+        """From the layout table the kernel's offsets come from
+        (:data:`~gearchaos.model.layout.PLANETARY_GROUPS`)."""
+        return L.planetary_obs_names(self.n_planets)
 
     @property
     def n_track(self) -> int:
         """Extrema are tracked for the 2N mesh deflections, the two sun-bearing displacements
         (dead-zone switches located) and the 2N mesh contact forces (no switch of their own)."""
-        return 4 * self.n_planets + 2
+        return L.planetary_n_track(self.n_planets)
 
     @property
     def n_contact_forces(self) -> int:
