@@ -1,7 +1,8 @@
 """Argument checks shared by every entry point: real numbers, integers, flags, choices, sizes.
 
 Each check raises :class:`~gearchaos.errors.ParameterError` whose message names the argument,
-the rule and the value (``rtol must be a number in [1e-14, 0.1]: got -1.0``). ``bool`` is never
+the rule and the value (``rtol must be a number in [1e-14, 0.1]: got -1.0``) and whose ``name``
+is the argument's name. ``bool`` is never
 a number, strings are never numbers (``"1e-8"`` is refused, not parsed), numpy scalars are
 accepted. A leaf module: it imports nothing from the package but :mod:`gearchaos.errors`.
 """
@@ -65,19 +66,19 @@ def check_real(
     whole = _bound(lo, hi, lo_open, hi_open)
     rule = f"{name} must be a finite number" + (f" {whole}" if whole else "")
     if not isinstance(value, numbers.Real) or isinstance(value, bool):
-        raise ParameterError(f"{rule}: {got(value)}")
+        raise ParameterError(f"{rule}: {got(value)}", name=name)
     try:
         x = float(value)
     except (OverflowError, ValueError, TypeError):
-        raise ParameterError(f"{rule}: {got(value)}") from None
+        raise ParameterError(f"{rule}: {got(value)}", name=name) from None
     if not math.isfinite(x):
-        raise ParameterError(f"{rule}: {got(value)}")
+        raise ParameterError(f"{rule}: {got(value)}", name=name)
     if lo is not None and (x < lo or (lo_open and x == lo)):
         side = _bound(lo, None, lo_open, False)
-        raise ParameterError(f"{name} must be a finite number {side}: {got(value)}")
+        raise ParameterError(f"{name} must be a finite number {side}: {got(value)}", name=name)
     if hi is not None and (x > hi or (hi_open and x == hi)):
         side = _bound(None, hi, False, hi_open)
-        raise ParameterError(f"{name} must be a finite number {side}: {got(value)}")
+        raise ParameterError(f"{name} must be a finite number {side}: {got(value)}", name=name)
     return x
 
 
@@ -86,13 +87,13 @@ def check_int(name: str, value: Any, *, lo: int | None = None, hi: int | None = 
     whole = _bound(lo, hi, False, False)
     if not isinstance(value, numbers.Integral) or isinstance(value, bool):
         raise ParameterError(
-            f"{name} must be an integer{' ' + whole if whole else ''}: {got(value)}"
+            f"{name} must be an integer{' ' + whole if whole else ''}: {got(value)}", name=name
         )
     n = int(value)
     if lo is not None and n < lo:
-        raise ParameterError(f"{name} must be an integer >= {lo}: {got(value)}")
+        raise ParameterError(f"{name} must be an integer >= {lo}: {got(value)}", name=name)
     if hi is not None and n > hi:
-        raise ParameterError(f"{name} must be an integer <= {hi}: {got(value)}")
+        raise ParameterError(f"{name} must be an integer <= {hi}: {got(value)}", name=name)
     return n
 
 
@@ -114,7 +115,7 @@ def check_bool(name: str, value: Any) -> bool:
     """``True`` or ``False`` (numpy bools too); ``"yes"`` or 1 are refused."""
     if isinstance(value, bool) or type(value).__name__ == "bool_":
         return bool(value)
-    raise ParameterError(f"{name} must be True or False: {got(value)}")
+    raise ParameterError(f"{name} must be True or False: {got(value)}", name=name)
 
 
 def check_choice(name: str, value: Any, choices: Iterable[str]) -> str:
@@ -122,7 +123,7 @@ def check_choice(name: str, value: Any, choices: Iterable[str]) -> str:
     options = tuple(choices)
     if not isinstance(value, str) or value not in options:
         allowed = ", ".join(repr(c) for c in options)
-        raise ParameterError(f"{name} must be one of {allowed}: {got(value)}")
+        raise ParameterError(f"{name} must be one of {allowed}: {got(value)}", name=name)
     return value
 
 

@@ -17,7 +17,29 @@ class ParameterError(ValueError):
 
     The message always names the parameter (by its dotted name), the rule and the value,
     e.g. ``backlash.sun_planet must be >= 0: got -3.0``.
+
+    Parameters
+    ----------
+    message
+        What a person reads.
+    name
+        The dotted name of the parameter, setting or keyword that was refused
+        (``"backlash.sun_planet"``, ``"rtol"``), where the check knows it; ``None`` otherwise.
+        Front ends (the command line) map it to their own spelling of the option instead of
+        reading the message.
     """
+
+    def __init__(self, message: str = "", *, name: str | None = None) -> None:
+        super().__init__(message)
+        self.name = name
+
+    def __reduce__(self) -> tuple[object, ...]:
+        # keep the name when the error crosses a process boundary
+        return (_parameter_error, (str(self), self.name))
+
+
+def _parameter_error(message: str, name: str | None) -> ParameterError:
+    return ParameterError(message, name=name)
 
 
 class IntegrationError(RuntimeError):

@@ -349,21 +349,22 @@ def solver_settings(
         )
         return settings if perturbation is None else settings.replace(perturbation=perturbation)
     except ParameterError as exc:
-        setting = str(exc).split(" ", 1)[0]
-        option = _OPTIONS.get(setting)
-        raise ParameterError(f"{option}: {exc}" if option else str(exc)) from None
+        option = setting_option(exc.name)
+        raise ParameterError(f"{option}: {exc}" if option else str(exc), name=exc.name) from None
 
 
-#: The command-line option of each solver setting.
-_OPTIONS = {
-    "transient_periods": "--transient",
-    "periods": "--periods",
-    "samples_per_period": "--samples-per-period",
-    "rtol": "--rtol",
-    "settle": "--settle",
-    "atol": "--atol",
-    "perturbation": "--perturbation",
-}
+def setting_option(name: str | None) -> str | None:
+    """The command-line option of a solver setting (by its field name: ``--rtol``,
+    ``--samples-per-period``; ``--transient`` for ``transient_periods``), else None."""
+    from ..integrate.settings import SolverSettings
+
+    if name not in SolverSettings.field_names():
+        return None
+    return _SHORTENED.get(name, "--" + name.replace("_", "-"))
+
+
+#: Solver settings whose option is not their field name spelled with hyphens.
+_SHORTENED = {"transient_periods": "--transient"}
 
 
 # --------------------------------------------------------------------------- shared options

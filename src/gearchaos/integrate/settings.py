@@ -135,7 +135,8 @@ class SolverSettings:
         if 0 < self.transient_periods < MIN_TRANSIENT:
             raise ParameterError(
                 f"transient_periods must be 0 or at least {MIN_TRANSIENT:g} (a shorter "
-                f"transient is below any step of the integrator): got {self.transient_periods!r}"
+                f"transient is below any step of the integrator): got {self.transient_periods!r}",
+                name="transient_periods",
             )
         check_int("periods", self.periods, lo=1, hi=MAX_PERIODS)
         check_int("samples_per_period", self.samples_per_period, lo=1, hi=MAX_SAMPLES_PER_PERIOD)
@@ -158,7 +159,8 @@ class SolverSettings:
         base value. Unknown names are refused with the closest valid name."""
         if base is not None and not isinstance(base, SolverSettings):
             raise ParameterError(
-                f"settings must be a SolverSettings or None: got {type(base).__name__}"
+                f"settings must be a SolverSettings or None: got {type(base).__name__}",
+                name="settings",
             )
         names = cls.field_names()
         for key in changes:
@@ -166,7 +168,8 @@ class SolverSettings:
                 close = difflib.get_close_matches(key, names, n=1)
                 hint = f"; did you mean {close[0]!r}?" if close else ""
                 raise ParameterError(
-                    f"unknown solver setting {key!r}{hint} (settings: {', '.join(names)})"
+                    f"unknown solver setting {key!r}{hint} (settings: {', '.join(names)})",
+                    name=key,
                 )
         kept = {k: v for k, v in changes.items() if v is not None or k == "max_steps"}
         if base is None:
