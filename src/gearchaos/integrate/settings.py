@@ -12,6 +12,8 @@ from __future__ import annotations
 import dataclasses
 import difflib
 import math
+import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -20,7 +22,16 @@ import numpy as np
 from .._checks import check_choice, check_int, check_memory, check_real
 from ..errors import ParameterError
 
-__all__ = ["PERTURBATION", "SIMULATION", "SampleTimes", "SolverSettings", "rest_direction"]
+__all__ = [
+    "PERTURBATION",
+    "SIMULATION",
+    "UNRECORDED",
+    "SampleTimes",
+    "SolverSettings",
+    "renamed_keyword",
+    "rest_direction",
+    "split_keywords",
+]
 
 #: Bounds of the settings (see :meth:`SolverSettings.check`).
 RTOL_RANGE = (1e-14, 0.1)
@@ -221,21 +232,44 @@ class SolverSettings:
             nbytes,
         )
 
-    def attrs(self) -> dict[str, Any]:
-        """The settings as result attributes (``settle`` only when it is not "off")."""
-        out: dict[str, Any] = {
-            "rtol": self.rtol,
-            "atol": self.atol,
-            "transient_periods": self.transient_periods,
-            "periods": self.periods,
-            "samples_per_period": self.samples_per_period,
-            "section_phase": self.section_phase,
-        }
-        if self.settle != "off":
-            out["settle"] = self.settle
-        if self.perturbation:
-            out["perturbation"] = self.perturbation
+    # ------------------------------------------------------------------ records
+    def to_record(self) -> dict[str, Any]:
+        """The settings as a record — TOML keys, store and result-file attributes — by field
+        name in field order: real settings as floats, counts as ints, choices as text.
+
+        A record leaves out a setting whose value is what a record without it means
+        (:data:`UNRECORDED`: the value results had before that setting was recorded), so a
+        record of the same settings written before is the same record, and
+        :meth:`from_record` gives back exactly these settings (``max_steps`` None included:
+        TOML has no null)."""
+        out: dict[str, Any] = {}
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            if f.name in UNRECORDED and value == UNRECORDED[f.name]:
+                continue
+            out[f.name] = _KINDS[f.name](value)
         return out
+
+    @classmethod
+    def from_record(cls, record: Mapping[str, Any]) -> SolverSettings:
+        """The settings of a record written by :meth:`to_record` (other keys are ignored); a
+        setting it lacks has its :data:`UNRECORDED` value, one that every record holds is
+        required. Invalid values raise :class:`~gearchaos.errors.ParameterError`."""
+        values: dict[str, Any] = {}
+        for name in cls.field_names():
+            if name in record:
+                value = record[name]
+                # numpy scalars of netCDF attributes as Python numbers
+                values[name] = value.item() if isinstance(value, np.generic) else value
+            elif name in UNRECORDED:
+                values[name] = UNRECORDED[name]
+            else:
+                raise ParameterError(f"the record has no setting {name}", name=name)
+        return cls(**values)
+
+    def attrs(self) -> dict[str, Any]:
+        """The settings as result attributes: :meth:`to_record`."""
+        return self.to_record()
 
     def rest_state(self, n: int) -> np.ndarray | None:
         """The start "from rest" of an n-dimensional system: ε·u (:func:`rest_direction`), or
@@ -245,12 +279,78 @@ class SolverSettings:
         return float(self.perturbation) * rest_direction(n)
 
 
+#: What a record (:meth:`SolverSettings.to_record`) without a setting means: the value results
+#: had before the setting was recorded. Sweep specifications recorded neither the samples per
+#: period (one: the sections) nor the section phase, max_steps, settle or the perturbation of
+#: the start (they began exactly at rest); result files neither settle nor the perturbation.
+UNRECORDED: dict[str, Any] = {
+    "samples_per_period": 1,
+    "section_phase": 0.0,
+    "max_steps": None,
+    "settle": "off",
+    "perturbation": 0.0,
+}
+
+
+def _optional_int(value: Any) -> Any:
+    return None if value is None else int(value)
+
+
+#: How each setting is written to a record, by the field's annotation.
+_KINDS: dict[str, Any] = {
+    f.name: {"float": float, "int": int, "int | None": _optional_int, "str": str}[str(f.type)]
+    for f in dataclasses.fields(SolverSettings)
+}
+
+
 #: The defaults of one simulation, the same from Python (:func:`gearchaos.simulate`,
 #: :func:`~gearchaos.dynamics.point.analyse_point`) and from ``gearchaos simulate``: the
 #: seed's protocol with 64 samples per mesh period (time histories, spectra, RMS values).
 SIMULATION = SolverSettings(samples_per_period=64)
 
 
-def sample_index(n_samples: int, samples_per_period: int) -> np.ndarray:
-    """Indices of the Poincaré section samples among ``n_samples`` samples."""
-    return np.arange(0, n_samples, samples_per_period)
+# ------------------------------------------------------------------ the front doors' keywords
+def split_keywords(
+    keywords: Mapping[str, Any],
+    settings: SolverSettings | None,
+    params: Mapping[str, Any] | None,
+    default: SolverSettings,
+) -> tuple[dict[str, Any], SolverSettings]:
+    """The one keyword vocabulary of the front doors (``simulate``, ``bifurcation``,
+    ``response``, ``periodic_orbit``, ``continuation``, ``attractors``,
+    ``lyapunov_spectrum``): ``settings=`` a :class:`SolverSettings` (default ``default``) and
+    setting fields by name (``rtol=1e-10``), which override it; ``params=`` a mapping of dotted
+    parameter names to values (``{"backlash.sun_planet": 2.4}``) and parameters whose names are
+    Python identifiers by name (``omega=1.5``, ``xi=0.05``).
+
+    ``keywords`` are a door's remaining keyword arguments: setting fields and parameters by
+    name. Returns the parameter values by name and the settings."""
+    names = set(SolverSettings.field_names())
+    changes = {k: v for k, v in keywords.items() if k in names}
+    values = {k: v for k, v in keywords.items() if k not in names}
+    if params is not None and not isinstance(params, Mapping):
+        raise ParameterError(
+            f"params must be a mapping of names to values: got {params!r}", name="params"
+        )
+    for k, v in (params or {}).items():
+        if k in values:
+            raise ParameterError(f"parameter {k!r} is given twice (keyword and params)", name=k)
+        values[k] = v
+    return values, SolverSettings.build(default if settings is None else settings, **changes)
+
+
+def renamed_keyword(door: str, old: str, new: str, value: Any, current: Any = None) -> Any:
+    """``value``, given to ``door`` as ``old=``, the spelling of the keyword ``new=`` before the
+    one vocabulary (:func:`split_keywords`): accepted for one more release with a
+    :class:`DeprecationWarning` that names the new spelling; both at once are refused."""
+    if current is not None:
+        raise ParameterError(
+            f"{door}: give {new}= only ({old}= is its deprecated spelling): got both", name=new
+        )
+    warnings.warn(
+        f"{door}({old}=...) is deprecated and will be removed in the next release; "
+        f"use {new}=... instead",
+        DeprecationWarning,
+        stacklevel=3,
+    )
+    return value

@@ -25,15 +25,16 @@ import difflib
 import math
 import numbers
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, fields
 from typing import Any
 
 import numpy as np
 
 from .._checks import check_bool, check_choice, check_int
 from ..errors import ParameterError, StoreError
-from ..integrate.settings import SolverSettings
+from ..integrate.settings import SolverSettings, renamed_keyword
 from ..model.target import OMEGA, check_omega
+from .execute import EXECUTION_OPTIONS
 
 __all__ = ["Axis", "SweepSpec", "parse_axis", "parse_values"]
 
@@ -218,6 +219,49 @@ SPEC_OPTIONS = (
 )
 
 
+def check_params(keyword: str, params: Any) -> Any:
+    """``params`` (given as ``keyword``): None or a mapping of dotted names to values."""
+    if params is not None and not isinstance(params, Mapping):
+        raise ParameterError(
+            f"{keyword} must be a mapping of dotted names to values "
+            f"(e.g. {{'omega': 1.5}}): got {params!r}",
+            name=keyword,
+        )
+    return params
+
+
+def sweep_keywords(
+    door: str, target: Any, keywords: Mapping[str, Any], params: Any
+) -> tuple[dict[str, Any], dict[str, Any]]:
+    """A sweep door's keywords in the front doors' vocabulary
+    (:func:`~gearchaos.integrate.settings.split_keywords`): the parameter values — ``params``
+    and every keyword that is neither a sweep option nor a solver setting, by name — and the
+    sweep options and settings. A name that is none of these is refused with the closest."""
+    from ..model.target import parameter_names
+
+    known = {*SPEC_OPTIONS, *SolverSettings.field_names()}
+    values = dict(check_params("params", params) or {})
+    options: dict[str, Any] = {}
+    for key, value in keywords.items():
+        if key in known:
+            options[key] = value
+            continue
+        names = parameter_names(target)
+        if key not in names:
+            valid = sorted({*known, *EXECUTION_OPTIONS, *(n for n in names if n.isidentifier())})
+            close = difflib.get_close_matches(key, valid, n=1)
+            hint = f"; did you mean {close[0]!r}?" if close else ""
+            raise ParameterError(
+                f"unknown {door} option {key!r}{hint} (a parameter whose name is not a Python "
+                "identifier goes in params={name: value})",
+                name=key,
+            )
+        if key in values:
+            raise ParameterError(f"parameter {key!r} is given twice (keyword and params)", name=key)
+        values[key] = value
+    return values, options
+
+
 def _names(what: str, items: Any) -> tuple[str, ...]:
     if isinstance(items, str):
         items = (items,)
@@ -278,18 +322,18 @@ class SweepSpec:
         every ``samples_per_period``-th sample).
     """
 
+    # the fields after ``fixed`` are written to TOML in this order (:meth:`to_toml`)
     vary: tuple[Axis, ...]
     family: Axis | None = None
     fixed: tuple[tuple[str, Any], ...] = ()
-    observe: tuple[str, ...] = DEFAULT_OBSERVE
-    planets: tuple[int, ...] = (1,)
     initial_conditions: str = "fresh"
     direction: str = "up"
     solver: SolverSettings = SWEEP_SOLVER
     lyapunov: bool = False
+    observe: tuple[str, ...] = DEFAULT_OBSERVE
+    planets: tuple[int, ...] = (1,)
     orbits: bool = False
     verdicts: bool = True
-    extra: tuple[tuple[str, Any], ...] = field(default=())
     response: bool = False
 
     def __post_init__(self) -> None:
@@ -357,44 +401,61 @@ class SweepSpec:
         vary: Any,
         *,
         family: Any = None,
+        params: Mapping[str, Any] | None = None,
+        settings: SolverSettings | None = None,
         fixed: Mapping[str, Any] | None = None,
         solver: SolverSettings | None = None,
         **options: Any,
     ) -> SweepSpec:
-        """A spec from strings, mappings or sequences (see the module doc). ``options`` are
+        """A spec from strings, mappings or sequences (see the module doc).
+
+        ``params`` are the fixed values by dotted name (the field ``fixed``); ``settings`` a
+        :class:`~gearchaos.integrate.settings.SolverSettings` (the field ``solver``; default
+        :data:`SWEEP_SOLVER`, :data:`RESPONSE_SOLVER` for a response sweep). ``options`` are
         the spec's own (``observe``, ``planets``, ``initial_conditions``, ``direction``,
-        ``lyapunov``) and the solver settings by name (``transient_periods``, ``periods``,
-        ``rtol``, ``atol``, ``max_steps``), which override ``solver``."""
+        ``lyapunov``, ``orbits``, ``verdicts``, ``response``) and solver settings by name
+        (``transient_periods``, ``periods``, ``rtol``, ``atol``, ``max_steps`` …), which
+        override ``settings``. ``fixed=`` and ``solver=`` are the deprecated spellings of
+        ``params=`` and ``settings=``."""
+        if fixed is not None:
+            fixed = check_params("fixed", fixed)
+            params = renamed_keyword("SweepSpec.build", "fixed", "params", fixed, params)
+        if solver is not None:
+            settings = renamed_keyword("SweepSpec.build", "solver", "settings", solver, settings)
+        return cls._build(vary, family, params, settings, options)
+
+    @classmethod
+    def _build(
+        cls,
+        vary: Any,
+        family: Any,
+        params: Mapping[str, Any] | None,
+        settings: SolverSettings | None,
+        options: dict[str, Any],
+    ) -> SweepSpec:
         fam = _axes(family, "family")
         if len(fam) > 1:
-            raise ParameterError(f"family must be a single axis: got {len(fam)}")
-        if fixed is not None and not isinstance(fixed, Mapping):
-            raise ParameterError(
-                "fixed must be a mapping of dotted names to values "
-                f"(e.g. {{'omega': 1.5}}): got {fixed!r}"
-            )
+            raise ParameterError(f"family must be a single axis: got {len(fam)}", name="family")
+        params = check_params("params", params)
         own = {k: v for k, v in options.items() if k in SPEC_OPTIONS}
-        settings = {k: v for k, v in options.items() if k not in SPEC_OPTIONS}
-        for key in settings:
+        changes = {k: v for k, v in options.items() if k not in SPEC_OPTIONS}
+        for key in changes:
             if key not in SolverSettings.field_names():
                 valid = [*SPEC_OPTIONS, *SolverSettings.field_names()]
                 close = difflib.get_close_matches(key, valid, n=1)
                 hint = f"; did you mean {close[0]!r}?" if close else ""
-                raise ParameterError(f"unknown sweep option {key!r}{hint}")
+                raise ParameterError(f"unknown sweep option {key!r}{hint}", name=key)
         if "observe" in own:
             own["observe"] = _names("observe", own["observe"])
         if "planets" in own:
             own["planets"] = _planets(own["planets"])
+        if settings is None:
+            settings = RESPONSE_SOLVER if own.get("response") else SWEEP_SOLVER
         return cls(
             vary=_axes(vary),
             family=fam[0] if fam else None,
-            fixed=tuple(sorted((fixed or {}).items())),
-            solver=SolverSettings.build(
-                (RESPONSE_SOLVER if own.get("response") else SWEEP_SOLVER)
-                if solver is None
-                else solver,
-                **settings,
-            ),
+            fixed=tuple(sorted((params or {}).items())),
+            solver=SolverSettings.build(settings, **changes),
             **own,
         )
 
@@ -427,69 +488,38 @@ class SweepSpec:
 
     # ------------------------------------------------------------------ TOML
     def to_toml(self) -> str:
-        """Canonical TOML text (values written with ``repr``: exact)."""
-
-        def val(v: Any) -> str:
-            if isinstance(v, bool):
-                return "true" if v else "false"
-            if isinstance(v, int | np.integer):
-                return str(int(v))
-            if isinstance(v, float | np.floating):
-                return repr(float(v))
-            if isinstance(v, str):
-                return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
-            if isinstance(v, list | tuple):
-                return "[" + ", ".join(val(x) for x in v) + "]"
-            raise TypeError(f"cannot write {v!r} to TOML")
-
-        lines = [
-            f"initial_conditions = {val(self.initial_conditions)}",
-            f"direction = {val(self.direction)}",
-            f"transient_periods = {val(float(self.solver.transient_periods))}",
-            f"periods = {val(self.solver.periods)}",
-            f"rtol = {val(float(self.solver.rtol))}",
-            f"atol = {val(float(self.solver.atol))}",
-            # written only when used: stores of the exact start stay identical
-            *(
-                [f"perturbation = {val(float(self.solver.perturbation))}"]
-                if self.solver.perturbation
-                else []
-            ),
-            f"lyapunov = {val(self.lyapunov)}",
-            f"observe = {val(list(self.observe))}",
-            f"planets = {val(list(self.planets))}",
-            *([f"orbits = {val(self.orbits)}"] if self.orbits else []),
-            *([f"verdicts = {val(self.verdicts)}"] if self.verdicts else []),
-            *(
-                [
-                    f"response = {val(True)}",
-                    f"samples_per_period = {self.solver.samples_per_period}",
-                ]
-                if self.response
-                else []
-            ),
-            "",
-        ]
-        if self.solver.settle != "off":  # written only when used: older stores stay identical
-            lines.insert(6, f"settle = {val(self.solver.settle)}")
+        """Canonical TOML text (values written with ``repr``: exact), generated from the
+        fields: the options in field order, the solver settings in their place
+        (:meth:`~gearchaos.integrate.settings.SolverSettings.to_record`), then the tables
+        ``[[vary]]``, ``[family]`` and ``[fixed]``. An option or setting whose value is what
+        its absence means (:data:`UNRECORDED`) is left out, so the text of a sweep stored
+        before it existed is the same text, and :meth:`from_toml` reads every value back
+        exactly."""
+        lines = []
+        for name, value in self._options():
+            if name == "solver":
+                lines += [f"{k} = {_toml(v)}" for k, v in self.solver.to_record().items()]
+            elif not (name in UNRECORDED and value == UNRECORDED[name]):
+                lines.append(f"{name} = {_toml(value)}")
+        lines.append("")
         for a in self.vary:
-            lines += ["[[vary]]", f"name = {val(a.name)}", f"values = {val(list(a.values))}", ""]
+            lines += ["[[vary]]", f"name = {_toml(a.name)}", f"values = {_toml(a.values)}", ""]
         if self.family is not None:
             lines += [
                 "[family]",
-                f"name = {val(self.family.name)}",
-                f"values = {val(list(self.family.values))}",
+                f"name = {_toml(self.family.name)}",
+                f"values = {_toml(self.family.values)}",
                 "",
             ]
         if self.fixed:
             lines.append("[fixed]")
-            lines += [f'"{k}" = {val(v)}' for k, v in self.fixed]
-            lines.append("")
-        if self.extra:
-            lines.append("[extra]")
-            lines += [f'"{k}" = {val(v)}' for k, v in self.extra]
+            lines += [f'"{k}" = {_toml(v)}' for k, v in self.fixed]
             lines.append("")
         return "\n".join(lines)
+
+    def _options(self) -> list[tuple[str, Any]]:
+        """The fields that are not tables, by name, in field order."""
+        return [(f.name, getattr(self, f.name)) for f in fields(self) if f.name not in _TABLES]
 
     @classmethod
     def from_toml(cls, text: str) -> SweepSpec:
@@ -499,31 +529,26 @@ class SweepSpec:
         try:
             d = tomllib.loads(text)
             fam = d.get("family")
+            options: dict[str, Any] = {}
+            for f in fields(cls):
+                if f.name == "solver":
+                    options["solver"] = SolverSettings.from_record(d)
+                elif f.name in _TABLES:
+                    continue
+                elif f.name in d:
+                    value = d[f.name]
+                    options[f.name] = tuple(value) if isinstance(value, list) else value
+                elif f.name in UNRECORDED:
+                    options[f.name] = UNRECORDED[f.name]
+                else:
+                    raise KeyError(f.name)
             return cls(
                 vary=tuple(
                     Axis(a["name"], tuple(float(x) for x in a["values"])) for a in d["vary"]
                 ),
                 family=Axis(fam["name"], tuple(float(x) for x in fam["values"])) if fam else None,
                 fixed=tuple(sorted(d.get("fixed", {}).items())),
-                observe=tuple(d["observe"]),
-                planets=tuple(int(p) for p in d["planets"]),
-                initial_conditions=d["initial_conditions"],
-                direction=d["direction"],
-                solver=SolverSettings(
-                    transient_periods=d["transient_periods"],
-                    periods=int(d["periods"]),
-                    rtol=d["rtol"],
-                    atol=d["atol"],
-                    samples_per_period=int(d.get("samples_per_period", 1)),
-                    settle=d.get("settle", "off"),
-                    # stores written before the perturbed start began exactly at rest
-                    perturbation=float(d.get("perturbation", 0.0)),
-                ),
-                lyapunov=bool(d.get("lyapunov", False)),
-                orbits=bool(d.get("orbits", False)),
-                verdicts=bool(d.get("verdicts", False)),
-                response=bool(d.get("response", False)),
-                extra=tuple(sorted(d.get("extra", {}).items())),
+                **options,
             )
         except (tomllib.TOMLDecodeError, KeyError, TypeError, ValueError, AttributeError) as exc:
             if isinstance(exc, ParameterError):
@@ -531,3 +556,26 @@ class SweepSpec:
             raise StoreError(
                 f"the stored sweep specification is not readable ({type(exc).__name__}: {exc})"
             ) from None
+
+
+#: The fields of a :class:`SweepSpec` written as TOML tables, not as options.
+_TABLES = ("vary", "family", "fixed")
+
+#: What a specification without an option means: sweeps stored before the option existed
+#: neither confirmed orbits nor ran verdicts nor stored response quantities.
+UNRECORDED = {"orbits": False, "verdicts": False, "response": False}
+
+
+def _toml(v: Any) -> str:
+    """A value as TOML (floats with ``repr``: exact)."""
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int | np.integer):
+        return str(int(v))
+    if isinstance(v, float | np.floating):
+        return repr(float(v))
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(v, list | tuple):
+        return "[" + ", ".join(_toml(x) for x in v) + "]"
+    raise TypeError(f"cannot write {v!r} to TOML")

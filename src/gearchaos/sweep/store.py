@@ -186,10 +186,13 @@ class SweepStore:
         old = self.attrs()
         diffs = []
         for k, v in identity.items():
-            if old.get(k) != v:
-                if k == "sweep_toml" and isinstance(old.get(k), str):
-                    diffs.append(_toml_diff(old[k], v, "sweep"))
-                elif k == "gearset_toml" and isinstance(old.get(k), str):
+            if k == "sweep_toml" and isinstance(old.get(k), str):
+                # the same sweep, whatever the version that wrote its text
+                stored = _spec_text(old[k])
+                if stored != v:
+                    diffs.append(_toml_diff(stored, v, "sweep"))
+            elif old.get(k) != v:
+                if k == "gearset_toml" and isinstance(old.get(k), str):
                     diffs.append(_toml_diff(old[k], v, "gear set"))
                 else:
                     diffs.append(f"{k}: store has {_short(old.get(k))}, now {_short(v)}")
@@ -369,6 +372,17 @@ class SweepStore:
 def _short(v: Any, limit: int = 80) -> str:
     r = repr(v)
     return r if len(r) <= limit else r[: limit - 3] + "..."
+
+
+def _spec_text(text: str) -> str:
+    """A stored sweep specification as this version writes it (the text itself when it is not
+    readable: then it differs)."""
+    from .spec import SweepSpec
+
+    try:
+        return SweepSpec.from_toml(text).to_toml()
+    except StoreError:
+        return text
 
 
 def _toml_diff(old: str, new: str, what: str) -> str:

@@ -138,6 +138,21 @@ def _same(got: Any, want: Any) -> bool:
     return type(got) is type(want) and bool(got == want)
 
 
+def _recorded_settings(solver: Any, attrs: Any) -> dict[str, Any]:
+    """The solver settings a store's attributes must repeat: its record
+    (:meth:`~gearchaos.integrate.settings.SolverSettings.to_record`); a setting that older
+    stores did not record (:data:`~gearchaos.integrate.settings.UNRECORDED`) only where the
+    attribute is there."""
+    from ..integrate.settings import UNRECORDED
+
+    record = solver.to_record()
+    return {
+        name: record.get(name, UNRECORDED.get(name))
+        for name in solver.field_names()
+        if name not in UNRECORDED or name in attrs
+    }
+
+
 def verify_attributes(root: str, ds: Any) -> Any:
     """Check a sweep dataset's attributes against its sweep specification; return the
     :class:`~gearchaos.sweep.spec.SweepSpec`."""
@@ -178,10 +193,7 @@ def verify_attributes(root: str, ds: Any) -> Any:
             f"records {spec.solver.periods} periods",
         )
     expected = {
-        "periods": spec.solver.periods,
-        "transient_periods": float(spec.solver.transient_periods),
-        "rtol": float(spec.solver.rtol),
-        "atol": float(spec.solver.atol),
+        **_recorded_settings(spec.solver, attrs),
         "initial_conditions": spec.initial_conditions,
         "direction": spec.direction,
         "dims": list(spec.dims),
