@@ -104,7 +104,7 @@ SETTING_DOORS = {
 }
 #: Doors where None means "the default" (``SolverSettings.build``); elsewhere it is refused.
 NONE_IS_DEFAULT = {"SolverSettings.build", "integrate", "integrate_batch", "lyapunov_spectrum"}
-NONE_IS_DEFAULT |= {"max_lyapunov", "SweepSpec.build", "bifurcation", "run_gallery"}
+NONE_IS_DEFAULT |= {"max_lyapunov", "SweepSpec.build", "bifurcation", "run_gallery", "simulate"}
 
 
 @pytest.mark.parametrize("profile", PROFILES)

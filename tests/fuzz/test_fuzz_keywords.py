@@ -39,6 +39,7 @@ from gearchaos.analysis.lyapunov import lyapunov_spectrum, max_lyapunov
 from gearchaos.dynamics.point import analyse_point
 from gearchaos.integrate import integrate, integrate_batch
 from gearchaos.integrate.settings import SolverSettings
+from gearchaos.model.target import parameter_names
 from gearchaos.paper.galleries import MAX_GALLERY_VALUES, run_gallery
 from gearchaos.sweep import SweepResult, SweepSpec, classify_store
 
@@ -169,6 +170,8 @@ ROWS = [
     ),
     Row("simulate", "y0", lambda v: _sim(y0=v), BAD_Y0),
     Row("simulate", "check", lambda v: _sim(check=v), NOT_BOOL),
+    Row("simulate", "params", lambda v: _sim(params=v), NOT_MAPPING),
+    Row("simulate", "settings", lambda v: _sim(settings=v), NOT_SETTINGS),
     # bifurcation and SweepSpec.build
     Row(
         "bifurcation",
@@ -177,7 +180,8 @@ ROWS = [
         NOT_TARGET.filter(lambda v: not isinstance(v, str) or v != ""),
         "target",
     ),
-    Row("bifurcation", "fixed", lambda v: _bif(fixed=v), NOT_MAPPING),
+    Row("bifurcation", "params", lambda v: _bif(params=v), NOT_MAPPING),
+    Row("bifurcation", "fixed", lambda v: _bif(fixed=v), NOT_MAPPING),  # deprecated: params
     Row("bifurcation", "store", lambda v: _bif(store=v), NOT_PATH, "store", "path"),
     Row("bifurcation", "overwrite", lambda v: _bif(overwrite=v), NOT_BOOL),
     Row("bifurcation", "progress", lambda v: _bif(progress=v), NOT_BOOL),
@@ -199,6 +203,8 @@ ROWS = [
     Row("bifurcation", "workers", lambda v: _bif(workers=v), BAD_WORKERS),
     Row("bifurcation", "dask_local", lambda v: _bif(dask_local=v), BAD_WORKERS),
     Row("bifurcation", "scheduler", lambda v: _bif(scheduler=v), BAD_SCHEDULER),
+    Row("bifurcation", "settings", lambda v: _bif(settings=v), NOT_SETTINGS),
+    # deprecated spelling of settings
     Row("bifurcation", "solver", lambda v: _bif(solver=v), NOT_SETTINGS, "solver", "settings"),
     Row(
         "bifurcation",
@@ -215,7 +221,8 @@ ROWS = [
         NOT_TARGET.filter(lambda v: not isinstance(v, str) or v != ""),
         "target",
     ),
-    Row("response", "fixed", lambda v: _resp(fixed=v), NOT_MAPPING),
+    Row("response", "params", lambda v: _resp(params=v), NOT_MAPPING),
+    Row("response", "fixed", lambda v: _resp(fixed=v), NOT_MAPPING),  # deprecated: params
     Row("response", "store", lambda v: _resp(store=v), NOT_PATH, "store", "path"),
     Row("response", "overwrite", lambda v: _resp(overwrite=v), NOT_BOOL),
     Row("response", "progress", lambda v: _resp(progress=v), NOT_BOOL),
@@ -225,9 +232,18 @@ ROWS = [
         lambda v: _resp(direction=v),
         NOT_CHOICE.filter(lambda v: v not in ("up", "down", "both")),
     ),
+    Row("response", "settings", lambda v: _resp(settings=v), NOT_SETTINGS),
     Row("response", "solver", lambda v: _resp(solver=v), NOT_SETTINGS, "solver", "settings"),
+    Row(
+        "response",
+        "<unknown option>",
+        lambda v: _resp(**{v: 1}),
+        UNKNOWN_OPTION.filter(lambda v: v not in _OPTIONS),
+        "unknown",
+    ),
     # explore: the store is read (and refused) before any server starts
     Row("explore", "store", lambda v: _explore(store=v), NOT_PATH, "store", "path"),
+    Row("SweepSpec.build", "params", lambda v: _build(params=v), NOT_MAPPING),
     Row("SweepSpec.build", "fixed", lambda v: _build(fixed=v), NOT_MAPPING),
     Row(
         "SweepSpec.build",
@@ -267,6 +283,7 @@ ROWS = [
         NOT_CHOICE.filter(lambda v: v not in ("fresh", "continuation")),
     ),
     Row("SweepSpec.build", "lyapunov", lambda v: _build(lyapunov=v), NOT_BOOL),
+    Row("SweepSpec.build", "settings", lambda v: _build(settings=v), NOT_SETTINGS),
     Row(
         "SweepSpec.build", "solver", lambda v: _build(solver=v), NOT_SETTINGS, "solver", "settings"
     ),
@@ -521,6 +538,8 @@ _OPTIONS |= {"target", "vary", "family", "fixed", "store", "overwrite", "progres
 # every SweepSpec field is a keyword of the sweep functions too ('response' and 'orbits' were
 # missing: hypothesis drew 'response' as an "unknown" option, a flaky failure)
 _OPTIONS |= {f.name for f in dataclasses.fields(SweepSpec)}
+# the one vocabulary (issue 25): params and settings, and parameters by name (xi, omega)
+_OPTIONS |= {"params", "settings", *(n for n in parameter_names(BASE) if n.isidentifier())}
 
 
 @pytest.mark.parametrize("profile", PROFILES)

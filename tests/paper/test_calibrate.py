@@ -297,7 +297,7 @@ def test_sweep_plan_covers_each_landmark_range_and_panel() -> None:
     assert not np.any((om > 1.45) & (om < 2.9))  # only the landmarks' own ranges
     assert plan["fig4"]["family"] == {"xi": [0.03]}
     assert plan["fig8"]["family"] == {"omega": [2.0]}
-    assert plan["fig8"]["fixed"]["xi"] == 0.11
+    assert plan["fig8"]["params"]["xi"] == 0.11
     assert plan["fig4"]["lyapunov"] is True
 
 

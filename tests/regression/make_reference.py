@@ -32,7 +32,7 @@ SWEEP_FRESH = {
 }
 SWEEP_CONTINUATION = {
     "vary": "backlash.sun_planet=1:5:6",
-    "fixed": {"omega": 1.5, "xi": 0.05},
+    "params": {"omega": 1.5, "xi": 0.05},
     "initial_conditions": "continuation",
     "direction": "both",
     "transient_periods": 10,

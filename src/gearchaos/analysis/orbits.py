@@ -37,7 +37,7 @@ import numpy as np
 from .._checks import check_int, check_real
 from .._version import provenance
 from ..errors import IntegrationError, ParameterError, Status
-from ..integrate.settings import SolverSettings
+from ..integrate.settings import SolverSettings, split_keywords
 from ..model.system import System
 from ..model.target import resolve, scale_attrs
 from .contact import contact_regime
@@ -339,18 +339,9 @@ def split_values(
     params: Mapping[str, Any] | None,
     default: SolverSettings,
 ) -> tuple[dict[str, Any], SolverSettings]:
-    """Split keyword arguments into parameter values by name and solver settings."""
-    names = set(SolverSettings.field_names())
-    solver = {k: v for k, v in values_and_settings.items() if k in names}
-    values = {k: v for k, v in values_and_settings.items() if k not in names}
-    if params is not None and not isinstance(params, Mapping):
-        raise ParameterError(f"params must be a mapping of names to values: got {params!r}")
-    for k, v in (params or {}).items():
-        if k in values:
-            raise ParameterError(f"parameter {k!r} is given twice (keyword and params)")
-        values[k] = v
-    cfg = SolverSettings.build(default if settings is None else settings, **solver)
-    return values, cfg
+    """Split keyword arguments into parameter values by name and solver settings
+    (:func:`~gearchaos.integrate.settings.split_keywords`, the front doors' vocabulary)."""
+    return split_keywords(values_and_settings, settings, params, default)
 
 
 def default_tol(settings: SolverSettings) -> float:

@@ -517,7 +517,7 @@ def run_sweep(
     t0 = time.perf_counter()
     ds = fn(
         *args,
-        solver=settings,
+        settings=settings,
         store=output,
         overwrite=overwrite,
         workers=workers,

@@ -97,7 +97,7 @@ def response(
             workers=workers,
             quiet=quiet,
             direction=direction,
-            fixed=fixed,
+            params=fixed,
         )
         ds = res.ds
         lf = {

@@ -243,7 +243,7 @@ def bifurcation(
             workers=workers,
             quiet=quiet,
             family=family,
-            fixed=fixed,
+            params=fixed,
             observe=tuple(observe) if observe else None,
             planets=_parse_planets(planets),
             initial_conditions=ic,

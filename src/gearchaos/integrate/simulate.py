@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -22,7 +23,7 @@ from ..model.target import resolve
 from ._chains import ChainRun, run_chains
 from .interface import Info
 from .result import SimulationResult
-from .settings import SIMULATION, SolverSettings
+from .settings import SIMULATION, SolverSettings, split_keywords
 from .trajectory import Trajectory
 
 __all__ = ["Trajectory", "integrate", "run_simulation", "simulate"]
@@ -112,6 +113,7 @@ def integrate(
         status=out.statuses()[0],
         steps_accepted=int(out.info[0, 0, Info.ACCEPTED]),
         steps_rejected=int(out.info[0, 0, Info.REJECTED]),
+        steps_switch=int(out.info[0, 0, Info.SWITCH_RETRIES]),
         solver=cfg,
         t0=t_start,
         y0=None if y is None else y.copy(),
@@ -125,18 +127,11 @@ def integrate(
 def simulate(
     system_or_gearset: Any,
     *,
-    omega: float | None = None,
-    transient_periods: float = _DEFAULT.transient_periods,
-    periods: int = _DEFAULT.periods,
-    samples_per_period: int = _DEFAULT.samples_per_period,
-    rtol: float = _DEFAULT.rtol,
-    atol: float = _DEFAULT.atol,
+    settings: SolverSettings | None = None,
+    params: Mapping[str, Any] | None = None,
     y0: Any = None,
-    section_phase: float = _DEFAULT.section_phase,
-    max_steps: int | None = None,
     check: bool = True,
-    settle: str = _DEFAULT.settle,
-    perturbation: float = _DEFAULT.perturbation,
+    **values_and_settings: Any,
 ) -> SimulationResult:
     """Simulate a gear set (or any :class:`System`) with the seed's protocol.
 
@@ -145,30 +140,41 @@ def simulate(
     system_or_gearset
         A :class:`~gearchaos.gearset.GearSet` (then ``omega`` is required) or a
         :class:`~gearchaos.model.System` (``omega``, if given, replaces its Ω).
-    omega
-        Dimensionless mesh frequency Ω = ω/ω_n.
-    transient_periods, periods
-        Forcing periods discarded, then recorded (one Poincaré point each).
-    samples_per_period
-        Samples per period for time histories, phase portraits and spectra.
-    rtol, atol
-        Error tolerances of the Dormand–Prince 5(4) controller.
+    settings
+        A :class:`~gearchaos.integrate.settings.SolverSettings` (default
+        :data:`~gearchaos.integrate.settings.SIMULATION`: 100 transient and 200 recorded
+        periods, 64 samples per period); settings given by name override it.
+    params
+        Parameter values by dotted name (``{"backlash.sun_planet": 2.4}``).
     y0
         Initial state (default: rest, MODEL.md §6, perturbed by ``perturbation``).
-    section_phase
-        Phase φ of the Poincaré section, τ_k = (2πk + φ)/Ω.
-    max_steps
-        Step budget (default: 100 000 + 50 000 per simulated period).
     check
         Raise :class:`~gearchaos.errors.IntegrationError` (carrying ``.result``) when the
         integration fails; with ``check=False`` inspect ``result.status`` instead.
-    perturbation
-        Size of the reproducible perturbation of the start from rest (default 1e-6; 0: the
-        exact zero state; see :class:`~gearchaos.integrate.settings.SolverSettings`).
-    settle
-        ``"auto"``: end the transient early once the section sequence repeats (see
-        :class:`~gearchaos.integrate.settings.SolverSettings`); ``"off"`` (default): the full
-        transient.
+    **values_and_settings
+        Parameters whose names are Python identifiers by name: ``omega``, the dimensionless
+        mesh frequency Ω = ω/ω_n, ``xi`` …; and solver settings by name
+        (:class:`~gearchaos.integrate.settings.SolverSettings`):
+
+        ``transient_periods``, ``periods``
+            Forcing periods discarded, then recorded (one Poincaré point each).
+        ``samples_per_period``
+            Samples per period for time histories, phase portraits and spectra.
+        ``rtol``, ``atol``
+            Error tolerances of the Dormand–Prince 5(4) controller.
+        ``section_phase``
+            Phase φ of the Poincaré section, τ_k = (2πk + φ)/Ω.
+        ``max_steps``
+            Step budget (default: 100 000 + 50 000 per simulated period).
+        ``perturbation``
+            Size of the reproducible perturbation of the start from rest (default 1e-6; 0:
+            the exact zero state).
+        ``settle``
+            ``"auto"``: end the transient early once the section sequence repeats;
+            ``"off"`` (default): the full transient.
+
+        This is the vocabulary of every front door (``bifurcation``, ``response``,
+        ``periodic_orbit``, ``continuation``, ``attractors``).
 
     Returns
     -------
@@ -176,20 +182,10 @@ def simulate(
         Samples, extrema, status and step statistics; ``.to_dataset()`` gives an
         :class:`xarray.Dataset` with units and the full gear set in its attributes.
     """
-    settings = SolverSettings(
-        transient_periods=transient_periods,
-        periods=periods,
-        samples_per_period=samples_per_period,
-        section_phase=section_phase,
-        rtol=rtol,
-        atol=atol,
-        max_steps=max_steps,
-        settle=settle,
-        perturbation=perturbation,
-    )
+    values, cfg = split_keywords(values_and_settings, settings, params, _DEFAULT)
     raise_on_failure = check_bool("check", check)
-    system = resolve(system_or_gearset, {} if omega is None else {"omega": omega})
-    return run_simulation(system, settings, y0=y0, check=raise_on_failure)
+    system = resolve(system_or_gearset, values)
+    return run_simulation(system, cfg, y0=y0, check=raise_on_failure)
 
 
 def run_simulation(
@@ -208,7 +204,7 @@ def run_simulation(
     if check and not traj.ok:
         err = IntegrationError(
             f"simulation at omega={system.omega:g} stopped at tau={traj.tau_reached:.6g} "
-            f"after {traj.steps_accepted + traj.steps_rejected} step attempts: "
+            f"after {traj.steps_accepted + traj.steps_rejected + traj.steps_switch} step attempts: "
             f"{traj.status.name}: {traj.status.message}"
         )
         err.result = result  # type: ignore[attr-defined]

@@ -228,11 +228,11 @@ def sweep_plan(
         plan[fig] = {
             "vary": {rec.vary.name: _grid(intervals, settings.points, floor)},
             "family": {fam_name: sorted(set(families))},
-            "fixed": fixed,
+            "params": fixed,
             "observe": rec.observe,
             "planets": (1,),
             "initial_conditions": "fresh",
-            "solver": settings.solver,
+            "settings": settings.solver,
             "lyapunov": settings.lyapunov,
         }
     return plan

@@ -145,7 +145,7 @@ class Recipe:
         return {
             "vary": {self.vary.name: self.vary.values(quick)},
             "family": {self.family.name: list(self.family.values)},
-            "fixed": dict(self.fixed),
+            "params": dict(self.fixed),
             "observe": self.observe,
             "planets": (1,),
             "initial_conditions": "fresh",

@@ -18,13 +18,16 @@ besides the sections and extrema of every sweep (:mod:`gearchaos.model.response`
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 
 from .._checks import check_real
 from ..errors import ParameterError
+from ..integrate.settings import SolverSettings, renamed_keyword
 from .run import bifurcation
+from .spec import check_params
 
 __all__ = ["find_jumps", "response"]
 
@@ -34,10 +37,13 @@ def response(
     vary: Any,
     *,
     direction: str = "both",
-    fixed: dict[str, Any] | None = None,
+    params: Mapping[str, Any] | None = None,
+    settings: SolverSettings | None = None,
     store: str | os.PathLike[str] | None = None,
     overwrite: bool = False,
     progress: bool = True,
+    fixed: Mapping[str, Any] | None = None,
+    solver: SolverSettings | None = None,
     **options: Any,
 ) -> Any:
     """Frequency-response curves: dynamic mesh forces, load factors and transmission errors
@@ -53,12 +59,17 @@ def response(
     direction
         ``up``, ``down`` or ``both`` (default): each point starts from the final state of its
         neighbour in that direction, so coexisting branches and the jumps between them show.
-    fixed, store, overwrite, progress
-        As for :func:`~gearchaos.sweep.run.bifurcation`.
+    params, store, overwrite, progress
+        As for :func:`~gearchaos.sweep.run.bifurcation`: fixed values by dotted name (and
+        parameters by name among ``options``).
+    settings
+        A :class:`~gearchaos.integrate.settings.SolverSettings` (default
+        :data:`~gearchaos.sweep.spec.RESPONSE_SOLVER`: 100 transient and 50 recorded periods,
+        32 samples per period); settings by name among ``options`` override it.
     **options
-        Further sweep options (``observe``, ``planets``, ``lyapunov``, ``family``) and solver
-        settings (default :data:`~gearchaos.sweep.spec.RESPONSE_SOLVER`: 100 transient and 50
-        recorded periods, 32 samples per period).
+        Further sweep options (``observe``, ``planets``, ``lyapunov``, ``family``), solver
+        settings and parameters by name. ``fixed=`` and ``solver=`` are the deprecated
+        spellings of ``params=`` and ``settings=``.
 
     Returns
     -------
@@ -68,10 +79,17 @@ def response(
         ``load_factor_m`` = max_i max |F̄ᶜ_i| / (T̄_D/N) and ``dte_rms_m`` = √⟨(δ̄ − ⟨δ̄⟩)²⟩
         (module docstring); the attribute ``kind`` is ``"response"``.
     """
+    if fixed is not None:  # the spellings before the one vocabulary
+        params = renamed_keyword(
+            "response", "fixed", "params", check_params("fixed", fixed), params
+        )
+    if solver is not None:
+        settings = renamed_keyword("response", "solver", "settings", solver, settings)
     return bifurcation(
         target,
         vary,
-        fixed=fixed,
+        params=params,
+        settings=settings,
         store=store,
         overwrite=overwrite,
         progress=progress,

@@ -13,7 +13,7 @@ import itertools
 import os
 import signal
 import threading
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from typing import Any
 
 import numpy as np
@@ -23,6 +23,7 @@ from .._version import provenance
 from ..errors import ParameterError, Status, StoreError
 from ..integrate._chains import ChainOutput, ChainRun
 from ..integrate.interface import Info
+from ..integrate.settings import SolverSettings, renamed_keyword
 from ..integrate.threads import abandon, resume
 from ..model.target import scale_attrs
 from ._response_store import response_extract, response_variables
@@ -31,7 +32,7 @@ from .grid import Grid, Task
 from .integrity import StoreLock
 from .orbits import ORBIT_VARIABLES, status_attrs, task_orbits
 from .progress import _Bar
-from .spec import DEFAULT_OBSERVE, SweepSpec
+from .spec import DEFAULT_OBSERVE, SweepSpec, check_params, sweep_keywords
 from .store import SweepStore
 from .verdicts import VERDICT_VARIABLES, task_verdicts, verdict_attrs
 
@@ -497,10 +498,13 @@ def bifurcation(
     vary: Any,
     *,
     family: Any = None,
-    fixed: dict[str, Any] | None = None,
+    params: Mapping[str, Any] | None = None,
+    settings: SolverSettings | None = None,
     store: str | os.PathLike[str] | None = None,
     overwrite: bool = False,
     progress: bool = True,
+    fixed: Mapping[str, Any] | None = None,
+    solver: SolverSettings | None = None,
     **options: Any,
 ) -> Any:
     """Bifurcation diagram (or 2-D map) data: Poincaré sections over a parameter grid.
@@ -515,8 +519,13 @@ def bifurcation(
         ``log:start:stop:count`` or ``a,b,c``.
     family
         One more axis drawn as separate panels (e.g. ``{"xi": [0.03, 0.05, 0.07, 0.09]}``).
-    fixed
-        Fixed overrides by dotted name, ``omega`` included when it is not swept.
+    params
+        Fixed parameter values by dotted name (``{"backlash.sun_planet": 2.4}``), ``omega``
+        included when it is not swept; parameters whose names are Python identifiers may also
+        be given by name (``omega=1.5``, ``xi=0.05``).
+    settings
+        A :class:`~gearchaos.integrate.settings.SolverSettings` (default: 100 transient and
+        100 recorded periods); settings given by name (``periods=200``) override it.
     store
         Path of a Zarr store. Written chunk by chunk; an interrupted sweep (Ctrl-C, SIGTERM,
         SIGKILL) resumes when called again with the same arguments; other settings are refused
@@ -542,9 +551,8 @@ def bifurcation(
             Confirm every label nT (n ≤ 8) by shooting a period-n orbit from the point's final
             state and store ``orbit_residual``, ``orbit_max_multiplier`` (max |μ|),
             ``orbit_period`` and ``orbit_status`` (:mod:`gearchaos.sweep.orbits`).
-        ``transient_periods`` (100), ``periods`` (100), ``rtol``, ``atol``, ``max_steps``
-            Protocol and tolerances (:class:`~gearchaos.integrate.settings.SolverSettings`),
-            or ``solver=SolverSettings(...)``.
+        ``transient_periods`` (100), ``periods`` (100), ``rtol``, ``atol``, ``max_steps`` …
+            Solver settings by name, overriding ``settings``.
 
         and where it runs (:class:`~gearchaos.sweep.execute.Execution`): ``workers`` (N local
         processes), ``scheduler`` (the address of a ``dask.distributed`` cluster) or
@@ -558,10 +566,17 @@ def bifurcation(
         point ``status``, step counts, extrema of every mesh deflection and the final state.
         Attributes carry the gear set, the sweep specification, the solver settings and versions.
     """
+    if fixed is not None:  # the spellings before the one vocabulary
+        params = renamed_keyword(
+            "bifurcation", "fixed", "params", check_params("fixed", fixed), params
+        )
+    if solver is not None:
+        settings = renamed_keyword("bifurcation", "solver", "settings", solver, settings)
     where = Execution(**{k: options.pop(k) for k in EXECUTION_OPTIONS if k in options})
+    values, options = sweep_keywords("sweep", target, options, params)
     if options.get("observe") is None:
         options["observe"] = _default_observe(target)
-    spec = SweepSpec.build(vary, family=family, fixed=fixed, **options)
+    spec = SweepSpec.build(vary, family=family, params=values, settings=settings, **options)
     return run_sweep(
         target, spec, store=store, overwrite=overwrite, execution=where, progress=progress
     )

@@ -1,0 +1,159 @@
+"""One keyword vocabulary across the front doors (issue 25).
+
+``settings=`` a :class:`SolverSettings` plus setting fields by name; ``params=`` a mapping of
+dotted names to values plus parameters whose names are identifiers by name. Every door accepts
+it and gives bitwise the same result whichever way a value is given; the spellings from before
+(``fixed=``, ``solver=`` of the sweeps) still work for one release, with a DeprecationWarning
+that names the new spelling.
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import Any
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import gearchaos as gc
+from gearchaos.errors import ParameterError
+from gearchaos.integrate.settings import SolverSettings
+from gearchaos.sweep import SweepSpec
+
+GS = gc.preset("hindawi2021")
+OSC = gc.backlash_oscillator(1.0, zeta=0.05, b=1.0, f_mean=0.1, f_alt=0.2)
+TINY = SolverSettings(transient_periods=2, periods=3)
+VARY = "omega=1.2:1.4:2"
+
+
+def _quiet(call: Any) -> Any:
+    """``call()``, failing on any DeprecationWarning: the new spelling warns about nothing."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", DeprecationWarning)
+        return call()
+
+
+def _same_dataset(a: xr.Dataset, b: xr.Dataset) -> None:
+    assert sorted(a.variables) == sorted(b.variables)
+    for name in a.variables:
+        x, y = np.asarray(a[name].values), np.asarray(b[name].values)
+        assert x.dtype == y.dtype and x.shape == y.shape, name
+        assert x.tobytes() == y.tobytes(), name
+    keep = {k for k in a.attrs if k not in ("version",)}
+    assert {k: a.attrs[k] for k in keep} == {k: b.attrs[k] for k in keep}
+
+
+# ----------------------------------------------------------------------------- simulate
+def test_simulate_takes_settings_and_params() -> None:
+    by_name = _quiet(lambda: gc.simulate(GS, omega=1.5, xi=0.05, transient_periods=2, periods=3))
+    new = _quiet(
+        lambda: gc.simulate(
+            GS,
+            settings=TINY.replace(samples_per_period=64),
+            params={"omega": 1.5, "xi": 0.05},
+        )
+    )
+    mixed = _quiet(
+        lambda: gc.simulate(
+            GS, settings=TINY, samples_per_period=64, omega=1.5, params={"xi": 0.05}
+        )
+    )
+    for other in (new, mixed):
+        _same_dataset(by_name.to_dataset(), other.to_dataset())
+    assert by_name.system.model.gearset.damping.sun_planet == 0.05
+
+
+def test_simulate_refuses_a_value_given_twice_and_settings_of_the_wrong_kind() -> None:
+    with pytest.raises(ParameterError, match="given twice") as info:
+        gc.simulate(GS, omega=1.5, params={"omega": 1.4}, settings=TINY)
+    assert info.value.name == "omega"
+    with pytest.raises(ParameterError, match="settings must be a SolverSettings"):
+        gc.simulate(GS, omega=1.5, settings={"rtol": 1e-8})
+
+
+# ----------------------------------------------------------------------------- sweeps
+@pytest.mark.parametrize("door", ["bifurcation", "response"])
+def test_sweeps_take_params_and_settings_and_the_old_spellings_warn(door: str) -> None:
+    fn = getattr(gc, door)
+    settings = TINY.replace(samples_per_period=4) if door == "response" else TINY
+    new = _quiet(
+        lambda: fn(GS, VARY, params={"backlash.sun_planet": 2.5}, settings=settings, progress=False)
+    )
+    by_name = _quiet(
+        lambda: fn(
+            GS, VARY, params={"backlash.sun_planet": 2.5}, progress=False, **settings.to_record()
+        )
+    )
+    with pytest.warns(DeprecationWarning, match=rf"{door}\(fixed=\.\.\.\).*use params="):
+        with pytest.warns(DeprecationWarning, match=rf"{door}\(solver=\.\.\.\).*use settings="):
+            old = fn(GS, VARY, fixed={"backlash.sun_planet": 2.5}, solver=settings, progress=False)
+    _same_dataset(new, old)
+    _same_dataset(new, by_name)
+    assert new.attrs["sweep_toml"] == old.attrs["sweep_toml"]
+
+
+def test_a_sweep_takes_parameters_by_name() -> None:
+    by_name = _quiet(lambda: gc.bifurcation(GS, VARY, xi=0.05, settings=TINY, progress=False))
+    in_params = _quiet(
+        lambda: gc.bifurcation(GS, VARY, params={"xi": 0.05}, settings=TINY, progress=False)
+    )
+    _same_dataset(by_name, in_params)
+    assert dict(SweepSpec.from_toml(by_name.attrs["sweep_toml"]).fixed) == {"xi": 0.05}
+
+
+def test_sweeps_refuse_both_spellings_at_once_and_unknown_names() -> None:
+    with pytest.raises(ParameterError, match=r"give params= only \(fixed= is its deprecated"):
+        gc.bifurcation(GS, VARY, params={"xi": 0.05}, fixed={"xi": 0.05}, progress=False)
+    with pytest.raises(ParameterError, match=r"give settings= only"):
+        gc.response(GS, VARY, settings=TINY, solver=TINY, progress=False)
+    with pytest.raises(ParameterError, match="unknown sweep option 'rtoll'; did you mean 'rtol'"):
+        gc.bifurcation(GS, VARY, rtoll=1e-6, progress=False)
+    with pytest.raises(ParameterError, match="given twice") as info:
+        gc.bifurcation(GS, VARY, xi=0.05, params={"xi": 0.07}, progress=False)
+    assert info.value.name == "xi"
+
+
+def test_sweep_spec_build_takes_the_vocabulary_too() -> None:
+    new = _quiet(lambda: SweepSpec.build(VARY, params={"xi": 0.05}, settings=TINY))
+    with pytest.warns(DeprecationWarning, match="use params="):
+        with pytest.warns(DeprecationWarning, match="use settings="):
+            old = SweepSpec.build(VARY, fixed={"xi": 0.05}, solver=TINY)
+    assert new == old
+
+
+# ----------------------------------------------------------------------------- orbits
+def test_periodic_orbit_takes_settings_and_params() -> None:
+    settings = SolverSettings(transient_periods=30, rtol=1e-9)
+    by_name = _quiet(lambda: gc.periodic_orbit(OSC, omega=1.3, transient_periods=30, rtol=1e-9))
+    new = _quiet(lambda: gc.periodic_orbit(OSC, settings=settings, params={"omega": 1.3}))
+    assert by_name.state.tobytes() == new.state.tobytes()
+    assert by_name.multipliers.tobytes() == new.multipliers.tobytes()
+
+
+def test_continuation_takes_settings_and_params() -> None:
+    kw: dict[str, Any] = {"max_points": 4}
+    by_name = _quiet(
+        lambda: gc.continuation(OSC, ("omega", 1.5, 1.6), transient_periods=30, zeta=0.06, **kw)
+    )
+    new = _quiet(
+        lambda: gc.continuation(
+            OSC,
+            ("omega", 1.5, 1.6),
+            settings=SolverSettings(transient_periods=30),
+            params={"zeta": 0.06},
+            **kw,
+        )
+    )
+    _same_dataset(by_name, new)
+
+
+def test_attractors_take_settings_and_params() -> None:
+    settings = SolverSettings(transient_periods=20, periods=20)
+    by_name = _quiet(
+        lambda: gc.attractors(OSC, starts=2, omega=1.3, transient_periods=20, periods=20)
+    )
+    new = _quiet(lambda: gc.attractors(OSC, starts=2, settings=settings, params={"omega": 1.3}))
+    assert len(by_name) == len(new)
+    for a, b in zip(by_name, new, strict=True):
+        assert a.sections.tobytes() == b.sections.tobytes()
