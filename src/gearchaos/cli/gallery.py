@@ -10,6 +10,7 @@ import typer
 
 from ..errors import ParameterError
 from ..model.target import DEFAULT_OMEGA
+from ..paper.galleries import GALLERY_SETTINGS
 from . import _common as c
 from ._render import gallery_rows_table
 
@@ -36,8 +37,8 @@ def poincare(
     preset: c.PresetOpt = None,
     gearset: c.GearsetOpt = None,
     set_: c.SetOpt = None,
-    transient: c.TransientOpt = 100.0,
-    periods: c.PeriodsOpt = 300,
+    transient: c.TransientOpt = GALLERY_SETTINGS.transient_periods,
+    periods: c.PeriodsOpt = GALLERY_SETTINGS.periods,
     with_: Annotated[
         str | None,
         typer.Option(
@@ -47,8 +48,8 @@ def poincare(
         ),
     ] = None,
     planet: Annotated[int, typer.Option("--planet", help="Planet of X̄_sp.")] = 1,
-    rtol: c.RtolOpt = 1e-8,
-    atol: c.AtolOpt = 1e-10,
+    rtol: c.RtolOpt = GALLERY_SETTINGS.rtol,
+    atol: c.AtolOpt = GALLERY_SETTINGS.atol,
     quiet: c.QuietOpt = False,
     json_out: c.JsonOpt = False,
 ) -> None:

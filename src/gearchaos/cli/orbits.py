@@ -13,6 +13,8 @@ from rich.markup import escape
 from rich.table import Table
 from rich.text import Text
 
+from ..analysis.orbits import ORBIT_SETTINGS
+from ..dynamics.coexistence import ATTRACTOR_SETTINGS
 from ..errors import IntegrationError, ParameterError
 from . import _common as c
 from ._render import pairs_table
@@ -111,7 +113,7 @@ def orbit(
     model: c.ModelOpt = None,
     set_: c.SetOpt = None,
     period: PeriodOpt = None,
-    transient: GuessOpt = 50.0,
+    transient: GuessOpt = ORBIT_SETTINGS.transient_periods,
     from_: FromOpt = None,
     at: AtOpt = None,
     output: Annotated[
@@ -124,8 +126,8 @@ def orbit(
             show_default=False,
         ),
     ] = None,
-    rtol: c.RtolOpt = 1e-8,
-    atol: c.AtolOpt = 1e-10,
+    rtol: c.RtolOpt = ORBIT_SETTINGS.rtol,
+    atol: c.AtolOpt = ORBIT_SETTINGS.atol,
     json_out: c.JsonOpt = False,
 ) -> None:
     """Find the period-n orbit at one operating point by shooting (Newton on Pⁿ(y) − y = 0,
@@ -227,11 +229,11 @@ def continue_(
     model: c.ModelOpt = None,
     set_: c.SetOpt = None,
     period: PeriodOpt = None,
-    transient: GuessOpt = 50.0,
+    transient: GuessOpt = ORBIT_SETTINGS.transient_periods,
     from_: FromOpt = None,
     at: AtOpt = None,
-    rtol: c.RtolOpt = 1e-8,
-    atol: c.AtolOpt = 1e-10,
+    rtol: c.RtolOpt = ORBIT_SETTINGS.rtol,
+    atol: c.AtolOpt = ORBIT_SETTINGS.atol,
     max_points: Annotated[
         int, typer.Option("--max-points", help="Most points of the branch.")
     ] = 2000,
@@ -384,10 +386,10 @@ def attractors(
         ),
     ] = 8,
     seed: Annotated[int, typer.Option("--seed", help="Seed of the random starts.")] = 0,
-    transient: c.TransientOpt = 200.0,
-    periods: c.PeriodsOpt = 100,
-    rtol: c.RtolOpt = 1e-8,
-    atol: c.AtolOpt = 1e-10,
+    transient: c.TransientOpt = ATTRACTOR_SETTINGS.transient_periods,
+    periods: c.PeriodsOpt = ATTRACTOR_SETTINGS.periods,
+    rtol: c.RtolOpt = ATTRACTOR_SETTINGS.rtol,
+    atol: c.AtolOpt = ATTRACTOR_SETTINGS.atol,
     json_out: c.JsonOpt = False,
 ) -> None:
     """List the distinct attractors at one operating point, from several initial conditions.

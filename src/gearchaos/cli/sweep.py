@@ -12,6 +12,7 @@ from rich.text import Text
 
 from ..errors import ParameterError
 from ..gearset.parsing import parse_int
+from ..sweep.spec import SWEEP_SOLVER
 from . import _common as c
 from ._render import regime_table, sweep_summary
 
@@ -120,15 +121,15 @@ def bifurcation(
             help="up, down or both (continuation only; both overlays the branches).",
         ),
     ] = "up",
-    transient: c.TransientOpt = 100.0,
-    settle: c.SettleOpt = "off",
+    transient: c.TransientOpt = SWEEP_SOLVER.transient_periods,
+    settle: c.SettleOpt = SWEEP_SOLVER.settle,
     perturbation: c.PerturbationOpt = None,
     periods: Annotated[
         int,
         typer.Option("--periods", help="Mesh periods recorded at every point (section points)."),
-    ] = 100,
-    rtol: c.RtolOpt = 1e-8,
-    atol: c.AtolOpt = 1e-10,
+    ] = SWEEP_SOLVER.periods,
+    rtol: c.RtolOpt = SWEEP_SOLVER.rtol,
+    atol: c.AtolOpt = SWEEP_SOLVER.atol,
     workers: c.WorkersOpt = None,
     scheduler: Annotated[
         str | None,
