@@ -147,15 +147,6 @@ class SweepSettings:
         return cls(points=6, transient_periods=20, periods=16)
 
 
-_VARY_NAMES = (
-    "omega",
-    "xi",
-    "backlash.sun_planet",
-    "backlash.planet_ring",
-    "clearance.sun_bearing",
-)
-
-
 def _landmark_interval(lm: Any) -> tuple[float, float]:
     lo = getattr(lm, "lo", None)
     hi = getattr(lm, "hi", None)

@@ -327,32 +327,3 @@ def message(ax: Any, text: str) -> Any:
     ax.set_xticks([])
     ax.set_yticks([])
     return ax
-
-
-def readable_limits(ax: Any, *, rel: float = 1e-3, joint: bool = False) -> None:
-    """Keep tiny ranges in context and drop axis offsets on linear axes.
-
-    Autoscaling zooms onto the integration noise of a periodic orbit (a 1T Poincaré point
-    spread by 10⁻⁹ fills the panel and looks like structure). When an axis spans less than
-    ``rel`` times the largest magnitude it shows (with ``joint``, the largest magnitude on
-    either axis — for x–x' planes, matching :func:`~gearchaos.analysis.count_distinct`), it is
-    widened to ±5 % of that magnitude (±1 around zero); axis offsets (“1e-6 + 3.49”) are
-    turned off.
-    """
-    axes = (
-        (ax.xaxis, ax.get_xlim, ax.set_xlim),
-        (ax.yaxis, ax.get_ylim, ax.set_ylim),
-    )
-    limits = [get() for _, get, _ in axes]
-    joint_mag = max(abs(v) for lim in limits for v in lim)
-    for (axis, _, set_), (lo, hi) in zip(axes, limits, strict=True):
-        if axis.get_scale() != "linear":
-            continue
-        mag = joint_mag if joint else max(abs(lo), abs(hi))
-        if hi - lo <= rel * mag or mag == 0.0:
-            centre = 0.5 * (lo + hi)
-            half = 0.05 * mag if mag > 0 else 1.0
-            set_(centre - half, centre + half)
-        formatter = axis.get_major_formatter()
-        if hasattr(formatter, "set_useOffset"):
-            formatter.set_useOffset(False)
