@@ -77,7 +77,8 @@ class Grid:
                 self.fixed_omega = target.omega
             else:
                 raise ParameterError(
-                    "omega must be swept or fixed (e.g. fixed={'omega': 1.5} or --set omega=1.5)"
+                    "omega must be swept or fixed (e.g. omega=1.5 or params={'omega': 1.5}; "
+                    "--set omega=1.5 on the command line)"
                 )
         self.shape = spec.shape
         self.dims = spec.dims
