@@ -26,6 +26,7 @@ def test_batch_points_bitwise_equal_to_single_runs(systems):
         np.testing.assert_array_equal(batch.obs_max[i], single.obs_max)
         assert batch.steps_accepted[i] == single.steps_accepted
         assert batch.steps_rejected[i] == single.steps_rejected
+        assert batch.steps_switch[i] == single.steps_switch
 
 
 def test_batch_independent_of_thread_count():

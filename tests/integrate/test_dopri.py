@@ -140,7 +140,7 @@ def test_max_steps() -> None:
     system = gc.linear_oscillator(1.0, zeta=0.1)
     tr = integrate(system, y0=[1.0, 0.0], transient_periods=0, periods=10, max_steps=10)
     assert tr.status is Status.MAX_STEPS
-    assert tr.steps_accepted + tr.steps_rejected == 10
+    assert tr.steps_accepted + tr.steps_rejected + tr.steps_switch == 10
     assert np.all(np.isnan(tr.tau[1:]))
     assert np.all(np.isnan(tr.states[1:]))
     assert tr.status.message  # informative text

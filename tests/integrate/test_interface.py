@@ -49,6 +49,24 @@ def test_info_columns_are_what_their_names_say(run: ChainRun) -> None:
     assert info[Info.ACCEPTED] > 0 and info[Info.ACCEPTED] == int(info[Info.ACCEPTED])
     assert info[Info.REJECTED] >= 0 and info[Info.NEXT_STEP] > 0
     assert info[Info.SKIPPED] == 0  # settle is off
+    assert info[Info.SWITCH_RETRIES] > 0  # the meshes open and close at Ω = 1.5
+
+
+def test_switch_retries_are_counted_apart_from_rejections() -> None:
+    """A step retried to end on a contact switch is no error-test rejection: smooth systems
+    have none, and a budget counts every attempt."""
+    smooth = gc.integrate.integrate(gc.linear_oscillator(1.0, zeta=0.1), periods=5)
+    assert smooth.steps_switch == 0
+    res = gc.simulate(gc.preset("sheng2016"), omega=1.5, transient_periods=5, periods=5)
+    assert res.steps_switch > 0 and res.steps_rejected >= 0
+    attempts = res.steps_accepted + res.steps_rejected + res.steps_switch
+    capped = gc.simulate(
+        gc.preset("sheng2016"), omega=1.5, transient_periods=5, periods=5,
+        max_steps=attempts - 1, check=False,
+    )  # fmt: skip
+    assert capped.status is Status.MAX_STEPS
+    assert capped.steps_accepted + capped.steps_rejected + capped.steps_switch == attempts - 1
+    assert res.to_dataset().attrs["steps_switch"] == res.steps_switch
 
 
 def test_kernel_status_codes_are_status_members() -> None:
@@ -61,4 +79,5 @@ def test_kernel_status_codes_are_status_members() -> None:
 def test_step_budget_stops_with_max_steps(run: ChainRun) -> None:
     out = run_chains(dataclasses.replace(run, max_steps=7))
     assert out.statuses() == [Status.MAX_STEPS]
-    assert out.info[0, 0, Info.ACCEPTED] + out.info[0, 0, Info.REJECTED] == 7
+    info = out.info[0, 0]
+    assert info[Info.ACCEPTED] + info[Info.REJECTED] + info[Info.SWITCH_RETRIES] == 7

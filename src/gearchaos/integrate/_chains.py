@@ -223,7 +223,8 @@ class ChainOutput(SampleArrays):
     ``observables`` (C, L, s, n_obs), ``obs_min``/``obs_max`` (C, L, n_track), ``final_state``
     (C, L, n_full) with the tangent vectors; then ``info`` (C, L, len(Info)): the columns of
     :class:`~gearchaos.integrate.interface.Info` (accepted and rejected steps, time reached,
-    next step size, transient periods skipped by ``settle``); ``status`` (C, L)
+    next step size, transient periods skipped by ``settle``, steps retried to end on a contact
+    switch); ``status`` (C, L)
     :class:`~gearchaos.errors.Status` codes; ``log_sums`` (C, L, k) accumulated log stretch
     factors of the tangent vectors.
     """

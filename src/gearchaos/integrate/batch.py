@@ -33,13 +33,15 @@ class BatchResult(SampleArrays):
     The :class:`~gearchaos.integrate._chains.SampleArrays` with shapes ``tau`` (m, s),
     ``states`` (m, s, n_state), ``observables`` (m, s, n_obs), ``obs_min``/``obs_max``
     (m, n_track), ``final_state`` (m, n_state); then the ``systems``, ``status`` (m,) int codes
-    (:class:`~gearchaos.errors.Status`), ``steps_accepted``/``steps_rejected`` (m,).
+    (:class:`~gearchaos.errors.Status`), ``steps_accepted``/``steps_rejected``/``steps_switch``
+    (m,) as in :class:`~gearchaos.integrate.Trajectory`.
     """
 
     systems: tuple[System, ...]
     status: np.ndarray
     steps_accepted: np.ndarray
     steps_rejected: np.ndarray
+    steps_switch: np.ndarray
     samples_per_period: int
 
     def __len__(self) -> int:
@@ -114,5 +116,6 @@ def integrate_batch(
         status=out.status[:, 0],
         steps_accepted=out.info[:, 0, Info.ACCEPTED].astype(np.int64),
         steps_rejected=out.info[:, 0, Info.REJECTED].astype(np.int64),
+        steps_switch=out.info[:, 0, Info.SWITCH_RETRIES].astype(np.int64),
         samples_per_period=cfg.samples_per_period,
     )

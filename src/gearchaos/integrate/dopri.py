@@ -229,7 +229,7 @@ def dopri_run(
     retried so that it ends on the switch, so no step straddles a kink of the vector field
     (DOPRI5's error estimate can miss a kink inside a step: 10–100× larger errors).
     ``info`` (float64, columns :class:`~gearchaos.integrate.interface.Info`) receives accepted
-    steps, rejected steps (including steps discarded to land on a switch), the final time
+    steps, steps rejected by the error test, steps discarded to land on a switch, the final time
     reached, the next step size and the transient periods skipped by ``settle``.
 
     Settling (``settle_spp`` > 0, the samples per period, so T = settle_spp·dt_sample): the
@@ -280,6 +280,7 @@ def dopri_run(
     rhs(kind, t, y, p, K[0], obs, OBS_ALL)
     n_acc = 0
     n_rej = 0
+    n_sw = 0  # steps retried to end on a switch
     status = ST_OK
     for i in range(n):
         if not math.isfinite(K[0, i]) or not math.isfinite(y[i]):
@@ -337,7 +338,7 @@ def dopri_run(
             target = t_end
         if j >= n_samples and t >= t_end:
             break
-        if n_acc + n_rej >= max_steps:
+        if n_acc + n_rej + n_sw >= max_steps:
             status = ST_MAX_STEPS
             break
         hmin = 16.0 * 2.220446049250313e-16 * max(abs(t), abs(target))
@@ -437,7 +438,7 @@ def dopri_run(
                 h_event = theta * hs + AIM * max(h, hs)
                 if h_event >= hs:
                     h_event = theta * hs
-                n_rej += 1
+                n_sw += 1
                 continue
 
         if err > 1.0:
@@ -504,6 +505,7 @@ def dopri_run(
     _copy(y_final, y, n)
     info[Info.ACCEPTED] = n_acc
     info[Info.REJECTED] = n_rej
+    info[Info.SWITCH_RETRIES] = n_sw
     info[Info.TAU_REACHED] = t
     info[Info.NEXT_STEP] = h
     info[Info.SKIPPED] = skipped

@@ -39,7 +39,8 @@ class Info(enum.IntEnum):
     """Columns of the float64 ``info`` record of each integrated point."""
 
     ACCEPTED = 0  # steps accepted
-    REJECTED = 1  # step attempts rejected
+    REJECTED = 1  # step attempts rejected by the error test (or not finite)
     TAU_REACHED = 2  # the time τ the integration reached
     NEXT_STEP = 3  # the step size it would take next
     SKIPPED = 4  # transient periods skipped (settle="auto")
+    SWITCH_RETRIES = 5  # step attempts discarded to end the step on a contact switch

@@ -64,6 +64,7 @@ class SimulationResult(Trajectory):
             "status_message": self.status.message,
             "steps_accepted": self.steps_accepted,
             "steps_rejected": self.steps_rejected,
+            "steps_switch": self.steps_switch,
             "initial_state": (
                 "given"
                 if self.y0 is not None

@@ -44,12 +44,16 @@ class Trajectory(SampleArrays):
         Initial state (``None``: the zero state).
     tau_reached
         Where the integration stopped (the end time when it succeeded).
+    steps_accepted, steps_rejected, steps_switch
+        Steps accepted, step attempts rejected by the error test, and step attempts discarded
+        to end the step on a contact switch (steps_rejected counted these before issue 25).
     """
 
     system: System
     status: Status
     steps_accepted: int
     steps_rejected: int
+    steps_switch: int = 0
     solver: SolverSettings = field(default_factory=SolverSettings)
     t0: float = 0.0
     y0: np.ndarray | None = None

@@ -40,6 +40,12 @@ __all__ = ["bifurcation", "run_sweep"]
 
 #: Per-point variable of a ``settle="auto"`` sweep: transient periods skipped (0: full transient).
 SKIPPED = "transient_skipped"
+#: the step counts stored per point, with their descriptions
+STEP_COUNTS = {
+    "steps_accepted": "steps accepted",
+    "steps_rejected": "steps rejected",
+    "steps_switch": "steps retried to end on a contact switch",
+}
 
 
 class _Layout:
@@ -85,8 +91,8 @@ class _Layout:
             {"flag_values": [int(s) for s in Status], "flag_meanings": Status.meanings()},
         )
         chunks["status"] = ch
-        for nm in ("steps_accepted", "steps_rejected"):
-            var[nm] = (lead, (shp, "int64"), -1, {"long_name": nm.replace("_", " ")})
+        for nm, long_name in STEP_COUNTS.items():
+            var[nm] = (lead, (shp, "int64"), -1, {"long_name": long_name})
             chunks[nm] = ch
         if spec.solver.settle != "off":
             var[SKIPPED] = (
@@ -153,8 +159,8 @@ class _Layout:
                     (*bshape, *((cols.size,) if per_planet else ())), np.nan
                 )
         data["status"] = np.full(bshape, int(Status.NOT_RUN), dtype=np.int8)
-        data["steps_accepted"] = np.full(bshape, -1, dtype=np.int64)
-        data["steps_rejected"] = np.full(bshape, -1, dtype=np.int64)
+        for nm in STEP_COUNTS:
+            data[nm] = np.full(bshape, -1, dtype=np.int64)
         settle = spec.solver.settle != "off"
         if settle:
             data[SKIPPED] = np.full(bshape, -1, dtype=np.int64)
@@ -181,6 +187,7 @@ class _Layout:
             data["status"][pos] = out.status[c, j]
             data["steps_accepted"][pos] = int(out.info[c, j, Info.ACCEPTED])
             data["steps_rejected"][pos] = int(out.info[c, j, Info.REJECTED])
+            data["steps_switch"][pos] = int(out.info[c, j, Info.SWITCH_RETRIES])
             if settle:
                 data[SKIPPED][pos] = int(out.info[c, j, Info.SKIPPED])
             data["final_state"][pos] = out.final_state[c, j, :n_st]
