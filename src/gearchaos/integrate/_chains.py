@@ -192,13 +192,6 @@ class ChainRun:
         }
         return replace(runs[0], **stacked)
 
-    @property
-    def output_bytes(self) -> float:
-        """Memory the outputs of this job take."""
-        C, L = self.shape
-        n_full = self.Y0.shape[1]
-        return 8.0 * C * L * self.n_samples * (1 + n_full + self.n_obs)
-
 
 @dataclass(frozen=True, eq=False)
 class SampleArrays:

@@ -176,10 +176,8 @@ DU_DELTA = 1
 DU_ALPHA = 2
 DU_BETA = 3
 DU_GAMMA = 4
-DU_SIZE = 5
 
 # ---------- Lorenz (kind 4)
 LZ_SIGMA = 0
 LZ_RHO = 1
 LZ_BETA = 2
-LZ_SIZE = 3
