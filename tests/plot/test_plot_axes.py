@@ -80,7 +80,7 @@ def test_reference_system_plots(oscillator: gc.SimulationResult) -> None:
     ax = poincare_map(oscillator, var="x")
     assert "x" in ax.get_xlabel()
     assert clearance_values(ax, "x") == [-1.0, 1.0]
-    with pytest.raises(ParameterError, match="planetary"):
+    with pytest.raises(ParameterError, match="sun coordinates x_s, y_s"):
         sun_orbit(oscillator)
 
 

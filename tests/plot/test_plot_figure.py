@@ -55,5 +55,5 @@ def test_summary_figure_with_one_sample_per_period(tmp_path) -> None:
 
 def test_summary_figure_of_a_reference_system(oscillator: gc.SimulationResult, tmp_path) -> None:
     fig = summary_figure(oscillator)
-    assert any("not a planetary model" in t.get_text() for t in fig.axes[4].texts)
+    assert any("has no sun coordinates" in t.get_text() for t in fig.axes[4].texts)
     savefig(fig, tmp_path / "osc.png")

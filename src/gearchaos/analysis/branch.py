@@ -69,10 +69,8 @@ __all__ = [
 
 
 def _default_observe(system: Any) -> tuple[str, ...]:
-    if hasattr(system.model, "n_planets"):
-        return ("delta_sp", "delta_sp_dot")
-    names, nt = system.obs_names, system.n_track
-    return (names[0], names[nt]) if len(names) > nt else (names[0],)
+    var, dot = system.default_observables
+    return (var, dot) if dot != var else (var,)
 
 
 def check_observe(system: Any, observe: Any) -> tuple[str, ...]:
@@ -122,7 +120,7 @@ def branch_dataset(
     observed = [ref.observable(nm) for nm in check_observe(ref, observe)]
     tracked = ref.tracked_groups()
     levels = br.levels
-    n_planets = int(getattr(ref.model, "n_planets", 0))
+    n_planets = ref.group_size
     coords: dict[str, Any] = {
         br.name: ("point", np.array([p.lam for p in pts])),
         "arclength": ("point", np.array([p.s for p in pts])),

@@ -60,28 +60,22 @@ def contact_regime(delta_min: float, b: float) -> str:
 def mesh_deflections(result: Any) -> dict[str, tuple[str, int, float]]:
     """Meshes of a result: name → (deflection variable, tracked index, half clearance).
 
-    Planetary results give ``sun_planet_1..N`` then ``planet_ring_1..N``; the single-mesh
-    backlash oscillator gives ``mesh``. Other systems have no mesh and raise
-    :class:`~gearchaos.errors.ParameterError`.
+    The model's mesh :attr:`~gearchaos.model.System.contacts`: planetary results give
+    ``sun_planet_1..N`` then ``planet_ring_1..N``; the single-mesh backlash oscillator gives
+    ``mesh``. Systems without a mesh raise :class:`~gearchaos.errors.ParameterError`.
     """
-    model = result.system.model
-    if hasattr(model, "n_planets"):
-        N = int(model.n_planets)
-        cl = model.clearances
-        out: dict[str, tuple[str, int, float]] = {}
-        for i in range(1, N + 1):
-            out[f"sun_planet_{i}"] = (f"delta_sp_{i}", i - 1, float(cl["sun_planet"]))
-        for i in range(1, N + 1):
-            out[f"planet_ring_{i}"] = (f"delta_rp_{i}", N + i - 1, float(cl["planet_ring"]))
-        return out
-    cl = getattr(model, "clearances", {})
-    if result.system.n_track >= 1 and len(cl) == 1:
-        ((name, b),) = cl.items()
-        return {"mesh": (name, 0, float(b))}
-    raise ParameterError(
-        f"contact regimes need a model with gear meshes (planetary or backlash oscillator): "
-        f"got {result.system.name}"
-    )
+    system = result.system
+    names = system.obs_names
+    out = {
+        c.name: (names[c.column], c.column, float(c.clearance))
+        for c in system.contacts
+        if c.kind == "mesh"
+    }
+    if not out:
+        raise ParameterError(
+            f"contact regimes need a model with gear meshes (its contacts): got {system.name}"
+        )
+    return out
 
 
 def contact_regimes(result: Any) -> dict[str, str]:

@@ -66,27 +66,13 @@ BEARING_REGIMES = ("free", "single_sided", "double_sided")
 def contact_levels(system: System) -> list[tuple[str, int, float, str]]:
     """The contacts of a system: (name, tracked index, half clearance, ``mesh``/``bearing``).
 
-    Planetary models: ``sun_planet_1..N``, ``planet_ring_1..N`` (regime from min δ as in
+    The model's :attr:`~gearchaos.model.System.contacts`: planetary models
+    ``sun_planet_1..N``, ``planet_ring_1..N`` (regime from min δ as in
     :mod:`gearchaos.analysis.contact`) and ``sun_bearing_x``, ``sun_bearing_y`` (regime from
-    the extrema of x̄_s, ȳ_s against ±b̄_s); the backlash oscillator: ``mesh``; systems
-    without clearances: none.
+    the extrema of x̄_s, ȳ_s against ±b̄_s); the backlash oscillator ``mesh``; systems without
+    clearances none.
     """
-    model = system.model
-    if hasattr(model, "n_planets"):
-        N = int(model.n_planets)
-        cl = model.clearances
-        out = [(f"sun_planet_{i + 1}", i, float(cl["sun_planet"]), "mesh") for i in range(N)]
-        out += [(f"planet_ring_{i + 1}", N + i, float(cl["planet_ring"]), "mesh") for i in range(N)]
-        out += [
-            ("sun_bearing_x", 2 * N, float(cl["sun_bearing"]), "bearing"),
-            ("sun_bearing_y", 2 * N + 1, float(cl["sun_bearing"]), "bearing"),
-        ]
-        return out
-    cl = getattr(model, "clearances", {})
-    if system.n_track >= 1 and len(cl) == 1:
-        ((_, b),) = cl.items()
-        return [("mesh", 0, float(b), "mesh")]
-    return []
+    return [(c.name, int(c.column), float(c.clearance), c.kind) for c in system.contacts]
 
 
 def bearing_regime(lo: float, hi: float, b: float) -> str:
@@ -324,7 +310,7 @@ def model_attrs(system: System) -> dict[str, Any]:
     model = system.model
     gs = getattr(model, "gearset", None)
     a: dict[str, Any] = {
-        "model": "planetary" if hasattr(model, "n_planets") else system.name,
+        "model": "planetary" if gs is not None else system.name,
         "gearset_toml": gs.to_toml() if gs is not None else "",
         "model_parameters": "" if gs is not None else repr(model),
     }

@@ -99,29 +99,31 @@ def count_distinct(
     return n
 
 
-def _is_planetary(result: Any) -> bool:
-    return hasattr(result.system.model, "n_planets")
-
-
 def section_variables(result: Any, var: str | None = None, planet: int = 1) -> tuple[str, str]:
     """Names of a variable and of its τ-derivative in ``result`` (state or observable names).
 
-    For the planetary model ``var`` is a per-planet quantity (``delta_sp``, ``delta_rp``;
-    ``planet`` selects the planet) or a sun coordinate (``x_s``, ``y_s``); the default is
-    ``delta_sp``. For any other system ``var`` names a state or observable that has a
-    ``<var>_dot`` partner (default: the first state, e.g. ``x`` of the backlash oscillator).
+    ``var`` names a state or observable that has a ``<var>_dot`` partner, or a per-member
+    group (the planetary model's ``delta_sp``, ``delta_rp``, ``p``: ``planet`` selects the
+    member); the default is the model's :attr:`~gearchaos.model.System.default_observables`
+    (the seed's ``delta_sp`` for the planetary model), else the first state (``x`` of the
+    backlash oscillator).
     """
     system = result.system
     names = tuple(system.state_names) + tuple(system.obs_names)
-    if _is_planetary(result):
-        n_planets = int(system.model.n_planets)
-        var = "delta_sp" if var is None else var
-        if var in ("delta_sp", "delta_rp", "p"):
-            if not (isinstance(planet, int | np.integer) and 1 <= planet <= n_planets):
-                raise ParameterError(f"planet must be an integer in 1..{n_planets}: got {planet!r}")
-            var = f"{var}_{planet}"
-    else:
+    if var is None:
+        default = system.default_observables[0]
+        var = default if getattr(system.model, "default_observables", None) else None
         var = system.state_names[0] if var is None else var
+    if var not in names and system.group_size:
+        members = system.group_size
+        try:
+            group = system.observable(var)
+        except ParameterError:
+            group = None
+        if group is not None and group.per_planet:
+            if not (isinstance(planet, int | np.integer) and 1 <= planet <= members):
+                raise ParameterError(f"planet must be an integer in 1..{members}: got {planet!r}")
+            var = f"{var}_{planet}"
     if var not in names:
         raise ParameterError(
             f"var must name a variable of {system.name} ({', '.join(names)}): got {var!r}"

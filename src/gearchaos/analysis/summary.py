@@ -18,7 +18,7 @@ from ..model.response import response_quantities
 from .classify import classify_motion
 from .contact import contact_regimes, separation_fraction
 from .lyapunov import format_exponent
-from .poincare import count_distinct, section_points
+from .poincare import count_distinct, section_points, section_variables
 
 __all__ = ["SUMMARY_KEYS", "format_summary", "motion_name", "summarize"]
 
@@ -99,12 +99,13 @@ def summarize(
         teeth are apart, its extrema tracked inside every integration step so that it does not
         depend on ``samples_per_period``), ``dte_sp1_rms`` (RMS dynamic transmission error
         √⟨(X̄_sp1 − ⟨X̄_sp1⟩)²⟩ over the samples, in b_c), ``transient_periods``, ``periods``,
-        ``samples_per_period``. Quantities that do not apply (no gear set, a reference system)
+        ``samples_per_period``, ``section_variable`` (the variable whose section the
+        ``x_sp1_*`` keys give: ``delta_sp_1``, or another model's default). Quantities that do
+        not apply (no gear set, a reference system)
         are ``None``; for reference systems the ``x_sp1_*`` keys hold the first state.
     """
     system = result.system
     model = system.model
-    planetary = hasattr(model, "n_planets")
     x, xd = section_points(result)
     pts = np.column_stack([x, xd])
     n_recorded = int(np.sum(np.all(np.isfinite(pts), axis=1)))
@@ -144,6 +145,7 @@ def summarize(
         "steps_rejected": int(result.steps_rejected),
     }
     out["recorded_section_points"] = n_recorded
+    out["section_variable"] = section_variables(result)[0]
     if verdict is not None:
         out["motion"] = verdict["motion"]
         out["lle"] = verdict["lle"]
@@ -172,12 +174,13 @@ def summarize(
     out["load_factor_sp_max"] = None
     out["load_factor_rp_max"] = None
     out["dte_sp1_rms"] = None
-    if planetary:
+    labels = [label for label, _, _ in system.force_groups]
+    if labels == ["sp", "rp"]:  # a planetary train: the keys above
         # peak contact forces from the extrema tracked inside every step (not from samples)
         rq = response_quantities(system, result.obs_min, result.obs_max, result.observables)
-        for mesh in ("sp", "rp"):
+        for mesh in labels:
             out[f"load_factor_{mesh}_max"] = _num(rq[f"load_factor_{mesh}"])
-        out["dte_sp1_rms"] = _num(rq["dte_rms_sp"][0])
+        out["dte_sp1_rms"] = _num(np.ravel(rq["dte_rms_sp"])[0])
     s = result.solver
     out["transient_periods"] = _num(s.transient_periods)
     out["periods"] = int(s.periods)
@@ -224,9 +227,19 @@ def format_summary(summary: dict[str, Any], *, title: str | None = None) -> Any:
         "steps_accepted": "steps accepted",
         "steps_rejected": "steps rejected",
     }
+    var = summary.get("section_variable")
+    if var is not None and var != "delta_sp_1":  # another model: its own section variable
+        labels["x_sp1_section_min"] = f"{var} section min"
+        labels["x_sp1_section_max"] = f"{var} section max"
+    optional = {
+        "omega_n_rad_s", "mesh_frequency_hz", "sun_speed_rpm", "load_factor_sp_max",
+        "load_factor_rp_max", "dte_sp1_rms",
+    }  # fmt: skip
     for key, label in labels.items():
         if key in summary:
             value = summary[key]
+            if value is None and key in optional and summary.get("gearset") is None:
+                continue  # quantities of a gear set, absent for other models
             recorded = summary.get("recorded_section_points")
             if key == "distinct_section_points" and recorded:
                 value = f"{int(value)} of {int(recorded)}"

@@ -143,7 +143,7 @@ def reported_errors() -> Iterator[None]:
 
     on_first_compile(
         lambda: stderr().print(
-            "compiling numerical kernels for this model (once per planet count and "
+            "compiling numerical kernels for this model (once per model, planet count and "
             "analysis: from a few seconds to a minute or two on a small machine; later runs "
             "load them from the cache)…"
         )

@@ -23,6 +23,7 @@ import numpy as np
 from .._checks import check_real, real_array
 from ..errors import ParameterError
 from . import layout as L
+from .contract import Contact
 from .system import System
 
 __all__ = [
@@ -90,6 +91,18 @@ class BacklashOscillator:
     @property
     def clearances(self) -> dict[str, float]:
         return {"x": self.b}
+
+    @property
+    def contacts(self) -> tuple[Contact, ...]:
+        """The single mesh, judged on x against ±b."""
+        return (Contact("mesh", 0, self.b),)
+
+    #: Mesh types whose contact forces are tracked: (label, force, deflection).
+    force_groups = (("mesh", "contact_force", "x"),)
+
+    def static_mesh_force(self, omega: float) -> float:
+        """F_m, the mean load (the load factor's reference)."""
+        return float(self.f_mean)
 
     @property
     def switch_widths(self) -> np.ndarray:

@@ -13,8 +13,10 @@ removed, so the zero state is a consistent start.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
-from typing import Any
+from types import MappingProxyType
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -22,6 +24,7 @@ from ..errors import ParameterError
 from ..gearset import GearSet
 from ..gearset.validation import warn_if_eccentric
 from . import layout as L
+from .contract import Contact
 from .system import System
 
 __all__ = [
@@ -324,6 +327,65 @@ class PlanetaryModel:
         """Half clearances of each contact, dimensionless."""
         par = self.parameters
         return {"sun_planet": par.b_sp, "planet_ring": par.b_rp, "sun_bearing": par.b_s}
+
+    @property
+    def contacts(self) -> tuple[Contact, ...]:
+        """The 2N meshes (judged on δ̄_spi, δ̄_rpi) and the sun bearing in x and y (judged on
+        x̄_s, ȳ_s), in the order of the tracked observables."""
+        par, N = self.parameters, self.n_planets
+        out = [Contact(f"sun_planet_{i + 1}", i, par.b_sp) for i in range(N)]
+        out += [Contact(f"planet_ring_{i + 1}", N + i, par.b_rp) for i in range(N)]
+        out += [
+            Contact("sun_bearing_x", 2 * N, par.b_s, "bearing"),
+            Contact("sun_bearing_y", 2 * N + 1, par.b_s, "bearing"),
+        ]
+        return tuple(out)
+
+    #: The seed's section variables: the sun–planet mesh deflection X̄_spi and its derivative.
+    default_observables = ("delta_sp", "delta_sp_dot")
+    #: Figure symbols: variable → (mathtext symbol, definition, clearance name, clearance
+    #: symbol); ``%d`` marks a per-planet group (its member's number goes there).
+    symbols: ClassVar[Mapping[str, tuple[str, str | None, str | None, str | None]]] = (
+        MappingProxyType(
+            {
+                "delta_sp": (
+                    r"\bar{X}_{sp%d}",
+                    r"\delta_{sp%d}/b_c",
+                    "sun_planet",
+                    r"\bar{b}_{sp}",
+                ),
+                "delta_rp": (
+                    r"\bar{X}_{rp%d}",
+                    r"\delta_{rp%d}/b_c",
+                    "planet_ring",
+                    r"\bar{b}_{rp}",
+                ),
+                "force_sp": (r"\bar{F}_{sp%d}", r"F_{sp%d}/(k_{m,sp}\,b_c)", None, None),
+                "force_rp": (r"\bar{F}_{rp%d}", r"F_{rp%d}/(k_{m,sp}\,b_c)", None, None),
+                "p": (r"\bar{p}_{%d}", r"p_{%d}/b_c", None, None),
+                "x_s": (r"\bar{x}_s", r"x_s/b_c", "sun_bearing", r"\bar{b}_s"),
+                "y_s": (r"\bar{y}_s", r"y_s/b_c", "sun_bearing", r"\bar{b}_s"),
+                "sigma": (r"\bar{\sigma}", r"\sigma/b_c", None, None),
+            }
+        )
+    )
+    #: What one forcing period is called (axes: "mesh periods", ω/ω_m) and a group member.
+    period_name = "mesh"
+    member_name = "planet"
+    #: Mesh types whose contact forces are tracked: (label, force group, deflection group).
+    force_groups = (("sp", "contact_force_sp", "delta_sp"), ("rp", "contact_force_rp", "delta_rp"))
+
+    def result_dataset(self, result: Any, attrs: dict[str, Any], series: Any) -> Any:
+        """The dataset of a simulation result of this model, per planet
+        (:func:`~gearchaos.model.planetary_dataset.planetary_dataset`)."""
+        from .planetary_dataset import planetary_dataset
+
+        return planetary_dataset(self, result, attrs, series)
+
+    def static_mesh_force(self, omega: float) -> float:
+        """F̄_static = T̄_D/N at Ω (MODEL.md §10.1), the load factor's reference."""
+        td, _ = self.parameters.loads(omega)
+        return float(td) / int(self.n_planets)
 
     def pack(self, omega: float) -> np.ndarray:
         return pack_planetary(self.parameters, omega)

@@ -65,16 +65,15 @@ class MeshGroup:
 def mesh_groups(system: System) -> list[MeshGroup]:
     """The mesh types of ``system`` whose contact forces the kernel tracks (empty for smooth
     reference systems)."""
-    if system.n_contact_forces == 0:
-        return []
-    if hasattr(system.model, "n_planets"):
-        return [
-            MeshGroup(m, system.observable(f"contact_force_{m}"), system.observable(f"delta_{m}"))
-            for m in ("sp", "rp")
-        ]
-    # the deflection as the tracked observable x (also a state: the same values)
-    x = Observable("x", "obs", np.array([system.obs_names.index("x")]), False)
-    return [MeshGroup("mesh", system.observable("contact_force"), x)]
+    out = []
+    for label, force, deflection in system.force_groups:
+        d = system.observable(deflection)
+        if d.source == "state" and deflection in system.obs_names:
+            # a deflection that is both a state and an observable: the observable, read
+            # beside its force (the same values)
+            d = Observable(deflection, "obs", np.array([system.obs_names.index(deflection)]), False)
+        out.append(MeshGroup(label, system.observable(force), d))
+    return out
 
 
 def compressive_contact_forces(
@@ -141,12 +140,8 @@ def compressive_contact_forces(
 def static_mesh_force(system: System) -> float:
     """F̄_static: T̄_D/N (planetary, MODEL.md §10.1, at this Ω) or F_m (oscillator); NaN when
     the model has no static load."""
-    model = system.model
-    if hasattr(model, "n_planets"):
-        td, _ = model.parameters.loads(system.omega)
-        return float(td) / int(model.n_planets)
-    fm = getattr(model, "f_mean", None)
-    return float(fm) if fm is not None else float("nan")
+    static = getattr(system.model, "static_mesh_force", None)
+    return float(static(system.omega)) if static is not None else float("nan")
 
 
 def response_quantities(

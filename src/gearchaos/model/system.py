@@ -177,6 +177,38 @@ class System:
             cols = [cols[int(p) - 1] for p in planets]
         return Observable(name, source, np.array(cols), True)
 
+    @property
+    def contacts(self) -> tuple[Any, ...]:
+        """The model's :class:`~gearchaos.model.contract.Contact` s (none for smooth systems)."""
+        from .contract import contacts_of
+
+        return contacts_of(self.model)
+
+    @property
+    def default_observables(self) -> tuple[str, str]:
+        """The (variable, derivative) pair sections and labels use by default (a group name
+        such as ``delta_sp`` stands for its members)."""
+        from .contract import default_observables
+
+        return default_observables(self.model)
+
+    @property
+    def group_size(self) -> int:
+        """Members of the model's per-member variable groups (``delta_sp_1 … delta_sp_N``: the
+        planets of a planetary model), 0 for a model without groups."""
+        sizes = [len(cols) for _, cols, per in self.tracked_groups() if per]
+        return max(sizes, default=0)
+
+    @property
+    def force_groups(self) -> tuple[tuple[str, str, str], ...]:
+        """(label, contact-force variable, deflection variable) of each mesh type whose contact
+        forces the kernel tracks (empty without contact forces)."""
+        if self.n_contact_forces == 0:
+            return ()
+        return tuple(
+            (str(a), str(b), str(c)) for a, b, c in getattr(self.model, "force_groups", ())
+        )
+
     n_contact_forces = property(
         lambda self: int(getattr(self.model, "n_contact_forces", 0)),
         doc="How many of the tracked observables, at their end, are mesh contact forces.",

@@ -187,8 +187,8 @@ def run_gallery(
         raise ParameterError(f"title must be text or None: got {type(title).__name__}")
     # resolve every point first: a bad name or value fails before anything runs
     systems = [resolve(gs, {**fixed, param: v}) for v in vals]
-    n_planets = getattr(systems[0].model, "n_planets", None)
-    if n_planets is not None and planet > n_planets:
+    n_planets = systems[0].group_size
+    if n_planets and planet > n_planets:
         raise ParameterError(f"planet must be one of 1..{n_planets}: got {planet}")
     results: list[Any] = []
     summaries: list[dict[str, Any]] = []

@@ -152,20 +152,6 @@ def resonance_lines(ax: Any, gearset: Any, lo: float, hi: float) -> int:
 CLEARANCE_GID = "clearance"
 _CLEARANCE_STYLE: dict[str, Any] = {"color": "0.35", "linestyle": "--", "linewidth": 0.9}
 
-# planetary per-planet variables: name -> (symbol, definition, clearance key, clearance symbol)
-_PLANET_VARS: dict[str, tuple[str, str, str | None, str | None]] = {
-    "delta_sp": (r"\bar{X}_{sp%d}", r"\delta_{sp%d}/b_c", "sun_planet", r"\bar{b}_{sp}"),
-    "delta_rp": (r"\bar{X}_{rp%d}", r"\delta_{rp%d}/b_c", "planet_ring", r"\bar{b}_{rp}"),
-    "force_sp": (r"\bar{F}_{sp%d}", r"F_{sp%d}/(k_{m,sp}\,b_c)", None, None),
-    "force_rp": (r"\bar{F}_{rp%d}", r"F_{rp%d}/(k_{m,sp}\,b_c)", None, None),
-    "p": (r"\bar{p}_{%d}", r"p_{%d}/b_c", None, None),
-}
-_SUN_VARS: dict[str, tuple[str, str, str | None, str | None]] = {
-    "x_s": (r"\bar{x}_s", r"x_s/b_c", "sun_bearing", r"\bar{b}_s"),
-    "y_s": (r"\bar{y}_s", r"y_s/b_c", "sun_bearing", r"\bar{b}_s"),
-    "sigma": (r"\bar{\sigma}", r"\sigma/b_c", None, None),
-}
-
 
 @dataclass(frozen=True)
 class VarInfo:
@@ -193,8 +179,14 @@ class VarInfo:
         return rf"${self.dot_symbol} = \mathrm{{d}}{self.symbol}/\mathrm{{d}}\tau$"
 
 
-def is_planetary(result: Any) -> bool:
-    return hasattr(result.system.model, "n_planets")
+def period_name(result: Any) -> str:
+    """What the model calls its forcing period (``mesh`` for gear trains, else ``forcing``)."""
+    return str(getattr(result.system.model, "period_name", "forcing"))
+
+
+def has_physical_scales(result: Any) -> bool:
+    """Whether the model converts to SI units (a gear set's ω_n, b_c …)."""
+    return getattr(result.system.model, "scales", None) is not None
 
 
 def _generic_symbol(name: str) -> str:
@@ -207,43 +199,36 @@ def _generic_symbol(name: str) -> str:
 def variable(result: Any, var: str | None = None, planet: int = 1) -> VarInfo:
     """Resolve ``var`` (and ``planet``) into a :class:`VarInfo` for ``result``.
 
-    Planetary results: ``delta_sp`` (default), ``delta_rp``, ``force_sp``, ``force_rp``, ``p``
-    per planet, or ``x_s``, ``y_s``, ``sigma``. Other systems: any state or observable name
-    (default: the first state).
+    Any state or observable name, or a group of the model's ``symbols`` (the planetary
+    model's ``delta_sp`` (default), ``delta_rp``, ``force_sp``, ``force_rp``, ``p`` per planet;
+    ``x_s``, ``y_s``, ``sigma``) drawn with its symbol and clearance; the default is the model's
+    default observable, else the first state.
     """
     system = result.system
+    model = system.model
     names = tuple(system.state_names) + tuple(system.obs_names)
-    clearances = dict(getattr(system.model, "clearances", {}))
-    if is_planetary(result):
-        var = "delta_sp" if var is None else var
-        n_planets = int(system.model.n_planets)
-        if var in _PLANET_VARS:
-            if not (isinstance(planet, int | np.integer) and 1 <= planet <= n_planets):
-                raise ParameterError(f"planet must be an integer in 1..{n_planets}: got {planet!r}")
-            sym, definition, ckey, csym = _PLANET_VARS[var]
-            name = f"{var}_{planet}"
-            dot = f"{var}_dot_{planet}" if var.startswith("delta") else f"{var}_{planet}_dot"
-            return VarInfo(
-                name,
-                dot if dot in names else None,
-                sym % planet,
-                definition % planet,
-                None if ckey is None else float(clearances[ckey]),
-                csym,
-            )
-        if var in _SUN_VARS:
-            sym, definition, ckey, csym = _SUN_VARS[var]
+    clearances = dict(getattr(model, "clearances", {}))
+    symbols = dict(getattr(model, "symbols", {}))
+    if var is None:
+        has_default = getattr(model, "default_observables", None) is not None
+        var = system.default_observables[0] if has_default else system.state_names[0]
+    if var in symbols:
+        sym, definition, ckey, csym = symbols[var]
+        clearance = None if ckey is None else float(clearances[ckey])
+        if "%d" not in sym:
             dot = f"{var}_dot"
-            return VarInfo(
-                var,
-                dot if dot in names else None,
-                sym,
-                definition,
-                None if ckey is None else float(clearances[ckey]),
-                csym,
-            )
-    else:
-        var = system.state_names[0] if var is None else var
+            return VarInfo(var, dot if dot in names else None, sym, definition, clearance, csym)
+        members = system.group_size
+        if not (isinstance(planet, int | np.integer) and 1 <= planet <= members):
+            raise ParameterError(f"planet must be an integer in 1..{members}: got {planet!r}")
+        name = f"{var}_{planet}"
+        member_dot = next(
+            (d for d in (f"{var}_dot_{planet}", f"{var}_{planet}_dot") if d in names), None
+        )
+        return VarInfo(
+            name, member_dot, sym % planet, None if definition is None else definition % planet,
+            clearance, csym,
+        )  # fmt: skip
     if var not in names:
         raise ParameterError(
             f"var must name a variable of {system.name} ({', '.join(names)}): got {var!r}"
@@ -256,7 +241,7 @@ def variable(result: Any, var: str | None = None, planet: int = 1) -> VarInfo:
         _generic_symbol(var),
         None,
         None if b is None else float(b),
-        None if b is None else r"\bar{b}" if is_planetary(result) else "b",
+        None if b is None else r"\bar{b}" if symbols else "b",
     )
 
 
@@ -271,9 +256,9 @@ def get_ax(ax: Any) -> Any:
 
 
 def period_axis_label(result: Any) -> str:
-    if is_planetary(result):
+    if period_name(result) == "mesh":
         return r"$t\,/\,T_m$ (mesh periods)"
-    return r"$t\,/\,T$ (forcing periods)"
+    return rf"$t\,/\,T$ ({period_name(result)} periods)"
 
 
 def to_periods(result: Any, tau: np.ndarray) -> np.ndarray:

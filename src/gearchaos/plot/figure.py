@@ -12,7 +12,7 @@ from .._files import check_output_file
 from .._output import check_replaceable, file_has_mark, staged_file
 from .._version import __version__
 from ..errors import ParameterError
-from ._common import is_planetary, message
+from ._common import message, variable
 from .phase import phase_portrait, poincare_map, sun_orbit
 from .timeseries import mesh_force_history, spectrum, time_history
 
@@ -52,7 +52,7 @@ def _text_lines(result: Any, summary: dict[str, Any]) -> list[str]:
     lines.append(f"distinct section points: {points} (motion: {motion})")
     lo, hi = summary.get("x_sp1_section_min"), summary.get("x_sp1_section_max")
     if lo is not None:
-        sym = r"$\bar{X}_{sp1}$" if is_planetary(result) else f"${result.system.state_names[0]}$"
+        sym = f"${variable(result).symbol}$"
         lines.append(f"{sym} on the section: {_fmt(lo)} … {_fmt(hi)}")
     if summary.get("load_factor_sp_max") is not None:
         lines.append(
@@ -62,7 +62,8 @@ def _text_lines(result: Any, summary: dict[str, Any]) -> list[str]:
         )
     contact = summary.get("contact", [])
     if contact:
-        per = " (planets 1…N)" if is_planetary(result) else ""
+        member = getattr(result.system.model, "member_name", None)
+        per = f" ({member}s 1…N)" if member and result.system.group_size else ""
         lines.append(f"contact regimes{per}:")
         groups: dict[str, list[str]] = {}
         for c in contact:
@@ -128,8 +129,8 @@ def summary_figure(
         height_ratios=[1.0, 1.0, 0.8],
     )
     axs = np.array([[mosaic[f"{r}{c}"] for c in range(3)] for r in range(2)])
-    planetary = is_planetary(result)
-    var = "delta_sp" if planetary else None
+    var = None  # the model's default observable
+    sun = {"x_s", "y_s"} <= set(result.system.state_names)
     periods = min(float(history_periods), float(result.solver.periods))
 
     ax = time_history(result, var, planet, ax=axs[0, 0], periods=periods)
@@ -164,13 +165,13 @@ def summary_figure(
         )
         axs[1, 0].set_title("amplitude spectrum")
 
-    if planetary:
+    if sun:
         sun_periods = min(5.0 * periods, float(result.solver.periods))
         ax = sun_orbit(result, ax=axs[1, 1], periods=sun_periods)
         ax.set_title(f"sun centre orbit (last {sun_periods:g} periods)")
         ax.legend(loc="upper right", fontsize="small")
     else:
-        message(axs[1, 1], f"no sun orbit: {result.system.name} is not a planetary model")
+        message(axs[1, 1], f"no sun orbit: {result.system.name} has no sun coordinates x_s, y_s")
 
     try:
         ax = mesh_force_history(result, planet, ax=mosaic["force"], periods=periods)

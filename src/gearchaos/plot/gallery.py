@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from ._common import axis_symbol, is_planetary, message, variable
+from ._common import axis_symbol, message, period_name, variable
 from .phase import phase_portrait, poincare_map
 from .regimes import regime_colour, regime_legend_below
 from .timeseries import spectrum
@@ -158,7 +158,7 @@ def poincare_gallery(
         labels.append(label)
         shown = {**summary, "motion": label}
         r0, c = (k // cols) * block, k % cols
-        var = "delta_sp" if is_planetary(result) else None
+        var = None  # the model's default observable
         info = variable(result, var, planet)
         if var0 is None:
             var0 = info
@@ -191,7 +191,8 @@ def poincare_gallery(
                     message(ex, str(e))
             elif result.samples_per_period >= 4:
                 spectrum(result, var, planet, ax=ex)
-                ex.set_xlabel(r"$\omega/\omega_m$" if is_planetary(result) else r"$\omega/\Omega$")
+                mesh = period_name(result) == "mesh"
+                ex.set_xlabel(r"$\omega/\omega_m$" if mesh else r"$\omega/\Omega$")
                 ex.set_ylabel("amplitude")
                 ex.set_title("amplitude spectrum", fontsize="x-small", loc="left")
             else:

@@ -12,7 +12,6 @@ from ._common import (
     VarInfo,
     clearance_lines,
     get_ax,
-    is_planetary,
     sample_window,
     variable,
 )
@@ -162,9 +161,10 @@ def sun_orbit(result: Any, ax: Any = None, periods: float | None = None) -> Any:
     """
     from matplotlib.patches import Rectangle
 
-    if not is_planetary(result):
+    if not {"x_s", "y_s"} <= set(result.system.state_names):
         raise ParameterError(
-            f"sun_orbit needs a planetary result: got a result of {result.system.name}"
+            f"sun_orbit needs a result with sun coordinates x_s, y_s: got a result of "
+            f"{result.system.name}"
         )
     ax = get_ax(ax)
     xi = variable(result, "x_s")

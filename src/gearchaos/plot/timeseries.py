@@ -11,8 +11,9 @@ from ..errors import ParameterError
 from ._common import (
     clearance_lines,
     get_ax,
-    is_planetary,
+    has_physical_scales,
     period_axis_label,
+    period_name,
     sample_window,
     to_periods,
     variable,
@@ -180,7 +181,7 @@ def mesh_force_history(
     ax.set_xlabel(period_axis_label(result))
     ax.set_ylabel(
         r"contact force $\bar F^c = F^c/(k_{m,sp}\,b_c)$"
-        if is_planetary(result)
+        if has_physical_scales(result)
         else r"contact force $F^c$"
     )
     fit_to_data(ax, t, np.concatenate(ys))
@@ -275,7 +276,7 @@ def spectrum(
         shown = amp[ratio <= hi]
         lo = max(float(np.min(shown[shown > 0])) if np.any(shown > 0) else floor, top * 1e-9)
         ax.set_ylim(lo / 2.0, top * 3.0)
-    scales = PhysicalScales.of_result(result) if is_planetary(result) else PhysicalScales()
+    scales = PhysicalScales.of_result(result) if has_physical_scales(result) else PhysicalScales()
     f_m = float(result.omega) * scales.omega_n / (2.0 * math.pi) if scales.omega_n else None
     for h in range(1, math.floor(hi) + 1):
         ax.axvline(h, color="0.8", lw=0.6, zorder=0)
@@ -301,7 +302,7 @@ def spectrum(
             for r in (h - side, h + side):
                 if 0.0 < r <= hi:
                     ax.axvline(r, color="0.85", lw=0.5, ls=":", zorder=0, gid=HARMONIC_GID)
-    if is_planetary(result):
+    if period_name(result) == "mesh":
         ax.set_xlabel(r"$\omega/\omega_m$ (multiples of the mesh frequency $f_m$)")
         if f_m is not None:
             linear_axis(ax, "x", f_m, "frequency [Hz]")

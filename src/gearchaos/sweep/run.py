@@ -58,7 +58,7 @@ class _Layout:
         self.lead_shape = grid.shape
         self.observed = [ref.observable(nm, spec.planets) for nm in spec.observe]
         self.tracked = ref.tracked_groups()
-        self.n_planets = int(getattr(ref.model, "n_planets", 0))
+        self.n_planets = ref.group_size
         self.state_names = ref.state_names
 
     def variables(self) -> tuple[dict[str, Any], dict[str, tuple[int, ...]]]:
@@ -494,10 +494,10 @@ def _default_observe(target: Any) -> tuple[str, ...]:
     derivative."""
     from ..model.system import System
 
-    if not isinstance(target, System) or hasattr(target.model, "n_planets"):
+    if not isinstance(target, System):
         return DEFAULT_OBSERVE
-    names, nt = target.obs_names, target.n_track
-    return (names[0], names[nt]) if len(names) > nt else (names[0],)
+    var, dot = target.default_observables
+    return (var, dot) if dot != var else (var,)
 
 
 def bifurcation(
