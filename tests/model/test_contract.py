@@ -194,3 +194,21 @@ def test_a_user_models_kind_follows_its_source() -> None:
     kind = Pendulum().kind
     assert kind >= gc.model.contract.EXTERNAL_KIND_BASE
     assert Pendulum(zeta=0.3).kind == kind
+
+
+@pytest.mark.parametrize("name", [n for n in SYSTEMS if n.startswith(("planetary", "backlash"))])
+def test_switch_widths_are_the_clearances_the_kernel_reads(name: str) -> None:
+    """The integrator lands steps at ±switch_widths while the compiled right-hand side bends
+    at the clearances it reads from the packed parameters (MODEL.md's b̄_sp, b̄_rp, b̄_s; the
+    oscillator's b): the two must be the same numbers, for every model that has clearances."""
+    from gearchaos.model import layout as L
+
+    system = SYSTEMS[name]
+    p = system.params
+    if name.startswith("planetary"):
+        n = system.group_size
+        packed = [p[L.P_BSP]] * n + [p[L.P_BRP]] * n + [p[L.P_BS]] * 2
+    else:
+        packed = [p[L.BO_B]]
+    widths = system.switch_widths[: len(packed)]
+    assert widths.tolist() == packed
