@@ -293,7 +293,7 @@ def test_sweep_lle_equals_max_lyapunov(sheng: gc.GearSet) -> None:
     kw = {"transient_periods": 20, "periods": 40}
     # the recorded run's λ₁ (verdicts=False: the verdict would store its own, and replace the
     # record where it extends the run)
-    common = {"fixed": {"xi": 0.05}, "progress": False, "verdicts": False, **kw}
+    common = {"params": {"xi": 0.05}, "progress": False, "verdicts": False, **kw}
     ds = gc.bifurcation(sheng, "omega=0.5,1.2,1.5,2.0", lyapunov=True, **common)
     plain = gc.bifurcation(sheng, "omega=0.5,1.2,1.5,2.0", **common)
     assert "lle" in ds and "lle" not in plain

@@ -186,7 +186,7 @@ def test_branch_over_a_backlash_diagram_is_drawn_relative_to_the_backlash(tmp_pa
     system = gc.backlash_oscillator(1.0, zeta=zeta, f_alt=0.1, f_mean=0.1)
     run = tmp_path / "b.zarr"
     gc.bifurcation(
-        system, "b=0.5:1.5:11", fixed={"omega": omega}, transient_periods=300, periods=4,
+        system, "b=0.5:1.5:11", params={"omega": omega}, transient_periods=300, periods=4,
         store=run, progress=False,
     )  # fmt: skip
     up, down = tmp_path / "up.nc", tmp_path / "down.nc"

@@ -220,7 +220,7 @@ def test_every_settled_orbit_of_a_batch_is_confirmed_from_its_record() -> None:
     # must not change how the next point of the same batch is judged)
     from gearchaos import sweep
 
-    ds = sweep.bifurcation(GS, "omega=0.05:0.1:6", fixed={"xi": 0.03}, progress=False)
+    ds = sweep.bifurcation(GS, "omega=0.05:0.1:6", params={"xi": 0.03}, progress=False)
     assert [str(m) for m in ds.motion.values] == ["1T"] * 6
     assert np.all(ds.extra_periods.values == 0)
     assert np.all(ds.max_multiplier.values < 1)

@@ -137,11 +137,11 @@ PARAMETER_DOORS = ["fixed", "vary", "family", "gallery", "analyse_point"]
 def _parameter_call(door: str, name: str, value: Any) -> Any:
     if door == "fixed":
         return lambda: gc.bifurcation(
-            BASE, "omega=1:2:2", fixed={name: value}, progress=False, **TINY
+            BASE, "omega=1:2:2", params={name: value}, progress=False, **TINY
         )
     if door == "vary":
         return lambda: gc.bifurcation(
-            BASE, {name: [value]}, fixed={"omega": 1.5}, progress=False, **TINY
+            BASE, {name: [value]}, params={"omega": 1.5}, progress=False, **TINY
         )
     if door == "family":
         return lambda: gc.bifurcation(
@@ -188,7 +188,7 @@ OMEGA_DOORS = {
     "simulate": lambda v: gc.simulate(BASE, omega=v, **TINY),
     "simulate(System)": lambda v: gc.simulate(SYSTEM, omega=v, **TINY),
     "bifurcation": lambda v: gc.bifurcation(
-        BASE, "xi=0.05,0.07", fixed={"omega": v}, progress=False, **TINY
+        BASE, "xi=0.05,0.07", params={"omega": v}, progress=False, **TINY
     ),
     "bifurcation(vary)": lambda v: gc.bifurcation(
         BASE, {"omega": [1.0, v]}, progress=False, **TINY
@@ -312,11 +312,11 @@ def test_malformed_vary_and_family_specs_are_refused(profile: dict[str, int]) ->
         text, names = spec
         fixed = {"omega": 1.5} if not text.startswith("omega=") else {}
         if where == "vary":
-            call = lambda: gc.bifurcation(BASE, text, fixed=fixed, progress=False, **TINY)  # noqa: E731
+            call = lambda: gc.bifurcation(BASE, text, params=fixed, progress=False, **TINY)  # noqa: E731
         elif where == "family":
             other = "xi=0.05,0.07" if not text.startswith("xi") else "backlash.sun_planet=1,2"
             call = lambda: gc.bifurcation(  # noqa: E731
-                BASE, other, family=text, fixed=fixed, progress=False, **TINY
+                BASE, other, family=text, params=fixed, progress=False, **TINY
             )
         elif where == "build vary":
             call = lambda: SweepSpec.build(text)  # noqa: E731
@@ -429,7 +429,7 @@ def test_vary_and_family_objects_of_the_wrong_kind_are_refused(profile: dict[str
 def test_an_axis_both_swept_and_fixed_or_family_is_refused() -> None:
     refused(
         "vary spec",
-        lambda: gc.bifurcation(BASE, "omega=1:2:2", fixed={"omega": 1.5}, progress=False),
+        lambda: gc.bifurcation(BASE, "omega=1:2:2", params={"omega": 1.5}, progress=False),
         "omega",
     )
     refused(

@@ -70,7 +70,7 @@ def bases(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
         gs,
         "backlash.sun_planet=1:3:3",
         family="xi=0.05,0.07",
-        fixed={"omega": 1.5},
+        params={"omega": 1.5},
         store=family,
         lyapunov=True,
         **SHORT,

@@ -184,7 +184,7 @@ def test_missing_panel_or_axis_is_not_evaluated(marks):
 def test_stored_fixed_values_must_agree(marks):
     omega = np.linspace(0.01, 4.0, 50)
     ds = _sweep(omega, ["1T"] * omega.size)
-    spec = SweepSpec.build({"omega": omega}, fixed={"backlash.sun_planet": 4.0})
+    spec = SweepSpec.build({"omega": omega}, params={"backlash.sun_planet": 4.0})
     ds.attrs["sweep_toml"] = spec.to_toml()  # what a store made with that value records
     res = evaluate(marks["fig4a-1T-low"], ds)
     assert res.verdict == "not evaluated"

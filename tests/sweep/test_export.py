@@ -118,7 +118,7 @@ def test_a_csv_stands_alone(tmp_path: Path, sheng: gc.GearSet) -> None:
     gc.bifurcation(
         sheng.evolve({"backlash.planet_ring": 2.0}),
         "backlash.sun_planet=1:2:2",
-        fixed={"omega": 1.5},
+        params={"omega": 1.5},
         store=path,
         progress=False,
         **SHORT,

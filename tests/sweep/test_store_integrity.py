@@ -27,7 +27,7 @@ from gearchaos.cli import app
 from gearchaos.errors import StoreError
 from gearchaos.sweep.integrity import MANIFEST, StoreLock
 
-KW = {"fixed": {"xi": 0.05}, "progress": False, **SHORT}
+KW = {"params": {"xi": 0.05}, "progress": False, **SHORT}
 
 
 @pytest.fixture(scope="module")
@@ -209,7 +209,7 @@ def test_a_damaged_finished_task_is_recomputed_on_resume(
     from gearchaos.sweep.run import _attrs, _coords, _Layout
     from gearchaos.sweep.store import SweepStore
 
-    spec = SweepSpec.build("omega=0.8:2.4:9", fixed={"xi": 0.05}, **SHORT)
+    spec = SweepSpec.build("omega=0.8:2.4:9", params={"xi": 0.05}, **SHORT)
     grid = Grid(sheng, spec, chunk_points=3)
     layout = _Layout(grid)
     path = tmp_path / "partial.zarr"

@@ -208,13 +208,13 @@ def run(target, path, *, overwrite=False, **changes):
 @pytest.fixture()
 def base_store(sheng, tmp_path):
     path = tmp_path / "base.zarr"
-    run(sheng, path, fixed={"backlash.sun_planet": 3.0})
+    run(sheng, path, params={"backlash.sun_planet": 3.0})
     return path
 
 
 def test_rerun_with_same_settings_changes_no_file(sheng, base_store):
     before = file_snapshot(base_store)
-    ds = run(sheng, base_store, fixed={"backlash.sun_planet": 3.0})
+    ds = run(sheng, base_store, params={"backlash.sun_planet": 3.0})
     assert file_snapshot(base_store) == before
     assert_bitwise_equal(ds.load(), open_store(base_store))
 
@@ -227,10 +227,10 @@ def test_rerun_with_same_settings_changes_no_file(sheng, base_store):
         ({"rtol": 1e-9}, "rtol"),
         ({"vary": {"omega": "0.5:2.5:6"}}, "omega"),
         (
-            {"vary": {"backlash.planet_ring": "2:4:5"}, "fixed": {"omega": 1.5}},
+            {"vary": {"backlash.planet_ring": "2:4:5"}, "params": {"omega": 1.5}},
             "backlash.planet_ring",
         ),
-        ({"fixed": {"backlash.sun_planet": 2.5}}, "backlash.sun_planet"),
+        ({"params": {"backlash.sun_planet": 2.5}}, "backlash.sun_planet"),
         ({"observe": ("delta_sp", "delta_rp")}, "observe"),
         ({"planets": (1, 2)}, "planets"),
     ],
@@ -238,7 +238,7 @@ def test_rerun_with_same_settings_changes_no_file(sheng, base_store):
 )
 def test_other_settings_are_refused_naming_what_differs(sheng, base_store, changes, named):
     before = file_snapshot(base_store)
-    changes = {"fixed": {"backlash.sun_planet": 3.0}, **changes}
+    changes = {"params": {"backlash.sun_planet": 3.0}, **changes}
     with pytest.raises(gc.StoreError, match="overwrite") as info:
         run(sheng, base_store, **changes)
     assert named in str(info.value)
@@ -247,11 +247,11 @@ def test_other_settings_are_refused_naming_what_differs(sheng, base_store, chang
 
 def test_another_gear_set_is_refused(sheng, base_store):
     with pytest.raises(gc.StoreError, match=r"mass\.planet"):
-        run(sheng.evolve({"mass.planet": 9.0}), base_store, fixed={"backlash.sun_planet": 3.0})
+        run(sheng.evolve({"mass.planet": 9.0}), base_store, params={"backlash.sun_planet": 3.0})
 
 
 def test_overwrite_replaces_the_store(sheng, base_store, tmp_path):
-    new = {"periods": 9, "fixed": {"backlash.sun_planet": 2.5}}
+    new = {"periods": 9, "params": {"backlash.sun_planet": 2.5}}
     ds = run(sheng, base_store, overwrite=True, **new).load()
     fresh = run(sheng, tmp_path / "fresh.zarr", **new).load()
     assert ds.sizes["section"] == 9

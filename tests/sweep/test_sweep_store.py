@@ -42,7 +42,9 @@ def target():
 @pytest.fixture(scope="module")
 def store(target, tmp_path_factory):
     path = tmp_path_factory.mktemp("store") / "map.zarr"
-    gc.bifurcation(target, VARY, family=FAMILY, fixed=FIXED, store=path, progress=False, **SETTINGS)
+    gc.bifurcation(
+        target, VARY, family=FAMILY, params=FIXED, store=path, progress=False, **SETTINGS
+    )
     return xr.open_zarr(path)  # plain xarray, default arguments
 
 
@@ -79,7 +81,7 @@ def test_provenance_attributes(store, target):
     a = store.attrs
     assert gc.GearSet.from_toml_string(a["gearset_toml"]) == target
     spec = SweepSpec.from_toml(a["sweep_toml"])
-    assert spec == SweepSpec.build(VARY, family=FAMILY, fixed=FIXED, **SETTINGS)
+    assert spec == SweepSpec.build(VARY, family=FAMILY, params=FIXED, **SETTINGS)
     assert a["rtol"] == SETTINGS["rtol"] and a["atol"] == SETTINGS["atol"]
     assert a["transient_periods"] == SETTINGS["transient_periods"]
     assert a["periods"] == SETTINGS["periods"]
