@@ -38,6 +38,7 @@ from .._checks import check_int, check_real
 from .._version import provenance
 from ..errors import IntegrationError, ParameterError, Status
 from ..integrate.settings import SolverSettings, split_keywords
+from ..model.contract import model_reference
 from ..model.system import System
 from ..model.target import resolve, scale_attrs
 from .contact import contact_regime
@@ -313,6 +314,7 @@ def model_attrs(system: System) -> dict[str, Any]:
         "model": "planetary" if gs is not None else system.name,
         "gearset_toml": gs.to_toml() if gs is not None else "",
         "model_parameters": "" if gs is not None else repr(model),
+        **model_reference(model),
     }
     a.update(scale_attrs(model))
     return a

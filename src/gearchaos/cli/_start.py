@@ -96,10 +96,17 @@ def _gearset(attrs: Any, path: str) -> Any:
 
     text = str(attrs.get("gearset_toml", ""))
     if not text:
-        raise StoreError(
-            f"--from {path}: its model is not a gear set (no gearset_toml); start such a model "
-            "from Python (periodic_orbit(system, guess=state))"
-        )
+        from ..model import System
+        from ..model.contract import rebuild_model
+
+        model = rebuild_model(attrs)
+        if model is None:
+            raise StoreError(
+                f"--from {path}: its model is neither a gear set (no gearset_toml) nor one it "
+                "records how to build (no model_class); start it from Python "
+                "(periodic_orbit(system, guess=state))"
+            )
+        return System(model, 1.0)
     return GearSet.from_toml_string(text)
 
 

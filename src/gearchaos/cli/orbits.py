@@ -290,8 +290,8 @@ def continue_(
         if start is not None:  # the orbit at the file's point: the branch starts there
             from ..analysis.orbits import periodic_orbit
 
-            if name not in values:
-                values[name] = gs[name]
+            if name not in values:  # the start's own value of the continued parameter
+                values[name] = gs[name] if hasattr(gs, "evolve") else getattr(gs.model, name)
             settings = settings.replace(**start.section)
             with c.warnings_to_stderr():
                 first = periodic_orbit(

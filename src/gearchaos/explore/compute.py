@@ -37,15 +37,29 @@ def point_target(res: Any, values: Mapping[str, float]) -> tuple[Any, dict[str, 
     """The gear set and parameter values (dotted names, Ω included) of one point of a store.
 
     ``values`` are the point's swept values; Ω is added from the store's fixed values when it
-    was not swept. Raises :class:`~gearchaos.errors.StoreError` for a store that does not hold
-    a gear set (reference systems): their points can be read, not recomputed.
+    was not swept. A store of another model gives that model at Ω = 1 (the values set Ω) when
+    it records how to build it (``model_class``, ``model_fields``: built-in reference systems
+    and models from outside the package); else :class:`~gearchaos.errors.StoreError` (its
+    points can be read, not recomputed).
     """
     gs = res.gearset
     if gs is None:
-        raise StoreError(
-            "this store's model is not a gear set (no gearset_toml): its stored sections can be "
-            "explored, but points cannot be recomputed from it"
-        )
+        from ..model import System
+        from ..model.contract import rebuild_model
+
+        model = rebuild_model(res.ds.attrs)
+        if model is None:
+            raise StoreError(
+                "this store's model is neither a gear set (no gearset_toml) nor a model it can "
+                "build again (no model_class): its stored sections can be explored, but points "
+                "cannot be recomputed from it"
+            )
+        fixed = {k: v for k, v in res.fixed.items() if k != OMEGA}
+        gs = System(model, 1.0)
+        if fixed:
+            from ..model.target import resolve
+
+            gs = resolve(gs, fixed)
     out = {str(k): float(v) for k, v in values.items()}
     if OMEGA not in out:
         omega = res.fixed_value(OMEGA)
@@ -61,7 +75,7 @@ def point_target(res: Any, values: Mapping[str, float]) -> tuple[Any, dict[str, 
 def compute_point(
     store: str,
     values: Mapping[str, float],
-    var: str = "delta_sp",
+    var: str | None = None,
     planet: int = 1,
     history_periods: float = 10.0,
 ) -> dict[str, Any]:
@@ -81,8 +95,10 @@ def compute_point(
     values
         The point's swept values by dotted name (``{"omega": 1.43}``).
     var, planet
-        The variable of the phase portrait and the first time history (``delta_sp`` of planet
-        1: X̄_sp1 = δ_sp1/b_c); the second time history is its mesh's contact force.
+        The variable of the phase portrait and the first time history (default: the model's
+        section variable, ``delta_sp`` of planet 1, X̄_sp1 = δ_sp1/b_c, for a gear set); the
+        second time history is the contact force of its mesh (of the first mesh type when the
+        variable is no mesh deflection).
     history_periods
         Forcing periods shown in the time histories (the last ones recorded).
 
@@ -161,13 +177,15 @@ def _plain(obj: Any) -> Any:
     return obj
 
 
-def _figure_png(result: Any, var: str, planet: int, periods: float) -> bytes:
-    """Phase portrait, X̄ and contact force against time, and spectrum, as PNG bytes."""
+def _figure_png(result: Any, var: str | None, planet: int, periods: float) -> bytes:
+    """Phase portrait, the variable and its mesh's contact force against time, and spectrum,
+    as PNG bytes."""
     from matplotlib.figure import Figure
 
     from ..plot import phase_portrait, spectrum, time_history
 
-    force = "force_sp" if var in ("delta_sp", "force_sp") else "force_rp"
+    groups = result.system.force_groups
+    force = next((f for _, f, d in groups if d == var), groups[0][1] if groups else "")
     fig = Figure(figsize=(11.0, 7.2), dpi=90, layout="constrained")
     axs = fig.subplots(2, 2)
     with warnings.catch_warnings():
@@ -176,13 +194,20 @@ def _figure_png(result: Any, var: str, planet: int, periods: float) -> bytes:
         axs[0, 0].set_title("phase portrait")
         time_history(result, var, planet, ax=axs[0, 1], periods=periods)
         axs[0, 1].set_title("time history")
-        try:
+        if force:
             time_history(result, force, planet, ax=axs[1, 0], periods=periods)
             axs[1, 0].set_title("contact force of the mesh")
-        except ParameterError as exc:
-            axs[1, 0].text(0.5, 0.5, str(exc), ha="center", wrap=True)
+        else:
+            axs[1, 0].set_axis_off()
+            axs[1, 0].text(
+                0.5, 0.5, f"{result.system.name} tracks no contact forces", ha="center",
+                va="center", transform=axs[1, 0].transAxes, color="0.4",
+            )  # fmt: skip
         spectrum(result, var, planet, ax=axs[1, 1])
-        axs[1, 1].set_title("amplitude spectrum (mesh harmonics labelled)")
+        mesh = getattr(result.system.model, "period_name", "forcing") == "mesh"
+        axs[1, 1].set_title(
+            f"amplitude spectrum ({'mesh' if mesh else 'forcing'} harmonics labelled)"
+        )
     buf = io.BytesIO()
     fig.savefig(buf, format="png")
     return buf.getvalue()

@@ -27,6 +27,7 @@ from .._files import check_output_file, check_regular_file
 from .._output import check_replaceable, file_has_mark, write_file
 from .._version import provenance
 from ..errors import ParameterError, StoreError
+from ..model.contract import model_reference
 from .trajectory import Trajectory
 
 __all__ = ["SimulationResult", "open_simulation"]
@@ -82,6 +83,7 @@ class SimulationResult(Trajectory):
             attrs["mesh_frequency_rad_s"] = self.omega * sc.omega_n
         for k, v in getattr(model, "clearances", {}).items():
             attrs[f"clearance_{k}"] = v
+        attrs.update(model_reference(model))  # to build the model again (not a gear set)
         return attrs
 
     def to_dataset(self) -> Any:

@@ -376,3 +376,56 @@ def build_model(cls: type, changes: dict[str, Any] | None = None) -> Any:
         raise ParameterError(f"{cls.__name__}: {exc}") from None
     check_model(model)
     return model
+
+
+# ------------------------------------------------------------------ building a model again
+def model_reference(model: Any) -> dict[str, str]:
+    """What a store or branch file records to build ``model`` again (:func:`rebuild_model`):
+    ``model_class`` (``MODULE:CLASS``, or ``/abs/path/FILE.py:CLASS`` for a model loaded from
+    a file) and ``model_fields`` (JSON of its dataclass fields); empty for a gear-set model
+    (its gear set TOML says it all) or a model that is no dataclass of JSON values."""
+    import dataclasses
+    import json
+    import os
+    import sys
+
+    if getattr(model, "gearset", None) is not None or not dataclasses.is_dataclass(model):
+        return {}
+    cls = type(model)
+    fields = {f.name: getattr(model, f.name) for f in dataclasses.fields(model) if f.init}
+    try:
+        text = json.dumps(fields, allow_nan=False)
+    except (TypeError, ValueError):
+        return {}
+    module = sys.modules.get(cls.__module__)
+    path = getattr(module, "__file__", None) or ""
+    package = (getattr(module, "__package__", None) or "").split(".")[0]
+    if package and package in sys.modules and not path.endswith(f"{cls.__module__}.py"):
+        where = cls.__module__  # importable by name (gearchaos.model.library, a package)
+    elif path:
+        where = os.path.abspath(path)  # a file loaded with --model FILE.py:CLASS
+    else:
+        return {}
+    return {"model_class": f"{where}:{cls.__qualname__}", "model_fields": text}
+
+
+def rebuild_model(attrs: Any) -> Any:
+    """The model a store's or branch file's ``model_class``/``model_fields`` attributes
+    describe (:func:`model_reference`), or ``None`` when they are absent."""
+    import json
+
+    spec, fields = attrs.get("model_class"), attrs.get("model_fields")
+    if not spec or fields is None:
+        return None
+    cls = load_model_class(str(spec))
+    values = json.loads(str(fields))
+    if isinstance(values, dict):
+        for key, value in values.items():  # JSON lists back to the tuples dataclasses hold
+            if isinstance(value, list):
+                values[key] = tuple(value)
+    try:
+        model = cls(**values)
+    except TypeError as exc:
+        raise ParameterError(f"{spec}: the stored fields no longer fit the class ({exc})") from None
+    check_model(model)
+    return model

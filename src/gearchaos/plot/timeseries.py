@@ -280,7 +280,8 @@ def spectrum(
     f_m = float(result.omega) * scales.omega_n / (2.0 * math.pi) if scales.omega_n else None
     for h in range(1, math.floor(hi) + 1):
         ax.axvline(h, color="0.8", lw=0.6, zorder=0)
-        label = f"{h}$f_m$" if f_m is None else f"{h}$f_m$ = {h * f_m:.0f} Hz"
+        base = "$f_m$" if period_name(result) == "mesh" else r"$\Omega$"
+        label = f"{h}{base}" if f_m is None else f"{h}{base} = {h * f_m:.0f} Hz"
         ax.text(
             h,
             0.98,

@@ -25,6 +25,7 @@ from ..integrate._chains import ChainOutput, ChainRun
 from ..integrate.interface import Info
 from ..integrate.settings import SolverSettings, renamed_keyword
 from ..integrate.threads import abandon, resume
+from ..model.contract import model_reference
 from ..model.target import scale_attrs
 from ._response_store import response_extract, response_variables
 from .execute import EXECUTION_OPTIONS, Execution, InProcess, executor
@@ -225,6 +226,7 @@ def _attrs(target: Any, grid: Grid) -> dict[str, Any]:
         "model": ref.model.name if not isinstance(target, GearSet) else "planetary",
         "gearset_toml": target.to_toml() if isinstance(target, GearSet) else "",
         "model_parameters": "" if isinstance(target, GearSet) else repr(target.model),
+        **({} if isinstance(target, GearSet) else model_reference(target.model)),
         "sweep_toml": spec.to_toml(),
         **spec.solver.to_record(),
         "initial_conditions": spec.initial_conditions,
