@@ -160,3 +160,26 @@ def test_bad_models_are_refused_naming_the_option(
     result = runner.invoke(app, ["simulate", *filled, "--no-plot"])
     assert result.exit_code == 2, result.output
     assert needle in result.output
+
+
+def test_plot_of_a_simulation_file_says_what_the_file_is(runner: CliRunner, tmp_path: Path) -> None:
+    out = tmp_path / "sim"
+    args = ["--set", "omega=0.5", "--transient", "5", "--periods", "5", "--no-verdict"]
+    result = runner.invoke(app, ["simulate", *args, "-o", str(out), "--no-plot"])
+    assert result.exit_code == 0, result.output
+    result = runner.invoke(app, ["plot", str(out / "simulation.nc"), "-o", str(tmp_path / "x.png")])
+    assert result.exit_code != 0
+    assert "is a simulation file" in result.output and "simulate -o" in result.output
+
+
+def test_a_simulation_file_says_where_its_record_starts(runner: CliRunner, tmp_path: Path) -> None:
+    """Where the motion verdict had to settle a record (Ω = 1.5: a slow approach to the 1T
+    orbit) the saved record is integrated again from the orbit it confirmed, and the file says
+    so instead of 'given'; a record the verdict took as it is (Ω = 0.5) started from rest."""
+    for omega, words in (("1.5", "periodic orbit the motion verdict confirmed"),
+                         ("0.5", "rest, perturbed")):  # fmt: skip
+        out = tmp_path / f"sim{omega}"
+        result = runner.invoke(app, ["simulate", "--set", f"omega={omega}", "-o", str(out),
+                                     "--no-plot"])  # fmt: skip
+        assert result.exit_code == 0, result.output
+        assert words in gc.open_simulation(out / "simulation.nc").attrs["initial_state"]

@@ -393,7 +393,15 @@ def open_branch(path: str | os.PathLike[str]) -> Any:
             f"branch {path} is damaged or no branch file ({type(exc).__name__})"
         ) from None
     if "parameter" not in ds.attrs or "multiplier_re" not in ds:
-        raise StoreError(f"{path} is not a gearchaos branch (no 'parameter' attribute)")
+        title = str(ds.attrs.get("title", ""))
+        what = (
+            "a simulation file: gearchaos simulate -o DIR draws its figure"
+            if title.startswith("gearchaos simulation")
+            else "an orbit file: start a branch from it with gearchaos continue --from"
+            if title.startswith("gearchaos periodic orbit")
+            else "no branch file (no 'parameter' attribute)"
+        )
+        raise StoreError(f"{path} is not a gearchaos branch: it is {what}")
     ds.encoding["source"] = path  # figures name a branch by its file
     return ds
 

@@ -203,7 +203,7 @@ class PeriodicOrbit:
         ``x_sp1`` (the section values of X̄_sp1, or of the first tracked observable of a
         reference system), ``contact`` ([{contact, regime}]) and ``message`` (how it converged
         or why not; how long the guess settled)."""
-        first = self.system.obs_names[0]
+        first = self.system.section_pair()[0]
         return {
             "period": int(self.period),
             "minimal_period": int(self.minimal_period),

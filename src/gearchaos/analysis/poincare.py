@@ -110,10 +110,12 @@ def section_variables(result: Any, var: str | None = None, planet: int = 1) -> t
     """
     system = result.system
     names = tuple(system.state_names) + tuple(system.obs_names)
-    if var is None:
-        default = system.default_observables[0]
-        var = default if getattr(system.model, "default_observables", None) else None
-        var = system.state_names[0] if var is None else var
+    if var is None:  # the model's default pair (planetary: X̄_sp of ``planet``)
+        if system.group_size and not 1 <= planet <= system.group_size:
+            raise ParameterError(
+                f"planet must be an integer in 1..{system.group_size}: got {planet!r}"
+            )
+        return system.section_pair(planet)
     if var not in names and system.group_size:
         members = system.group_size
         try:

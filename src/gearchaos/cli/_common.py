@@ -406,7 +406,8 @@ SetOpt = Annotated[
         help=(
             "NAME=VALUE, repeatable: omega=1.5 (the dimensionless mesh frequency Ω), "
             "xi=0.05 (all damping ratios), or any dotted gear-set parameter such as "
-            "backlash.sun_planet=3, clearance.sun_bearing=2, torque.input=1500."
+            "backlash.sun_planet=3, clearance.sun_bearing=2, torque.input=1500; with --model, "
+            "omega and the model's own parameters (its field names)."
         ),
         show_default=False,
     ),

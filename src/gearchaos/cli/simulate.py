@@ -82,7 +82,9 @@ def simulate(
     X̄_sp1 = δ_sp1/b_c at each τ_k = 2πk/Ω. Ω is set with **--set omega=...**
     (default **1.5**). Prints the motion verdict (1T … nT confirmed by shooting with its
     largest Floquet multiplier, QP or chaos from λ₁ ± its error, or unresolved with the
-    reason), the section range of X̄_sp1 and the contact regime of every mesh.
+    reason), the section range of X̄_sp1 and the contact regime of every mesh. With
+    **--model FILE.py:CLASS** the same for your own model (its default section variable and
+    its contacts; see docs/howto/own-model.md).
 
     Example: **gearchaos simulate --preset sheng2016 --set omega=1.5 --set xi=0.05 -o out/**
     """

@@ -140,13 +140,21 @@ def _finished(system: Any, cfg: SolverSettings, v: Verdict, check: bool) -> Simu
     m = int(cfg.periods)
     if v.record.source == "orbit" and v.orbit_state is not None:
         start = v.orbit_state
+        origin = (
+            "on the periodic orbit the motion verdict confirmed (its run started from rest, "
+            f"perturbed by {cfg.perturbation:g})"
+        )
     else:
         start = v.record.states[max(0, v.record.states.shape[0] - m)]
+        origin = (
+            "the state the motion verdict's extension reached from rest (perturbed by "
+            f"{cfg.perturbation:g})"
+        )
     window = cfg.replace(transient_periods=0.0, section_phase=0.0)
     tau_s = section_fraction(cfg) * system.period
     result = run_simulation(system, window, y0=start, t0=tau_s, check=check)
     shown = cfg.replace(transient_periods=float(cfg.transient_periods) + v.extra_periods)
-    return dataclasses.replace(result, solver=shown)
+    return dataclasses.replace(result, solver=shown, origin=origin)
 
 
 def _verdict_settings(verdict: Any) -> VerdictSettings | None:

@@ -66,7 +66,8 @@ class SimulationResult(Trajectory):
             "steps_accepted": self.steps_accepted,
             "steps_rejected": self.steps_rejected,
             "steps_switch": self.steps_switch,
-            "initial_state": (
+            "initial_state": self.origin
+            or (
                 "given"
                 if self.y0 is not None
                 else ("zero" if self.solver.perturbation == 0 else "rest, perturbed")

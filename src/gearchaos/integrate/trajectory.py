@@ -61,6 +61,9 @@ class Trajectory(SampleArrays):
     tau_reached: float = float("nan")
     tangent_log_sums: np.ndarray = field(default_factory=lambda: np.empty(0))
     tangent_log_stretch: np.ndarray = field(default_factory=lambda: np.empty(0))
+    #: Where a run that did not start from ``y0`` or rest comes from, in words (a motion
+    #: verdict's record: the confirmed orbit, or the end of its extension); "" otherwise.
+    origin: str = ""
 
     @property
     def samples_per_period(self) -> int:

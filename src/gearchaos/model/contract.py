@@ -209,6 +209,16 @@ class UserModel:
     field name (``params={"zeta": 0.1}``, ``--set zeta=0.1``).
     """
 
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        """Keep the compiled ``rhs``/``tangent`` plain functions: a numba dispatcher set as a
+        class attribute would bind like a method (``model.rhs(t, …)`` passing the model as
+        ``t``), so they are stored as static methods."""
+        super().__init_subclass__(**kwargs)
+        for attr in ("rhs", "tangent"):
+            fn = cls.__dict__.get(attr)
+            if fn is not None and hasattr(fn, "py_func"):
+                setattr(cls, attr, staticmethod(fn))
+
     name: ClassVar[str]
     state_names: ClassVar[tuple[str, ...]]
     obs_names: ClassVar[tuple[str, ...]]

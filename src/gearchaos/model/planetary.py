@@ -362,6 +362,18 @@ class PlanetaryModel:
                 ),
                 "force_sp": (r"\bar{F}_{sp%d}", r"F_{sp%d}/(k_{m,sp}\,b_c)", None, None),
                 "force_rp": (r"\bar{F}_{rp%d}", r"F_{rp%d}/(k_{m,sp}\,b_c)", None, None),
+                "contact_force_sp": (
+                    r"\bar{F}^c_{sp%d}",
+                    r"F^c_{sp%d}/(k_{m,sp}\,b_c)",
+                    None,
+                    None,
+                ),
+                "contact_force_rp": (
+                    r"\bar{F}^c_{rp%d}",
+                    r"F^c_{rp%d}/(k_{m,sp}\,b_c)",
+                    None,
+                    None,
+                ),
                 "p": (r"\bar{p}_{%d}", r"p_{%d}/b_c", None, None),
                 "x_s": (r"\bar{x}_s", r"x_s/b_c", "sun_bearing", r"\bar{b}_s"),
                 "y_s": (r"\bar{y}_s", r"y_s/b_c", "sun_bearing", r"\bar{b}_s"),

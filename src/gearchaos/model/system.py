@@ -192,6 +192,19 @@ class System:
 
         return default_observables(self.model)
 
+    def section_pair(self, planet: int = 1) -> tuple[str, str]:
+        """The default section variables as concrete names: :attr:`default_observables`, a
+        group's member ``planet`` (``delta_sp`` → ``delta_sp_1``, ``delta_sp_dot_1``)."""
+        out = []
+        for name in self.default_observables:
+            if name in self.state_names or name in self.obs_names:
+                out.append(name)
+                continue
+            ob = self.observable(name, [planet])  # a group: its member
+            names = self.state_names if ob.source == "state" else self.obs_names
+            out.append(names[int(ob.columns[0])])
+        return out[0], out[1]
+
     @property
     def group_size(self) -> int:
         """Members of the model's per-member variable groups (``delta_sp_1 … delta_sp_N``: the

@@ -176,7 +176,8 @@ class VarInfo:
 
     @property
     def dot_label(self) -> str:
-        return rf"${self.dot_symbol} = \mathrm{{d}}{self.symbol}/\mathrm{{d}}\tau$"
+        thin = r"\," if len(self.symbol) > 1 and self.symbol[0].isalpha() else ""
+        return rf"${self.dot_symbol} = \mathrm{{d}}{thin}{self.symbol}/\mathrm{{d}}\tau$"
 
 
 def period_name(result: Any) -> str:
@@ -191,6 +192,10 @@ def has_physical_scales(result: Any) -> bool:
 
 def _generic_symbol(name: str) -> str:
     base, dot = (name[:-4], "'") if name.endswith("_dot") else (name, "")
+    if base.count("_") > 1:  # a long name: upright, as written (contact_force_1)
+        return r"\mathrm{" + base.replace("_", r"\_") + "}" + dot
+    if "_" not in base and len(base) > 1:  # a word (delta, theta): upright, not a product
+        return r"\mathrm{" + base + "}" + dot
     head, sep, tail = base.partition("_")
     sym = f"{head}_{{{tail}}}" if sep else head
     return sym + dot
@@ -210,8 +215,7 @@ def variable(result: Any, var: str | None = None, planet: int = 1) -> VarInfo:
     clearances = dict(getattr(model, "clearances", {}))
     symbols = dict(getattr(model, "symbols", {}))
     if var is None:
-        has_default = getattr(model, "default_observables", None) is not None
-        var = system.default_observables[0] if has_default else system.state_names[0]
+        var = system.default_observables[0]
     if var in symbols:
         sym, definition, ckey, csym = symbols[var]
         clearance = None if ckey is None else float(clearances[ckey])
@@ -229,6 +233,19 @@ def variable(result: Any, var: str | None = None, planet: int = 1) -> VarInfo:
             name, member_dot, sym % planet, None if definition is None else definition % planet,
             clearance, csym,
         )  # fmt: skip
+    if var not in names and system.group_size:  # a group without a symbol: its member
+        try:
+            group = system.observable(var, [planet]) if isinstance(planet, int) else None
+        except ParameterError:
+            group = None
+        if group is not None and group.per_planet:
+            member = (system.state_names if group.source == "state" else system.obs_names)[
+                int(group.columns[0])
+            ]
+            member_dot = next(
+                (d for d in (f"{var}_dot_{planet}", f"{member}_dot") if d in names), None
+            )
+            return VarInfo(member, member_dot, _generic_symbol(member), None, None, None)
     if var not in names:
         raise ParameterError(
             f"var must name a variable of {system.name} ({', '.join(names)}): got {var!r}"

@@ -34,13 +34,14 @@ def _fmt(v: Any, spec: str = ".4g") -> str:
 
 
 def _text_lines(result: Any, summary: dict[str, Any]) -> list[str]:
-    gs = summary.get("gearset") or result.system.name
+    gs = summary.get("gearset")
+    owner = f"gear set: {gs}" if gs else f"model: {result.system.name}"
     n = summary["distinct_section_points"]
     motion = summary["motion"]
     recorded = summary.get("recorded_section_points")
     points = f"{n} of {recorded}" if recorded else str(n)
     lines = [
-        f"gear set: {gs}",
+        owner,
         rf"$\Omega = \omega/\omega_n$ = {_fmt(summary['omega'])}",
     ]
     if summary.get("omega_n_rad_s") is not None:

@@ -140,7 +140,8 @@ def mesh_force_history(
     groups = mesh_groups(result.system)
     if not groups:
         raise ParameterError(
-            f"mesh_force_history needs a model with gear meshes: got {result.system.name}"
+            "mesh_force_history needs a model that tracks mesh contact forces (its "
+            f"force_groups): {result.system.name} tracks none"
         )
     ax = get_ax(ax)
     sl = sample_window(result, periods)

@@ -321,7 +321,35 @@ class SweepResult:
                 return np.array(self.values("b")), "b"
             except KeyError:
                 return np.full(shape, float(attrs[f"clearance_{var}"])), "b"
-        return None
+        return self._model_clearance(var)
+
+    def _model_clearance(self, var: str) -> tuple[np.ndarray, str] | None:
+        """The clearance of a contact judged on ``var`` (a model that records how to build it
+        again): the model at every point, with its swept and fixed values, says it."""
+        import dataclasses
+
+        from ..model.contract import rebuild_model
+
+        try:
+            model = rebuild_model(self.ds.attrs)
+        except ParameterError:
+            return None
+        if model is None:
+            return None
+        names = tuple(model.obs_names)
+        found = [c for c in getattr(model, "contacts", ()) if names[c.column] == var]
+        if not found:
+            return None
+        column = found[0].column
+        fields = {f.name for f in dataclasses.fields(model)}
+        fixed = {k: v for k, v in self.fixed.items() if k in fields}
+        swept = {d: self.values(d) for d in self.lead_dims if d in fields}
+        out = np.empty(self.shape)
+        for idx in np.ndindex(*self.shape):
+            point = {**fixed, **{d: float(v[idx]) for d, v in swept.items()}}
+            at = dataclasses.replace(model, **point) if point else model
+            out[idx] = next(c.clearance for c in at.contacts if c.column == column)
+        return out, rf"b_{{\mathrm{{{found[0].name.replace('_', ' ')}}}}}"
 
     def _to_bar(self, parameter: str, value: np.ndarray) -> np.ndarray:
         gs = self.base_gearset
