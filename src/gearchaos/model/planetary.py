@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Any, ClassVar
 
@@ -407,12 +407,6 @@ class PlanetaryModel:
         :func:`~gearchaos.gearset.validation.warn_if_eccentric`)."""
         if self.gearset is not None and self.gearset.has_eccentricity:
             warn_if_eccentric(self.gearset, analysis)
-
-    def with_parameters(self, **changes: Any) -> PlanetaryModel:
-        """A copy with some dimensionless parameters changed (the gear set is dropped)."""
-        return PlanetaryModel(
-            replace(self.parameters, **changes), self.scales, None, name=self.name
-        )
 
 
 def planetary_system(gs: GearSet, omega: float) -> System:

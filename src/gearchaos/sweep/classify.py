@@ -176,9 +176,6 @@ def label_periods(
     return out
 
 
-CONTACT_CODES = {"none": 0, "single_sided": 1, "double_sided": 2}
-
-
 def _contact(res: SweepResult) -> dict[str, Any]:
     """Contact regime codes per mesh (MODEL.md §8) from the stored minimum deflections."""
     out: dict[str, Any] = {}
