@@ -183,3 +183,22 @@ def test_a_simulation_file_says_where_its_record_starts(runner: CliRunner, tmp_p
                                      "--no-plot"])  # fmt: skip
         assert result.exit_code == 0, result.output
         assert words in gc.open_simulation(out / "simulation.nc").attrs["initial_state"]
+
+
+def test_an_installed_model_is_found_by_its_entry_point_name(
+    runner: CliRunner, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A package that declares ``[project.entry-points."gearchaos.models"] twin_well = ...``
+    offers its model by name (--model twin_well): here a distribution's metadata on sys.path."""
+    site = tmp_path / "site"
+    dist = site / "twin_well_models-0.1.dist-info"
+    dist.mkdir(parents=True)
+    (dist / "METADATA").write_text("Metadata-Version: 2.1\nName: twin-well-models\nVersion: 0.1\n")
+    (dist / "entry_points.txt").write_text(
+        "[gearchaos.models]\ntwin_well = twin_well_ep:TwinWell\n"
+    )
+    (site / "twin_well_ep.py").write_text(MODEL, encoding="utf-8")
+    monkeypatch.syspath_prepend(str(site))
+    out = _json(runner, ["simulate", "--model", "twin_well", "--set", "omega=0.9",
+                         "--set", "gamma=0.2", "--no-verdict"])  # fmt: skip
+    assert out["x_sp1_section_min"] == float(np.min(gc.simulate(_builtin(0.9, 0.2)).section("x")))

@@ -2,9 +2,12 @@
 
 ``nondimensionalise(gearset)`` → :class:`PlanetaryParameters` + :class:`Scales`;
 :func:`planetary_system` builds the :class:`System` the integrator runs; :mod:`.library` holds
-reference systems (single-mesh backlash oscillator, linear systems, Duffing, Lorenz).
+reference systems (single-mesh backlash oscillator, linear systems, Duffing, Lorenz);
+:mod:`.contract` is the model contract every model meets, and :class:`UserModel` the base of a
+model written outside the package (docs/howto/own-model.md).
 """
 
+from .contract import Contact, UserModel, check_model, load_model_class
 from .library import (
     backlash_oscillator,
     duffing,
@@ -25,16 +28,20 @@ from .target import DEFAULT_OMEGA, OMEGA, resolve
 __all__ = [
     "DEFAULT_OMEGA",
     "OMEGA",
+    "Contact",
     "Model",
     "Observable",
     "PlanetaryModel",
     "PlanetaryParameters",
     "Scales",
     "System",
+    "UserModel",
     "backlash_oscillator",
+    "check_model",
     "duffing",
     "linear_oscillator",
     "linear_system",
+    "load_model_class",
     "lorenz",
     "nondimensionalise",
     "planetary_system",

@@ -11,9 +11,11 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any, Protocol, runtime_checkable
+from typing import Any
 
 import numpy as np
+
+from .contract import Model
 
 __all__ = ["Model", "Observable", "System"]
 
@@ -53,30 +55,6 @@ class Observable:
         arr = states if self.source == "state" else observables
         values = arr[..., self.columns]
         return values if self.per_planet else values[..., 0]
-
-
-@runtime_checkable
-class Model(Protocol):
-    """What a dimensionless model provides to build a :class:`System`."""
-
-    name: str
-
-    @property
-    def kind(self) -> int: ...
-
-    @property
-    def n_state(self) -> int: ...
-
-    @property
-    def state_names(self) -> tuple[str, ...]: ...
-
-    @property
-    def obs_names(self) -> tuple[str, ...]: ...
-
-    @property
-    def n_track(self) -> int: ...
-
-    def pack(self, omega: float) -> np.ndarray: ...
 
 
 @dataclass(frozen=True, eq=False)
