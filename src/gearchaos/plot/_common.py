@@ -11,6 +11,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..gearset.schema import OMEGA, describe
+from ..model.planetary import PlanetaryModel
 
 #: ``gid`` of the vertical lines where a mesh harmonic meets a natural frequency.
 RESONANCE_GID = "resonance"
@@ -27,16 +28,8 @@ _REFERENCE_TEX: dict[str, str] = {
 _DEFINITIONS: dict[str, str] = {OMEGA: r"\omega/\omega_n"}
 
 # section variable -> mathtext symbol (%d: planet); derivatives get a prime
-_VAR_SYMBOLS: dict[str, str] = {
-    "delta_sp": r"\bar{X}_{sp%d}",
-    "delta_rp": r"\bar{X}_{rp%d}",
-    "force_sp": r"\bar{F}_{sp%d}",
-    "force_rp": r"\bar{F}_{rp%d}",
-    "p": r"\bar{p}_{%d}",
-    "x_s": r"\bar{x}_s",
-    "y_s": r"\bar{y}_s",
-    "sigma": r"\bar{\sigma}",
-}
+#: Symbols of the planetary model's variables (its own table, for figures drawn from stores).
+_VAR_SYMBOLS: dict[str, str] = {k: v[0] for k, v in PlanetaryModel.symbols.items()}
 
 
 # --------------------------------------------------------------------------- names and labels
@@ -78,9 +71,7 @@ def var_symbol(var: str, planet: int | None) -> str:
         # prime before the subscript: \bar{X}'_{sp1}
         head, sep, tail = sym.partition("_")
         return f"{head}{prime}{sep}{tail}" if sep else sym + prime
-    head, sep, tail = base.partition("_")
-    sym = f"{head}_{{{tail}}}" if sep else head
-    return sym + prime
+    return _generic_symbol(base) + prime
 
 
 def fmt(v: Any) -> str:
