@@ -71,7 +71,7 @@ def sweep_dataset(
     spec = SweepSpec.build(
         vary,
         family={family: axes[family]} if family else None,
-        fixed=fixed or ({} if "omega" in axes else {"omega": 1.5}),
+        params=fixed or ({} if "omega" in axes else {"omega": 1.5}),
         periods=SECTIONS,
         initial_conditions="continuation" if direction else "fresh",
         direction="both" if direction else "up",
