@@ -75,6 +75,23 @@ def _settings_record_issue_25(attrs: dict[str, object], store: bool) -> dict[str
     return out
 
 
+def _model_reference_issue_25(new: dict[str, object], ref: dict[str, object]) -> dict[str, object]:
+    """Issue 25 records how to build a model that is not a gear set again (``model_class``,
+    ``model_fields``): the model they build must be the one the reference recorded by its
+    repr (``model_parameters``); then take them."""
+    from gearchaos.model.contract import rebuild_model
+
+    out = dict(ref)
+    if "model_class" in new:
+        model = rebuild_model(new)
+        assert str(new["model_class"]).startswith("gearchaos.model.library:")
+        assert _model_repr_issue_12({"model_parameters": repr(model)}) == {
+            "model_parameters": ref["model_parameters"]
+        }
+        out["model_class"], out["model_fields"] = new["model_class"], new["model_fields"]
+    return out
+
+
 def _switch_retries_issue_25(new: dict[str, object], ref: dict[str, object]) -> dict[str, object]:
     """Issue 25 counts the step attempts discarded to end a step on a contact switch apart
     (``steps_switch``) from those the error test rejected (``steps_rejected``), which the
@@ -122,6 +139,7 @@ def _assert_same_store(new: Path, ref: Path) -> None:
     g_new = zarr.open_group(os.fspath(new), mode="r")
     g_ref = zarr.open_group(os.fspath(ref), mode="r")
     ref_attrs = _settings_record_issue_25(_model_repr_issue_12(dict(g_ref.attrs)), store=True)
+    ref_attrs = _model_reference_issue_25(dict(g_new.attrs), ref_attrs)
     _same_attrs(dict(g_new.attrs), ref_attrs, "store")
     names_new = sorted(k for k, _ in g_new.arrays())
     names_ref = sorted(k for k, _ in g_ref.arrays())
