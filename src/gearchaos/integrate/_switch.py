@@ -11,11 +11,18 @@ landed on. The extrema of the tracked observables are refined inside each accept
 
 Interpolants (all on the values v and derivatives v' of an observable at accepted points):
 
-* the cubic Hermite interpolant of one step, for the check and the extrema (4th order);
+* the cubic Hermite interpolant of one step (:func:`hermite`), for the check and the extrema
+  (4th order; exact for cubic polynomials);
 * the quintic Hermite interpolant of the last three accepted points, extrapolated forward for the
   prediction (6th order), in Newton form on the confluent nodes (0, 0, −h₁, −h₁, −h₁−h₂,
   −h₁−h₂) of local time u = τ − τ_n. Only points since the last switch are used (v''' jumps at a
   kink); with two of them the cubic is extrapolated instead.
+
+The integrator's loop calls :func:`aim_step` before a step (the step to try: the proposal,
+shortened to end just past a predicted switch, clipped to the next target time),
+:func:`land_switch` after it (the step to retry with when it crossed a switch it should have
+ended on), :func:`track` after an accepted step and :func:`push_point` to keep the points of
+the current smooth piece.
 """
 
 from __future__ import annotations
@@ -27,7 +34,17 @@ import numpy as np
 
 from .._numba import njit_noalloc
 
-__all__ = ["LAND", "check_step", "predict_switch", "track"]
+__all__ = [
+    "AIM",
+    "LAND",
+    "aim_step",
+    "check_step",
+    "hermite",
+    "land_switch",
+    "predict_switch",
+    "push_point",
+    "track",
+]
 
 #: A switch within this fraction of a step from either end counts as landed on. The local error
 #: a kink at distance δ from a step end leaves is ~ b·h·J·δ v' (J the contact stiffness over
@@ -38,7 +55,7 @@ AIM = 0.5 * LAND
 
 
 @numba.njit(cache=True, inline="always")
-def _hermite(v0, v1, d0, d1, s):  # pragma: no cover - compiled
+def hermite(v0, v1, d0, d1, s):  # pragma: no cover - compiled
     """Cubic Hermite interpolant on s ∈ [0, 1] (d0, d1 already multiplied by the step)."""
     s2 = s * s
     s3 = s2 * s
@@ -81,7 +98,7 @@ def _hermite_root(v0, v1, d0, d1, level):  # pragma: no cover - compiled
             x = 0.5 * (lo + hi)
         else:
             x = (lo * fhi - hi * flo) / (fhi - flo)
-        fx = _hermite(v0, v1, d0, d1, x) - level
+        fx = hermite(v0, v1, d0, d1, x) - level
         if abs(fx) <= sc or hi - lo < 1e-14:
             break
         if (fx > 0.0) == (fhi > 0.0):
@@ -170,7 +187,7 @@ def track(hist, obs, dt, n_track, omin, omax):  # pragma: no cover - compiled
                 s2 = c / q if q != 0.0 else -1.0
                 s = s1 if 0.0 <= s1 <= 1.0 else s2
             if 0.0 < s < 1.0:
-                v = _hermite(v0, v1, d0, d1, s)
+                v = hermite(v0, v1, d0, d1, s)
                 if v < omin[k]:
                     omin[k] = v
                 if v > omax[k]:
@@ -277,3 +294,60 @@ def predict_switch(hist, n_pts, t_hist, n_track, sw, h):  # pragma: no cover - c
         if best < 0.0 or x < best:
             best = x
     return best
+
+
+@njit_noalloc
+def aim_step(
+    h, h_event, t, target, hist, n_pts, t_hist, n_track, sw, has_switch, hmin
+):  # pragma: no cover - compiled
+    """The step to try from ``t``: ``h_event`` (> 0: a retry that ends just past a switch
+    the last attempt crossed), else the proposal ``h``, shortened to end just past a switch
+    predicted within it (from the ``n_pts`` ≥ 2 points of the current smooth piece, see
+    :func:`predict_switch`), and clipped to end exactly on ``target`` (the next sample or
+    section time, or the end) if it would reach it. Returns ``(hs, clipped, shortened)``."""
+    clipped = False
+    shortened = False
+    hs = h
+    if h_event > 0.0:
+        hs = h_event
+        shortened = True
+    elif has_switch and n_pts >= 2:
+        hp = predict_switch(hist, n_pts, t_hist, n_track, sw, min(h, target - t))
+        if hp > LAND * hs and hp > hmin:
+            hs = hp + AIM * hs
+            shortened = True
+    if t + hs >= target:
+        hs = target - t
+        clipped = True
+        shortened = False
+    return hs, clipped, shortened
+
+
+@njit_noalloc
+def land_switch(hist, obs, hs, h, n_track, sw, hmin):  # pragma: no cover - compiled
+    """After a step ``hs`` (proposal ``h``) from ``hist[0]`` to ``obs``: a switch within
+    LAND·max(h, hs) of either end counts as landed on (h the proposal: a shortened step must not
+    make that window shrink); one inside the step (farther than ``hmin`` from its start) means
+    the step must be retried to end just past it. Returns ``(h_event, where)``: the step to
+    retry with (−1: keep the step) and ``where`` as in :func:`check_step`."""
+    win = LAND * max(h, hs)
+    theta, where = check_step(hist, obs, hs, n_track, sw, win)
+    h_event = -1.0
+    if theta < 1.0 and theta * hs > hmin:
+        h_event = theta * hs + AIM * max(h, hs)
+        if h_event >= hs:
+            h_event = theta * hs
+    return h_event, where
+
+
+@njit_noalloc
+def push_point(hist, t_hist, obs, t, n):  # pragma: no cover - compiled
+    """Make the accepted point (t, ``obs[:n]``) the newest of the three kept: rows of ``hist``
+    one older (row 2 ← 1 ← 0), row 0 ← obs[:n], and their times ``t_hist`` likewise."""
+    for i in range(n):
+        hist[2, i] = hist[1, i]
+        hist[1, i] = hist[0, i]
+        hist[0, i] = obs[i]
+    t_hist[2] = t_hist[1]
+    t_hist[1] = t_hist[0]
+    t_hist[0] = t

@@ -8,18 +8,28 @@ continues to τ_end. Over [τ_rec, τ_end] it keeps the running minimum and maxi
 interpolant of the observable and its derivative (the observables come for free from the FSAL
 stage).
 
-Error control follows Hairer, Nørsett & Wanner (*Solving ODEs I*, §II.4) as in scipy's
-``RK45``: the scaled RMS norm of h Σ (b_i − b̂_i) k_i with scale atol + rtol·max(|y_n|, |y_{n+1}|),
-PI step-size control as in Hairer's DOPRI5 code (Gustafsson; HNW II §IV.2): factor
-0.9·err_n^(−α)·err_{n−1}^β, β = 0.04, α = 1/5 − 0.75β, clipped to [0.2, 10] (no growth right after
-a rejection), and Hairer's starting-step heuristic. Contact switches are predicted from the
-points of the current smooth piece and a step is shortened to end just past the next one
-(:mod:`~gearchaos.integrate._switch`). After a step clipped to land on a sample the pre-clip
-step size is restored, so sampling does not throttle the integration.
+:func:`dopri_run` is the loop; each of its parts is a compiled function of its own that a test
+can call alone:
 
-The stages are written out with the coefficients of :data:`~gearchaos.integrate.tableau.DOPRI5`
-as compile-time constants; the inner stages ask the right-hand side for no observables, the last
-(FSAL) stage for the tracked ones only, or for all of them on a sample step.
+* the step (:mod:`~gearchaos.integrate._step`): :func:`~._step.rk_step` (the stages, from the
+  Butcher tableau as data, :data:`~gearchaos.integrate.tableau.DOPRI5`),
+  :func:`~._step.error_norm` (the scaled RMS norm of h Σ (b_i − b̂_i) k_i with scale
+  atol + rtol·max(|y_n|, |y_{n+1}|), as in Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.4 and
+  scipy's ``RK45``), :func:`~._step.initial_step` (Hairer's starting step);
+* step-size control (:mod:`~gearchaos.integrate._control`): PI control as in Hairer's DOPRI5
+  code, after an accepted or a rejected step;
+* events (:mod:`~gearchaos.integrate._switch`): contact switches are predicted from the points
+  of the current smooth piece and a step is shortened to end just past the next one
+  (:func:`~._switch.aim_step`), a step that crossed one is retried to end on it
+  (:func:`~._switch.land_switch`), and the extrema are refined in each step
+  (:func:`~._switch.track`);
+* settling (:mod:`~gearchaos.integrate._settle`): whether the transient's section points repeat;
+* sampling (:mod:`~gearchaos.integrate._sample`): a sample recorded, tangent vectors
+  renormalised there.
+
+After a step clipped to land on a sample the pre-clip step size is restored, so sampling does
+not throttle the integration. Another explicit FSAL pair runs this same code with its own
+constants (:func:`~gearchaos.integrate.methods.kernels_for`).
 
 :func:`dopri_run` allocates nothing: its scratch arrays come from :func:`workspace`, once per
 block of chains, so it is compiled without numba's reference counting. With it, every array
@@ -39,158 +49,20 @@ import numpy as np
 
 from .._numba import njit_noalloc
 from ..errors import Status
-from ..model.kernels import OBS_ALL, OBS_NONE, OBS_TRACK, rhs, tangent
-from ._switch import AIM, LAND, check_step, predict_switch, track
+from ..model.kernels import OBS_ALL, OBS_TRACK, rhs
+from ._control import LOG_ERR_OLD_MIN, accepted_step, rejected_step
+from ._sample import copy_into, record_sample, start_extrema
+from ._settle import SETTLE_MAX_PERIOD, first_section, settled
+from ._step import ALPHA, STAGES, error_norm, fsal_advance, initial_step, rk_step
+from ._switch import aim_step, land_switch, push_point, track
 from .interface import Config, Info
-from .tableau import DOPRI5
 
 __all__ = ["dopri_chains", "dopri_run"]
-
-# ---------------------------------------------------------------------------- constants from data
-STAGES = DOPRI5.stages
-assert STAGES == 7 and DOPRI5.fsal  # the last row of A is b: the last stage value is y_{n+1}
-_A = DOPRI5.a_matrix()
-_E = [float(x) for x in DOPRI5.error_weights]
-# the unrolled stages below skip these zero coefficients
-assert _A[6, 1] == 0.0 and _E[1] == 0.0
-C2, C3, C4, C5 = (float(x) for x in DOPRI5.c[1:5])
-A21 = float(_A[1, 0])
-A31, A32 = (float(x) for x in _A[2, :2])
-A41, A42, A43 = (float(x) for x in _A[3, :3])
-A51, A52, A53, A54 = (float(x) for x in _A[4, :4])
-A61, A62, A63, A64, A65 = (float(x) for x in _A[5, :5])
-A71, A73, A74, A75, A76 = (float(_A[6, q]) for q in (0, 2, 3, 4, 5))
-E1, E3, E4, E5, E6, E7 = (_E[q] for q in (0, 2, 3, 4, 5, 6))
-
-SAFETY = 0.9
-MIN_FACTOR = 0.2
-MAX_FACTOR = 10.0
-#: PI step-size control (Gustafsson): h_{n+1} = h_n · SAFETY · err_n^(−α) · err_{n−1}^β with
-#: β = 0.04 and α = 1/5 − 0.75 β, as in Hairer's DOPRI5 code (HNW II §IV.2)
-BETA = 0.04
-ALPHA = 0.2 - 0.75 * BETA
-ERR_OLD_MIN = 1e-4  # lower bound on err_{n−1} (Hairer's facold)
-LOG_ERR_OLD_MIN = math.log(ERR_OLD_MIN)
-
-#: ``settle="auto"``: the transient ends at the first transient section point τ_k at which the
-#: section sequence has repeated with some period n ≤ SETTLE_MAX_PERIOD, every component within
-#: SETTLE_TOL·(1 + |y|) of its value n periods earlier, for the last max(SETTLE_CYCLES·n,
-#: SETTLE_MIN_MATCHES) section points in a row.
-SETTLE_MAX_PERIOD = 64
-SETTLE_CYCLES = 3
-SETTLE_MIN_MATCHES = 8
-SETTLE_TOL = 1e-7
 
 ST_OK = int(Status.OK)
 ST_MAX_STEPS = int(Status.MAX_STEPS)
 ST_UNDERFLOW = int(Status.STEP_UNDERFLOW)
 ST_NON_FINITE = int(Status.NON_FINITE)
-
-
-@numba.njit(cache=True, inline="always")
-def _copy(dst, src, n):  # pragma: no cover - compiled
-    """dst[:n] = src[:n], as a loop: a slice assignment drags numba's shape-mismatch error
-    formatting into every kernel (seconds of compile time)."""
-    for i in range(n):
-        dst[i] = src[i]
-
-
-@numba.njit(cache=True, inline="always")
-def _shift(hist, obs, n):  # pragma: no cover - compiled
-    """Rows of ``hist`` one older (row 2 ← 1 ← 0), row 0 ← obs[:n]."""
-    for i in range(n):
-        hist[2, i] = hist[1, i]
-        hist[1, i] = hist[0, i]
-        hist[0, i] = obs[i]
-
-
-@njit_noalloc
-def initial_step(kind, t, y, f0, p, rtol, atol, obs, n, y1, f1):  # pragma: no cover - compiled
-    """Hairer's starting step (HNW I, §II.4) for the 5(4) pair, from the first n components
-    (``obs``, ``y1``, ``f1``: scratch)."""
-    numba.literally(kind)
-    d0 = 0.0
-    d1 = 0.0
-    for i in range(n):
-        sc = atol + rtol * abs(y[i])
-        d0 += (y[i] / sc) ** 2
-        d1 += (f0[i] / sc) ** 2
-    d0 = math.sqrt(d0 / n)
-    d1 = math.sqrt(d1 / n)
-    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
-    for i in range(y.size):
-        y1[i] = y[i] + h0 * f0[i]
-    rhs(kind, t + h0, y1, p, f1, obs, OBS_NONE)
-    d2 = 0.0
-    for i in range(n):
-        sc = atol + rtol * abs(y[i])
-        d2 += ((f1[i] - f0[i]) / sc) ** 2
-    d2 = math.sqrt(d2 / n) / h0
-    if d1 <= 1e-15 and d2 <= 1e-15:
-        h1 = max(1e-6, h0 * 1e-3)
-    else:
-        h1 = (0.01 / max(d1, d2)) ** 0.2
-    return min(100.0 * h0, h1)
-
-
-@njit_noalloc
-def _renormalize(kind, t, y, p, obs, K, n, k, lsum, tan_on):  # pragma: no cover - compiled
-    """Tangent vectors in y[n:]: make them orthonormal (first call: the given ones, if any is
-    nonzero, else the first k basis vectors) or re-orthonormalise them by modified Gram–Schmidt,
-    adding log stretch factors to ``lsum``; refresh their FSAL stage ``K[0]`` (``obs``)."""
-    numba.literally(kind)
-    given = False
-    if not tan_on:
-        for i in range(n, n + k * n):
-            if y[i] != 0.0:
-                given = True
-        if not given:
-            for r in range(k):
-                o = n + r * n
-                for i in range(n):
-                    y[o + i] = 1.0 if i == r else 0.0
-    if tan_on or given:
-        for r in range(k):
-            o = n + r * n
-            for q in range(r):
-                oq = n + q * n
-                d = 0.0
-                for i in range(n):
-                    d += y[o + i] * y[oq + i]
-                for i in range(n):
-                    y[o + i] -= d * y[oq + i]
-            nrm = 0.0
-            for i in range(n):
-                nrm += y[o + i] * y[o + i]
-            nrm = math.sqrt(nrm)
-            if tan_on:
-                lsum[r] += math.log(nrm)
-            for i in range(n):
-                y[o + i] /= nrm
-    tangent(kind, t, y, p, obs, K[0], n, k)
-    return True
-
-
-@njit_noalloc
-def _settled(y, ring, runs, n_sec, n_base):  # pragma: no cover - compiled
-    """Store transient section point number ``n_sec`` (state ``y``) in ``ring``; update the
-    run lengths ``runs[n]`` of consecutive repeats with period n; whether one is long enough."""
-    n_ring = ring.shape[0]
-    row = n_sec % n_ring
-    for i in range(n_base):
-        ring[row, i] = y[i]
-    done = False
-    for per in range(1, min(n_sec, n_ring - 1) + 1):
-        prev = (n_sec - per) % n_ring
-        close = True
-        for i in range(n_base):
-            if abs(y[i] - ring[prev, i]) > SETTLE_TOL * (1.0 + abs(y[i])):
-                close = False
-                break
-        runs[per] = runs[per] + 1 if close else 0
-        if runs[per] >= max(SETTLE_CYCLES * per, SETTLE_MIN_MATCHES):
-            done = True
-    return done
 
 
 @numba.njit(cache=True)
@@ -234,8 +106,9 @@ def dopri_run(
 
     Settling (``settle_spp`` > 0, the samples per period, so T = settle_spp·dt_sample): the
     steps also land on the transient section points τ_rec − mT, and once their sequence repeats
-    (see ``SETTLE_TOL``) at τ_rec − mT, the recording starts there: τ_rec and τ_end move back
-    by mT (whole periods, so the forcing phase of every sample is unchanged).
+    (:func:`~gearchaos.integrate._settle.settled`) at τ_rec − mT, the recording starts there:
+    τ_rec and τ_end move back by mT (whole periods, so the forcing phase of every sample is
+    unchanged).
 
     Lyapunov exponents: with ``k = lsum.size > 0`` the state holds ``n_base`` system
     components followed by k tangent vectors, integrated with the variational equations
@@ -260,8 +133,7 @@ def dopri_run(
     out_t, out_y, out_obs, obs_min, obs_max, y_final = out
     y, yt, K, obs, hist, t_hist, ring, runs, f1, o1 = ws
     n = y0.size
-    n_err = n_base if math.isinf(tan_tol) else n  # the components in the error norm
-    _copy(y, y0, n)
+    copy_into(y, y0, n)
     for s in range(STAGES):
         for i in range(n):
             K[s, i] = 0.0  # tangent components stay zero until the tangents start
@@ -271,11 +143,10 @@ def dopri_run(
         obs_max[k] = -np.inf
 
     t = t0
-    n_tan = lsum.size
     # np.bool_ (and np.int64 for n_pts, n_sec): a plain literal would make numba compile the
     # helpers that take these variables twice, once for the literal value and once widened
     tan_on = np.bool_(False)
-    for r in range(n_tan):
+    for r in range(lsum.size):
         lsum[r] = 0.0
     rhs(kind, t, y, p, K[0], obs, OBS_ALL)
     n_acc = 0
@@ -294,21 +165,17 @@ def dopri_run(
     j = 0
     tracking = False
     if status == ST_OK and n_samples > 0 and t >= t_rec:
-        out_t[0] = t
-        _copy(out_y[0], y, n)
-        if n_tan > 0:
-            tan_on = _renormalize(kind, t, y, p, obs, K, n_base, n_tan, lsum, tan_on)
-        _copy(out_obs[0], obs, n_obs)
+        tan_on = record_sample(
+            kind, 0, t, y, p, obs, K, out_t, out_y, out_obs, n_base, n_obs, lsum, tan_on
+        )
         j = 1
         tracking = True
-        for k in range(n_track):
-            obs_min[k] = obs[k]
-            obs_max[k] = obs[k]
+        start_extrema(obs, n_track, obs_min, obs_max)
     # tracked observables at the last three accepted points, newest first, and their times;
     # n_pts of them lie on the current smooth piece (since the last switch)
     for r in range(3):
         t_hist[r] = 0.0
-    _copy(hist[0], obs, n_tr2)
+    copy_into(hist[0], obs, n_tr2)
     t_hist[0] = t
     n_pts = int(np.int64(1))  # not a literal: see tan_on
     last_rejected = False
@@ -322,7 +189,7 @@ def dopri_run(
     # settling: transient section points, the newest SETTLE_MAX_PERIOD + 1 in a ring
     settling = settle_spp > 0 and n_samples > 0 and t < t_rec
     period = dt_sample * settle_spp
-    m_next = int((t_rec - t) / period - 1e-9) if settling else 0
+    m_next = first_section(t, t_rec, period) if settling else 0
     for r in range(SETTLE_MAX_PERIOD + 1):
         runs[r] = 0
     n_sec = int(np.int64(0))  # not a literal: see tan_on
@@ -345,137 +212,49 @@ def dopri_run(
         if h < hmin:
             status = ST_NON_FINITE if nonfinite else ST_UNDERFLOW
             break
-        clipped = False
-        shortened = False
-        hs = h
-        if h_event > 0.0:
-            hs = h_event
-            shortened = True
-            h_event = -1.0
-        elif has_switch and n_pts >= 2:
-            # a switch predicted within the step (extrapolating the points of the current
-            # smooth piece): shorten the step to end just past it
-            hp = predict_switch(hist, n_pts, t_hist, n_track, sw, min(h, target - t))
-            if hp > LAND * hs and hp > hmin:
-                hs = hp + AIM * hs
-                shortened = True
-        if t + hs >= target:
-            hs = target - t
-            clipped = True
-            shortened = False
-
+        # the step: aimed past a predicted switch, clipped to the target; the last stage is
+        # evaluated at (t_new, y_new) (FSAL), with all observables on a sample step
+        hs, clipped, shortened = aim_step(
+            h, h_event, t, target, hist, n_pts, t_hist, n_track, sw, has_switch, hmin
+        )
+        h_event = -1.0
         t_new = target if clipped else t + hs
-        # the stages; the last one is evaluated at (t_new, y_new) (FSAL)
         last_level = OBS_ALL if (clipped or tan_on) else OBS_TRACK
-        for s in range(1, STAGES):
-            if s == 1:
-                for i in range(n):
-                    yt[i] = y[i] + hs * (A21 * K[0, i])
-                ts = t + C2 * hs
-            elif s == 2:
-                for i in range(n):
-                    yt[i] = y[i] + hs * (A31 * K[0, i] + A32 * K[1, i])
-                ts = t + C3 * hs
-            elif s == 3:
-                for i in range(n):
-                    yt[i] = y[i] + hs * (A41 * K[0, i] + A42 * K[1, i] + A43 * K[2, i])
-                ts = t + C4 * hs
-            elif s == 4:
-                for i in range(n):
-                    yt[i] = y[i] + hs * (
-                        A51 * K[0, i] + A52 * K[1, i] + A53 * K[2, i] + A54 * K[3, i]
-                    )
-                ts = t + C5 * hs
-            elif s == 5:
-                for i in range(n):
-                    yt[i] = y[i] + hs * (
-                        A61 * K[0, i] + A62 * K[1, i] + A63 * K[2, i] + A64 * K[3, i]
-                        + A65 * K[4, i]
-                    )  # fmt: skip
-                ts = t + hs
-            else:
-                for i in range(n):
-                    yt[i] = y[i] + hs * (
-                        A71 * K[0, i] + A73 * K[2, i] + A74 * K[3, i] + A75 * K[4, i]
-                        + A76 * K[5, i]
-                    )  # fmt: skip
-                ts = t_new
-            level = last_level if s == STAGES - 1 else (OBS_ALL if tan_on else OBS_NONE)
-            rhs(kind, ts, yt, p, K[s], obs, level)
-            if tan_on:
-                tangent(kind, ts, yt, p, obs, K[s], n_base, n_tan)
-        # yt is y_{n+1}; the scaled RMS norm of the embedded error estimate, which is NaN
-        # also when y_{n+1} is not finite
-        acc = 0.0
-        for i in range(n):
-            e = hs * (
-                E1 * K[0, i] + E3 * K[2, i] + E4 * K[3, i] + E5 * K[4, i] + E6 * K[5, i]
-                + E7 * K[6, i]
-            )  # fmt: skip
-            sc = atol + rtol * max(abs(y[i]), abs(yt[i]))
-            if i >= n_base:
-                sc *= tan_tol  # the tangents' own tolerance (1: the state's; inf: r = 0)
-            r = e / sc
-            acc += r * r + 0.0 * yt[i]
-        err = math.sqrt(acc / n_err)
-
+        rk_step(kind, t, y, hs, t_new, p, K, yt, obs, n, n_base, lsum.size, tan_on, last_level)
+        err = error_norm(y, yt, K, hs, n, n_base, rtol, atol, tan_tol)
         if not math.isfinite(err):
             nonfinite = True
             n_rej += 1
-            h = hs * MIN_FACTOR
+            h = rejected_step(err, hs, ALPHA)
             last_rejected = True
             continue
         nonfinite = False
 
         where = 0
         if has_switch:
-            # a switch within LAND·h of either end of the step counts as landed on (h the
-            # proposal: a shortened step must not make that window shrink)
-            win = LAND * max(h, hs)
-            theta, where = check_step(hist, obs, hs, n_track, sw, win)
-            if theta < 1.0 and theta * hs > hmin:
-                # a switch lies inside the step: retry, ending just past it
-                h_event = theta * hs + AIM * max(h, hs)
-                if h_event >= hs:
-                    h_event = theta * hs
-                n_sw += 1
+            h_event, where = land_switch(hist, obs, hs, h, n_track, sw, hmin)
+            if h_event > 0.0:
+                n_sw += 1  # a switch lies inside the step: retry, ending just past it
                 continue
 
         if err > 1.0:
             n_rej += 1
-            h = hs * max(MIN_FACTOR, SAFETY * math.exp(-ALPHA * math.log(err)))
+            h = rejected_step(err, hs, ALPHA)
             last_rejected = True
             continue
 
         n_acc += 1
-        # PI step-size control (Gustafsson; HNW II §IV.2 and Hairer's DOPRI5)
-        if err == 0.0:
-            log_err = LOG_ERR_OLD_MIN
-            factor = MAX_FACTOR
-        else:
-            log_err = math.log(err)
-            factor = SAFETY * math.exp(BETA * log_err_old - ALPHA * log_err)
-            factor = min(MAX_FACTOR, max(MIN_FACTOR, factor))
-        if last_rejected and factor > 1.0:
-            factor = 1.0
+        cut = clipped or shortened
+        h, log_err_old = accepted_step(err, hs, h, log_err_old, last_rejected, cut, max_step, ALPHA)
         last_rejected = False
-        h_next = hs * factor
-        if clipped or shortened:
-            if h_next < h:
-                h_next = h  # restore the proposal made before clipping to a sample or switch
-        else:
-            log_err_old = max(log_err, LOG_ERR_OLD_MIN)  # steps cut short say little
-        h = min(h_next, max_step)
         t = t_new
-        for i in range(n):
-            y[i] = yt[i]
-            K[0, i] = K[STAGES - 1, i]
+        fsal_advance(y, yt, K, n)
         if tracking:
             track(hist, obs, hs, n_track, obs_min, obs_max)
         record = clipped and j < n_samples and not sec_step
         if clipped and sec_step:
             m_next -= 1
-            if _settled(y, ring, runs, n_sec, n_base):
+            if settled(y, ring, runs, n_sec, n_base):
                 # settled: the recording starts here, whole periods before the planned start
                 skipped = m_next + 1
                 t_rec = t
@@ -484,25 +263,18 @@ def dopri_run(
                 record = True
             n_sec += 1
         if record:
-            out_t[j] = t
-            _copy(out_y[j], y, n)  # tangents before renormalising: their stretch is readable
-            if n_tan > 0:
-                tan_on = _renormalize(kind, t, y, p, obs, K, n_base, n_tan, lsum, tan_on)
-            _copy(out_obs[j], obs, n_obs)
+            tan_on = record_sample(
+                kind, j, t, y, p, obs, K, out_t, out_y, out_obs, n_base, n_obs, lsum, tan_on
+            )
             if not tracking:
                 tracking = True
-                for k in range(n_track):
-                    obs_min[k] = obs[k]
-                    obs_max[k] = obs[k]
+                start_extrema(obs, n_track, obs_min, obs_max)
             j += 1
         # the smooth piece: a switch at the end starts a new one, at the start one of two points
         n_pts = 1 if where == 2 else (2 if where == 1 else min(n_pts + 1, 3))
-        _shift(hist, obs, n_tr2)
-        t_hist[2] = t_hist[1]
-        t_hist[1] = t_hist[0]
-        t_hist[0] = t
+        push_point(hist, t_hist, obs, t, n_tr2)
 
-    _copy(y_final, y, n)
+    copy_into(y_final, y, n)
     info[Info.ACCEPTED] = n_acc
     info[Info.REJECTED] = n_rej
     info[Info.SWITCH_RETRIES] = n_sw
@@ -563,9 +335,9 @@ def dopri_chains(
             )
             status[c, j] = st
             # a successor: the final system state, tangents afresh from Y0 (monodromy factors)
-            _copy(y, Y0[c], y.size)
+            copy_into(y, Y0[c], y.size)
             if continuation and st == ST_OK:
-                _copy(y, y_final[c, j], n_base)
+                copy_into(y, y_final[c, j], n_base)
 
 
 def _guard() -> None:
@@ -580,12 +352,16 @@ def _guard() -> None:
         reference_kernels.__file__,
         layout.__file__,
         os.path.join(here, "dopri.py"),
+        os.path.join(here, "_step.py"),
+        os.path.join(here, "_control.py"),
+        os.path.join(here, "_sample.py"),
+        os.path.join(here, "_settle.py"),
         os.path.join(here, "_switch.py"),
         os.path.join(here, "tableau.py"),
         os.path.join(here, "interface.py"),
         os.path.join(os.path.dirname(here), "errors.py"),
     ]
-    _numba.guard_cache([dopri_run, dopri_chains], sources)
+    _numba.guard_cache([dopri_run, dopri_chains, rk_step, record_sample], sources)
 
 
 _guard()
