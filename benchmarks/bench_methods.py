@@ -13,10 +13,10 @@ sweep's tolerances (rtol 1e-8, atol 1e-10):
    attempts, right-hand-side evaluations and the global error against scipy's DOP853 at rtol
    1e-13; and the same for scipy's DOP853 (an 8(5,3) pair) at the sweep's tolerances.
 2. **The sweep.** The Fig. 4(a) sweep (``--points``, default 200, 100 + 100 periods, all cores)
-   with this code and with a temporary copy of ``src/`` whose compiled kernel carries Tsit5's
-   coefficients instead (the two extra terms a₇₂ and e₂ written into the stage and error
-   sums); each in a child process after a warm-up (``bench_speed.run_sweep``). Printed: wall
-   time and step attempts of both and their ratios.
+   with the package's Dormand–Prince kernel and with the same compiled code run on Tsit5's
+   tableau (:data:`gearchaos.integrate.tableau.TSIT5`, as data:
+   :func:`gearchaos.integrate.methods.use_tableau`); each in a child process after a warm-up.
+   Printed: wall time and step attempts of both and their ratios.
 
 Run as ``python benchmarks/bench_methods.py [--points N] [--skip-sweep]``.
 """
@@ -24,71 +24,29 @@ Run as ``python benchmarks/bench_methods.py [--points N] [--skip-sweep]``.
 from __future__ import annotations
 
 import argparse
+import json
 import math
-import shutil
+import subprocess
 import sys
-import tempfile
-from fractions import Fraction as Fr
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_speed import ATOL, FIG4_FIXED, ROOT, RTOL, run_sweep
+from bench_speed import ATOL, FIG4_FIXED, FIG4_RANGE, RTOL
 
 SMOOTH_OMEGAS = (0.05, 0.2, 0.46)
 
-#: Tsitouras (2011) 5(4), as published (floating-point coefficients): c, rows of A, b,
-#: and e = b − b̂
-TSIT5_C = (0.0, 0.161, 0.327, 0.9, 0.9800255409045097, 1.0, 1.0)
-TSIT5_A = (
-    (),
-    (0.161,),
-    (-0.008480655492356989, 0.335480655492357),
-    (2.897153057105493, -6.359448489975075, 4.3622954328695815),
-    (5.325864828439257, -11.748883564062828, 7.4955393428898365, -0.09249506636175525),
-    (5.86145544294642, -12.92096931784711, 8.159367898576159, -0.071584973281401,
-     -0.028269050394068383),
-    (0.09646076681806523, 0.01, 0.4798896504144996, 1.379008574103742, -3.290069515436081,
-     2.324710524099774),
-)  # fmt: skip
-TSIT5_E = (-0.00178001105222577714, -0.0008164344596567469, 0.007880878010261995,
-           -0.1447110071732629, 0.5823571654525552, -0.45808210592918697, 1.0 / 66.0)  # fmt: skip
-
-
-def tsit5_tableau() -> Any:
-    """Tsit5 as a :class:`ButcherTableau` (exact binary fractions of the published floats),
-    its order conditions checked to round-off (5 for b, 4 for b̂)."""
-    from gearchaos.integrate.tableau import ButcherTableau
-
-    b = (*TSIT5_A[-1], 0.0)
-    tab = ButcherTableau(
-        name="Tsitouras 5(4)",
-        c=tuple(Fr(x) for x in TSIT5_C),
-        a=tuple(tuple(Fr(x) for x in row) for row in TSIT5_A),
-        b=tuple(Fr(x) for x in b),
-        b_hat=tuple(Fr(x) - Fr(e) for x, e in zip(b, TSIT5_E, strict=True)),
-        order=5,
-        order_hat=4,
-    )
-    for w, p in ((tab.b, 5), (tab.b_hat, 4)):
-        worst = max(abs(float(r)) for r in tab.order_residuals(w, p).values())
-        assert worst < 1e-12, f"Tsit5 order-{p} conditions off by {worst:g}"
-    for i, row in enumerate(tab.a):
-        assert abs(float(sum(row, Fr(0)) - tab.c[i])) < 1e-14, f"row sum {i}"
-    return tab
-
 
 def pi_loop(f: Any, t0: float, y0: np.ndarray, t1: float, tab: Any) -> tuple[np.ndarray, int]:
-    """The package's step control (its constants from dopri.py) around one embedded pair, in
-    Python: returns y(t1) and the number of step attempts."""
-    from gearchaos.integrate import dopri as D
+    """The package's step control (its constants from ``integrate._control``) around one
+    embedded pair, in Python: returns y(t1) and the number of step attempts."""
+    from gearchaos.integrate import _control as D
 
-    a = tab.a_matrix()
-    c = np.array([float(x) for x in tab.c])
-    e = np.array([float(x) for x in tab.error_weights])
+    a, _, _, c, e = tab.arrays()
     s = tab.stages
+    alpha = D.pi_alpha(tab.order_hat)
     t, y, h = t0, y0.copy(), 0.01
     k = np.zeros((s, y.size))
     k[0] = f(t, y)
@@ -102,12 +60,12 @@ def pi_loop(f: Any, t0: float, y0: np.ndarray, t1: float, tab: Any) -> tuple[np.
         err = float(np.sqrt(np.mean((hs * (e @ k) / sc) ** 2)))
         attempts += 1
         if err > 1.0:
-            h = hs * max(D.MIN_FACTOR, D.SAFETY * err**-D.ALPHA)
+            h = hs * max(D.MIN_FACTOR, D.SAFETY * err**-alpha)
             last_rejected = True
             continue
         fac = D.MAX_FACTOR
         if err > 0.0:
-            fac = D.SAFETY * err**-D.ALPHA * err_old**D.BETA
+            fac = D.SAFETY * err**-alpha * err_old**D.BETA
             fac = min(D.MAX_FACTOR, max(D.MIN_FACTOR, fac))
         if last_rejected:
             fac = min(fac, 1.0)
@@ -122,11 +80,10 @@ def smooth_table() -> None:
     from scipy.integrate import solve_ivp
 
     import gearchaos
-    from gearchaos.integrate.tableau import DOPRI5
+    from gearchaos.integrate.tableau import DOPRI5, TSIT5
     from gearchaos.model import kernels
     from gearchaos.model.target import resolve
 
-    tsit5 = tsit5_tableau()
     gs = gearchaos.preset("sheng2016").evolve(FIG4_FIXED)
     print("1. smooth points (every mesh in contact), 2 periods after 100, Python loop over the "
           "compiled right-hand side")  # fmt: skip
@@ -158,7 +115,7 @@ def smooth_table() -> None:
 
         ref = solve_ivp(f, (t0, t1), y0, method="DOP853", rtol=1e-13, atol=1e-15).y[:, -1]
         rows = []
-        for tab in (DOPRI5, tsit5):
+        for tab in (DOPRI5, TSIT5):
             y, att = pi_loop(f, t0, y0, t1, tab)
             rows.append((tab.name, att, 6 * att, float(np.max(np.abs(y - ref)))))
         sol = solve_ivp(f, (t0, t1), y0, method="DOP853", rtol=RTOL, atol=ATOL)
@@ -169,54 +126,56 @@ def smooth_table() -> None:
                   f"{rows[0][2] / nfev:6.2f}")  # fmt: skip
 
 
-_ANCHORS = (
-    ("A71 * K[0, i] + A73 * K[2, i]", "A71 * K[0, i] + A72 * K[1, i] + A73 * K[2, i]"),
-    ("E1 * K[0, i] + E3 * K[2, i]", "E1 * K[0, i] + E2 * K[1, i] + E3 * K[2, i]"),
-)
+_SWEEP_CHILD = r"""
+import json, os, sys, tempfile, time
+import numpy as np
+import gearchaos
+from gearchaos.integrate import tableau
+from gearchaos.integrate.methods import use_tableau
+spec = json.loads(sys.argv[1])
+gs = gearchaos.preset("sheng2016")
+common = dict(rtol=spec["rtol"], atol=spec["atol"], progress=False, params=spec["fixed"])
+with use_tableau(getattr(tableau, spec["tableau"])), tempfile.TemporaryDirectory() as d:
+    gearchaos.bifurcation(gs, {"omega": np.array([1.0, 2.0])}, store=os.path.join(d, "w.zarr"),
+                          transient_periods=1, periods=2, **common)
+    omega = np.linspace(spec["lo"], spec["hi"], spec["points"])
+    t0 = time.perf_counter()
+    ds = gearchaos.bifurcation(gs, {"omega": omega}, store=os.path.join(d, "s.zarr"),
+                               transient_periods=100, periods=100, **common)
+    wall = time.perf_counter() - t0
+    steps = ds["steps_accepted"].values.sum() + ds["steps_rejected"].values.sum()
+    rejected = ds["steps_rejected"].values.sum()
+    if "steps_switch" in ds:
+        steps += ds["steps_switch"].values.sum()
+print("RESULT" + json.dumps({"wall": wall, "steps": float(steps), "rejected": float(rejected)}))
+"""
 
 
-def tsit5_copy(dst: Path) -> Path:
-    """A copy of ``src/`` whose compiled kernel has Tsit5's coefficients; returns its src."""
-    src = dst / "src"
-    shutil.copytree(ROOT / "src", src, ignore=shutil.ignore_patterns("__pycache__"))
-    path = src / "gearchaos" / "integrate" / "dopri.py"
-    text = path.read_text()
-    first = text.index("STAGES = DOPRI5.stages")
-    last = text.index("SAFETY = 0.9")
-    a = TSIT5_A
-    consts = [
-        "STAGES = 7",
-        f"C2, C3, C4, C5 = {TSIT5_C[1]!r}, {TSIT5_C[2]!r}, {TSIT5_C[3]!r}, {TSIT5_C[4]!r}",
-        f"A21 = {a[1][0]!r}",
-        f"A31, A32 = {', '.join(map(repr, a[2]))}",
-        f"A41, A42, A43 = {', '.join(map(repr, a[3]))}",
-        f"A51, A52, A53, A54 = {', '.join(map(repr, a[4]))}",
-        f"A61, A62, A63, A64, A65 = {', '.join(map(repr, a[5]))}",
-        f"A71, A72, A73, A74, A75, A76 = {', '.join(map(repr, a[6]))}",
-        f"E1, E2, E3, E4, E5, E6, E7 = {', '.join(map(repr, TSIT5_E))}",
-    ]
-    text = text[:first] + "\n".join(consts) + "\n\n" + text[last:]
-    for old, new in _ANCHORS:
-        if text.count(old) != 1:
-            raise RuntimeError(f"dopri.py changed: cannot patch {old!r}; update this benchmark")
-        text = text.replace(old, new)
-    path.write_text(text)
-    return src
+def run_sweep(points: int, tableau: str) -> dict[str, Any]:
+    """The Fig. 4(a) sweep with the compiled integrator on ``tableau`` (a name in
+    ``gearchaos.integrate.tableau``), in a child process."""
+    spec = {"points": points, "lo": FIG4_RANGE[0], "hi": FIG4_RANGE[1], "rtol": RTOL,
+            "atol": ATOL, "fixed": FIG4_FIXED, "tableau": tableau}  # fmt: skip
+    proc = subprocess.run(
+        [sys.executable, "-c", _SWEEP_CHILD, json.dumps(spec)],
+        capture_output=True, text=True, check=False,
+    )  # fmt: skip
+    for line in proc.stdout.splitlines():
+        if line.startswith("RESULT"):
+            return dict(json.loads(line[6:]))
+    raise RuntimeError(f"sweep child failed ({tableau}):\n{proc.stderr[-3000:]}")
 
 
 def sweep_table(points: int) -> None:
     print(f"\n2. Fig. 4(a) sweep, {points} Ω in [0.05, 4], 100 + 100 periods, all cores")
-    with tempfile.TemporaryDirectory() as d:
-        tsit_src = tsit5_copy(Path(d))
-        res = {}
-        for name, src in (("Dormand–Prince 5(4)", ROOT / "src"), ("Tsitouras 5(4)", tsit_src)):
-            res[name] = run_sweep(src, points, 100, 100, False, str(Path(d) / "s.npy"))
-            r = res[name]
-            print(f"   {name:22} {r['wall']:7.2f} s wall, {r['steps']:.3g} attempts, "
-                  f"{r['rejected'] / r['steps']:.1%} rejected")  # fmt: skip
-        dp, ts = res["Dormand–Prince 5(4)"], res["Tsitouras 5(4)"]
-        print(f"   Tsit5 / DP5: wall {ts['wall'] / dp['wall']:.2f}, "
-              f"attempts {ts['steps'] / dp['steps']:.2f}")  # fmt: skip
+    res = {}
+    for name, tab in (("Dormand–Prince 5(4)", "DOPRI5"), ("Tsitouras 5(4)", "TSIT5")):
+        res[name] = r = run_sweep(points, tab)
+        print(f"   {name:22} {r['wall']:7.2f} s wall, {r['steps']:.3g} attempts, "
+              f"{r['rejected'] / r['steps']:.1%} rejected")  # fmt: skip
+    dp, ts = res["Dormand–Prince 5(4)"], res["Tsitouras 5(4)"]
+    print(f"   Tsit5 / DP5: wall {ts['wall'] / dp['wall']:.2f}, "
+          f"attempts {ts['steps'] / dp['steps']:.2f}")  # fmt: skip
 
 
 def main() -> None:

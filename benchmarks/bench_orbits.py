@@ -113,7 +113,7 @@ def bench_branch(gs: gc.GearSet, points: int) -> dict[str, float]:
         "all_evals_per_point": branch.attrs["map_evaluations"] / n_b,
         "events": int(branch.sizes["event"]),
         "stop_reason": branch.attrs["stop_reason"],
-        "event_list": ", ".join(f"{e.kind} {e.value:.4f}" for e in gc.analysis.events(branch)),
+        "event_list": ", ".join(f"{e.kind} {e.value:.4f}" for e in gc.dynamics.events(branch)),
     }
 
 

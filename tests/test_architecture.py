@@ -1,6 +1,7 @@
 """The package's layering holds: no import cycle between modules, no import from a lower layer
 to a higher one (``gearset → model → integrate → analysis → dynamics → sweep → plot → paper →
-cli``), and no module over 600 lines.
+cli``), the layers hold their concepts (analysis pure, the integrator driven from dynamics),
+and no module over 600 lines.
 
 Imports are read from the source with :mod:`ast`, *including imports inside functions* (a lazy
 import hides a cycle from Python but not from a reader), and resolved to the module they load:
@@ -110,6 +111,25 @@ def test_no_import_from_a_lower_layer_to_a_higher_one() -> None:
             if rank[_layer(dep)] > rank[_layer(module)]:
                 bad.append(f"{module} ({_layer(module)}) imports {dep} ({_layer(dep)})")
     assert not bad, "imports against the layering:\n" + "\n".join(sorted(bad))
+
+
+def test_analysis_is_pure_and_the_integrator_is_driven_from_dynamics() -> None:
+    """Issue 25's layers by concept: the analysis layer holds pure functions of recorded
+    arrays (it never imports the integrator); what drives the integrator — Lyapunov
+    exponents, orbits, continuation and its events, branch files, attractors, verdicts —
+    lives in dynamics; modal analysis and derived quantities with the model; rendering of
+    tables in the command line."""
+    graph = _graph()
+    mods = _modules()
+    for module, deps in graph.items():
+        if _layer(module) == "analysis":
+            assert not any(d.startswith("gearchaos.integrate") for d in deps), (module, deps)
+            assert "rich" not in mods[module].read_text(encoding="utf-8"), module
+    for name in ("lyapunov", "orbits", "shooting", "arclength", "branch", "branch_events",
+                 "coexistence", "verdict", "orbit_batch"):  # fmt: skip
+        assert f"gearchaos.dynamics.{name}" in graph, name
+        assert f"gearchaos.analysis.{name}" not in graph, name
+    assert "gearchaos.model.modal" in graph and "gearchaos.model.derived" in graph
 
 
 def test_no_import_cycle() -> None:

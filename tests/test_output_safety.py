@@ -20,7 +20,7 @@ import pytest
 
 import gearchaos as gc
 from gearchaos._output import file_has_mark, staged_file, write_file
-from gearchaos.analysis import open_branch, save_branch
+from gearchaos.dynamics import open_branch, save_branch
 from gearchaos.errors import StoreError
 from gearchaos.sweep.integrity import StoreLock
 from gearchaos.sweep.store import is_sweep_store

@@ -56,7 +56,7 @@ def test_python_entry_points_refuse_identically(
             gs, "omega=1,2", store=tmp_path / "x.zarr", progress=False, **{name: value}
         ),
         "SweepSpec.build": lambda: SweepSpec.build("omega=1:2:3", **{name: value}),
-        "lyapunov_spectrum": lambda: gc.analysis.lyapunov_spectrum(
+        "lyapunov_spectrum": lambda: gc.dynamics.lyapunov_spectrum(
             gc.planetary_system(gs, 1.5), **{name: value}
         ),
         "calibrate settings": lambda: SweepSettings(**{name: value}),

@@ -66,27 +66,27 @@ __all__ = [
 ]
 
 if TYPE_CHECKING:
-    from .analysis.arclength import continuation
-    from .analysis.branch import open_branch, save_branch
-    from .analysis.branch_events import Event
-    from .analysis.lyapunov import lyapunov_spectrum, max_lyapunov
-    from .analysis.orbit_batch import periodic_orbits
-    from .analysis.orbits import PeriodicOrbit, periodic_orbit
+    from .dynamics.arclength import continuation
+    from .dynamics.branch import open_branch, save_branch
+    from .dynamics.branch_events import Event
     from .dynamics.coexistence import attractors
+    from .dynamics.lyapunov import lyapunov_spectrum, max_lyapunov
+    from .dynamics.orbit_batch import periodic_orbits
+    from .dynamics.orbits import PeriodicOrbit, periodic_orbit
     from .explore import explore
 
-_LAZY_SUBPACKAGES = ("analysis", "plot", "paper", "explore")
+_LAZY_SUBPACKAGES = ("analysis", "dynamics", "plot", "paper", "explore")
 #: Functions of the lazy subpackages exported here, by the module that defines them.
 _LAZY_ATTRIBUTES = {
-    "PeriodicOrbit": "analysis.orbits",
-    "periodic_orbit": "analysis.orbits",
-    "continuation": "analysis.arclength",
-    "Event": "analysis.branch_events",
-    "open_branch": "analysis.branch",
-    "save_branch": "analysis.branch",
-    "lyapunov_spectrum": "analysis.lyapunov",
-    "max_lyapunov": "analysis.lyapunov",
-    "periodic_orbits": "analysis.orbit_batch",
+    "PeriodicOrbit": "dynamics.orbits",
+    "periodic_orbit": "dynamics.orbits",
+    "continuation": "dynamics.arclength",
+    "Event": "dynamics.branch_events",
+    "open_branch": "dynamics.branch",
+    "save_branch": "dynamics.branch",
+    "lyapunov_spectrum": "dynamics.lyapunov",
+    "max_lyapunov": "dynamics.lyapunov",
+    "periodic_orbits": "dynamics.orbit_batch",
     "attractors": "dynamics.coexistence",
 }
 

@@ -8,14 +8,14 @@ import math
 import numpy as np
 
 import gearchaos as gc
-from gearchaos.analysis.modal import mass_stiffness
+from gearchaos.model.modal import mass_stiffness
 
 
 def damping_trace(gs: gc.GearSet) -> float:
     """−tr(M⁻¹C)/ω_n: the sum of the Lyapunov exponents per unit τ (MODEL.md §10.7).
 
     C is built from MODEL.md §4 along the lines of action, like K in
-    :func:`~gearchaos.analysis.modal.mass_stiffness`:
+    :func:`~gearchaos.model.modal.mass_stiffness`:
     C = c_sp Σ a_i a_iᵀ + c_rp Σ r_i r_iᵀ + c_s (e_x e_xᵀ + e_y e_yᵀ) in the physical
     coordinates (x_s, y_s, u_s, u_1..u_N, u_c). The rigid rotation is undamped (C has it as a
     null vector), so the minimal coordinates of the model carry the whole trace.

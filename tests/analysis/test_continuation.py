@@ -26,9 +26,9 @@ import numpy as np
 import pytest
 
 import gearchaos as gc
-from gearchaos.analysis.arclength import parse_vary
-from gearchaos.analysis.branch_events import Event, events
 from gearchaos.analysis.periodicity import periods_of
+from gearchaos.dynamics.arclength import parse_vary
+from gearchaos.dynamics.branch_events import Event, events
 
 TIGHT = {"rtol": 1e-10, "atol": 1e-12}
 
@@ -211,7 +211,7 @@ def test_branch_dataset_layout_and_provenance(planetary_branch) -> None:
 
 @pytest.mark.parametrize("suffix", [".nc", ".zarr"])
 def test_branch_files_round_trip(planetary_branch, tmp_path, suffix) -> None:
-    from gearchaos.analysis.branch import open_branch, save_branch
+    from gearchaos.dynamics.branch import open_branch, save_branch
 
     ds = planetary_branch
     path = tmp_path / f"branch{suffix}"
@@ -333,7 +333,7 @@ def test_neimark_sacker_of_the_duffing_oscillator_where_the_damping_vanishes() -
 def test_branch_summary_is_json_and_segments_cover_the_branch(planetary_branch) -> None:
     import json
 
-    from gearchaos.analysis.branch import branch_summary
+    from gearchaos.dynamics.branch import branch_summary
 
     summary = branch_summary(planetary_branch)
     json.dumps(summary)

@@ -9,7 +9,7 @@ import math
 import pytest
 
 import gearchaos as gc
-from gearchaos.analysis.derived import gearset_info
+from gearchaos.model.derived import gearset_info
 
 # MODEL.md §9 table values of the hindawi2021 preset.
 N = 5

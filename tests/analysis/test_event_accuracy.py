@@ -23,9 +23,9 @@ import pytest
 from typer.testing import CliRunner
 
 import gearchaos as gc
-from gearchaos.analysis.branch import branch_summary, open_branch
-from gearchaos.analysis.branch_events import events
 from gearchaos.cli import app
+from gearchaos.dynamics.branch import branch_summary, open_branch
+from gearchaos.dynamics.branch_events import events
 
 ZETA = 0.05
 FINE = {"rtol": 1e-11, "atol": 1e-13}
@@ -74,7 +74,7 @@ def test_default_event_location_is_within_its_stated_uncertainty(vary, kind, tmp
 def test_files_without_uncertainty_still_read(tmp_path) -> None:
     path = tmp_path / "old.nc"
     ds = gc.continuation(backlash(), "omega=0.6:0.72", max_step=0.005)
-    gc.analysis.branch.save_branch(ds.drop_vars("event_uncertainty"), path)
+    gc.dynamics.branch.save_branch(ds.drop_vars("event_uncertainty"), path)
     (graze,) = events(open_branch(path))
     assert math.isnan(graze.uncertainty)
     assert branch_summary(open_branch(path))["events"][0]["uncertainty"] is None

@@ -28,7 +28,7 @@ from gear_reference import damping_trace
 
 import gearchaos as gc
 from gearchaos.analysis.contact import contact_regimes
-from gearchaos.analysis.lyapunov import lyapunov_spectrum, max_lyapunov
+from gearchaos.dynamics.lyapunov import lyapunov_spectrum, max_lyapunov
 
 LORENZ_LLE = 0.9056  # Sprott (2003), Chaos and Time-Series Analysis, Table A.1
 

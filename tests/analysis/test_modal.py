@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import gearchaos as gc
-from gearchaos.analysis.modal import Mode, mass_stiffness, modes_table, natural_frequencies
+from gearchaos.model.modal import Mode, mass_stiffness, modes_table, natural_frequencies
 
 RTOL = 1e-9
 

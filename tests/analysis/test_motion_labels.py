@@ -20,8 +20,8 @@ import pytest
 
 import gearchaos as gc
 from gearchaos.analysis.contact import contact_fractions, contact_regimes
-from gearchaos.analysis.lyapunov import max_lyapunov
 from gearchaos.analysis.summary import summarize
+from gearchaos.dynamics.lyapunov import max_lyapunov
 
 SAMPLES = 256  # per forcing period, for the dense time histories
 

@@ -26,7 +26,7 @@ from gear_reference import damping_trace
 from scipy.optimize import linear_sum_assignment
 
 import gearchaos as gc
-from gearchaos.analysis.orbits import PeriodicOrbit
+from gearchaos.dynamics.orbits import PeriodicOrbit
 
 TIGHT = {"rtol": 1e-12, "atol": 1e-14}
 
@@ -283,8 +283,8 @@ def test_dotted_parameters_by_params(sheng: gc.GearSet) -> None:
 def test_batched_orbits_confirm_the_points_of_a_sweep(sheng: gc.GearSet) -> None:
     """The sweep's final states (at a section time) are the guesses; the batched Newton finds
     the orbits the sweep converged to, and each is what periodic_orbit finds alone."""
-    from gearchaos.analysis.orbit_batch import periodic_orbits
     from gearchaos.analysis.periodicity import periods_of
+    from gearchaos.dynamics.orbit_batch import periodic_orbits
 
     sweep = gc.bifurcation(
         sheng, "omega=2.9:3.1:5", progress=False, transient_periods=600, periods=16

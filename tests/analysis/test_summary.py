@@ -7,7 +7,8 @@ import json
 import pytest
 
 import gearchaos as gc
-from gearchaos.analysis.summary import SUMMARY_KEYS, format_summary, motion_name, summarize
+from gearchaos.analysis.summary import SUMMARY_KEYS, motion_name, summarize
+from gearchaos.cli._render import format_summary
 
 REQUIRED = {
     "omega",

@@ -17,8 +17,8 @@ import pytest
 from typer.testing import CliRunner
 
 import gearchaos as gc
-from gearchaos.analysis.branch_events import events
 from gearchaos.cli import app
+from gearchaos.dynamics.branch_events import events
 
 TIGHT = {"rtol": 1e-10, "atol": 1e-12}
 
@@ -154,7 +154,7 @@ def test_plot_draws_a_branch_file_on_its_own(files, tmp_path) -> None:
 
 def test_plot_draws_several_branch_files_apart(files, tmp_path) -> None:
     _, branch, _ = files
-    from gearchaos.analysis import open_branch
+    from gearchaos.dynamics import open_branch
 
     system = gc.backlash_oscillator(1.0, zeta=0.05, f_alt=0.1, f_mean=0.1)
     (event,) = [e for e in events(open_branch(branch)) if e.kind == "period_doubling"]

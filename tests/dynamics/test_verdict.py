@@ -14,9 +14,14 @@ import numpy as np
 import pytest
 
 import gearchaos as gc
-from gearchaos.analysis import periodic_orbit, periodic_orbits
-from gearchaos.analysis.lyapunov import exponent_estimate, lyapunov_spectrum
-from gearchaos.dynamics import EVIDENCE, VerdictSettings, decide_motion
+from gearchaos.dynamics import (
+    EVIDENCE,
+    VerdictSettings,
+    decide_motion,
+    periodic_orbit,
+    periodic_orbits,
+)
+from gearchaos.dynamics.lyapunov import exponent_estimate, lyapunov_spectrum
 from gearchaos.dynamics.point import analyse_point, point_verdict
 from gearchaos.integrate.settings import SolverSettings
 from gearchaos.integrate.simulate import integrate

@@ -35,7 +35,7 @@ from hypothesis import strategies as st
 from test_fuzz_gearset import BASE, culprits, invalid_values
 
 import gearchaos as gc
-from gearchaos.analysis.lyapunov import lyapunov_spectrum, max_lyapunov
+from gearchaos.dynamics.lyapunov import lyapunov_spectrum, max_lyapunov
 from gearchaos.dynamics.point import analyse_point
 from gearchaos.gearset.schema import ALIASES, FIELDS
 from gearchaos.integrate import integrate, integrate_batch

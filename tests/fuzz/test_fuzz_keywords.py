@@ -35,7 +35,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 import gearchaos as gc
-from gearchaos.analysis.lyapunov import lyapunov_spectrum, max_lyapunov
+from gearchaos.dynamics.lyapunov import lyapunov_spectrum, max_lyapunov
 from gearchaos.dynamics.point import analyse_point
 from gearchaos.integrate import integrate, integrate_batch
 from gearchaos.integrate.settings import SolverSettings

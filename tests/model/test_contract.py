@@ -23,7 +23,7 @@ import numpy as np
 import pytest
 
 import gearchaos as gc
-from gearchaos.analysis.shooting import shoot
+from gearchaos.dynamics.shooting import shoot
 from gearchaos.integrate.settings import SolverSettings
 from gearchaos.integrate.simulate import integrate
 from gearchaos.model import System

@@ -15,8 +15,8 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 import gearchaos as gc
-from gearchaos.analysis.derived import gearset_info
 from gearchaos.errors import ParameterError
+from gearchaos.model.derived import gearset_info
 from gearchaos.plot import (
     axis_label,
     bifurcation,

@@ -10,10 +10,10 @@ import pytest
 import xarray as xr
 
 import gearchaos as gc
-from gearchaos.analysis import save_branch
 from gearchaos.analysis.classify import classify_motion
-from gearchaos.analysis.modal import natural_frequencies
+from gearchaos.dynamics import save_branch
 from gearchaos.errors import ParameterError
+from gearchaos.model.modal import natural_frequencies
 from gearchaos.sweep.store import SweepStore
 
 OSC = gc.backlash_oscillator(1.0, zeta=0.05, b=1.0, f_mean=0.1, f_alt=0.2)

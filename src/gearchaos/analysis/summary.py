@@ -3,7 +3,7 @@
 :func:`summarize` condenses a :class:`~gearchaos.SimulationResult` into the numbers a reader
 wants first: where it ran (Ω, ω_n, sun speed), what motion it found (distinct Poincaré points of
 (X̄_sp1, X̄'_sp1), named 1T, 2T, … or ``many``), the contact regime of every mesh and whether the
-integration succeeded. :func:`format_summary` renders it as a :class:`rich.table.Table`.
+integration succeeded (the command line renders it as a table).
 """
 
 from __future__ import annotations
@@ -17,10 +17,9 @@ from ..errors import ParameterError
 from ..model.response import response_quantities
 from .classify import classify_motion
 from .contact import contact_regimes, separation_fraction
-from .lyapunov import format_exponent
 from .poincare import count_distinct, section_points, section_variables
 
-__all__ = ["SUMMARY_KEYS", "format_summary", "motion_name", "summarize"]
+__all__ = ["SUMMARY_KEYS", "format_exponent", "motion_name", "summarize"]
 
 #: Keys every summary of a planetary result has (in this order); extras follow them.
 SUMMARY_KEYS = (
@@ -73,7 +72,7 @@ def summarize(
         Passed to :func:`~gearchaos.analysis.poincare.count_distinct`.
     lle
         Largest Lyapunov exponent of the run (per unit τ), if computed
-        (:func:`~gearchaos.analysis.lyapunov.max_lyapunov`); it decides quasi-periodic vs
+        (:func:`~gearchaos.dynamics.lyapunov.max_lyapunov`); it decides quasi-periodic vs
         chaotic motion, confirmed by the 0–1 test and the spectrum. Ignored with ``verdict``.
     verdict
         The motion verdict's fields (:meth:`gearchaos.dynamics.verdict.Verdict.to_dict`):
@@ -188,72 +187,13 @@ def summarize(
     return out
 
 
-def _fmt(v: Any) -> str:
-    if v is None:
+def format_exponent(value: float | None, error: float | None) -> str:
+    """``0.0412 ± 0.0031``, ``-0.0125 (exact)`` for error 0 (from Floquet multipliers), the
+    value alone when the error is unknown, ``—`` without a value."""
+    if value is None or not math.isfinite(value):
         return "—"
-    if isinstance(v, float):
-        return f"{v:.6g}"
-    return str(v)
-
-
-def format_summary(summary: dict[str, Any], *, title: str | None = None) -> Any:
-    """A :class:`rich.table.Table` of a summary from :func:`summarize` (for the CLI)."""
-    from rich.markup import escape
-    from rich.table import Table
-
-    if title is None:
-        gs = summary.get("gearset")
-        title = f"gearchaos simulation{f' of {gs}' if gs else ''}"
-    table = Table(title=title, show_header=True, header_style="bold")
-    table.add_column("quantity")
-    table.add_column("value", justify="right")
-    labels = {
-        "omega": "Ω = ω/ω_n",
-        "omega_n_rad_s": "ω_n [rad/s]",
-        "mesh_frequency_hz": "mesh frequency [Hz]",
-        "sun_speed_rpm": "sun speed [rpm]",
-        "distinct_section_points": "distinct section points",
-        "motion": "motion",
-        "evidence": "decided by",
-        "max_multiplier": "max |μ| (Floquet)",
-        "lle": "λ₁ [1/τ]",
-        "extra_periods": "periods added to finish the transient",
-        "x_sp1_section_min": "X̄_sp1 section min",
-        "x_sp1_section_max": "X̄_sp1 section max",
-        "load_factor_sp_max": "load factor sun–planet (max)",
-        "load_factor_rp_max": "load factor planet–ring (max)",
-        "dte_sp1_rms": "DTE RMS sun–planet 1 [b_c]",
-        "status": "status",
-        "steps_accepted": "steps accepted",
-        "steps_rejected": "steps rejected",
-    }
-    var = summary.get("section_variable")
-    if var is not None and var != "delta_sp_1":  # another model: its own section variable
-        labels["x_sp1_section_min"] = f"{var} section min"
-        labels["x_sp1_section_max"] = f"{var} section max"
-    optional = {
-        "omega_n_rad_s", "mesh_frequency_hz", "sun_speed_rpm", "load_factor_sp_max",
-        "load_factor_rp_max", "dte_sp1_rms",
-    }  # fmt: skip
-    for key, label in labels.items():
-        if key in summary:
-            value = summary[key]
-            if value is None and key in optional and summary.get("gearset") is None:
-                continue  # quantities of a gear set, absent for other models
-            recorded = summary.get("recorded_section_points")
-            if key == "distinct_section_points" and recorded:
-                value = f"{int(value)} of {int(recorded)}"
-            if key == "lle" and value is not None:
-                value = format_exponent(value, summary.get("lle_error"))
-            if key in ("max_multiplier", "extra_periods") and not value:
-                continue
-            if key in ("evidence", "lle") and summary.get("evidence", "record") == "record":
-                continue
-            table.add_row(escape(label), escape(_fmt(value)))
-    style = {"none": "green", "single_sided": "yellow", "double_sided": "red"}
-    for c in summary.get("contact", []):
-        regime = c["regime"]
-        table.add_row(
-            escape(f"contact {c['mesh']}"), f"[{style.get(regime, 'white')}]{escape(regime)}[/]"
-        )
-    return table
+    if error is None or not math.isfinite(error):
+        return f"{value:.4g}"
+    if error == 0:
+        return f"{value:.4g} (exact)"
+    return f"{value:.4g} ± {error:.2g}"

@@ -13,6 +13,7 @@ from rich.markup import escape
 from rich.table import Table
 from rich.text import Text
 
+from ..analysis.summary import format_exponent
 from ..gearset.mapping import flatten
 from ..gearset.schema import display_symbol as symbol
 
@@ -220,7 +221,7 @@ def regime_table(table: Mapping[str, Mapping[str, float]], *, title: str | None)
 
 def add_motion_rows(table: Table, summary: Mapping[str, Any]) -> None:
     """The evidence behind a summary's motion label as rows of its table (λ₁ and the
-    multiplier are rows of :func:`~gearchaos.analysis.summary.format_summary`)."""
+    multiplier are rows of :func:`format_summary`)."""
     lle = summary.get("lle")
     k01 = summary.get("k01")
     if summary.get("evidence", "record") == "record":
@@ -239,7 +240,6 @@ def add_motion_rows(table: Table, summary: Mapping[str, Any]) -> None:
 def gallery_rows_table(rows: Sequence[Mapping[str, Any]], param: str, *, title: str) -> Table:
     """One row per value: value, motion (in its palette colour), what decided it, max |μ|,
     λ₁ ± its error, K, agree, points."""
-    from ..analysis.lyapunov import format_exponent
     from ..plot.regimes import regime_colour
 
     table = Table(title=escape(title), title_justify="left")
@@ -285,4 +285,73 @@ def sweep_table(title: str, res: Any, summary: Mapping[str, Any]) -> Table:
     table.add_row("points", str(summary["points"]))
     failed = summary["failed"]
     table.add_row("failed", Text(str(failed), style="bold red" if failed else ""))
+    return table
+
+
+def _fmt(v: Any) -> str:
+    if v is None:
+        return "—"
+    if isinstance(v, float):
+        return f"{v:.6g}"
+    return str(v)
+
+
+def format_summary(summary: dict[str, Any], *, title: str | None = None) -> Any:
+    """A :class:`rich.table.Table` of a summary from
+    :func:`~gearchaos.analysis.summary.summarize`."""
+    if title is None:
+        gs = summary.get("gearset")
+        title = f"gearchaos simulation{f' of {gs}' if gs else ''}"
+    table = Table(title=title, show_header=True, header_style="bold")
+    table.add_column("quantity")
+    table.add_column("value", justify="right")
+    labels = {
+        "omega": "Ω = ω/ω_n",
+        "omega_n_rad_s": "ω_n [rad/s]",
+        "mesh_frequency_hz": "mesh frequency [Hz]",
+        "sun_speed_rpm": "sun speed [rpm]",
+        "distinct_section_points": "distinct section points",
+        "motion": "motion",
+        "evidence": "decided by",
+        "max_multiplier": "max |μ| (Floquet)",
+        "lle": "λ₁ [1/τ]",
+        "extra_periods": "periods added to finish the transient",
+        "x_sp1_section_min": "X̄_sp1 section min",
+        "x_sp1_section_max": "X̄_sp1 section max",
+        "load_factor_sp_max": "load factor sun–planet (max)",
+        "load_factor_rp_max": "load factor planet–ring (max)",
+        "dte_sp1_rms": "DTE RMS sun–planet 1 [b_c]",
+        "status": "status",
+        "steps_accepted": "steps accepted",
+        "steps_rejected": "steps rejected",
+    }
+    var = summary.get("section_variable")
+    if var is not None and var != "delta_sp_1":  # another model: its own section variable
+        labels["x_sp1_section_min"] = f"{var} section min"
+        labels["x_sp1_section_max"] = f"{var} section max"
+    optional = {
+        "omega_n_rad_s", "mesh_frequency_hz", "sun_speed_rpm", "load_factor_sp_max",
+        "load_factor_rp_max", "dte_sp1_rms",
+    }  # fmt: skip
+    for key, label in labels.items():
+        if key in summary:
+            value = summary[key]
+            if value is None and key in optional and summary.get("gearset") is None:
+                continue  # quantities of a gear set, absent for other models
+            recorded = summary.get("recorded_section_points")
+            if key == "distinct_section_points" and recorded:
+                value = f"{int(value)} of {int(recorded)}"
+            if key == "lle" and value is not None:
+                value = format_exponent(value, summary.get("lle_error"))
+            if key in ("max_multiplier", "extra_periods") and not value:
+                continue
+            if key in ("evidence", "lle") and summary.get("evidence", "record") == "record":
+                continue
+            table.add_row(escape(label), escape(_fmt(value)))
+    style = {"none": "green", "single_sided": "yellow", "double_sided": "red"}
+    for c in summary.get("contact", []):
+        regime = c["regime"]
+        table.add_row(
+            escape(f"contact {c['mesh']}"), f"[{style.get(regime, 'white')}]{escape(regime)}[/]"
+        )
     return table

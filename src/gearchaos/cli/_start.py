@@ -74,13 +74,13 @@ def load_start(path: str, at: str | None) -> Start:
 
     if os.path.isdir(path) and is_sweep_store(path):
         return _from_store(path, where)
-    from ..analysis.branch import open_branch
+    from ..dynamics.branch import open_branch
 
     try:
         return _from_branch(path, open_branch(path), where)
     except StoreError:
         pass
-    from ..analysis.orbit_file import open_orbit
+    from ..dynamics.orbit_file import open_orbit
 
     try:
         ds = open_orbit(path)

@@ -29,7 +29,7 @@ def info(
     with c.reported_errors():
         omega, changes = c.parse_sets(set_ or [])
         gs = c.load_gearset(preset, gearset, changes)
-        from ..analysis.derived import gearset_info
+        from ..model.derived import gearset_info
 
         data = dict(gearset_info(gs))
         if omega is not None:

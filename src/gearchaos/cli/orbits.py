@@ -13,8 +13,8 @@ from rich.markup import escape
 from rich.table import Table
 from rich.text import Text
 
-from ..analysis.orbits import ORBIT_SETTINGS
 from ..dynamics.coexistence import ATTRACTOR_SETTINGS
+from ..dynamics.orbits import ORBIT_SETTINGS
 from ..errors import IntegrationError, ParameterError
 from . import _common as c
 from ._render import pairs_table
@@ -145,7 +145,7 @@ def orbit(
 
     Example: **gearchaos orbit --set omega=1.5 --period 1**
     """
-    from ..analysis.orbits import periodic_orbit
+    from ..dynamics.orbits import periodic_orbit
 
     with c.reported_errors():
         gs, values, start = _start_values(from_, at, preset, gearset, set_ or [], model)
@@ -252,8 +252,8 @@ def continue_(
 
     Example: **gearchaos continue --vary omega=0.2:4 --set xi=0.03 -o branch.nc**
     """
-    from ..analysis.arclength import continuation
-    from ..analysis.branch import branch_summary
+    from ..dynamics.arclength import continuation
+    from ..dynamics.branch import branch_summary
 
     with c.reported_errors():
         if not vary or "=" not in vary:
@@ -288,7 +288,7 @@ def continue_(
         period = _period(period, start)
         first = None
         if start is not None:  # the orbit at the file's point: the branch starts there
-            from ..analysis.orbits import periodic_orbit
+            from ..dynamics.orbits import periodic_orbit
 
             if name not in values:  # the start's own value of the continued parameter
                 values[name] = gs[name] if hasattr(gs, "evolve") else getattr(gs.model, name)

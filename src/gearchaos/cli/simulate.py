@@ -135,7 +135,7 @@ def simulate(
         for path in written:
             c.stderr().print(f"wrote {path}", soft_wrap=True)
         return
-    from ..analysis.summary import format_summary
+    from ._render import format_summary
 
     out = c.stdout()
     table = format_summary(summary, title=f"gearchaos simulation of {gs.name} at Ω = {omega:g}")

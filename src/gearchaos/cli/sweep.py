@@ -297,7 +297,7 @@ def bifurcation(
 def _is_branch(path: Path) -> bool:
     """Whether ``path`` names a branch file of `gearchaos continue` (netCDF, or a Zarr branch
     with its chunk manifest) rather than a sweep store."""
-    from ..analysis.branch import MANIFEST
+    from ..dynamics.branch import MANIFEST
 
     if path.suffix.lower() in (".nc", ".nc4", ".h5"):
         return True
@@ -384,7 +384,7 @@ def plot(
         import matplotlib
 
         matplotlib.use("Agg")
-        from ..analysis.branch import open_branch
+        from ..dynamics.branch import open_branch
         from ..plot import savefig, sweep_figure
 
         if all(_is_branch(p) for p in stores):

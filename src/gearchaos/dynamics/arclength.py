@@ -11,7 +11,7 @@ tangent t_k the predictor is z_k + Δs t_k and the corrector solves, by Newton's
     G(y, λ) = 0,    ⟨t_k, z − z_k − Δs t_k⟩_W = 0
 
 (Keller's pseudo-arclength; the second equation fixes the position along the branch, so folds
-are passed), by the quasi-Newton corrector of :mod:`gearchaos.analysis.shooting` with the
+are passed), by the quasi-Newton corrector of :mod:`gearchaos.dynamics.shooting` with the
 bordered Jacobian [[M − I, G_λ], [W t_kᵀ]]: M = DPⁿ from the variational equations, G_λ by a
 forward difference (two chains of one compiled call), both started from the previous point's,
 extrapolated along the branch. The next tangent solves [[M − I, G_λ], [W t_kᵀ]] t = (0, 1)
@@ -21,14 +21,14 @@ arclength in units of the parameter: a state change of the size of the state cou
 whole range. The step grows after corrector solves of ≤ 3 Newton steps, shrinks after ≥ 6,
 and halves after a failure, down to ``min_step`` where the continuation stops with the reason.
 
-Between consecutive points the test functions of :mod:`gearchaos.analysis.branch_events` detect
+Between consecutive points the test functions of :mod:`gearchaos.dynamics.branch_events` detect
 folds, branch points, period doublings, Neimark–Sacker and grazing events; each is located by
 the Illinois iteration on the arclength, every trial point corrected onto the branch. A branch
 started at a period-doubling event (``start=event``) is the period-2n branch, so cascades can
 be followed; at a branch point the same switch starts the other branch.
 
 Every map evaluation is one compiled :func:`~gearchaos.integrate._chains.run_chains` call
-(:func:`~gearchaos.analysis.shooting.shoot`).
+(:func:`~gearchaos.dynamics.shooting.shoot`).
 """
 
 from __future__ import annotations
@@ -315,7 +315,7 @@ class _Branch:
     # -- events -------------------------------------------------------------------------
     def detect(self, p: Solution, q: Solution, index: int) -> None:
         """Find, locate and record the events between consecutive points p and q
-        (:func:`gearchaos.analysis.branch_locate.detect`)."""
+        (:func:`gearchaos.dynamics.branch_locate.detect`)."""
         self.found.extend(detect(self, p, q, index))
 
 
@@ -356,9 +356,9 @@ def continuation(
         n, in forcing periods (default 1, or what ``start`` implies).
     start
         ``None`` (the orbit at START from a simulation of ``transient_periods``, as
-        :func:`~gearchaos.analysis.orbits.periodic_orbit`), a state (the Newton guess at
-        START), a :class:`~gearchaos.analysis.orbits.PeriodicOrbit` (its state, at its Ω or
-        its value of the parameter), or an :class:`~gearchaos.analysis.Event` of
+        :func:`~gearchaos.dynamics.orbits.periodic_orbit`), a state (the Newton guess at
+        START), a :class:`~gearchaos.dynamics.orbits.PeriodicOrbit` (its state, at its Ω or
+        its value of the parameter), or an :class:`~gearchaos.dynamics.Event` of
         kind ``period_doubling`` (start the period-2n branch there) or ``branch_point``
         (the other branch, same n), with the target, fixed values and settings of the
         branch it was found on.
@@ -378,7 +378,7 @@ def continuation(
         relative size ``tol``, what the corrector resolves, counts as that much arclength).
         Every event reports its location uncertainty in the parameter (the final bracket
         and the integrator's error of its test function, see
-        :mod:`gearchaos.analysis.branch_locate`).
+        :mod:`gearchaos.dynamics.branch_locate`).
     grid
         Parameter values to land on: every time the branch passes one, a branch point is
         computed exactly there (flagged ``on_grid``), e.g. a sweep's grid, to compare
@@ -396,7 +396,7 @@ def continuation(
         point ``orbit_state``, multipliers, ``stable``, ``residual``, ``iterations``,
         section values, extrema and contact regimes; dimension ``event`` with the located
         events; attributes with the stop reason and provenance
-        (see :func:`gearchaos.analysis.branch.branch_dataset`).
+        (see :func:`gearchaos.dynamics.branch.branch_dataset`).
     """
     from .branch import branch_dataset, check_observe, check_store, save_branch
 

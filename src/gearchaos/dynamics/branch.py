@@ -25,7 +25,7 @@ events
     before it), ``event_arclength``, ``event_multiplier_re``, ``event_multiplier_im``,
     ``event_state`` (event, state), ``event_vector`` (event, state), ``event_detail``,
     ``event_located`` (int8), ``event_uncertainty`` (the location uncertainty in the
-    parameter, :mod:`gearchaos.analysis.branch_locate`).
+    parameter, :mod:`gearchaos.dynamics.branch_locate`).
 attributes
     ``parameter``, ``period``, ``range_start``, ``range_stop``, ``vary``, ``fixed`` (JSON of the
     fixed values), ``stop_reason``, ``start`` (how the branch started), ``tol``, the step

@@ -24,7 +24,7 @@ kind                   test function                               meaning
 
 Each sign change is located by the Illinois (modified regula falsi) iteration on the arclength
 between the two points, every trial point corrected onto the branch
-(:mod:`gearchaos.analysis.branch_locate` does that), to a tolerance in arclength; every event
+(:mod:`gearchaos.dynamics.branch_locate` does that), to a tolerance in arclength; every event
 carries its location uncertainty in the parameter.
 Grazing makes the stroboscopic map only C¹, so the multipliers may change steeply (not
 smoothly) across a grazing event; a multiplier test that changes sign in the same step as a
@@ -91,7 +91,7 @@ class Event:
     uncertainty
         The location uncertainty in the parameter: the final bracket's half-width and the
         shift the integrator's error of the test function causes
-        (:mod:`gearchaos.analysis.branch_locate`); NaN for branch files written before it was
+        (:mod:`gearchaos.dynamics.branch_locate`); NaN for branch files written before it was
         stored.
     values
         The branch's fixed numeric parameter values by dotted name (its store's ``fixed``).
@@ -284,7 +284,7 @@ def illinois(
 # ------------------------------------------------------------------------------ reading
 def events(ds: Any) -> list[Event]:
     """The events of a continuation dataset (or of a file opened with
-    :func:`gearchaos.analysis.open_branch`) as :class:`Event` objects, in the
+    :func:`gearchaos.dynamics.open_branch`) as :class:`Event` objects, in the
     order of the ``event`` dimension."""
     if "event" not in ds.dims:
         return []

@@ -1,6 +1,6 @@
 """Finding and locating the events between two consecutive points of a continued branch.
 
-The test functions of :mod:`gearchaos.analysis.branch_events` are compared at the two points;
+The test functions of :mod:`gearchaos.dynamics.branch_events` are compared at the two points;
 every sign change is located by the Illinois iteration on the arclength σ from the first point,
 each trial point corrected onto the branch, until the bracket is shorter than the event
 tolerance (default: range × the corrector's residual tolerance — a state change of that
@@ -97,7 +97,7 @@ def locate(
     fb: float,
     detail: str,
 ) -> dict[str, Any]:
-    """The fields of the :class:`~gearchaos.analysis.branch_events.Event` where ``fn``
+    """The fields of the :class:`~gearchaos.dynamics.branch_events.Event` where ``fn``
     (the test function of a corrected point) changes sign between p and q."""
     assert p.tangent is not None and q.tangent is not None
     span = q.s - p.s  # q's coordinate along p's tangent

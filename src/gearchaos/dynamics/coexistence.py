@@ -20,7 +20,7 @@ distinct attractors:
 * a periodic and a non-periodic run are never the same.
 
 Each periodic attractor is confirmed by shooting its period-n orbit from the run's final state
-(:func:`~gearchaos.analysis.orbit_batch.periodic_orbits`), which gives its Floquet multipliers.
+(:func:`~gearchaos.dynamics.orbit_batch.periodic_orbits`), which gives its Floquet multipliers.
 """
 
 from __future__ import annotations
@@ -34,11 +34,11 @@ from typing import Any
 import numpy as np
 
 from .._checks import check_int, check_real
-from ..analysis.orbits import PeriodicOrbit, split_values
 from ..integrate._chains import ChainRun, run_chains
 from ..integrate.settings import SolverSettings
 from ..model.target import resolve
 from .evidence import Verdict
+from .orbits import PeriodicOrbit, split_values
 from .verdict import decide_motion
 
 __all__ = ["ATTRACTOR_SETTINGS", "Attractor", "attractors"]
@@ -106,7 +106,7 @@ class Attractor:
 
     def section(self, name: str, planets: Any = None) -> np.ndarray:
         """The section values of a state or observable of the first run by name (as
-        :meth:`~gearchaos.analysis.orbits.PeriodicOrbit.section`)."""
+        :meth:`~gearchaos.dynamics.orbits.PeriodicOrbit.section`)."""
         ob = self.system.observable(name, planets)
         return np.asarray(ob.take(self.section_states, self.sections))
 
@@ -202,7 +202,7 @@ def attractors(
     settings, params, **values_and_settings
         Parameter values by name (``omega=1.5``; dotted names in ``params``) and solver
         settings (``transient_periods`` (200), ``periods`` (100), ``rtol``, ``atol`` …), as
-        for :func:`~gearchaos.analysis.orbits.periodic_orbit`.
+        for :func:`~gearchaos.dynamics.orbits.periodic_orbit`.
     tol
         Two periodic runs are one attractor when their section states agree to ``tol``
         (scaled per component by max(1, spread)).
@@ -217,7 +217,7 @@ def attractors(
         them. Periodic ones carry their shot orbit (multipliers, stability); every one carries
         λ₁ (> 0 for chaos, < 0 for a stable orbit: ln max|μ| / nT).
     """
-    from ..analysis.orbit_batch import periodic_orbits
+    from .orbit_batch import periodic_orbits
 
     k = check_int("starts", starts, lo=1, hi=10_000)
     check_int("seed", seed, lo=0)

@@ -83,7 +83,7 @@ class Verdict:
 
     def lle_text(self) -> str:
         """λ₁ with its error as printed next to the label (``(exact)`` for Floquet)."""
-        from ..analysis.lyapunov import format_exponent
+        from ..analysis.summary import format_exponent
 
         return format_exponent(self.lle, self.lle_error)
 

@@ -11,11 +11,11 @@ from typing import Any
 
 import numpy as np
 
-from ..analysis.lyapunov import random_tangents
-from ..analysis.shooting import section_fraction
 from ..integrate._chains import ChainRun, run_chains
 from ..integrate.settings import SampleTimes, SolverSettings
 from ..model.system import System
+from .lyapunov import random_tangents
+from .shooting import section_fraction
 
 __all__ = ["RECORD_SOURCES", "VerdictRecord", "extend"]
 

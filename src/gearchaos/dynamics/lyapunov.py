@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from .._checks import check_int
+from ..analysis.summary import format_exponent
 from ..errors import ParameterError, Status
 from ..gearset import GearSet
 from ..integrate.settings import MAX_SAMPLES_PER_PERIOD, SolverSettings
@@ -143,7 +144,7 @@ def lyapunov_spectrum(
         :class:`~gearchaos.model.System`; its forcing period T = 2π/Ω sets the
         renormalisation interval T / ``renormalizations_per_period``.
     settings, params, **values_and_settings
-        Parameter values by name, as for :func:`~gearchaos.analysis.orbits.periodic_orbit`
+        Parameter values by name, as for :func:`~gearchaos.dynamics.orbits.periodic_orbit`
         (``omega=1.7``, ``xi=0.05``; dotted names in ``params={"backlash.sun_planet": 2}``),
         and :class:`~gearchaos.integrate.settings.SolverSettings` (default: 100 transient
         periods, 500 periods averaged over) and/or its fields by name: ``transient_periods``,
@@ -228,18 +229,6 @@ def lyapunov_spectrum(
         steps_rejected=traj.steps_rejected,
         largest_error=err,
     )
-
-
-def format_exponent(value: float | None, error: float | None) -> str:
-    """``0.0412 ± 0.0031``, ``-0.0125 (exact)`` for error 0 (from Floquet multipliers), the
-    value alone when the error is unknown, ``—`` without a value."""
-    if value is None or not math.isfinite(value):
-        return "—"
-    if error is None or not math.isfinite(error):
-        return f"{value:.4g}"
-    if error == 0:
-        return f"{value:.4g} (exact)"
-    return f"{value:.4g} ± {error:.2g}"
 
 
 def max_lyapunov(system: Any, **kwargs: object) -> float:

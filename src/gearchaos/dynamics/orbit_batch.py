@@ -3,7 +3,7 @@
 For K parameter points (e.g. the points of a sweep labelled nT, with the sweep's final states
 as guesses) Newton's method on Pⁿ(y) − y = 0 runs for all points together: every iteration
 evaluates the map of every unconverged point with tangents (for M) and without (for G, the map
-simulations and sweeps integrate) in two :func:`~gearchaos.analysis.shooting.shoot` calls of
+simulations and sweeps integrate) in two :func:`~gearchaos.dynamics.shooting.shoot` calls of
 K chains each, which run in parallel over the cores. A point whose ‖G‖ does not fall takes
 half its previous step instead; a point converges when the residual and the Newton
 correction are below ``tol`` (or the correction no longer lowers ‖G‖ below the tolerance: the
@@ -79,7 +79,7 @@ def periodic_orbits(
     guesses
         (K, n_state) Newton starts (a sweep's ``final_state`` at the same section: the same
         ``transient_periods`` fraction and ``section_phase``), or None: simulations from rest
-        of ``transient_periods`` (default 50) as :func:`~gearchaos.analysis.orbits.periodic_orbit`.
+        of ``transient_periods`` (default 50) as :func:`~gearchaos.dynamics.orbits.periodic_orbit`.
     settings
         Solver settings (tolerances, section phase, guess transient).
     tol

@@ -1,7 +1,7 @@
-"""Orbit files: a :class:`~gearchaos.analysis.orbits.PeriodicOrbit` written to netCDF-4 and read
+"""Orbit files: a :class:`~gearchaos.dynamics.orbits.PeriodicOrbit` written to netCDF-4 and read
 back (``gearchaos orbit -o ORBIT.nc``, then ``gearchaos continue --from ORBIT.nc``).
 
-The file is :meth:`PeriodicOrbit.to_dataset <gearchaos.analysis.orbits.PeriodicOrbit.to_dataset>`:
+The file is :meth:`PeriodicOrbit.to_dataset <gearchaos.dynamics.orbits.PeriodicOrbit.to_dataset>`:
 the orbit state at the section, its multipliers and monodromy, the section values, and the
 provenance a new start needs (gear set TOML with the values applied, ``omega``, every
 ``parameter:NAME`` value, the solver settings, the package version).

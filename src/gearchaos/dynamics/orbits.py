@@ -7,7 +7,7 @@ fixed point of the n-th iterate,
     G(y) = Pⁿ(y) − y = 0,
 
 solved by Newton's method with a backtracking (damped) step
-(:func:`gearchaos.analysis.shooting.correct`). The Jacobian is the monodromy
+(:func:`gearchaos.dynamics.shooting.correct`). The Jacobian is the monodromy
 matrix M = DPⁿ(y) = Φ_{n−1} ⋯ Φ_1 Φ_0, the product of the one-period fundamental solutions
 Φ_k = ∂y(τ_s + (k+1)T)/∂y(τ_s + kT) of the variational equations V' = J(τ, y) V that the
 compiled kernel integrates with the orbit (the tangent vectors start as the identity at each
@@ -21,7 +21,7 @@ The eigenvalues μ of M are the Floquet multipliers: the orbit is asymptotically
 tr J = −tr(M⁻¹C).
 
 Two levels (STYLE principle 8): :func:`periodic_orbit` for users;
-:mod:`gearchaos.analysis.shooting` (C shootings in one compiled
+:mod:`gearchaos.dynamics.shooting` (C shootings in one compiled
 :func:`~gearchaos.integrate._chains.run_chains` call, and the corrector) for the continuation.
 """
 
@@ -36,12 +36,12 @@ import numpy as np
 
 from .._checks import check_int, check_real
 from .._version import provenance
+from ..analysis.contact import contact_regime
 from ..errors import IntegrationError, ParameterError, Status
 from ..integrate.settings import SolverSettings, split_keywords
 from ..model.contract import model_reference
 from ..model.system import System
 from ..model.target import resolve, scale_attrs
-from .contact import contact_regime
 from .shooting import Problem, Solution, correct, section_time
 
 __all__ = [
@@ -222,7 +222,7 @@ class PeriodicOrbit:
 
     def save(self, path: Any) -> str:
         """Write the orbit to a netCDF-4 orbit file, the start ``gearchaos continue --from``
-        reads (:func:`~gearchaos.analysis.orbit_file.save_orbit`); returns the path."""
+        reads (:func:`~gearchaos.dynamics.orbit_file.save_orbit`); returns the path."""
         from .orbit_file import save_orbit
 
         return save_orbit(self, path)

@@ -20,8 +20,6 @@ from typing import Any
 import numpy as np
 
 from .._checks import check_bool
-from ..analysis.lyapunov import lyapunov_spectrum
-from ..analysis.shooting import section_fraction
 from ..analysis.summary import summarize
 from ..errors import Status
 from ..integrate.result import SimulationResult
@@ -29,6 +27,8 @@ from ..integrate.settings import SIMULATION, SolverSettings
 from ..integrate.simulate import run_simulation
 from ..model.target import resolve
 from .evidence import Verdict
+from .lyapunov import lyapunov_spectrum
+from .shooting import section_fraction
 from .verdict import VerdictSettings, decide_motion
 
 __all__ = ["PointAnalysis", "analyse_point", "point_verdict"]

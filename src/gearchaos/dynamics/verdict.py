@@ -10,7 +10,7 @@ asks them, for K points at once (a sweep task, or one point):
    A sequence that does not repeat but whose recurrence gaps ‖x_{k+n} − x_k‖ decay
    geometrically (a transient still converging) gives the candidate n of the fastest decay.
 2. **Confirmation by shooting.** Newton on Pⁿ(y) − y = 0 from the final state
-   (:func:`~gearchaos.analysis.orbit_batch.periodic_orbits`, every point of one n in one batch).
+   (:func:`~gearchaos.dynamics.orbit_batch.periodic_orbits`, every point of one n in one batch).
    The label nT stands when Newton converged, the orbit is the record's (its section points
    lie within ``same_orbit`` of the final state, or the record was converging), its minimal
    period d (the label is then dT) and every Floquet multiplier |μ| < 1 − ``margin``. Its
@@ -19,7 +19,7 @@ asks them, for K points at once (a sweep task, or one point):
 3. **Extension with a Lyapunov exponent.** Every point not yet decided is integrated further,
    ``extension_periods`` at a time, with one tangent vector from a seeded random start; λ₁
    and its standard error σ come from block means
-   (:func:`~gearchaos.analysis.lyapunov.exponent_estimate`). The new record goes back to
+   (:func:`~gearchaos.dynamics.lyapunov.exponent_estimate`). The new record goes back to
    step 1 (a transient may now have finished). Without a confirmed period, with θ = c_θ/t
    the finite-time bias bound of a regular attractor (t the extension's duration,
    :func:`~gearchaos.analysis.classify.lle_threshold_for`) and K the 0–1 test of the
@@ -53,7 +53,6 @@ from .._checks import check_int, check_real
 from ..analysis.chaos01 import MIN_LENGTH as MIN_LENGTH_01
 from ..analysis.chaos01 import chaos01
 from ..analysis.classify import K_CHAOS, K_REGULAR, LLE_C
-from ..analysis.lyapunov import LYAPUNOV_BLOCKS, exponent_estimate
 from ..analysis.periodicity import periods_of
 from ..analysis.recurrence import (
     approaches,
@@ -67,6 +66,7 @@ from ..integrate.settings import SolverSettings
 from ..model.system import System
 from .evidence import Verdict
 from .extension import VerdictRecord, extend
+from .lyapunov import LYAPUNOV_BLOCKS, exponent_estimate
 
 __all__ = ["VerdictSettings", "decide_motion"]
 
@@ -217,7 +217,7 @@ def _shoot_candidates(
     orbit must be the record's) or ``approach`` (the record converges or lingers near an
     orbit: a full-state record must come closer to it); decide the confirmed ones in
     ``done``, and note an unstable orbit the record sits on."""
-    from ..analysis.orbit_batch import periodic_orbits
+    from .orbit_batch import periodic_orbits
 
     finish: list[int] = []  # confirmed while the record was converging: show the orbit
     for n, how in sorted({c for cs in cands.values() for c in cs}):

@@ -28,7 +28,7 @@ from bokeh.models import ColumnDataSource, HoverTool, Range1d
 from bokeh.models.annotations import Span
 from bokeh.plotting import figure
 
-from ..analysis.lyapunov import format_exponent
+from ..analysis.summary import format_exponent
 from ..errors import ParameterError
 from ..plot.regimes import REGIME_COLOURS
 from ..sweep.result import open_result

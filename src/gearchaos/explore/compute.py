@@ -3,7 +3,7 @@
 Both functions run in a worker process (the compiled kernels hold the GIL, so a thread would
 stall the web server) and return plain, picklable values: numbers, text and PNG bytes. They
 reuse the library's front doors — :func:`~gearchaos.dynamics.point.analyse_point` (simulation,
-λ₁ and the motion label), :func:`~gearchaos.analysis.orbits.periodic_orbit` (Floquet
+λ₁ and the motion label), :func:`~gearchaos.dynamics.orbits.periodic_orbit` (Floquet
 multipliers of an nT orbit), the plots of :mod:`gearchaos.plot` (phase portrait, time
 histories, spectrum with the mesh harmonics labelled) and :func:`~gearchaos.sweep.run_sweep`
 (a resumable sweep into a store).
@@ -148,7 +148,7 @@ def _period(motion: str) -> int | None:
 def _multipliers(
     target: Any, values: dict[str, float], settings: Any, n: int, guess: Any
 ) -> tuple[list[tuple[float, float]] | None, str]:
-    from ..analysis.orbits import periodic_orbit
+    from ..dynamics.orbits import periodic_orbit
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

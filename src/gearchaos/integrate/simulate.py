@@ -69,7 +69,7 @@ def integrate(
         With ``k > 0`` the variational equations of k tangent vectors ride along (orthonormal
         from the first sample, re-orthonormalised at every later one) and
         :attr:`Trajectory.tangent_log_sums` holds their accumulated log stretch factors — the
-        raw material of :func:`gearchaos.analysis.lyapunov.lyapunov_spectrum`;
+        raw material of :func:`gearchaos.dynamics.lyapunov.lyapunov_spectrum`;
         :attr:`Trajectory.tangent_log_stretch` the first vector's log stretch per sample.
     tangent_start
         (k, n) start of the tangent vectors (orthonormalised at the first sample); default the

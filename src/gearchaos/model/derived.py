@@ -13,8 +13,8 @@ import math
 from typing import Any
 
 from ..gearset import GearSet
-from ..model.planetary import nondimensionalise
 from .modal import natural_frequencies
+from .planetary import nondimensionalise
 
 __all__ = ["RESONANCE_HARMONICS", "gearset_info"]
 
@@ -54,7 +54,7 @@ def gearset_info(gs: GearSet) -> dict[str, Any]:
           equilibrium (MODEL.md §10.1);
         - ``static_deflection``: F/k_m of each mesh in metres and in units of b_c
           (``*_m`` and ``*_bar``), the elastic part of δ = b + F/k_m;
-        - ``natural_frequencies``: :func:`gearchaos.analysis.modal.modes_table` rows;
+        - ``natural_frequencies``: :func:`gearchaos.model.modal.modes_table` rows;
         - ``omega_at_resonances``: for every non-zero mode and h in
           :data:`RESONANCE_HARMONICS`, ``{"mode_ratio", "kind", "harmonic", "omega"}`` with
           Ω = ratio/h, the dimensionless mesh frequency at which h Ω meets the mode; sorted by Ω.

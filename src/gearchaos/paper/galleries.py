@@ -4,7 +4,7 @@ Sheng et al. (2016) follow the motion along a parameter path with grids of Poinc
 X̄_sp1 against X̄'_sp1 and name the motion of each map by eye. :func:`run_gallery` runs one
 simulation per value (the seed's protocol: zero initial state, the transient discarded, one
 section point per mesh period), computes the largest Lyapunov exponent of each
-(:func:`~gearchaos.analysis.lyapunov.max_lyapunov`, same settings) and labels it
+(:func:`~gearchaos.dynamics.lyapunov.max_lyapunov`, same settings) and labels it
 (:func:`~gearchaos.analysis.summarize` with that LLE: 1T … nT, QP, chaos, unresolved), then
 draws :func:`~gearchaos.plot.gallery.poincare_gallery`.
 

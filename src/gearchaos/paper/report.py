@@ -242,7 +242,7 @@ def _gallery_table(rows: Sequence[Mapping[str, Any]], param: str) -> str:
         return "—" if v is None or (isinstance(v, float) and not math.isfinite(v)) else f"{v:.3g}"
 
     def lle(r: Mapping[str, Any]) -> str:
-        from ..analysis.lyapunov import format_exponent
+        from ..analysis.summary import format_exponent
 
         return _e(format_exponent(r.get("lle"), r.get("lle_error")))
 

@@ -218,9 +218,9 @@ def follow_branches(
 
     Returns the branch datasets (:func:`gearchaos.continuation`).
     """
-    from ..analysis.arclength import continuation
-    from ..analysis.branch import open_branch
-    from ..analysis.branch_events import events
+    from ..dynamics.arclength import continuation
+    from ..dynamics.branch import open_branch
+    from ..dynamics.branch_events import events
     from ..errors import IntegrationError, ParameterError
 
     xs = np.asarray(x, dtype=float)

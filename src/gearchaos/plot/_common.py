@@ -110,7 +110,7 @@ def resonance_lines(ax: Any, gearset: Any, lo: float, hi: float) -> int:
             "resonances need the gear set of the sweep (attribute gearset_toml); "
             "this dataset has none (a reference system?)"
         )
-    from ..analysis.derived import gearset_info
+    from ..model.derived import gearset_info
 
     found = sorted(
         gearset_info(gearset)["omega_at_resonances"],

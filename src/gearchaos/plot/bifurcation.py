@@ -151,7 +151,7 @@ def bifurcation(
     resonances
         When the x axis is Ω: vertical lines (``gid="resonance"``) at Ω = ω_k/(h ω_n), where
         the h-th mesh harmonic (h = 1 solid, 2 dashed, 3 dotted) meets a natural frequency
-        ω_k of the linear model (:func:`gearchaos.analysis.derived.gearset_info`).
+        ω_k of the linear model (:func:`gearchaos.model.derived.gearset_info`).
     color, s
         Dot colour (default black; up/down branches C0/C3) and size in points² (default:
         from 0.3 for 10⁴ or more drawn values up to 6 for a few hundred, so that a coarse

@@ -186,7 +186,7 @@ def branch_overlay(
     Parameters
     ----------
     branch
-        A branch dataset (:func:`gearchaos.continuation`, :func:`gearchaos.analysis.open_branch`).
+        A branch dataset (:func:`gearchaos.continuation`, :func:`gearchaos.dynamics.open_branch`).
     ax
         Axes to draw on (default: a new figure).
     var, planet
@@ -335,7 +335,7 @@ def branch_figure(
     Parameters
     ----------
     branches
-        Branch datasets of one parameter (:func:`gearchaos.analysis.open_branch`).
+        Branch datasets of one parameter (:func:`gearchaos.dynamics.open_branch`).
     var, planet
         Section variable (default ``delta_sp``, else the first one the branches observed) and
         planet.

@@ -83,7 +83,7 @@ def open_result(source: Any) -> Any:
             raise StoreError(
                 f"{path!r} is a branch of `gearchaos continue`, not a sweep store or a "
                 "simulation file: draw it with `gearchaos plot STORE --branch` or read it with "
-                "gearchaos.analysis.open_branch"
+                "gearchaos.dynamics.open_branch"
             ) from None
         raise StoreError(
             f"{path!r} is neither a sweep store nor a simulation file: {exc}"

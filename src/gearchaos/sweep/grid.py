@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from ..analysis.lyapunov import random_tangents
+from ..dynamics.lyapunov import random_tangents
 from ..errors import ParameterError
 from ..integrate._chains import ChainRun
 from ..model.system import System

@@ -1,7 +1,7 @@
 """Periodic orbits behind the labels of a sweep (``orbits=True``, ``--orbits``).
 
 A sweep point that the section sequence labels nT (n ≤ :data:`MAX_ORBIT_PERIOD`) is confirmed
-by shooting: Newton on Pⁿ(y) − y = 0 (:func:`gearchaos.analysis.periodic_orbits`, all the
+by shooting: Newton on Pⁿ(y) − y = 0 (:func:`gearchaos.dynamics.periodic_orbits`, all the
 task's points of one period together) from the point's final state, which lies on the sweep's
 section. Per point the store then holds
 
@@ -116,7 +116,7 @@ def orbit_checks(
     dict of numpy.ndarray
         ``orbit_residual``, ``orbit_max_multiplier``, ``orbit_period``, ``orbit_status`` (K,).
     """
-    from ..analysis.orbit_batch import periodic_orbits
+    from ..dynamics.orbit_batch import periodic_orbits
 
     K = len(points)
     out = empty((K,))
