@@ -94,6 +94,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numba
 import numpy as np
@@ -197,6 +198,12 @@ class KahramanSingh1991(UserModel):
     )
     n_track = 3
     default_observables = ("delta", "delta_dot")
+    #: Figure symbols: variable → (symbol, definition, clearance name, clearance symbol).
+    symbols: ClassVar[dict[str, tuple[str, str | None, str | None, str | None]]] = {
+        "delta": (r"\bar{\delta}", r"\delta/b_c", "mesh", r"\bar{b}_h"),
+        "y_p": (r"\bar{y}_p", r"y_p/b_c", "bearing_p", r"\bar{b}_p"),
+        "y_g": (r"\bar{y}_g", r"y_g/b_c", "bearing_g", r"\bar{b}_g"),
+    }
     rhs = rhs
     tangent = tangent
 

@@ -36,6 +36,7 @@ def poincare(
     ] = None,
     preset: c.PresetOpt = None,
     gearset: c.GearsetOpt = None,
+    model: c.ModelOpt = None,
     set_: c.SetOpt = None,
     transient: c.TransientOpt = GALLERY_SETTINGS.transient_periods,
     periods: c.PeriodsOpt = GALLERY_SETTINGS.periods,
@@ -88,7 +89,7 @@ def poincare(
             ) from None
         axis = parse_axis(vary)
         omega, changes = c.parse_sets(set_ or [])
-        fixed: dict[str, Any] = dict(changes)
+        fixed: dict[str, Any] = {} if model is not None else dict(changes)
         if axis.name in fixed or (axis.name == "omega" and omega is not None):
             raise ParameterError(f"{axis.name} is both varied and set with --set; choose one")
         if axis.name != "omega":
@@ -97,7 +98,11 @@ def poincare(
                 c.default_omega_note(quiet or json_out, "varied")
             fixed["omega"] = omega
         settings = c.solver_settings(transient, periods, rtol, atol)
-        gs = c.load_gearset(preset, gearset)
+        gs = (
+            c.load_target(preset, gearset, model, changes)
+            if model is not None
+            else c.load_gearset(preset, gearset)
+        )
 
         import matplotlib
 

@@ -38,6 +38,7 @@ def response(
     ],
     preset: c.PresetOpt = None,
     gearset: c.GearsetOpt = None,
+    model: c.ModelOpt = None,
     set_: c.SetOpt = None,
     direction: Annotated[
         str,
@@ -82,8 +83,13 @@ def response(
             raise ParameterError(f"--direction must be up, down or both: got {direction!r}")
         settings = c.solver_settings(transient, periods, rtol, atol, samples_per_period)
         omega, changes = c.parse_sets(set_ or [])
-        gs = c.load_gearset(preset, gearset)
-        fixed = c.sweep_fixed({vary.split("=", 1)[0].strip()}, omega, changes, quiet or json_out)
+        swept = {vary.split("=", 1)[0].strip()}
+        if model is not None:  # the model's own parameters are set on it, not fixed
+            gs = c.load_target(preset, gearset, model, changes)
+            fixed = c.sweep_fixed(swept, omega, {}, quiet or json_out)
+        else:
+            gs = c.load_gearset(preset, gearset)
+            fixed = c.sweep_fixed(swept, omega, changes, quiet or json_out)
 
         from .. import sweep
 

@@ -220,7 +220,11 @@ def run_gallery(
             bar.advance(task)
     if title is None:
         given = [f"{axis_symbol(k)} = {_fmt(fv)}" for k, fv in fixed.items() if _is_number(fv)]
-        title = f"Poincaré maps of $\\bar{{X}}_{{sp{planet}}}$ versus $\\bar{{X}}'_{{sp{planet}}}$"
+        from ..plot._common import variable
+
+        info = variable(results[0], None, planet) if results else None
+        symbol, dot = (info.symbol, info.dot_symbol) if info else (rf"\bar{{X}}_{{sp{planet}}}", "")
+        title = f"Poincaré maps of ${symbol}$ versus ${dot}$"
         title += f" at different {axis_symbol(param)}"
         if given:
             title += "\nat " + ", ".join(given)

@@ -85,6 +85,14 @@ def response(
         )
     if solver is not None:
         settings = renamed_keyword("response", "solver", "settings", solver, settings)
+    from ..model.system import System
+
+    if isinstance(target, System) and not target.force_groups:
+        raise ParameterError(
+            f"response needs a model that tracks mesh contact forces (its force_groups and "
+            f"n_contact_forces): {target.name} tracks none; its section values' hysteresis "
+            "is drawn by bifurcation with --ic continuation --direction both"
+        )
     return bifurcation(
         target,
         vary,
