@@ -22,6 +22,7 @@ import errno
 import os
 import stat
 from pathlib import Path
+from typing import Any
 
 from .errors import ParameterError, StoreError
 
@@ -228,3 +229,18 @@ def check_output_file(path: object, *, what: str) -> str:
         kind = next((k for test, k in _KINDS if test(mode)), "not a regular file")
         raise StoreError(f"{what} {text!r} is {kind}, not a regular file; choose another path")
     return text
+
+
+def load_netcdf(path: object, *, what: str) -> tuple[str, Any]:
+    """(the checked path, its :class:`xarray.Dataset` loaded into memory) of a netCDF-4 file
+    gearchaos wrote: a path that is not a regular file, or a file that is not readable
+    netCDF-4, raises :class:`~gearchaos.errors.StoreError` naming ``what`` and the file."""
+    import xarray as xr
+
+    name = check_regular_file(path, what=what)
+    try:
+        return name, xr.load_dataset(name, engine="h5netcdf")
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise StoreError(
+            f"{what} {name!r} is not a readable netCDF-4 file ({type(exc).__name__})"
+        ) from None

@@ -296,6 +296,24 @@ def load_target(
     return System(build_model(load_model_class(model), dict(changes or {})), DEFAULT_OMEGA)
 
 
+def sweep_target(
+    preset: str | None,
+    gearset_file: Path | None,
+    model: str | None,
+    swept: set[str],
+    omega: float | None,
+    changes: Mapping[str, object],
+    quiet: bool,
+) -> tuple[Any, dict[str, Any]]:
+    """(target, fixed values) of a sweep command: a ``--model``'s parameters are set on the
+    model itself (its fields), a gear set's changes are fixed values of the sweep."""
+    if model is not None:
+        return load_target(preset, gearset_file, model, changes), sweep_fixed(
+            swept, omega, {}, quiet
+        )
+    return load_gearset(preset, gearset_file), sweep_fixed(swept, omega, changes, quiet)
+
+
 def default_omega_note(quiet: bool, what: str = "swept") -> None:
     """Tell the user which Ω a command uses when it is neither swept nor set."""
     if not quiet:

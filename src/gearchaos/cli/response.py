@@ -84,12 +84,7 @@ def response(
         settings = c.solver_settings(transient, periods, rtol, atol, samples_per_period)
         omega, changes = c.parse_sets(set_ or [])
         swept = {vary.split("=", 1)[0].strip()}
-        if model is not None:  # the model's own parameters are set on it, not fixed
-            gs = c.load_target(preset, gearset, model, changes)
-            fixed = c.sweep_fixed(swept, omega, {}, quiet or json_out)
-        else:
-            gs = c.load_gearset(preset, gearset)
-            fixed = c.sweep_fixed(swept, omega, changes, quiet or json_out)
+        gs, fixed = c.sweep_target(preset, gearset, model, swept, omega, changes, quiet or json_out)
 
         from .. import sweep
 

@@ -225,12 +225,7 @@ def bifurcation(
         )
         omega, changes = c.parse_sets(set_ or [])
         swept = {_axis_name(v) for v in vary} | ({_axis_name(family)} if family else set())
-        if model is not None:  # the model's own parameters are set on it, not fixed
-            gs = c.load_target(preset, gearset, model, changes)
-            fixed = c.sweep_fixed(swept, omega, {}, quiet or json_out)
-        else:
-            gs = c.load_gearset(preset, gearset)
-            fixed = c.sweep_fixed(swept, omega, changes, quiet or json_out)
+        gs, fixed = c.sweep_target(preset, gearset, model, swept, omega, changes, quiet or json_out)
 
         from .. import sweep
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 import os
 from typing import Any
 
-from .._files import check_output_file, check_regular_file
+from .._files import check_output_file, load_netcdf
 from .._output import check_replaceable, file_has_mark, write_file
 from ..errors import ParameterError, StoreError
 
@@ -37,15 +37,7 @@ def save_orbit(orbit: Any, path: str | os.PathLike[str]) -> str:
 def open_orbit(path: str | os.PathLike[str]) -> Any:
     """Open an orbit file written by :func:`save_orbit` as an :class:`xarray.Dataset`; anything
     else raises :class:`~gearchaos.errors.StoreError` naming the file."""
-    import xarray as xr
-
-    name = check_regular_file(path, what="orbit file")
-    try:
-        ds = xr.load_dataset(name, engine="h5netcdf")
-    except (OSError, ValueError, KeyError, TypeError) as exc:
-        raise StoreError(
-            f"orbit file {name!r} is not a readable netCDF-4 file ({type(exc).__name__})"
-        ) from None
+    name, ds = load_netcdf(path, what="orbit file")
     if not str(ds.attrs.get("title", "")).startswith(ORBIT_TITLE) or "orbit_state" not in ds:
         raise StoreError(
             f"{name!r} is not a gearchaos orbit file: its title is "

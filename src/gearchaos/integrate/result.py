@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from .._files import check_output_file, check_regular_file
+from .._files import check_output_file, load_netcdf
 from .._output import check_replaceable, file_has_mark, write_file
 from .._version import provenance
 from ..errors import ParameterError, StoreError
@@ -164,15 +164,7 @@ def open_simulation(path: str | os.PathLike[str]) -> Any:
     never opened blocking); a path of the wrong type raises
     :class:`~gearchaos.errors.ParameterError`.
     """
-    import xarray as xr
-
-    name = check_regular_file(path, what="simulation file")
-    try:
-        ds = xr.load_dataset(name, engine="h5netcdf")
-    except (OSError, ValueError, KeyError, TypeError) as exc:
-        raise StoreError(
-            f"simulation file {name!r} is not a readable netCDF-4 file ({type(exc).__name__})"
-        ) from None
+    name, ds = load_netcdf(path, what="simulation file")
     if not str(ds.attrs.get("title", "")).startswith(SIMULATION_TITLE):
         what = "a branch (open it with open_branch)" if "parameter" in ds.attrs else "another"
         raise StoreError(

@@ -380,10 +380,16 @@ def build_model(cls: type, changes: dict[str, Any] | None = None) -> Any:
                     f"{key} must be {'an integer' if kind is int else 'a number'}: got {value!r}"
                 ) from None
         values[key] = value
+    return _instantiate(cls, values, cls.__name__)
+
+
+def _instantiate(cls: type, values: dict[str, Any], what: str) -> Any:
+    """``cls(**values)`` checked against the contract; a constructor's refusal of the values
+    as :class:`~gearchaos.errors.ParameterError` naming ``what``."""
     try:
         model = cls(**values)
     except TypeError as exc:
-        raise ParameterError(f"{cls.__name__}: {exc}") from None
+        raise ParameterError(f"{what}: the values do not fit the class ({exc})") from None
     check_model(model)
     return model
 
@@ -433,9 +439,4 @@ def rebuild_model(attrs: Any) -> Any:
         for key, value in values.items():  # JSON lists back to the tuples dataclasses hold
             if isinstance(value, list):
                 values[key] = tuple(value)
-    try:
-        model = cls(**values)
-    except TypeError as exc:
-        raise ParameterError(f"{spec}: the stored fields no longer fit the class ({exc})") from None
-    check_model(model)
-    return model
+    return _instantiate(cls, values, f"{spec} (stored fields)")
