@@ -126,6 +126,16 @@ def test_sweep_store_rebuilds_the_model_for_starts_and_the_explorer(
     for key in ("motion", "x_sp1_section_min", "x_sp1_section_max", "steps_accepted"):
         assert point["summary"][key] == ref_point.summary[key], key
     assert point["png"][:8] == b"\x89PNG\r\n\x1a\n"
+    # the explorer's finer sweep of the store: the model the store names, its protocol
+    from gearchaos.explore.compute import run_zoom
+
+    finer = gc.open_sweep(run_zoom(str(store), {"omega": (1.15, 1.25, 3)}))
+    ref = gc.bifurcation(
+        _builtin(1.0, 0.3), "omega=1.15:1.25:3", settings=settings.replace(samples_per_period=1),
+        progress=False,
+    )  # fmt: skip
+    np.testing.assert_array_equal(finer["x"].values, ref["x"].values)
+    assert list(finer["motion"].values) == list(ref["motion"].values)
 
 
 def test_continue_and_attractors_take_the_model(

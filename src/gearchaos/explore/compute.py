@@ -238,8 +238,18 @@ def run_zoom(store: str, axes: Mapping[str, tuple[float, float, int]]) -> str:
 
     res = open_result(store)
     spec = res.spec
-    if spec is None or res.base_gearset is None:
-        raise StoreError("a finer sweep needs a store of a gear set with its sweep specification")
+    target: Any = res.base_gearset
+    if target is None:  # a model the store records how to build (the fixed values apply)
+        from ..model import System
+        from ..model.contract import rebuild_model
+
+        model = rebuild_model(res.ds.attrs)
+        target = None if model is None else System(model, 1.0)
+    if spec is None or target is None:
+        raise StoreError(
+            "a finer sweep needs a store of a gear set, or of a model it records how to build, "
+            "with its sweep specification"
+        )
     vary = []
     for axis in spec.vary:
         if axis.name in axes:
@@ -255,5 +265,5 @@ def run_zoom(store: str, axes: Mapping[str, tuple[float, float, int]]) -> str:
     finer = dataclasses.replace(spec, vary=tuple(vary))
     path = zoom_path(store, axes)
     os.makedirs(os.path.dirname(path), exist_ok=True)
-    run_sweep(res.base_gearset, finer, store=path, progress=False)
+    run_sweep(target, finer, store=path, progress=False)
     return path
