@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import json
 import math
 import time
 from pathlib import Path
@@ -237,6 +238,24 @@ def continue_(
     max_points: Annotated[
         int, typer.Option("--max-points", help="Most points of the branch.")
     ] = 2000,
+    cascade: Annotated[
+        int | None,
+        typer.Option(
+            "--cascade",
+            help="Follow the period-doubling cascade K doublings deep: at every period "
+            "doubling of the branch (stable on one side) the period-2n branch born there, "
+            "then at theirs, ...; every branch goes into the one .nc file.",
+            show_default=False,
+        ),
+    ] = None,
+    cascade_all: Annotated[
+        bool,
+        typer.Option(
+            "--cascade-all",
+            help="With --cascade: switch also at period doublings of branches unstable on "
+            "both sides.",
+        ),
+    ] = False,
     overwrite: c.OverwriteOpt = False,
     quiet: c.QuietOpt = False,
     json_out: c.JsonOpt = False,
@@ -249,6 +268,10 @@ def continue_(
     Writes the branch (parameter, section state, X̄ values, multipliers, stability per point;
     the events table) and prints its stable and unstable segments and events. Overlay it on a
     sweep with **gearchaos plot STORE --branch BRANCH.nc**.
+
+    With **--cascade K** the period-2n branches born at its period doublings follow (K
+    doublings deep), each with its own events, all in BRANCH.nc (drawn together by
+    **gearchaos plot BRANCH.nc**).
 
     Example: **gearchaos continue --vary omega=0.2:4 --set xi=0.03 -o branch.nc**
     """
@@ -264,6 +287,13 @@ def continue_(
         assert path is not None
         if path.suffix.lower() not in (".nc", ".zarr"):
             raise ParameterError(f"--output must end in .nc or .zarr: got {output!r}")
+        if cascade is not None and path.suffix.lower() != ".nc":
+            raise ParameterError(
+                f"--cascade writes every branch into one netCDF file: --output must end in "
+                f".nc: got {output!r}"
+            )
+        if cascade_all and cascade is None:
+            raise ParameterError("--cascade-all needs --cascade K: got no --cascade")
         name = vary.partition("=")[0].strip()
         set_names = {item.partition("=")[0].strip() for item in set_ or []}
         if name in set_names:
@@ -316,20 +346,70 @@ def continue_(
                     max_points=max_points,
                     store=path,
                     overwrite=overwrite,
+                    cascade=cascade,
+                    cascade_every=cascade_all,
                 )
-        summary = branch_summary(ds)
+        branches = ds if isinstance(ds, list) else [ds]
+        summary = branch_summary(branches[0])
         summary["seconds"] = time.perf_counter() - t0
         summary["branch"] = str(path)
+        if cascade is not None:
+            summary["cascade"] = [_cascade_entry(b) for b in branches[1:]]
+            summary["cascade_skipped"] = json.loads(branches[0].attrs["cascade_skipped"])
     if json_out:
         c.print_json(summary)
         return
     if quiet:
         return
     out = c.stdout()
-    table = pairs_table(f"period-{period} branch of {gs.name} in {name}")
+    _print_branch(out, summary, f"period-{period} branch of {gs.name} in {name}", name)
+    for entry in summary.get("cascade", []):
+        title = (
+            f"{entry['branch']}: period-{entry['period']} branch from the period doubling at "
+            f"{name}={entry['parent_value']:.6g} of {entry['parent']}"
+        )
+        _print_branch(out, entry, title, name)
+    for skip in summary.get("cascade_skipped", []):
+        out.print(
+            Text(
+                f"no branch from the period doubling at {name}={skip['value']:.6g} of "
+                f"{skip['parent']}: {skip['reason']}",
+                style="dim",
+            )
+        )
+    if any(e["events"] for e in [summary, *summary.get("cascade", [])]):
+        out.print(
+            Text(
+                "± is half the final bracket of the location plus the integrator's error of "
+                "the event's test function (checked at rtol/100); a smaller --rtol locates "
+                "the events more precisely",
+                style="dim",
+            )
+        )
+    c.wrote(Path(path))
+
+
+def _cascade_entry(branch: Any) -> dict[str, Any]:
+    """The summary of one period-2n branch of a cascade, naming where it was born."""
+    from ..dynamics.branch import branch_summary
+
+    a = branch.attrs
+    return {
+        "branch": str(a["branch"]),
+        "parent": str(a["parent"]),
+        "parent_event": int(a["parent_event"]),
+        "parent_value": float(a["parent_value"]),
+        **branch_summary(branch),
+    }
+
+
+def _print_branch(out: Any, summary: dict[str, Any], title: str, name: str) -> None:
+    """The points, stop reason, segments and events table of one branch."""
+    table = pairs_table(title)
     table.add_row("points", str(summary["points"]))
     table.add_row("stopped", escape(str(summary["stop_reason"])))
-    table.add_row("seconds", f"{summary['seconds']:.3g}")
+    if "seconds" in summary:
+        table.add_row("seconds", f"{summary['seconds']:.3g}")
     for seg in summary["segments"]:
         what = "stable" if seg["stable"] else "unstable"
         table.add_row(
@@ -349,16 +429,6 @@ def continue_(
             escape(str(e.get("detail", ""))),
         )
     out.print(events)
-    if summary["events"]:
-        out.print(
-            Text(
-                "± is half the final bracket of the location plus the integrator's error of "
-                "the event's test function (checked at rtol/100); a smaller --rtol locates "
-                "the events more precisely",
-                style="dim",
-            )
-        )
-    c.wrote(Path(path))
 
 
 def _with_uncertainty(value: float, u: float | None) -> str:

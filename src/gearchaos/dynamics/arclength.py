@@ -48,6 +48,7 @@ from ..model.system import System
 from ..model.target import OMEGA, resolve
 from . import branch_events as ev
 from .branch_locate import detect
+from .cascade import check_cascade
 from .orbits import (
     ORBIT_SETTINGS,
     PeriodicOrbit,
@@ -339,6 +340,10 @@ def continuation(
     observe: Any = None,
     store: str | os.PathLike[str] | None = None,
     overwrite: bool = False,
+    cascade: int | None = None,
+    cascade_every: bool = False,
+    cascade_range: tuple[float, float] | None = None,
+    max_branches: int | None = None,
     **values_and_settings: Any,
 ) -> Any:
     """Continue a branch of period-n orbits in one parameter (pseudo-arclength).
@@ -387,16 +392,33 @@ def continuation(
         Variables stored at the section points (default ``delta_sp`` and ``delta_sp_dot``
         for gear sets, the first tracked observable and its derivative otherwise).
     store
-        A path ending in ``.nc`` (netCDF-4 via h5netcdf) or ``.zarr`` to save the branch.
+        A path ending in ``.nc`` (netCDF-4 via h5netcdf) or ``.zarr`` to save the branch
+        (with ``cascade``: ``.nc``, every branch in one file,
+        :func:`~gearchaos.dynamics.cascade.save_cascade`).
+    cascade
+        After the branch, follow the period-doubling cascade to this depth
+        (:mod:`gearchaos.dynamics.cascade`): at every period doubling the period-2n branch
+        born there (``start=event``, with the same settings, fixed values and steps), then
+        at every period doubling of those, … ``cascade`` doublings deep.
+    cascade_every
+        Also switch at period doublings where the parent is unstable on both sides (by
+        default only where the attractor doubles: stable on one side).
+    cascade_range
+        (lo, hi): the range of the period-2n branches (default: vary's); each heads for the
+        end its parent heads for.
+    max_branches
+        Most branches of the cascade, this one included (default: no limit).
 
     Returns
     -------
-    xarray.Dataset
+    xarray.Dataset or list of xarray.Dataset
         One branch: dimension ``point`` (coordinates: the parameter, ``arclength``), per
         point ``orbit_state``, multipliers, ``stable``, ``residual``, ``iterations``,
         section values, extrema and contact regimes; dimension ``event`` with the located
         events; attributes with the stop reason and provenance
-        (see :func:`gearchaos.dynamics.branch.branch_dataset`).
+        (see :func:`gearchaos.dynamics.branch.branch_dataset`). With ``cascade`` (even 0)
+        the list of the cascade's branches, this one first, each naming its ``parent`` and
+        ``parent_event`` (:func:`~gearchaos.dynamics.cascade.follow_cascade`).
     """
     from .branch import branch_dataset, check_observe, check_store, save_branch
 
@@ -404,6 +426,8 @@ def continuation(
     if store is not None:
         check_store(store, overwrite)
     check_bool("overwrite", overwrite)
+    check_bool("cascade_every", cascade_every)
+    child_range = check_cascade(cascade, cascade_range, max_branches, store, a, b)
     values, cfg = split_values(values_and_settings, settings, params, ORBIT_SETTINGS)
     if name in values:
         raise ParameterError(f"{name} is varied and cannot also be fixed")
@@ -493,6 +517,23 @@ def continuation(
     ds = branch_dataset(
         br, pts, sorted(br.found, key=lambda e: e.arclength), reason, (a, b), observe, start
     )
+    if cascade is not None:
+        from .cascade import follow_cascade, save_cascade
+
+        def child(event: ev.Event) -> Any:
+            return continuation(
+                target, (name, *child_range), start=event, settings=cfg, params=values,
+                step=step, min_step=min_step, max_step=max_step, max_points=max_points,
+                max_corrector=max_corrector, tol=tol, event_tol=event_tol, grid=grid,
+                observe=observe,
+            )  # fmt: skip
+
+        branches = follow_cascade(
+            ds, child, cascade, every=cascade_every, max_branches=max_branches
+        )
+        if store is not None:
+            save_cascade(branches, store, overwrite=overwrite)
+        return branches
     if store is not None:
         save_branch(ds, store, overwrite=overwrite)
     return ds

@@ -209,18 +209,20 @@ def follow_branches(
     cache: str | os.PathLike[str] | None = None,
 ) -> list[Any]:
     """Continue the branches of one panel: from the middle of every 1T (and 3T) stretch of the
-    sweep's labels, in both directions to the ends of the swept range, switching at every
-    period doubling of a branch that is stable on one side of it (the attractor doubles) up to
-    period ``max_period``, at most ``max_branches`` branches in all (breadth first), each of
-    at most ``max_points`` points. ``steps`` sets the largest step (range/steps);
-    ``cache`` is a directory where each branch is saved and, when present, read back (so a
-    report run twice continues nothing twice). Branches that fail to start are skipped.
+    sweep's labels, in both directions to the ends of the swept range, each with its
+    period-doubling cascade (``continuation(..., cascade=depth)``,
+    :mod:`gearchaos.dynamics.cascade`: at every period doubling of a branch that is stable on
+    one side of it — the attractor doubles — the period-2n branch, over the whole swept range)
+    up to period ``max_period``, at most ``max_branches`` branches in all (breadth first within
+    a cascade), each of at most ``max_points`` points. ``steps`` sets the largest step
+    (range/steps); ``cache`` is a directory where each cascade is saved in one file and, when
+    present, read back (so a report run twice continues nothing twice). Branches that fail to
+    start are skipped.
 
     Returns the branch datasets (:func:`gearchaos.continuation`).
     """
     from ..dynamics.arclength import continuation
-    from ..dynamics.branch import open_branch
-    from ..dynamics.branch_events import events
+    from ..dynamics.cascade import open_cascade
     from ..errors import IntegrationError, ParameterError
 
     xs = np.asarray(x, dtype=float)
@@ -231,53 +233,42 @@ def follow_branches(
         "max_step": span / steps,
         "step": span / (2 * steps),
         "max_points": max_points,
+        # the period-2n branches cover the whole swept range, heading where their parent heads
+        "cascade_range": (lo, hi),
     }
     if settings is not None:
         kw["settings"] = settings
     out: list[Any] = []
     counter = [0]
 
-    def run(vary: tuple[str, float, float], **more: Any) -> Any:
+    def run(vary: tuple[str, float, float], period: int, limit: int) -> list[Any]:
+        """The cascade of the period-n branch over ``vary``: doubled while the period stays
+        at most ``max_period`` (a cascade file in ``cache``, read back when present)."""
         counter[0] += 1
+        depth = 0
+        while period * 2 ** (depth + 1) <= max_period:
+            depth += 1
         path = None
         if cache is not None:
             Path(cache).mkdir(parents=True, exist_ok=True)
-            path = Path(cache) / f"branch{counter[0]:03d}.nc"
+            path = Path(cache) / f"cascade{counter[0]:03d}.nc"
             if path.exists():
-                return open_branch(path)
+                return open_cascade(path)
         try:
-            ds = continuation(target, vary, store=path, overwrite=True, **kw, **more)
+            found: list[Any] = continuation(
+                target, vary, period=period, store=path, overwrite=True, cascade=depth,
+                max_branches=limit, **kw,
+            )  # fmt: skip
         except (IntegrationError, ParameterError):
-            return None
-        return ds
+            return []
+        return found
 
     starts = [(s, 1) for s in _stretch_starts(xs, labels, "1T")]
     starts += [(s, 3) for s in _stretch_starts(xs, labels, "3T")]
-    queue: list[tuple[Any, float]] = []
     for s, n in starts:
         for end in (lo, hi):
-            if not math.isclose(s, end) and len(out) + len(queue) < max_branches:
-                ds = run((name, s, end), period=n)
-                if ds is not None:
-                    queue.append((ds, end))
-            while queue and len(out) < max_branches:
-                br, stop = queue.pop(0)
-                out.append(br)
-                if 2 * int(br.attrs.get("period", 1)) > max_period:
-                    continue
-                rows = event_rows(br)
-                for ev, row in zip(events(br), rows, strict=True):
-                    # switch where the attractor doubles: a PD of a branch stable on one side
-                    if ev.kind != "period_doubling" or not (
-                        row["stable_below"] or row["stable_above"]
-                    ):
-                        continue
-                    if len(out) + len(queue) >= max_branches:
-                        break
-                    # the whole range: the new branch leaves the event either way
-                    child = run((name, hi + lo - stop, stop), start=ev)
-                    if child is not None:
-                        queue.append((child, stop))
+            if not math.isclose(s, end) and len(out) < max_branches:
+                out.extend(run((name, s, end), n, max_branches - len(out)))
     return out
 
 

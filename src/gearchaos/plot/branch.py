@@ -117,19 +117,26 @@ def _clearance_symbol(var: str) -> str:
 
 def branch_labels(branches: Sequence[Any]) -> list[str]:
     """Legend labels that tell the branches apart: the file name (when the branch was opened
-    from one), the period and the start (``from a period doubling at Ω = 1.95``), numbered
-    where two would still read the same."""
+    from one; once per file for the branches of a cascade), the period and the start
+    (``from PD at Ω = 1.95``), numbered where two would still read the same."""
     labels = []
+    seen: set[str] = set()
     for br in branches:
         n = int(br.attrs.get("period", 1))
         source = str(getattr(br, "encoding", {}).get("source", "") or "")
         start = str(br.attrs.get("start", ""))
         text = f"period-{n} branch"
-        if source:
-            text = f"{Path(source).name}: {text}"
-        elif " at " in start:  # switched at an event: say where
+        if " at " in start:  # switched at an event: say where
             kind, _, where = start.partition(" at ")
-            text += f" from {kind.replace('_', ' ')} at {where.split(' (')[0]}"
+            pname, _, value = where.split(" (")[0].partition("=")
+            short = EVENT_STYLE[kind][2] if kind in EVENT_STYLE else kind.replace("_", " ")
+            try:
+                text += f" from {short} at {axis_symbol(pname)} = {fmt(float(value))}"
+            except ValueError:
+                text += f" from {short} at {where.split(' (')[0]}"
+        if source and source not in seen:
+            text = f"{Path(source).name}: {text}"
+        seen.add(source)
         labels.append(text)
     for text in set(labels):
         same = [k for k, t in enumerate(labels) if t == text]
