@@ -357,6 +357,16 @@ def plot(
             "the response curves.",
         ),
     ] = False,
+    impact: Annotated[
+        str | None,
+        typer.Option(
+            "--impact",
+            help="For a classified 2-D sweep of a gear set: the impact map of this mesh "
+            "(sun_planet or planet_ring): no impact, single- or double-sided impact at every "
+            "point, for --planet (default 1).",
+            show_default=False,
+        ),
+    ] = None,
 ) -> None:
     """Draw a sweep store: bifurcation diagrams (one panel per family value, with a band of
     motion labels under each) for a 1-D sweep, maps coloured by motion label (1T, 2T, …, QP,
@@ -379,7 +389,7 @@ def plot(
         import matplotlib
 
         matplotlib.use("Agg")
-        from ..dynamics.branch import open_branch
+        from ..dynamics.cascade import open_cascade
         from ..plot import savefig, sweep_figure
 
         if all(_is_branch(p) for p in stores):
@@ -388,7 +398,7 @@ def plot(
             from ..plot.branch import branch_figure
 
             fig = branch_figure(
-                [open_branch(b) for b in [*stores, *(branch or [])]],
+                [br for b in [*stores, *(branch or [])] for br in open_cascade(b)],
                 var=var,
                 planet=1 if planet is None else planet,
                 clearance_lines=clearance,
@@ -407,8 +417,13 @@ def plot(
             )
         store = stores[0]
         res = open_store(store)
-        branches = [open_branch(b) for b in branch or []]
-        if res.ds.attrs.get("kind") == "response" and not sections:
+        branches = [br for b in branch or [] for br in open_cascade(b)]
+        response = res.ds.attrs.get("kind") == "response"
+        if impact is not None or (branches and response and not sections):
+            from ._charts import chart_figure
+
+            fig = chart_figure(res, impact, branches, var, planet, sections)
+        elif response and not sections:
             from ..plot import response_figure
 
             given = [o for o, v in (("--var", var), ("--planet", planet)) if v is not None]
@@ -420,19 +435,15 @@ def plot(
                 )
 
             fig = response_figure(res)
-            if output.parent != Path(""):
-                output.parent.mkdir(parents=True, exist_ok=True)
-            savefig(fig, output)
-            c.wrote(output)
-            return
-        fig = sweep_figure(
-            res,
-            var="delta_sp" if var is None else var,
-            planet=1 if planet is None else planet,
-            clearance_lines=clearance,
-            resonances=resonances,
-            branches=branches,
-        )
+        else:
+            fig = sweep_figure(
+                res,
+                var="delta_sp" if var is None else var,
+                planet=1 if planet is None else planet,
+                clearance_lines=clearance,
+                resonances=resonances,
+                branches=branches,
+            )
         if output.parent != Path(""):
             output.parent.mkdir(parents=True, exist_ok=True)
         savefig(fig, output)

@@ -1,0 +1,240 @@
+"""Amplitude–frequency curves: continued branches beside the brute-force up/down sweeps.
+
+The response amplitude of a periodic orbit is the peak-to-peak deflection over the orbit,
+A = max δ̄ − min δ̄ (of a mesh, one planet), read from the extrema every branch point
+(:func:`gearchaos.continuation`) and every sweep point (:func:`gearchaos.response`,
+:func:`gearchaos.bifurcation`) stores. :func:`amplitude_figure` draws, over the swept
+parameter (usually Ω), A of every continued branch — stable stretches solid, unstable ones
+dashed, its folds, period doublings, Neimark–Sacker and grazing events marked — and beside it
+the brute-force points of the up and down sweeps of a response store (up ▲, down ▼), their
+jumps between periodic neighbours as arrows (:func:`~gearchaos.sweep.frequency.find_jumps`),
+and the motion band under it. Where the sweeps settle on a stable periodic orbit the points
+lie on a stable branch; a jump leaves a branch at a fold.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..sweep import SweepResult
+from ..sweep.frequency import find_jumps
+from ._common import axis_label, fmt, var_symbol
+from .branch import BRANCH_COLOURS, EVENT_NAMES, EVENT_STYLE, branch_labels
+from .regimes import regime_band, regime_categories, regime_category, regime_legend_below
+from .units import PhysicalScales, fit_to_data, linear_axis, var_quantity
+
+__all__ = ["AMPLITUDE_GID", "amplitude_figure", "amplitude_of", "amplitude_var"]
+
+#: ``gid`` prefix of the artists of :func:`amplitude_figure`.
+AMPLITUDE_GID = "amplitude"
+#: Marker and colour of the sweep directions.
+SWEEP_STYLE = {"up": ("^", "0.25"), "down": ("v", "0.6"), None: ("o", "0.4")}
+
+
+def amplitude_var(ds: Any, var: str | None = None) -> str:
+    """The deflection whose amplitude is drawn: ``var`` or, by default, ``delta_sp`` (else the
+    first tracked variable with stored extrema that is not a contact force)."""
+    have = [
+        str(v)[:-4]
+        for v in ds.data_vars
+        if str(v).endswith("_max") and f"{str(v)[:-4]}_min" in ds.data_vars
+    ]
+    if var is None:
+        plain = [v for v in have if not v.startswith("contact_force")]
+        if not plain:
+            raise ParameterError("the dataset stores no extrema (no VAR_min and VAR_max)")
+        return "delta_sp" if "delta_sp" in plain else plain[0]
+    if var not in have:
+        raise ParameterError(
+            f"var must be a variable with stored extrema ({', '.join(have)}): got {var!r}"
+        )
+    return var
+
+
+def amplitude_of(ds: Any, var: str, planet: int = 1) -> Any:
+    """max − min of ``var`` over the orbit (branch) or recorded window (sweep), of
+    ``planet`` for per-planet variables (a DataArray over the other dimensions)."""
+    amp = ds[f"{var}_max"] - ds[f"{var}_min"]
+    if "planet_all" in amp.dims:
+        planets = [int(p) for p in np.asarray(ds["planet_all"].values)]
+        if planet not in planets:
+            raise ParameterError(f"planet must be one of {planets}: got {planet!r}")
+        amp = amp.sel(planet_all=planet)
+    return amp
+
+
+def _periodic(ds: Any, direction: str | None) -> np.ndarray | None:
+    if "motion" not in ds.data_vars:
+        return None
+    cats = regime_categories(ds)
+    if direction is not None:
+        cats = cats.sel(direction=direction)
+    return np.array([regime_category(c).endswith("T") for c in np.ravel(cats.values)])
+
+
+def _draw_branch(ax: Any, br: Any, var: str, planet: int, colour: str, label: str,
+                 named: set[str]) -> np.ndarray:  # fmt: skip
+    name = str(br.attrs["parameter"])
+    lam = np.asarray(br[name].values, dtype=float)
+    amp = np.asarray(amplitude_of(br, var, planet).values, dtype=float)
+    stable = np.asarray(br["stable"].values, dtype=bool)
+    for which, style in ((True, "-"), (False, "--")):
+        shown = stable == which
+        shown[1:] |= (stable == which)[:-1]  # keep the joins between stretches
+        if not shown.any():
+            continue
+        ax.plot(
+            lam, np.where(shown, amp, np.nan), style, color=colour, lw=1.4 if which else 1.0,
+            zorder=3, gid=f"{AMPLITUDE_GID}:branch:{'stable' if which else 'unstable'}",
+            label=f"{label} ({'stable' if which else 'unstable'})",
+        )  # fmt: skip
+    s = np.asarray(br["arclength"].values, dtype=float)
+    for k in range(br.sizes.get("event", 0)):
+        kind = str(br.event_kind.values[k])
+        marker, ec, short = EVENT_STYLE.get(kind, ("o", "k", kind))
+        i = min(max(int(br.event_point.values[k]), 0), lam.size - 1)
+        a = amp[i]
+        if i + 1 < lam.size and s[i + 1] > s[i]:
+            f = (float(br.event_arclength.values[k]) - s[i]) / (s[i + 1] - s[i])
+            a = amp[i] + min(max(f, 0.0), 1.0) * (amp[i + 1] - amp[i])
+        filled = marker in ("x", "P")
+        ax.scatter(
+            [float(br.event_value.values[k])], [a], marker=marker, s=42, linewidths=1.3,
+            zorder=5, gid=f"{AMPLITUDE_GID}:event:{kind}",
+            **({"c": ec} if filled else {"facecolors": "none", "edgecolors": ec}),
+            label=EVENT_NAMES.get(kind, kind) if kind not in named else None,
+        )  # fmt: skip
+        named.add(kind)
+        ax.annotate(
+            short, (float(br.event_value.values[k]), a), xytext=(0, 6), color=ec,
+            textcoords="offset points", ha="center", fontsize="x-small",
+        )  # fmt: skip
+    return amp
+
+
+def amplitude_figure(
+    ds: Any,
+    branches: Sequence[Any],
+    *,
+    var: str | None = None,
+    planet: int = 1,
+    rel_jump: float = 0.25,
+    figsize: tuple[float, float] | None = None,
+) -> Any:
+    """The amplitude–frequency figure of a 1-D (response) sweep and continued branches.
+
+    Parameters
+    ----------
+    ds
+        A 1-D sweep store or dataset (a response store's up and down sweeps, or any 1-D
+        bifurcation sweep) with the extrema of ``var``.
+    branches
+        Continued branches of the swept parameter (:func:`gearchaos.continuation`,
+        :func:`gearchaos.dynamics.cascade.open_cascade`).
+    var, planet
+        The deflection (default ``delta_sp``; ``x`` for the backlash oscillator) and planet.
+    rel_jump
+        Jump threshold as a fraction of a sweep curve's range (:func:`find_jumps`); only
+        jumps between two periodic points are drawn.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The first axes holds the branches (``gid`` ``amplitude:branch:stable`` /
+        ``…:unstable``, events ``amplitude:event:<kind>``), the sweep points
+        (``amplitude:sweep:up`` / ``…:down``) and jumps (``amplitude:jump``); the second, when
+        the store has motion labels, the motion band.
+    """
+    from matplotlib.figure import Figure
+
+    res = SweepResult.of(ds)
+    sd = res.ds
+    var = amplitude_var(sd, var)
+    amp = amplitude_of(sd, var, planet)
+    lead = [d for d in amp.dims if d != "direction"]
+    if len(lead) != 1:
+        raise ParameterError(f"amplitude_figure draws 1-D sweeps: got dimensions {lead}")
+    xname = lead[0]
+    branches = list(branches)
+    for br in branches:
+        if str(br.attrs.get("parameter")) != xname:
+            raise ParameterError(
+                f"branches must continue the swept parameter {xname}: got "
+                f"{br.attrs.get('parameter')!r}"
+            )
+        amplitude_var(br, var)  # the branch stores the extrema of var
+    x = np.asarray(sd[xname].values, dtype=float)
+    directions = list(sd["direction"].values) if "direction" in sd.dims else [None]
+    labelled = "motion" in sd.data_vars
+    fig = Figure(figsize=figsize or (7.5, 5.6 if labelled else 5.0), layout="constrained")
+    if labelled:
+        grid = fig.add_gridspec(2, 1, height_ratios=[1.0, 0.1 * len(directions) + 0.02])
+        ax = fig.add_subplot(grid[0, 0])
+        band = fig.add_subplot(grid[1, 0], sharex=ax)
+    else:
+        ax, band = fig.add_subplot(), None
+    ys: list[np.ndarray] = []
+    for d in directions:
+        y = np.asarray((amp.sel(direction=d) if d is not None else amp).values, dtype=float)
+        ys.append(y)
+        marker, colour = SWEEP_STYLE.get(d, SWEEP_STYLE[None])
+        ax.plot(
+            x, y, ls="none", marker=marker, ms=4, mfc="none", mec=colour, zorder=4,
+            gid=f"{AMPLITUDE_GID}:sweep:{d or 'points'}",
+            label=f"brute-force sweep{', ' + d if d else ''}",
+        )  # fmt: skip
+        periodic = _periodic(sd, d)
+        if periodic is None:
+            continue
+        for xj in find_jumps(x, y, rel=rel_jump, where=periodic):
+            k = int(np.searchsorted(x, xj))
+            y0, y1 = (y[k], y[k - 1]) if d == "down" else (y[k - 1], y[k])
+            ax.annotate(
+                "", xy=(xj, y1), xytext=(xj, y0), gid=f"{AMPLITUDE_GID}:jump",
+                arrowprops={"arrowstyle": "->", "color": colour, "lw": 1.2},
+            )  # fmt: skip
+    labels = branch_labels(branches) if len(branches) > 1 else [
+        f"period-{int(br.attrs.get('period', 1))} branch" for br in branches
+    ]  # fmt: skip
+    named: set[str] = set()
+    lo, hi = float(np.min(x)), float(np.max(x))
+    for k, br in enumerate(branches):
+        a = _draw_branch(ax, br, var, planet, BRANCH_COLOURS[k % len(BRANCH_COLOURS)],
+                         labels[k], named)  # fmt: skip
+        lam = np.asarray(br[str(br.attrs["parameter"])].values, dtype=float)
+        ys.append(a[(lam >= lo) & (lam <= hi)])
+    pad = 0.02 * (hi - lo)
+    ax.set_xlim(lo - pad, hi + pad)
+    fit_to_data(ax, None, np.concatenate([np.ravel(y) for y in ys]))
+    per = "planet" in sd[f"{var}_max"].dims or "planet_all" in sd[f"{var}_max"].dims
+    sym = var_symbol(var, planet if per else None)
+    ax.set_ylabel(f"amplitude $\\max {sym} - \\min {sym}$")
+    ax.grid(alpha=0.3, lw=0.5)
+    scales = PhysicalScales.of_sweep(res)
+    quantity = var_quantity(var)
+    found = scales.factor(quantity) if quantity is not None else None
+    if found is not None:
+        linear_axis(ax, "y", found[0], f"amplitude {found[1]}")
+    if xname == "omega":
+        rpm = scales.factor("omega")
+        if rpm is not None:
+            linear_axis(ax, "x", rpm[0], rpm[1])
+    ax.legend(fontsize="x-small", loc="best")
+    bottom = ax
+    if band is not None:
+        limits = ax.get_xlim()
+        regime_band(res, band)
+        band.set_xlim(*limits)
+        ax.tick_params(axis="x", labelbottom=False)
+        regime_legend_below(fig, np.asarray(regime_categories(res).values, dtype=object).ravel())
+        bottom = band
+    bottom.set_xlabel(axis_label(xname))
+    title = str(sd.attrs.get("title", "")).replace("sweep", "amplitude–frequency curves")
+    rtols = sorted({fmt(br.attrs.get("rtol")) for br in branches if br.attrs.get("rtol")})
+    extra = f"continued branches (rtol {', '.join(rtols)}) beside the brute-force sweeps"
+    fig.suptitle(f"{title}\n{extra}" if title else extra, fontsize="medium")
+    return fig

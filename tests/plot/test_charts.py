@@ -1,0 +1,119 @@
+"""Impact maps and amplitude–frequency curves (issue 26, item 5).
+
+* The impact map's cells are the stored contact codes (read back from the image array), their
+  colours the palette's, and the codes are what the contact regime means: from the stored
+  minimum deflection and the swept clearance b̄_sp, no impact where δ_min > b̄, single-sided
+  where −b̄ ≤ δ_min ≤ b̄, double-sided below.
+* The amplitude curve of a continued branch is max − min of the deflection of the orbit
+  simulated independently (gc.simulate from the orbit state) at a few points, and the stable
+  branch passes through the brute-force up sweep's periodic points.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from matplotlib.colors import to_rgba
+
+import gearchaos as gc
+from gearchaos.plot.amplitude import amplitude_figure
+from gearchaos.plot.impact import IMPACT_COLOURS, IMPACT_GID, impact_figure, impact_map
+
+TIGHT = {"rtol": 1e-10, "atol": 1e-12}
+
+
+@pytest.fixture(scope="module")
+def impact_store(tmp_path_factory: pytest.TempPathFactory):
+    path = tmp_path_factory.mktemp("impact") / "map.zarr"
+    return gc.bifurcation(
+        gc.preset("sheng2016"), ["omega=0.6:2.4:7", "backlash.sun_planet=0.5:4:4"],
+        params={"xi": 0.05}, transient_periods=40, periods=16, progress=False, store=path,
+    )  # fmt: skip
+
+
+@pytest.mark.parametrize(("mesh", "planet"), [("sun_planet", 1), ("rp", 2)])
+def test_impact_map_cells_are_the_stored_contact_codes(impact_store, mesh, planet) -> None:
+    ax = impact_map(impact_store, mesh=mesh, planet=planet)
+    (quad,) = [c for c in ax.collections if c.get_gid() == IMPACT_GID]
+    key = "sp" if mesh == "sun_planet" else "rp"
+    stored = impact_store[f"contact_{key}"].sel(planet_all=planet)
+    want = stored.transpose("backlash.sun_planet", "omega").values
+    got = np.asarray(quad.get_array()).reshape(want.shape)
+    np.testing.assert_array_equal(got, want)
+    rgba = quad.to_rgba(quad.get_array()).reshape(*want.shape, 4)
+    for code in np.unique(want):
+        assert np.allclose(rgba[want == code], to_rgba(IMPACT_COLOURS[int(code)]))
+
+
+def test_impact_codes_mean_the_contact_regime_of_the_swept_clearance(impact_store) -> None:
+    """Independent of the classifier: δ_sp,min against the swept b̄_sp of each point."""
+    dmin = impact_store.delta_sp_min.sel(planet_all=1)
+    b = impact_store["backlash.sun_planet"]
+    expected = xr_where(dmin > b, 0, xr_where(dmin >= -b, 1, 2))
+    np.testing.assert_array_equal(
+        impact_store.contact_sp.sel(planet_all=1).transpose(*expected.dims).values,
+        expected.values,
+    )
+    assert len(np.unique(expected.values)) >= 2  # the map shows a boundary
+
+
+def xr_where(cond, a, b):
+    import xarray as xr
+
+    return xr.where(cond, a, b)
+
+
+def test_impact_figure_has_physical_axes_and_refuses_unknown_meshes(impact_store) -> None:
+    fig = impact_figure(impact_store, mesh="sp")
+    ax = fig.axes[0]
+    labels = [c.get_xlabel() for c in ax.child_axes] + [c.get_ylabel() for c in ax.child_axes]
+    assert any("rpm" in t for t in labels) and any("µm" in t for t in labels)
+    with pytest.raises(gc.ParameterError, match="mesh must be one of"):
+        impact_figure(impact_store, mesh="sun_ring")
+    with pytest.raises(gc.ParameterError, match="planet must be one of"):
+        impact_map(impact_store, planet=9)
+
+
+@pytest.fixture(scope="module")
+def oscillator_response():
+    system = gc.backlash_oscillator(1.0, zeta=0.05, f_alt=0.1, f_mean=0.1)
+    res = gc.response(system, "omega=0.8:1.2:9", progress=False)
+    branch = gc.continuation(system, "omega=0.75:1.25", **TIGHT)
+    return system, res, branch
+
+
+def _stable_line(fig):
+    ax = fig.axes[0]
+    (line,) = [ln for ln in ax.lines if ln.get_gid() == "amplitude:branch:stable"]
+    return np.asarray(line.get_xdata(), float), np.asarray(line.get_ydata(), float)
+
+
+def test_branch_amplitude_is_the_simulated_orbits_peak_to_peak(oscillator_response) -> None:
+    system, res, branch = oscillator_response
+    fig = amplitude_figure(res, [branch], var="x")
+    xs, ys = _stable_line(fig)
+    stable = np.flatnonzero(branch.stable.values == 1)
+    for k in (stable[0], stable[stable.size // 2], stable[-1]):
+        lam = float(branch.omega[k])
+        sim = gc.simulate(
+            system.at(lam), y0=branch.orbit_state.values[k], transient_periods=0, periods=1,
+            samples_per_period=4096, **TIGHT,
+        )  # fmt: skip
+        x = sim.series("x") if callable(getattr(sim, "series", None)) else sim.states[:, 0]
+        amp = float(np.max(x) - np.min(x))
+        assert xs[k] == lam
+        assert ys[k] == pytest.approx(amp, rel=1e-5)
+
+
+def test_stable_branch_passes_through_the_up_sweeps_periodic_points(oscillator_response) -> None:
+    _, res, branch = oscillator_response
+    fig = amplitude_figure(res, [branch])
+    xs, ys = _stable_line(fig)
+    ok = ~np.isnan(ys)
+    order = np.argsort(xs[ok])
+    up = res.sel(direction="up")
+    amp = (up.x_max - up.x_min).values
+    assert set(up.motion.values.astype(str)) == {"1T"}
+    on_branch = np.interp(up.omega.values, xs[ok][order], ys[ok][order])
+    np.testing.assert_allclose(amp, on_branch, rtol=2e-3)
+    assert [ln for ln in fig.axes[0].lines if ln.get_gid() == "amplitude:sweep:up"]
