@@ -43,6 +43,7 @@ __all__ = [
     "attractors",
     "backlash_oscillator",
     "bifurcation",
+    "boundary_curve",
     "continuation",
     "duffing",
     "explore",
@@ -54,6 +55,7 @@ __all__ = [
     "max_lyapunov",
     "nondimensionalise",
     "open_branch",
+    "open_curve",
     "open_simulation",
     "open_sweep",
     "periodic_orbit",
@@ -67,9 +69,11 @@ __all__ = [
 
 if TYPE_CHECKING:
     from .dynamics.arclength import continuation
+    from .dynamics.boundary import boundary_curve
     from .dynamics.branch import open_branch, save_branch
     from .dynamics.branch_events import Event
     from .dynamics.coexistence import attractors
+    from .dynamics.curve_file import open_curve
     from .dynamics.lyapunov import lyapunov_spectrum, max_lyapunov
     from .dynamics.orbit_batch import periodic_orbits
     from .dynamics.orbits import PeriodicOrbit, periodic_orbit
@@ -81,6 +85,8 @@ _LAZY_ATTRIBUTES = {
     "PeriodicOrbit": "dynamics.orbits",
     "periodic_orbit": "dynamics.orbits",
     "continuation": "dynamics.arclength",
+    "boundary_curve": "dynamics.boundary",
+    "open_curve": "dynamics.curve_file",
     "Event": "dynamics.branch_events",
     "open_branch": "dynamics.branch",
     "save_branch": "dynamics.branch",

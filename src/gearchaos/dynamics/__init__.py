@@ -5,7 +5,9 @@ by shooting, Floquet multipliers; :mod:`.shooting` the map evaluations and the N
 corrector, :mod:`.orbit_batch` many orbits in one Newton iteration, :mod:`.orbit_file` orbit
 files), :mod:`.arclength` (pseudo-arclength continuation of branches; :mod:`.branch_events`
 their folds, period doublings, Neimark–Sacker and grazing events, located by
-:mod:`.branch_locate`; :mod:`.branch` their datasets and files).
+:mod:`.branch_locate`; :mod:`.branch` their datasets and files; :mod:`.boundary`
+two-parameter boundary curves of their events (:mod:`.curves` the method,
+:mod:`.curve_tests` test functions and codimension-2 points, :mod:`.curve_file` curve files).
 
 :mod:`.verdict` — the one motion verdict (nT confirmed by shooting and Floquet multipliers,
 chaos and quasi-periodicity by a Lyapunov exponent with its error, transients finished by
@@ -15,9 +17,11 @@ to end) and :mod:`.coexistence` (coexisting attractors from several starts) use 
 """
 
 from .arclength import continuation
+from .boundary import boundary_curve
 from .branch import branch_multipliers, branch_summary, open_branch, save_branch
 from .branch_events import Event, events
 from .coexistence import Attractor, attractors
+from .curve_file import open_curve
 from .evidence import EVIDENCE, Verdict
 from .lyapunov import LyapunovResult, lyapunov_spectrum, max_lyapunov
 from .orbit_batch import periodic_orbits
@@ -36,6 +40,7 @@ __all__ = [
     "VerdictSettings",
     "analyse_point",
     "attractors",
+    "boundary_curve",
     "branch_multipliers",
     "branch_summary",
     "continuation",
@@ -44,6 +49,7 @@ __all__ = [
     "lyapunov_spectrum",
     "max_lyapunov",
     "open_branch",
+    "open_curve",
     "periodic_orbit",
     "periodic_orbits",
     "save_branch",

@@ -1,0 +1,341 @@
+"""The front door of two-parameter boundary curves: :func:`boundary_curve`.
+
+The method is in :mod:`gearchaos.dynamics.curves`, the test functions and codimension-2 points
+in :mod:`gearchaos.dynamics.curve_tests`, the file layout in
+:mod:`gearchaos.dynamics.curve_file`.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from collections.abc import Callable, Mapping
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+
+from .._checks import check_bool, check_int, check_real
+from ..errors import IntegrationError, ParameterError, StoreError
+from ..integrate.settings import SolverSettings
+from . import branch_events as ev
+from .arclength import parse_vary
+from .curve_file import RESUMABLE, curve_dataset, open_curve
+from .curve_tests import CURVE_KINDS, TestFunction, grazing_contact
+from .curves import Curve, CurvePoint, CurveSteps, parameter_value
+from .orbits import ORBIT_SETTINGS, check_tol, contact_levels, split_values
+from .shooting import multipliers_of
+
+__all__ = ["boundary_curve"]
+
+
+def boundary_curve(
+    target: Any,
+    event: ev.Event,
+    vary: Any,
+    *,
+    within: Any = None,
+    settings: SolverSettings | None = None,
+    params: Mapping[str, Any] | None = None,
+    step: float | None = None,
+    min_step: float | None = None,
+    max_step: float | None = None,
+    max_points: int = 200,
+    max_corrector: int = 10,
+    tol: float | None = None,
+    at: Any = None,
+    store: str | os.PathLike[str] | None = None,
+    resume: bool = False,
+    overwrite: bool = False,
+    progress: Callable[[int, CurvePoint], None] | None = None,
+    **values_and_settings: Any,
+) -> Any:
+    """Continue a fold, period-doubling, Neimark–Sacker or grazing event in a second parameter.
+
+    Parameters
+    ----------
+    target
+        The gear set or :class:`~gearchaos.model.System` of the branch the event was found on.
+    event
+        An :class:`~gearchaos.dynamics.Event` of kind ``fold``, ``period_doubling``,
+        ``neimark_sacker`` or ``grazing`` (:func:`gearchaos.dynamics.events` of a branch). Its
+        parameter is the curve's first parameter λ₁, its fixed values are kept fixed.
+    vary
+        The second parameter λ₂ and its range, ``"xi=0.02:0.1"`` (as for
+        :func:`~gearchaos.continuation`). The curve starts at the event (λ₂ at its fixed value
+        there, which must lie inside the range) and is followed both ways until it leaves the
+        range.
+    within
+        The range of λ₁ (``"omega=2:5"`` or (lo, hi); default: unbounded, the range of λ₂ sets
+        the arclength's units of λ₁ too).
+    settings, params, **values_and_settings
+        Solver settings and further fixed values, as for :func:`~gearchaos.continuation`
+        (the branch's settings: use the same ones).
+    step, min_step, max_step
+        Arclength steps in units of the ranges (defaults 0.01, 1e-6, 0.02).
+    max_points
+        Most new points per direction (per run: a resumed run adds as many again).
+    max_corrector
+        Chord Newton corrections per point.
+    tol
+        Residual tolerance of ‖Pⁿ(y) − y‖ (default as for periodic orbits: rtol/10).
+    at
+        Values of λ₂ to land on exactly (a point computed there, flagged ``on_grid``): to compare
+        with one-parameter branches at fixed λ₂.
+    store
+        A ``.nc`` (or ``.zarr``) path: the curve is written there, every
+        :data:`CHECKPOINT_EVERY` points too.
+    resume
+        When ``store`` exists: extend its ends that stopped at ``max_points`` or were
+        interrupted (the file must hold a curve of the same event kind, parameters, period
+        and gear set); ends that stopped for good stay.
+    overwrite
+        Replace an existing ``store`` (without ``resume``).
+    progress
+        Called as progress(points so far, point) after every new point.
+
+    Returns
+    -------
+    xarray.Dataset
+        The curve (layout: :mod:`gearchaos.dynamics.curve_file`): per point both parameters,
+        the orbit, its multipliers and the test value; the codimension-2 points met
+        (``event_*``); the stop reason of each end.
+    """
+    from .branch import check_store, save_branch
+
+    if not isinstance(event, ev.Event):
+        raise ParameterError(
+            f"event must be an Event of a branch (gearchaos.dynamics.events(branch)): got "
+            f"{type(event).__name__}"
+        )
+    if event.kind not in CURVE_KINDS:
+        raise ParameterError(
+            f"event kind must be one of {', '.join(CURVE_KINDS)} to continue its boundary: got "
+            f"{event.kind!r}"
+        )
+    name2, a2, b2 = parse_vary(vary)
+    name1 = event.parameter
+    if name2 == name1:
+        raise ParameterError(f"vary must name a second parameter, not the event's {name1}")
+    lo1, hi1 = (-math.inf, math.inf) if within is None else _within(within, name1)
+    check_bool("resume", resume)
+    check_bool("overwrite", overwrite)
+    if store is not None and not (resume and os.path.exists(os.fspath(store))):
+        check_store(store, overwrite)
+    values, cfg = split_values(values_and_settings, settings, params, ORBIT_SETTINGS)
+    fixed = {**event.values, **values}
+    fixed.pop(name1, None)
+    lam2 = float(fixed.pop(name2)) if name2 in fixed else parameter_value(target, name2)
+    lo2, hi2 = min(a2, b2), max(a2, b2)
+    if not lo2 <= lam2 <= hi2:
+        raise ParameterError(
+            f"the event's {name2}={lam2:g} lies outside vary's range [{lo2:g}, {hi2:g}]"
+        )
+    steps = CurveSteps(
+        initial=_pos("step", step, 0.01),
+        minimum=_pos("min_step", min_step, 1e-6),
+        maximum=_pos("max_step", max_step, 0.02),
+        max_points=check_int("max_points", max_points, lo=1, hi=1_000_000),
+        max_corrector=check_int("max_corrector", max_corrector, lo=2, hi=1000),
+    )
+    if not steps.minimum <= steps.initial <= steps.maximum:
+        raise ParameterError(
+            "the steps must satisfy min_step <= step <= max_step: got "
+            f"{steps.minimum:g}, {steps.initial:g}, {steps.maximum:g}"
+        )
+    grid = np.unique(np.asarray([] if at is None else at, dtype=float).reshape(-1))
+    if not np.all(np.isfinite(grid)):
+        raise ParameterError(f"at must be finite values of {name2}: got {at!r}")
+    fn = TestFunction(event.kind)
+    curve = Curve(
+        target, (name1, name2), fixed, cfg, int(event.period), check_tol(tol, cfg), fn,
+        ((lo1, hi1), (lo2, hi2)), steps,
+    )  # fmt: skip
+    y0 = np.asarray(event.state, dtype=float)
+    span1 = hi1 - lo1 if math.isfinite(hi1 - lo1) else max(abs(event.value), 1e-9)
+    curve.scale = np.array(
+        [max(1.0, float(np.max(np.abs(y0)))) * math.sqrt(y0.size)] * y0.size + [span1, hi2 - lo2]
+    )
+    extra = {
+        "vary": f"{name2}={a2:.10g}:{b2:.10g}",
+        "within": "" if within is None else f"{name1}={lo1:.10g}:{hi1:.10g}",
+        "start": f"{event.kind} at {name1}={event.value:.10g} (period {event.period})",
+        "start_value2": lam2,
+    }
+    if store is not None and resume and os.path.exists(os.fspath(store)):
+        backward, forward, reasons = _resume(curve, open_curve(store), extra)
+    else:
+        backward, forward, reasons = _start(curve, event, y0, lam2)
+
+    def save(reason_b: str, reason_f: str) -> Any:
+        for p in backward[1:]:
+            p.s = -abs(p.s)
+        ds = curve_dataset(curve, backward, forward, (reason_b, reason_f), extra)
+        for p in backward[1:]:
+            p.s = abs(p.s)
+        if store is not None:
+            save_branch(ds, store, overwrite=True if (resume or overwrite) else overwrite)
+        return ds
+
+    count = [0]
+    written = [store is None]
+
+    def step_done(q: CurvePoint) -> None:
+        count[0] += 1
+        if progress is not None:
+            progress(count[0], q)
+        if store is not None and count[0] % CHECKPOINT_EVERY == 0:
+            save(*(r if not r.startswith("running") else "interrupted" for r in reasons))
+            written[0] = True
+
+    for k, pts in ((1, forward), (0, backward)):
+        if not reasons[k].startswith((*RESUMABLE, "running")):
+            continue
+        end = pts[-1]
+        shot, _ = curve.shots(end.z[None])  # M and the borders at the end point, then DF
+        if shot is not None and shot.monodromy is not None:
+            fn.adapt(shot.monodromy[0], multipliers_of(shot.monodromy[0]))
+        got = None if shot is None else curve.jacobian(end.z)
+        if got is None:
+            reasons[k] = "the map failed at the end point"
+            continue
+        end.jac, end.monodromy = got[0], got[1].monodromy
+        curve.direction = 1 if k == 1 else -1
+        reasons[k] = "running"
+        reasons[k] = curve.run(pts, grid, step_done)
+    for e in curve.events:
+        if e["direction"] < 0:
+            e["s"] = -abs(e["s"])
+    return save(reasons[0], reasons[1])
+
+
+#: Points between checkpoints of the store.
+CHECKPOINT_EVERY = 20
+
+
+def _start(
+    curve: Curve, event: ev.Event, y0: np.ndarray, lam2: float
+) -> tuple[list[CurvePoint], list[CurvePoint], list[str]]:
+    """The start point (corrected at the event's λ₂) and the two directions' point lists."""
+    z0 = np.append(y0, [event.value, lam2])
+    shot, why = curve.shots(z0[None])
+    if shot is None or shot.monodromy is None:
+        raise IntegrationError(f"the map failed at the event {event!r}: {why}")
+    if event.kind == "grazing":
+        levels = contact_levels(curve.system(event.value, lam2))
+        curve.fn.contact = grazing_contact(levels, shot.obs_min[0], shot.obs_max[0], event.detail)
+    curve.fn.adapt(shot.monodromy[0], multipliers_of(shot.monodromy[0]))
+    e2 = np.zeros(z0.size)
+    e2[-1] = 1.0
+    p0, why = curve.correct(z0, e2, lam2)
+    if p0 is None:
+        raise IntegrationError(
+            f"the {event.kind} curve could not start at {event!r} ({why}); continue the branch "
+            "with a tighter tol or rtol so that the event is located more precisely"
+        )
+    left = curve._left(p0)
+    if left:
+        raise IntegrationError(f"the start point is no {event.kind}: {left}")
+    t = curve.tangent(p0, e2)
+    p0.tangent = t
+    back = replace(p0, tangent=-t)
+    return [back], [p0], ["running", "running"]
+
+
+def _resume(
+    curve: Curve, ds: Any, extra: dict[str, Any]
+) -> tuple[list[CurvePoint], list[CurvePoint], list[str]]:
+    """The point lists of a stored curve, after checking it is the same curve."""
+    want = {
+        "curve_kind": curve.fn.kind,
+        "parameter": curve.names[0],
+        "parameter2": curve.names[1],
+        "period": curve.n,
+        "vary": extra["vary"],
+        "within": extra["within"],
+        "start": extra["start"],
+    }
+    for key, value in want.items():
+        got = ds.attrs.get(key)
+        if str(got) != str(value):
+            raise StoreError(
+                f"cannot resume {ds.encoding.get('source', 'the store')}: its {key} is {got!r}, "
+                f"this run's is {value!r}"
+            )
+    if json.loads(str(ds.attrs.get("fixed", "{}"))) != json.loads(_fixed(curve.fixed)):
+        raise StoreError("cannot resume: the store's fixed values differ from this run's")
+    contact = str(ds.attrs.get("contact", ""))
+    if contact:
+        a, b = contact.split(":")
+        curve.fn.contact = (a, b)
+    curve.scale = np.asarray(json.loads(str(ds.attrs["scale"])), dtype=float)
+    n1, n2 = curve.names
+    mu = np.asarray(ds.multiplier_re.values) + 1j * np.asarray(ds.multiplier_im.values)
+    pts = []
+    for k in range(ds.sizes["point"]):
+        z = np.append(ds.orbit_state.values[k], [ds[n1].values[k], ds[n2].values[k]])
+        pts.append(
+            CurvePoint(
+                z=z, monodromy=np.eye(z.size - 2), mu=mu[k], g=float(ds.test_value.values[k]),
+                residual=float(ds.residual.values[k]), evals=int(ds.iterations.values[k]),
+                sections=np.asarray(ds.orbit_sections.values[k]),
+                obs_min=np.asarray(ds.obs_min.values[k]), obs_max=np.asarray(ds.obs_max.values[k]),
+                tangent=np.asarray(ds.tangent.values[k]), s=abs(float(ds.arclength.values[k])),
+                landed=bool(ds.on_grid.values[k]),
+            )
+        )  # fmt: skip
+    direction = np.asarray(ds.direction.values)
+    k0 = int(np.flatnonzero(direction == 0)[0])
+    forward = pts[k0:]
+    backward = [replace(pts[k0], tangent=-np.asarray(pts[k0].tangent)), *pts[k0 - 1 :: -1]]
+    if k0 == 0:
+        backward = backward[:1]
+    if curve.fn.kind == "neimark_sacker":
+        curve.fn.mu_ref = complex(ds.critical_re.values[-1], ds.critical_im.values[-1])
+    for k in range(ds.sizes.get("event", 0)):
+        p = int(ds.event_point.values[k])
+        s = float(ds.event_arclength.values[k])
+        curve.events.append(
+            {
+                "kind": str(ds.event_kind.values[k]),
+                "z": np.append(ds.event_state.values[k],
+                               [ds.event_value.values[k], ds.event_value2.values[k]]),
+                "s": s,
+                "mu": complex(ds.event_multiplier_re.values[k], ds.event_multiplier_im.values[k]),
+                "located": bool(ds.event_located.values[k]),
+                "uncertainty": (float(ds.event_uncertainty.values[k]),
+                                float(ds.event_uncertainty2.values[k])),
+                "p": pts[p] if 0 <= p < len(pts) else None,
+                "direction": -1 if s < 0 else 1,
+            }
+        )  # fmt: skip
+    reasons = [str(ds.attrs["stop_reason_backward"]), str(ds.attrs["stop_reason_forward"])]
+    return backward, forward, reasons
+
+
+def _fixed(values: Mapping[str, Any]) -> str:
+    from .branch import fixed_json
+
+    return fixed_json(values)
+
+
+def _within(within: Any, name1: str) -> tuple[float, float]:
+    if isinstance(within, str):
+        name, a, b = parse_vary(within)
+        if name != name1:
+            raise ParameterError(f"within must range the event's parameter {name1}: got {name}")
+    elif isinstance(within, tuple | list) and len(within) == 2:
+        a = check_real("within start", within[0])
+        b = check_real("within stop", within[1])
+    else:
+        raise ParameterError(f"within must be '{name1}=LO:HI' or (lo, hi): got {within!r}")
+    if a == b:
+        raise ParameterError(f"within's ends must differ: got {a!r} and {b!r}")
+    return min(a, b), max(a, b)
+
+
+def _pos(name: str, value: float | None, default: float) -> float:
+    if value is None:
+        return default
+    return check_real(name, value, lo=0.0, lo_open=True)

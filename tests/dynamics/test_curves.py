@@ -1,0 +1,179 @@
+"""Two-parameter boundary curves (gearchaos.boundary_curve) against independent truth.
+
+* The fold curve of the single-mesh backlash oscillator in (Ω, ε) passes through the folds that
+  a scipy shooting solver finds at fixed ε: solve_ivp (DOP853, rtol 1e-12, stopped at every
+  kink of the dead zone) for the map and its monodromy (variational equations), and
+  scipy.optimize.fsolve on (P(y) − y, det(DP(y) − I)) in (y, Ω) — the project's own code
+  only supplies the starting guess, which fsolve moves by its own equations.
+* From one fold, the fold curve in (Ω, ζ) turns at a cusp and comes back as the other fold of
+  the branch (both folds of the one-parameter continuation at ζ = 0.05).
+* A period-doubling curve of the planetary model in (Ω, ξ) passes through the period doublings
+  of one-parameter continuations at three fixed ξ, within their location uncertainties.
+* The curve file round-trips, refuses a different curve on resume and extends on resume.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+from scipy.optimize import fsolve
+
+import gearchaos as gc
+from gearchaos.dynamics.boundary import boundary_curve
+from gearchaos.dynamics.branch_events import events
+from gearchaos.dynamics.curve_file import open_curve
+
+ZETA, B, FM, FA = 0.05, 1.0, 0.1, 0.1
+TIGHT = {"rtol": 1e-10, "atol": 1e-12}
+
+
+def _rhs(omega: float, eps: float):
+    def f(t, u):
+        x, v = u[0], u[1]
+        c = np.cos(omega * t)
+        k = 1.0 + eps * c
+        fz = x - B if x > B else (x + B if x < -B else 0.0)
+        df = 1.0 if abs(x) > B else 0.0
+        out = [v, FM + FA * omega**2 * c - 2 * ZETA * v - k * fz]
+        # variational equations of the 2x2 fundamental matrix (column-major in u[2:])
+        phi = u[2:].reshape(2, 2, order="F")
+        a = np.array([[0.0, 1.0], [-k * df, -2 * ZETA]])
+        return np.concatenate([out, (a @ phi).ravel(order="F")])
+
+    return f
+
+
+def scipy_map(y: np.ndarray, omega: float, eps: float) -> tuple[np.ndarray, np.ndarray]:
+    """P(y) and DP(y) over one forcing period from τ = 0, integrating from kink to kink."""
+    T = 2 * np.pi / omega
+    u = np.concatenate([y, np.eye(2).ravel(order="F")])
+    t = 0.0
+    f = _rhs(omega, eps)
+
+    def hit_hi(t, u):
+        return u[0] - B
+
+    def hit_lo(t, u):
+        return u[0] + B
+
+    for ev in (hit_hi, hit_lo):
+        ev.terminal = True
+    while t < T:
+        sol = solve_ivp(
+            f, (t, T), u, method="DOP853", rtol=1e-12, atol=1e-13, events=(hit_hi, hit_lo)
+        )
+        u = sol.y[:, -1]
+        t_new = sol.t[-1]
+        if sol.status == 1:  # a kink: step just across it (the field is continuous there)
+            t_new = min(T, t_new + 1e-12)
+            u = u + 1e-12 * f(sol.t[-1], u)
+        t = t_new
+    return u[:2], u[2:].reshape(2, 2, order="F")
+
+
+def scipy_fold(guess_y: np.ndarray, guess_omega: float, eps: float) -> float:
+    def eqs(w):
+        y, om = w[:2], w[2]
+        p, m = scipy_map(y, om, eps)
+        return np.append(p - y, np.linalg.det(m - np.eye(2)))
+
+    w, _info, ok, msg = fsolve(eqs, np.append(guess_y, guess_omega), xtol=1e-12, full_output=True)
+    assert ok == 1, msg
+    assert np.max(np.abs(eqs(w))) < 1e-9
+    return float(w[2])
+
+
+@pytest.fixture(scope="module")
+def folds():
+    system = gc.backlash_oscillator(0.5, zeta=ZETA, b=B, f_mean=FM, f_alt=FA)
+    ds = gc.continuation(system, "omega=0.5:1.6", **TIGHT)
+    found = sorted((e for e in events(ds) if e.kind == "fold"), key=lambda e: -e.value)
+    assert len(found) == 2, found
+    return system, found
+
+
+def test_fold_curve_passes_through_scipy_folds_at_fixed_eps(folds) -> None:
+    system, (upper, _) = folds
+    at = [0.1, 0.3]
+    curve = boundary_curve(system, upper, "eps=0:0.4", at=at, **TIGHT)
+    assert curve.attrs["curve_kind"] == "fold"
+    assert "reached the range end eps=0.4" in curve.attrs["stop_reason_forward"]
+    assert np.all(curve.residual.values <= curve.attrs["tol"])
+    crit = curve.critical_re.values + 1j * curve.critical_im.values
+    assert np.all(np.abs(crit - 1.0) < 1e-3)
+    for eps in at:
+        (k,) = np.flatnonzero((curve.on_grid.values == 1) & np.isclose(curve.eps.values, eps))
+        om = float(curve.omega.values[k])
+        # scipy starts 1e-3 away in Ω; fsolve finds the fold by its own equations
+        truth = scipy_fold(curve.orbit_state.values[k], om - 1e-3, eps)
+        assert abs(om - truth) < 1e-6, (eps, om, truth)
+    # the fold moves: at ε = 0.3 it is far from the ε = 0 value (not a constant curve)
+    assert abs(truth - upper.value) > 0.05
+
+
+def test_fold_curve_in_zeta_turns_at_a_cusp_into_the_other_fold(folds) -> None:
+    system, (upper, lower) = folds
+    curve = boundary_curve(system, upper, "zeta=0.05:0.5", within="omega=0.3:1.2", **TIGHT)
+    kinds = list(curve.event_kind.values)
+    assert kinds == ["cusp"], kinds
+    # at the cusp ζ is largest along the curve; both ends are back at ζ = 0.05
+    zc = float(curve.event_value2.values[0])
+    assert zc >= curve.zeta.values.max() - float(curve.event_uncertainty2.values[0]) - 1e-9
+    ends = curve.omega.values[[0, -1]]
+    assert np.allclose(curve.zeta.values[[0, -1]], 0.05)
+    assert np.isclose(ends[0], upper.value, atol=1e-8)
+    assert abs(ends[-1] - lower.value) < 1e-6, (ends, lower)
+
+
+def test_curve_file_round_trip_resume_and_refusal(folds, tmp_path) -> None:
+    system, (upper, _) = folds
+    path = tmp_path / "curve.nc"
+    first = boundary_curve(system, upper, "eps=0:0.4", max_points=5, store=path, **TIGHT)
+    assert first.attrs["stop_reason_forward"].startswith("max_points")
+    back = open_curve(path)
+    assert np.array_equal(back.omega.values, first.omega.values)
+    for key in ("gearset_toml", "version", "rtol", "parameter2", "fixed"):
+        assert key in back.attrs or key == "gearset_toml"
+    with pytest.raises(gc.StoreError, match="exists"):
+        boundary_curve(system, upper, "eps=0:0.4", max_points=5, store=path, **TIGHT)
+    with pytest.raises(gc.StoreError, match="vary"):
+        boundary_curve(system, upper, "eps=0:0.3", store=path, resume=True, **TIGHT)
+    more = boundary_curve(system, upper, "eps=0:0.4", store=path, resume=True, **TIGHT)
+    assert more.sizes["point"] > first.sizes["point"]
+    assert "reached the range end eps=0.4" in more.attrs["stop_reason_forward"]
+    # the resumed curve starts with the stored points
+    n = first.sizes["point"]
+    assert np.allclose(more.omega.values[:n], first.omega.values)
+    with pytest.raises(gc.ParameterError, match="event kind"):
+        bp = type(upper)(**{**upper.__dict__, "kind": "branch_point"})
+        boundary_curve(system, bp, "eps=0:0.4")
+    with pytest.raises(gc.ParameterError, match="outside"):
+        boundary_curve(system, upper, "eps=0.1:0.4")
+
+
+def test_planetary_period_doubling_curve_matches_one_parameter_branches() -> None:
+    gs = gc.preset("sheng2016")
+    branch = gc.continuation(gs, "omega=3.3:3.45", max_step=0.01)
+    (pd,) = [e for e in events(branch) if e.kind == "period_doubling"]
+    # sheng2016 has ξ = 0.03; its period-doubling tongue closes near ξ = 0.032, so every ξ
+    # below crosses the curve twice (both sides of the tongue)
+    at = [0.015, 0.02, 0.025]
+    curve = boundary_curve(gs, pd, "xi=0.01:0.05", within="omega=3:4", at=at)
+    assert curve.attrs["curve_kind"] == "period_doubling"
+    crit = curve.critical_re.values + 1j * curve.critical_im.values
+    assert np.all(np.abs(crit + 1.0) < 1e-3)
+    assert curve.xi.values.max() < 0.035  # the tongue closes
+    checked = 0
+    for xi in at:
+        landed = np.flatnonzero((curve.on_grid.values == 1) & np.isclose(curve.xi.values, xi))
+        assert landed.size == 2, (xi, curve.xi.values[curve.on_grid.values == 1])
+        for k in landed:
+            om = float(curve.omega.values[k])
+            one = gc.continuation(gs, f"omega={om - 0.03}:{om + 0.03}", xi=xi, max_step=0.01)
+            pds = [e for e in events(one) if e.kind == "period_doubling"]
+            assert pds, (xi, om)
+            e = min(pds, key=lambda e: abs(e.value - om))
+            assert abs(e.value - om) <= max(e.uncertainty, 1e-7) + 1e-7, (xi, om, e)
+            checked += 1
+    assert checked == 6
