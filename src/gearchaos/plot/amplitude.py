@@ -170,7 +170,7 @@ def amplitude_figure(
     x = np.asarray(sd[xname].values, dtype=float)
     directions = list(sd["direction"].values) if "direction" in sd.dims else [None]
     labelled = "motion" in sd.data_vars
-    fig = Figure(figsize=figsize or (7.5, 5.6 if labelled else 5.0), layout="constrained")
+    fig = Figure(figsize=figsize or (10.0, 5.6 if labelled else 5.0), layout="constrained")
     if labelled:
         grid = fig.add_gridspec(2, 1, height_ratios=[1.0, 0.1 * len(directions) + 0.02])
         ax = fig.add_subplot(grid[0, 0])
@@ -223,7 +223,13 @@ def amplitude_figure(
         rpm = scales.factor("omega")
         if rpm is not None:
             linear_axis(ax, "x", rpm[0], rpm[1])
-    ax.legend(fontsize="x-small", loc="best")
+    # beside the axes: folds, jumps and resonance peaks fill every corner of the curves
+    ax.legend(
+        fontsize="x-small",
+        loc="upper left",
+        bbox_to_anchor=(1.12 if found else 1.02, 1.0),
+        borderaxespad=0.0,
+    )
     bottom = ax
     if band is not None:
         limits = ax.get_xlim()
