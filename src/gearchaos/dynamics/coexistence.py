@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from .._checks import check_int, check_real
+from ..errors import ParameterError
 from ..integrate._chains import ChainRun, run_chains
 from ..integrate.settings import SolverSettings
 from ..model.target import resolve
@@ -162,6 +163,24 @@ def _starts(system: Any, cfg: SolverSettings, k: int, seed: int) -> np.ndarray:
     return y0
 
 
+def _given_starts(initial_states: Any, n: int) -> np.ndarray:
+    """``initial_states`` as a finite (K, n) array, else a ParameterError naming it."""
+    try:
+        y0 = np.array(initial_states, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ParameterError(
+            f"initial_states must be an array of shape (K, {n}): got "
+            f"{type(initial_states).__name__}"
+        ) from None
+    if y0.ndim != 2 or y0.shape[1] != n or not 1 <= y0.shape[0] <= 10_000:
+        raise ParameterError(
+            f"initial_states must have shape (K, {n}) with 1 <= K <= 10000: got {y0.shape}"
+        )
+    if not np.all(np.isfinite(y0)):
+        raise ParameterError("initial_states must be finite: got NaN or inf")
+    return y0
+
+
 def _same_periodic(a: np.ndarray, b: np.ndarray, tol: float) -> bool:
     d = np.max(np.abs(a[:, None, :] - b[None, :, :]), axis=2)
     return bool(np.all(d.min(axis=1) <= tol) and np.all(d.min(axis=0) <= tol))
@@ -186,6 +205,7 @@ def attractors(
     params: Mapping[str, Any] | None = None,
     tol: float = 1e-4,
     spread_fraction: float = 0.25,
+    initial_states: Any = None,
     **values_and_settings: Any,
 ) -> list[Attractor]:
     """Distinct attractors at one operating point, from several initial conditions.
@@ -209,6 +229,10 @@ def attractors(
     spread_fraction
         Two non-periodic runs with one label are one attractor when the quantiles of their
         section sets agree to this fraction of their extent.
+    initial_states
+        (K, n_state) explicit starts instead of the rest start and the random ones (``starts``
+        and ``seed`` are then unused); the basins of :mod:`gearchaos.dynamics.basins` find
+        their catalogue of attractors from a sample of their own starts this way.
 
     Returns
     -------
@@ -226,7 +250,11 @@ def attractors(
     values, cfg = split_values(values_and_settings, settings, params, ATTRACTOR_SETTINGS)
     cfg = cfg.replace(samples_per_period=1)
     system = resolve(target, values)
-    y0 = _starts(system, cfg, k, seed)
+    if initial_states is None:
+        y0 = _starts(system, cfg, k, seed)
+    else:
+        y0 = _given_starts(initial_states, system.n_state)
+        k = y0.shape[0]
     run = ChainRun.from_systems([[system]] * k, cfg, y0=y0)
     out = run_chains(run)
     m = system.n_state

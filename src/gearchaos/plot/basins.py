@@ -1,0 +1,267 @@
+"""Basin images and basin fractions (stores of :mod:`gearchaos.sweep.basins`).
+
+* :func:`basin_image` — the 2-D slice of initial states, each cell coloured by the attractor
+  its start reaches, with every attractor's section points overlaid (its projection on the
+  slice's two coordinates) and a legend naming each attractor with its evidence
+  (``1T (x ≈ 1.13, |μ| 0.52)``, ``chaos (λ₁ 0.071)``);
+* :func:`fraction_curves` — across the parameter, the fraction of starts ending on each
+  attractor (followed as a track), with its confidence band;
+* :func:`basins_figure` — either as a figure, for ``gearchaos plot``.
+
+An attractor's colour is the regime palette's colour of its label
+(:data:`~gearchaos.plot.regimes.REGIME_COLOURS`), so a 1T basin is the blue of a 1T region
+of a regime map; a second (third …) attractor of the same label gets a darker (lighter)
+shade of it. Failed starts are black, starts not computed white.
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError
+from ._common import _generic_symbol, axis_label, edges, get_ax
+from .regimes import regime_colour
+from .units import PhysicalScales, linear_axis, var_quantity
+
+__all__ = ["attractor_colours", "basin_image", "basins_figure", "fraction_curves"]
+
+#: gid of the overlaid section points.
+SECTION_GID = "basin-attractor"
+_SHADES = (0.0, -0.35, 0.45, -0.6, 0.7)
+
+
+def _shade(colour: Any, amount: float) -> tuple[float, float, float]:
+    """``colour`` mixed with black (amount < 0) or white (amount > 0)."""
+    from matplotlib.colors import to_rgb
+
+    rgb = np.array(to_rgb(colour))
+    mixed = rgb * (1 + amount) if amount < 0 else rgb + (1 - rgb) * amount
+    r, g, b = (float(v) for v in np.clip(mixed, 0.0, 1.0))
+    return r, g, b
+
+
+def attractor_colours(labels: list[str]) -> list[tuple[float, float, float]]:
+    """One colour per attractor: its label's palette colour, shaded for repeats."""
+    seen: dict[str, int] = {}
+    out = []
+    for lab in labels:
+        k = seen.get(lab, 0)
+        seen[lab] = k + 1
+        out.append(_shade(regime_colour(lab), _SHADES[k % len(_SHADES)]))
+    return out
+
+
+def _symbol(name: str, attrs: Any) -> str:
+    """Mathtext label of a state: the planetary model's symbols, else the generic form."""
+    if attrs.get("model") == "planetary":
+        from ._common import var_symbol
+
+        return f"${var_symbol(name, None)}$"
+    return f"${_generic_symbol(name)}$"
+
+
+def _scales(attrs: Any) -> PhysicalScales:
+    length, omega_n = attrs.get("characteristic_length_m"), attrs.get("omega_n_rad_s")
+    rpm = None
+    if attrs.get("gearset_toml"):
+        from ..gearset import GearSet
+
+        rpm = GearSet.from_toml_string(attrs["gearset_toml"]).sun_speed_rpm(1.0)
+    return PhysicalScales(length_m=length, omega_n=omega_n, rpm_per_omega=rpm)
+
+
+def _physical(ax: Any, axis: str, name: str, attrs: Any) -> None:
+    q = "omega" if name == "omega" else var_quantity(name)
+    found = None if q is None else _scales(attrs).factor(q)
+    if found is not None:
+        label = found[1] if q == "omega" else f"{name} {found[1]}"
+        linear_axis(ax, axis, found[0], label)
+
+
+def _catalogue(ds: Any, group: int = 0) -> list[dict[str, Any]]:
+    text = ds.attrs.get("attractors")
+    if not isinstance(text, str):
+        raise ParameterError(
+            "the basin store has no attractor legend yet (an interrupted computation): run it "
+            "again to finish it"
+        )
+    entries: list[dict[str, Any]] = json.loads(text)[str(group)]["entries"]
+    return entries
+
+
+def _legend_text(e: dict[str, Any], name: str, column: int) -> str:
+    from ..dynamics.basins import BasinAttractor
+
+    return BasinAttractor.from_record(e).legend(name, column)
+
+
+def basin_image(ds: Any, ax: Any = None, *, points: bool = True) -> Any:
+    """Draw a ``basins`` store on ``ax`` (see the module docstring); return the Axes."""
+    from matplotlib.colors import ListedColormap
+    from matplotlib.patches import Patch
+
+    if ds.attrs.get("kind") != "basins":
+        raise ParameterError(f"basin_image needs a basins store: got kind {ds.attrs.get('kind')!r}")
+    ax = get_ax(ax)
+    yname, xname = ds.attrs["dims"]
+    entries = _catalogue(ds)
+    codes = np.asarray(ds["attractor"].values)
+    labels = [str(e["label"]) for e in entries]
+    colours = [
+        (0.0, 0.0, 0.0),
+        (1.0, 1.0, 1.0),
+        *attractor_colours(labels),
+    ]  # -2 failed, -1 not run, 0 …
+    cmap = ListedColormap(colours)
+    x, y = np.asarray(ds[xname].values), np.asarray(ds[yname].values)
+    ax.pcolormesh(
+        edges(x),
+        edges(y),
+        codes + 2,
+        cmap=cmap,
+        vmin=-0.5,
+        vmax=len(colours) - 0.5,
+        shading="flat",
+        rasterized=True,
+    )
+    names = list(np.asarray(ds["state"].values).astype(str))
+    ix, iy = names.index(xname), names.index(yname)
+    handles = []
+    present = set(np.unique(codes).tolist())
+    for k, e in enumerate(entries):
+        if k not in present:
+            continue
+        col = colours[k + 2]
+        frac = float(np.mean(codes == k))
+        handles.append(
+            Patch(
+                facecolor=col,
+                edgecolor="0.3",
+                linewidth=0.5,
+                label=f"{_legend_text(e, xname, ix)}: {100 * frac:.3g} %",
+            )
+        )
+        if points:
+            pts = np.asarray(e["section_states"], dtype=float)
+            ax.plot(
+                pts[:, ix],
+                pts[:, iy],
+                ls="none",
+                marker="o" if e["period"] else ".",
+                ms=6 if e["period"] else 2,
+                mfc=_shade(col, -0.5) if e["period"] else "k",
+                mec="white",
+                mew=1.0 if e["period"] else 0.0,
+                gid=SECTION_GID,
+                zorder=3,
+            )
+    for code, name, col in ((-2, "failed", (0, 0, 0)), (-1, "not run", (1, 1, 1))):
+        if code in present:
+            frac = float(np.mean(codes == code))
+            handles.append(
+                Patch(facecolor=col, edgecolor="0.3", label=f"{name}: {100 * frac:.3g} %")
+            )
+    ax.set_xlim(edges(x)[[0, -1]])
+    ax.set_ylim(edges(y)[[0, -1]])
+    ax.set_xlabel(_symbol(xname, ds.attrs))
+    ax.set_ylabel(_symbol(yname, ds.attrs))
+    _physical(ax, "x", xname, ds.attrs)
+    _physical(ax, "y", yname, ds.attrs)
+    ax.legend(
+        handles=handles,
+        title="attractor (basin share)",
+        fontsize="small",
+        title_fontsize="small",
+        loc="upper left",
+        bbox_to_anchor=(1.02 if not _has_right_axis(ds, yname) else 1.18, 1.0),
+        borderaxespad=0.0,
+    )
+    return ax
+
+
+def _has_right_axis(ds: Any, yname: str) -> bool:
+    q = var_quantity(yname)
+    return q is not None and _scales(ds.attrs).factor(q) is not None
+
+
+def fraction_curves(ds: Any, ax: Any = None, *, confidence: float = 0.95) -> Any:
+    """Draw the basin fractions of a ``basin_fractions`` store (one line per attractor
+    track, its Wilson band at ``confidence``); return the Axes."""
+    from ..sweep.basin_fractions import fractions
+
+    ax = get_ax(ax)
+    fr = fractions(ds, confidence=confidence)
+    param = ds.attrs["dims"][0]
+    p = np.asarray(fr[param].values, dtype=float)
+    labels = [str(v) for v in fr["track_label"].values]
+    colours = attractor_colours(labels)
+    for j, t in enumerate(np.asarray(fr["track"].values)):
+        col = (0.0, 0.0, 0.0) if t == -2 else colours[j]
+        there = np.asarray(fr["present"].values[:, j])  # drawn where the attractor exists
+        f = np.where(there, fr["fraction"].values[:, j], np.nan)
+        lo = np.where(there, fr["fraction_low"].values[:, j], np.nan)
+        hi = np.where(there, fr["fraction_high"].values[:, j], np.nan)
+        name = "failed" if t == -2 else f"{fr['track_legend'].values[j]}"
+        ax.fill_between(p, lo, hi, color=col, alpha=0.2, lw=0)
+        ax.errorbar(
+            p, f, yerr=[f - lo, hi - f], color=col, marker="o", ms=3, capsize=2, lw=1.2,
+            elinewidth=0.8, label=name,
+        )  # fmt: skip
+    ax.set_ylim(-0.02, 1.02)
+    if p.size > 1:  # a margin: the end points and their intervals stay visible
+        pad = 0.03 * (p.max() - p.min())
+        ax.set_xlim(p.min() - pad, p.max() + pad)
+    ax.set_xlabel(_parameter_label(param))
+    n = int(ds.sizes["start"])
+    ax.set_ylabel(f"fraction of {n} starts")
+    _physical(ax, "x", param, ds.attrs)
+    ax.legend(
+        title=f"attractor ({100 * confidence:g} % Wilson band)",
+        fontsize="small",
+        title_fontsize="small",
+        loc="upper left",
+        bbox_to_anchor=(1.02, 1.0),
+        borderaxespad=0.0,
+    )
+    return ax
+
+
+_GREEK = {k: "\\" + k for k in ("alpha", "beta", "gamma", "delta", "zeta", "sigma", "rho")}
+
+
+def _parameter_label(name: str) -> str:
+    """The registry's label of a parameter; a Greek-letter name of a reference system as
+    its letter."""
+    label = axis_label(name)
+    return f"${_GREEK[name]}$" if label == name and name in _GREEK else label
+
+
+def basins_figure(ds: Any) -> Any:
+    """A figure of a basin store: the image of a ``basins`` store, the fraction curves of a
+    ``basin_fractions`` store; the title says the model and the operating point."""
+    import matplotlib.pyplot as plt
+
+    kind = ds.attrs.get("kind")
+    fig, ax = plt.subplots(figsize=(8.4, 5.2), layout="constrained")
+    spec = json.loads(ds.attrs["basin_spec"])
+    if "omega" not in spec["values"] and "omega" in ds.attrs and ds.attrs["dims"][0] != "omega":
+        spec["values"] = {"Ω": float(ds.attrs["omega"]), **spec["values"]}
+    point = ", ".join(
+        f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}" for k, v in spec["values"].items()
+    )
+    if kind == "basins":
+        basin_image(ds, ax)
+        title = f"basins of attraction, {ds.attrs['model']}" + (f" at {point}" if point else "")
+        n = ds["attractor"].size
+        title += f" ({n} starts, {ds.attrs['transient_periods']:g} + {ds.attrs['periods']} periods)"
+    elif kind == "basin_fractions":
+        fraction_curves(ds, ax)
+        title = f"basin fractions, {ds.attrs['model']}" + (f" at {point}" if point else "")
+    else:
+        plt.close(fig)
+        raise ParameterError(f"not a basin store: kind {kind!r}")
+    ax.set_title(title, fontsize="medium")
+    return fig
