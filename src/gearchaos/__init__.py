@@ -42,6 +42,8 @@ __all__ = [
     "__version__",
     "attractors",
     "backlash_oscillator",
+    "basin_fractions",
+    "basins",
     "bifurcation",
     "boundary_curve",
     "continuation",
@@ -78,6 +80,8 @@ if TYPE_CHECKING:
     from .dynamics.orbit_batch import periodic_orbits
     from .dynamics.orbits import PeriodicOrbit, periodic_orbit
     from .explore import explore
+    from .sweep.basin_fractions import basin_fractions
+    from .sweep.basins import basins
 
 _LAZY_SUBPACKAGES = ("analysis", "dynamics", "plot", "paper", "explore")
 #: Functions of the lazy subpackages exported here, by the module that defines them.
@@ -94,6 +98,8 @@ _LAZY_ATTRIBUTES = {
     "max_lyapunov": "dynamics.lyapunov",
     "periodic_orbits": "dynamics.orbit_batch",
     "attractors": "dynamics.coexistence",
+    "basins": "sweep.basins",
+    "basin_fractions": "sweep.basin_fractions",
 }
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 from typing import Annotated, Any
@@ -299,6 +300,33 @@ def _is_branch(path: Path) -> bool:
     return path.is_dir() and (path / MANIFEST).is_file()
 
 
+def _is_basin_store(path: Path) -> bool:
+    """Whether ``path`` is a store of `gearchaos basins` or `basin-fractions`."""
+    from ..sweep._basin_store import KINDS
+
+    try:
+        attrs = json.loads((path / ".zattrs").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return False
+    return isinstance(attrs, dict) and attrs.get("kind") in KINDS
+
+
+def _plot_basins(store: Path, output: Path, **unused: Any) -> None:
+    """Draw a basin store (image, or fractions across the parameter)."""
+    from ..plot import savefig
+    from ..plot.basins import basins_figure
+    from ..sweep._basin_store import open_basins
+
+    given = [f"--{k}" for k, v in unused.items() if v not in (None, False, [])]
+    if given:
+        raise ParameterError(f"{', '.join(given)} do(es) not apply to the basin store {store}")
+    fig = basins_figure(open_basins(store))
+    if output.parent != Path(""):
+        output.parent.mkdir(parents=True, exist_ok=True)
+    savefig(fig, output)
+    c.wrote(output)
+
+
 @c.app.command()
 def plot(
     stores: Annotated[
@@ -416,6 +444,9 @@ def plot(
                 "--branch BRANCH.nc"
             )
         store = stores[0]
+        if _is_basin_store(store):
+            _plot_basins(store, output, var=var, planet=planet, branch=branch, sections=sections)
+            return
         res = open_store(store)
         branches = [br for b in branch or [] for br in open_cascade(b)]
         response = res.ds.attrs.get("kind") == "response"
