@@ -1,0 +1,167 @@
+"""Basins of attraction against systems whose basins are known exactly.
+
+* A damped, forced linear oscillator has one attractor: its image is one colour, the orbit's
+  section point is the exact steady state and |μ| = exp(−ζT).
+* The unforced twin-well Duffing oscillator x'' + δx' − x + x³ = 0 has two stable equilibria
+  x = ±1 (|μ| = exp(−δT/2) of the period T the sections are taken at). The energy
+  E = x'²/2 − x²/2 + x⁴/4 decreases along every motion and is ≥ 0 on x = 0, so a start with
+  E < 0 stays in its own well; the system is odd (x ↦ −x), so the start −p reaches the other
+  well than p, and a box symmetric about the origin splits exactly 1/2 : 1/2.
+* Forced twin well (small forcing): each start's attractor agrees with an independent scipy
+  DOP853 integration.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+import gearchaos as gc
+from gearchaos.analysis.fractions import wilson_interval
+from gearchaos.dynamics.basins import FAILED, BasinAttractor, Catalogue, link_tracks
+
+SHORT = {"transient_periods": 60, "periods": 8, "progress": False}
+
+
+def entries(ds):
+    return [
+        BasinAttractor.from_record(e) for e in json.loads(ds.attrs["attractors"])["0"]["entries"]
+    ]
+
+
+def test_linear_oscillator_has_one_attractor_everywhere():
+    omega, zeta, force = 1.3, 0.1, 0.5
+    system = gc.linear_oscillator(omega, zeta=zeta, force=force)
+    names = system.state_names
+    ds = gc.basins(system, f"{names[0]}=-3:3:7", f"{names[1]}=-3:3:6", **SHORT)
+    codes = ds["attractor"].values
+    assert codes.shape == (6, 7)
+    assert np.all(codes == 0)
+    (a,) = entries(ds)
+    assert a.label == "1T"
+    T = 2 * math.pi / omega
+    assert a.max_multiplier == pytest.approx(math.exp(-zeta * T), rel=1e-6)
+    X = force / (1 - omega**2 + 2j * zeta * omega)  # x = Re(X e^{iΩt}) at t = kT
+    np.testing.assert_allclose(a.section_states[0], [X.real, -omega * X.imag], atol=1e-6)
+    assert set(ds["label"].values.ravel()) == {"1T"}
+
+
+@pytest.fixture(scope="module")
+def twin_well():
+    delta, omega = 0.3, 1.0
+    system = gc.duffing(omega, delta=delta, alpha=-1.0, beta=1.0, gamma=0.0)
+    ds = gc.basins(system, "x=-1.9:1.9:16", "x_dot=-1.9:1.9:16", **SHORT)
+    return system, ds, delta, omega
+
+
+def test_twin_well_attractors_are_the_two_equilibria(twin_well):
+    _, ds, delta, omega = twin_well
+    found = sorted(entries(ds), key=lambda a: a.section_states[0, 0])
+    assert [a.label for a in found] == ["1T", "1T"]
+    np.testing.assert_allclose(found[0].section_states[0], [-1.0, 0.0], atol=1e-6)
+    np.testing.assert_allclose(found[1].section_states[0], [1.0, 0.0], atol=1e-6)
+    T = 2 * math.pi / omega
+    for a in found:  # linearisation x'' + δx' + 2x = 0: a complex pair, |μ| = exp(−δT/2)
+        assert a.max_multiplier == pytest.approx(math.exp(-0.5 * delta * T), rel=1e-5)
+
+
+def test_twin_well_starts_below_the_barrier_stay_in_their_well(twin_well):
+    _, ds, *_ = twin_well
+    x, v = np.meshgrid(ds["x"].values, ds["x_dot"].values)
+    energy = 0.5 * v**2 - 0.5 * x**2 + 0.25 * x**4
+    codes = ds["attractor"].values
+    where = {int(np.sign(a.section_states[0, 0])): k for k, a in enumerate(entries(ds))}
+    inside = energy < 0
+    assert inside.sum() > 20
+    assert np.all(codes[inside & (x > 0)] == where[1])
+    assert np.all(codes[inside & (x < 0)] == where[-1])
+
+
+def test_twin_well_image_is_odd_and_splits_in_half(twin_well):
+    _, ds, *_ = twin_well
+    codes = ds["attractor"].values
+    assert not np.any(codes == FAILED)
+    flipped = codes[::-1, ::-1]  # the grid is symmetric about the origin
+    assert np.all(codes != flipped)
+    assert np.mean(codes == 0) == 0.5
+
+
+@pytest.mark.slow
+def test_forced_twin_well_agrees_with_scipy():
+    from scipy.integrate import solve_ivp
+
+    delta, gamma, omega = 0.25, 0.1, 1.2
+    system = gc.duffing(omega, delta=delta, alpha=-1.0, beta=1.0, gamma=gamma)
+    ds = gc.basins(system, "x=-1.5:1.5:3", "x_dot=-1.5:1.5:3", transient_periods=100, periods=8,
+                   rtol=1e-10, atol=1e-10, progress=False)  # fmt: skip
+    found = entries(ds)
+    T = 2 * math.pi / omega
+
+    def rhs(t, y):
+        return [y[1], -delta * y[1] + y[0] - y[0] ** 3 + gamma * math.cos(omega * t)]
+
+    for i, v0 in enumerate(ds["x_dot"].values):
+        for j, x0 in enumerate(ds["x"].values):
+            sol = solve_ivp(rhs, (0, 108 * T), [x0, v0], method="DOP853", rtol=1e-10, atol=1e-10,
+                            t_eval=[108 * T])  # fmt: skip
+            end = sol.y[:, -1]
+            d = [np.min(np.max(np.abs(a.section_states - end), axis=1)) for a in found]
+            assert int(np.argmin(d)) == ds["attractor"].values[i, j]
+            assert min(d) < 1e-4
+
+
+def test_wilson_interval_known_values_and_coverage():
+    lo, hi = wilson_interval(5, 10)
+    assert (float(lo), float(hi)) == pytest.approx((0.2366, 0.7634), abs=1e-4)
+    lo, hi = wilson_interval(0, 10)
+    assert (float(lo), float(hi)) == pytest.approx((0.0, 0.2775), abs=1e-4)
+    lo, hi = wilson_interval(10, 10)
+    assert float(hi) == 1.0 and float(lo) == pytest.approx(10 / (10 + 1.959964**2), rel=1e-6)
+    # coverage of the true fraction over many binomial samples is close to 95 %
+    rng = np.random.default_rng(1)
+    p, n = 0.3, 50
+    k = rng.binomial(n, p, 4000)
+    lo, hi = wilson_interval(k, n)
+    cover = np.mean((lo <= p) & (p <= hi))
+    assert 0.93 <= cover <= 0.97
+
+
+def test_fractions_cover_the_exact_values():
+    system = gc.duffing(1.0, delta=0.3, alpha=-1.0, beta=1.0, gamma=0.0)
+    # a symmetric box: each well holds exactly half (the odd symmetry), at each damping
+    ds = gc.basin_fractions(system, "delta=0.3,0.5", starts=120, box={"x": (-1.8, 1.8),
+                            "x_dot": (-1.8, 1.8)}, **SHORT)  # fmt: skip
+    assert ds["fraction"].shape == (2, 2)
+    assert np.all(ds["track_label"].values == "1T")
+    assert np.all(ds["present"].values)  # the two wells are followed as two tracks
+    np.testing.assert_allclose(ds["fraction"].values.sum(axis=1), 1.0)
+    assert np.all(ds["fraction_low"].values <= 0.5) and np.all(0.5 <= ds["fraction_high"].values)
+    # below the barrier on the right: every start ends right, fraction exactly 1
+    right = gc.basin_fractions(system, "delta=0.3", starts=60, box={"x": (0.4, 1.3),
+                               "x_dot": (-0.25, 0.25)}, **SHORT)  # fmt: skip
+    assert right["fraction"].values.tolist() == [[1.0]]
+    assert right["fraction_low"].values[0, 0] < 1.0 == right["fraction_high"].values[0, 0]
+
+
+def test_tracks_link_the_nearest_attractor_of_the_same_label():
+    def cat(*points, label="1T"):
+        e = [BasinAttractor(label, 1, -0.1, 0.5, "floquet", np.array([p], float)) for p in points]
+        return Catalogue(e, np.ones(2))
+
+    tracks = link_tracks([cat([1, 0], [-1, 0]), cat([-0.95, 0], [1.02, 0]), cat([3, 3])])
+    assert tracks == [[0, 1], [1, 0], [2]]
+
+
+def test_errors_name_the_argument():
+    system = gc.duffing(1.0, alpha=-1.0, gamma=0.0)
+    with pytest.raises(gc.ParameterError, match=r"x must name a state .*x, x_dot.*'q'"):
+        gc.basins(system, "q=0:1:3", "x_dot=0:1:3", progress=False)
+    with pytest.raises(gc.ParameterError, match="two different states"):
+        gc.basins(system, "x=0:1:3", "x=0:1:3", progress=False)
+    with pytest.raises(gc.ParameterError, match="base_state names an unknown state 'z'"):
+        gc.basins(system, "x=0:1:3", "x_dot=0:1:3", base_state={"z": 1}, progress=False)
+    with pytest.raises(gc.ParameterError, match=r"box\['x'\] must be finite with low < high"):
+        gc.basin_fractions(system, "delta=0.1", box={"x": (1, 0)}, progress=False)
