@@ -16,6 +16,7 @@ One module per group of commands (:mod:`.simulate`, :mod:`.gearset`, :mod:`.swee
 # isort: off
 # the import order is the order of the commands in `gearchaos --help`
 from . import simulate, gearset, sweep, response, gallery, orbits, basins, paper, export, explore  # noqa: F401
+from . import boundary  # noqa: F401
 
 # isort: on
 from ._common import (

@@ -385,6 +385,16 @@ def plot(
             "the response curves.",
         ),
     ] = False,
+    boundaries: Annotated[
+        list[Path] | None,
+        typer.Option(
+            "--boundaries",
+            help="Curve file of `gearchaos boundary`, repeatable: the stability chart, boundary "
+            "curves over the 2-D regime map of the same two parameters (physical axes "
+            "opposite, a legend naming each kind of boundary).",
+            show_default=False,
+        ),
+    ] = None,
     impact: Annotated[
         str | None,
         typer.Option(
@@ -404,8 +414,11 @@ def plot(
     (section values against the continued parameter, stable solid, unstable dashed, events
     named), or over a sweep's diagram with --branch.
 
+    With --boundaries, curves of `gearchaos boundary` over the 2-D map (a stability chart);
+    curve files alone are drawn as a chart without a map.
+
     Example: **gearchaos plot fig4.zarr -o fig4.png --clearance-lines**, **gearchaos plot
-    branch.nc -o branch.png**
+    branch.nc -o branch.png**, **gearchaos plot map.zarr --boundaries pd.nc -o chart.png**
     """
     from ..plot.figure import SAVE_FORMATS
 
@@ -421,6 +434,15 @@ def plot(
         from ..plot import savefig, sweep_figure
 
         if all(_is_branch(p) for p in stores):
+            from .boundary import boundaries_figure, is_curve_file
+
+            if all(is_curve_file(p) for p in stores):  # a stability chart without a map
+                fig = boundaries_figure([*stores, *(boundaries or [])], None)
+                if output.parent != Path(""):
+                    output.parent.mkdir(parents=True, exist_ok=True)
+                savefig(fig, output)
+                c.wrote(output)
+                return
             if sections:
                 raise ParameterError("--sections applies to response stores, not branch files")
             from ..plot.branch import branch_figure
@@ -450,7 +472,11 @@ def plot(
         res = open_store(store)
         branches = [br for b in branch or [] for br in open_cascade(b)]
         response = res.ds.attrs.get("kind") == "response"
-        if impact is not None or (branches and response and not sections):
+        if boundaries:
+            from .boundary import boundaries_figure
+
+            fig = boundaries_figure(list(boundaries), res)
+        elif impact is not None or (branches and response and not sections):
             from ._charts import chart_figure
 
             fig = chart_figure(res, impact, branches, var, planet, sections)

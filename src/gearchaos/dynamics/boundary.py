@@ -168,18 +168,19 @@ def boundary_curve(
     else:
         backward, forward, reasons = _start(curve, event, y0, lam2)
 
+    count = [0]
+    written = [False]
+
     def save(reason_b: str, reason_f: str) -> Any:
         for p in backward[1:]:
             p.s = -abs(p.s)
         ds = curve_dataset(curve, backward, forward, (reason_b, reason_f), extra)
         for p in backward[1:]:
             p.s = abs(p.s)
-        if store is not None:
-            save_branch(ds, store, overwrite=True if (resume or overwrite) else overwrite)
+        if store is not None:  # a checkpoint of this run (or the resumed file) is replaced
+            save_branch(ds, store, overwrite=resume or overwrite or written[0])
+            written[0] = True
         return ds
-
-    count = [0]
-    written = [store is None]
 
     def step_done(q: CurvePoint) -> None:
         count[0] += 1
@@ -187,7 +188,6 @@ def boundary_curve(
             progress(count[0], q)
         if store is not None and count[0] % CHECKPOINT_EVERY == 0:
             save(*(r if not r.startswith("running") else "interrupted" for r in reasons))
-            written[0] = True
 
     for k, pts in ((1, forward), (0, backward)):
         if not reasons[k].startswith((*RESUMABLE, "running")):

@@ -264,8 +264,9 @@ class Curve:
         q, _ = self.correct(zp, normal, float(normal @ zp))
         return q
 
-    def land(self, p: CurvePoint, j: int, value: float) -> CurvePoint | None:
-        """The curve point where unknown j (−2: λ₁, −1: λ₂) equals ``value``."""
+    def land(self, p: CurvePoint, j: int, value: float, grid: bool = False) -> CurvePoint | None:
+        """The curve point where unknown j (−2: λ₁, −1: λ₂) equals ``value`` (flagged landed
+        when ``grid``: a value of ``at``)."""
         assert p.tangent is not None
         tj = float(p.tangent[j])
         sigma = (value - p.z[j]) / tj if tj != 0 else 0.0
@@ -274,7 +275,7 @@ class Curve:
         q, _ = self.correct(p.z + sigma * p.tangent, normal, value)
         if q is not None:
             q.tangent = self.tangent(q, p.tangent)
-            q.landed = True
+            q.landed = grid
         return q
 
     # -- the continuation loop ----------------------------------------------------------
@@ -375,7 +376,7 @@ class Curve:
         lo, hi = sorted((p.z[-1], q.z[-1]))
         inside = at[(at > lo) & (at < hi)]
         for value in inside if q.z[-1] > p.z[-1] else inside[::-1]:
-            g = self.land(p, -1, float(value))
+            g = self.land(p, -1, float(value), grid=True)
             if g is not None:
                 self._push(pts, g, progress)
                 p = g
