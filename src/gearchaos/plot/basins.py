@@ -263,5 +263,12 @@ def basins_figure(ds: Any) -> Any:
     else:
         plt.close(fig)
         raise ParameterError(f"not a basin store: kind {kind!r}")
+    fields = ds.attrs.get("model_fields")
+    if isinstance(fields, str):  # a model that is not a gear set: its parameters
+        layout = {"kind", "name", "n_state", "n_track", "n_contact_forces"}
+        layout |= {"state_names", "obs_names"}
+        shown = {k: v for k, v in json.loads(fields).items() if k not in layout}
+        title += "\n" + ", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}"
+                                  for k, v in shown.items())  # fmt: skip
     ax.set_title(title, fontsize="medium")
     return fig
