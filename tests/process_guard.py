@@ -83,6 +83,11 @@ def survivors(token: str, root: int) -> dict[int, str]:
             found[pid] = _proc(pid, "cmdline").replace(b"\0", b" ").decode(errors="replace")
         except OSError:
             del found[pid]
+            continue
+        if parents.get(pid) == root and "multiprocessing.resource_tracker" in found[pid]:
+            # the resource tracker of this very process: it ends when this process does
+            # (its pipe closes), after the check; one whose parent is gone is a leak
+            del found[pid]
     return found
 
 
