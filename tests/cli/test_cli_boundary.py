@@ -57,13 +57,20 @@ def test_boundary_refuses_unknown_events_by_name(curve_file) -> None:
     assert got.exit_code != 0 and "0 fold events" in got.output
 
 
-def test_plot_boundaries_over_a_map_and_alone(curve_file) -> None:
-    where, curve, *_ = curve_file
+@pytest.fixture(scope="module")
+def map_store(curve_file):
+    where, *_ = curve_file
     store = where / "map.zarr"
     gc.bifurcation(
         gc.preset("sheng2016"), ["omega=3.3:3.6:7", "xi=0.02:0.035:3"],
         transient_periods=30, periods=8, progress=False, store=store,
     )  # fmt: skip
+    return store
+
+
+def test_plot_boundaries_over_a_map_and_alone(curve_file, map_store) -> None:
+    where, curve, *_ = curve_file
+    store = map_store
     for args in (
         ["plot", str(store), "--boundaries", str(curve), "-o", str(where / "chart.png")],
         ["plot", str(curve), "-o", str(where / "alone.png")],
@@ -79,3 +86,25 @@ def test_plot_boundaries_over_a_map_and_alone(curve_file) -> None:
     assert [ln.get_gid() for ln in ax.lines] == ["boundary:period_doubling"]
     # the sun speed in rpm opposite Ω
     assert any("rpm" in a.get_xlabel() for a in fig.axes[1:] + ax.child_axes)
+
+
+def test_the_explorer_draws_the_curves_over_the_map(curve_file, map_store) -> None:
+    """Issue 26, item 6: the explorer shows the boundaries over a 2-D map when a curve file is
+    given — the line is the curve's own (Ω, ξ) points, named by its kind; a 1-D store or a
+    curve of other parameters is refused."""
+    from gearchaos.explore import explore
+
+    where, curve, *_ = curve_file
+    ex = explore(map_store, boundaries=[curve])
+    fig = ex._map_figure()
+    (line,) = [r for r in fig.renderers if r.name == "boundary-0"]
+    cv = gc.open_curve(curve)
+    np.testing.assert_array_equal(line.data_source.data["x"], cv["omega"].values)
+    np.testing.assert_array_equal(line.data_source.data["y"], cv["xi"].values)
+    labels = [item.label["value"] for item in fig.legend[0].items]
+    assert "period doubling" in labels
+    one_d = where / "line.zarr"
+    gc.bifurcation(gc.preset("sheng2016"), "omega=3.3:3.6:3", transient_periods=10, periods=4,
+                   progress=False, store=one_d)  # fmt: skip
+    with pytest.raises(gc.ParameterError, match="2-D sweep"):
+        explore(one_d, boundaries=[curve])

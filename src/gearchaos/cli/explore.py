@@ -32,6 +32,15 @@ def explore(
         ),
     ] = None,
     planet: Annotated[int, typer.Option("--planet", help="Planet of per-planet variables.")] = 1,
+    boundaries: Annotated[
+        list[Path] | None,
+        typer.Option(
+            "--boundaries",
+            help="Boundary-curve file (gearchaos boundary) drawn over the regime map of a 2-D "
+            "sweep; repeatable.",
+            show_default=False,
+        ),
+    ] = None,
 ) -> None:
     """Explore a sweep store in the browser: its bifurcation diagram with the band of motion
     labels (or the regime map of a 2-D sweep). Click a point, or move the slider, to see its
@@ -61,5 +70,8 @@ def explore(
             out.print(Text("Ctrl-C stops it", style="dim"))
             out.file.flush()
 
-        serve(store, port=port, show=not no_browser, var=var, planet=planet, ready=ready)
+        serve(
+            store, port=port, show=not no_browser, var=var, planet=planet, ready=ready,
+            boundaries=[str(b) for b in boundaries or []],
+        )  # fmt: skip
     c.stdout().print(Text("explorer stopped", style="dim"))

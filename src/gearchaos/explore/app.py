@@ -17,7 +17,7 @@ import concurrent.futures as cf
 import multiprocessing
 import os
 import threading
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -29,8 +29,10 @@ from bokeh.models.annotations import Span
 from bokeh.plotting import figure
 
 from ..analysis.summary import format_exponent
+from ..dynamics.curve_file import open_curve
 from ..errors import ParameterError
 from ..plot.regimes import REGIME_COLOURS
+from ..plot.stability import boundary_label
 from ..sweep.result import open_result
 from .compute import compute_point, run_zoom
 from .model import ExploreModel, Point, parameter_axis_label, parameter_label
@@ -111,13 +113,20 @@ class Explorer(pn.viewable.Viewer):
         var: str | None = None,
         planet: int = 1,
         workers: Workers | None = None,
+        boundaries: Sequence[str | os.PathLike[str]] = (),
         **params: Any,
     ):
         super().__init__(**params)
         self.root = str(store)
+        self.boundaries = [open_curve(b) for b in boundaries]
         self.planet = planet
         self.workers = workers if workers is not None else Workers()
         self.model = ExploreModel(open_result(store), var=var, planet=planet, store=self.root)
+        if self.boundaries and not self.model.is_map:
+            raise ParameterError(
+                "boundary curves are drawn over the regime map of a 2-D sweep: "
+                f"{Path(self.root).name} sweeps one parameter"
+            )
         self.var = self.model.var
         self.point: Point | None = None
         self.x_range: Any = None
@@ -313,9 +322,30 @@ class Explorer(pn.viewable.Viewer):
         fig.on_event(events.Tap, self._tapped)
         fig.on_event(events.DoubleTap, self._tapped)
         self._legend(fig, b["label"])
+        self._boundaries(fig, m.vary[0], m.vary[1])
         self.x_range = fig.x_range
         self.y_range = fig.y_range
         return fig
+
+    def _boundaries(self, fig: Any, xname: str, yname: str) -> None:
+        """The boundary curves given (:func:`gearchaos.boundary_curve`) over the map, in the
+        map's axes, each named by its kind in the legend."""
+        for k, cv in enumerate(self.boundaries):
+            names = (str(cv.attrs["parameter"]), str(cv.attrs["parameter2"]))
+            if set(names) != {xname, yname}:
+                raise ParameterError(
+                    f"boundary curve {k + 1} varies {names[0]} and {names[1]}, the map "
+                    f"{xname} and {yname}: give curves of the map's two parameters"
+                )
+            colour = BOUNDARY_COLOURS[k % len(BOUNDARY_COLOURS)]
+            fig.line(
+                np.asarray(cv[xname].values, dtype=float),
+                np.asarray(cv[yname].values, dtype=float),
+                line_width=3,
+                color=colour,
+                legend_label=boundary_label(cv),
+                name=f"boundary-{k}",
+            )
 
     @staticmethod
     def _legend(fig: Any, labels: list[str]) -> None:
@@ -492,7 +522,17 @@ def _computed_text(out: Mapping[str, Any]) -> str:
     return "  \n".join(lines)
 
 
-def explore(store: str | os.PathLike[str], *, var: str | None = None, planet: int = 1) -> Explorer:
+#: Line colours of boundary curves over a regime map (none of the regime colours).
+BOUNDARY_COLOURS = ("black", "#7f00ff", "#8b4513", "#ff1493")
+
+
+def explore(
+    store: str | os.PathLike[str],
+    *,
+    var: str | None = None,
+    planet: int = 1,
+    boundaries: Sequence[str | os.PathLike[str]] = (),
+) -> Explorer:
     """The explorer of a sweep store, as a Panel app (display it in a notebook, or serve it).
 
     Shows the bifurcation diagram — every stored section value X̄_k of ``var`` (default
@@ -509,6 +549,9 @@ def explore(store: str | os.PathLike[str], *, var: str | None = None, planet: in
         Path of a sweep store (:func:`gearchaos.bifurcation`, ``gearchaos bifurcation``).
     var, planet
         The section variable drawn (default: the store's first observed one) and its planet.
+    boundaries
+        Boundary-curve files (:func:`gearchaos.boundary_curve`, ``gearchaos boundary``) of the
+        map's two parameters, drawn over the regime map of a 2-D sweep.
 
     Returns
     -------
@@ -520,4 +563,4 @@ def explore(store: str | os.PathLike[str], *, var: str | None = None, planet: in
     ParameterError, StoreError
         For a missing, damaged or foreign store, as ``gearchaos plot``.
     """
-    return Explorer(store, var=var, planet=planet)
+    return Explorer(store, var=var, planet=planet, boundaries=boundaries)

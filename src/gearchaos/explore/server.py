@@ -12,12 +12,13 @@ from __future__ import annotations
 import os
 import signal
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
 import panel as pn
 
+from ..dynamics.curve_file import open_curve
 from ..sweep.result import open_result
 from .app import Explorer, Workers
 from .model import ExploreModel
@@ -70,15 +71,22 @@ def serve(
     var: str | None = None,
     planet: int = 1,
     ready: Callable[[str], None] | None = None,
+    boundaries: Sequence[str | os.PathLike[str]] = (),
 ) -> None:
     """Serve the explorer of ``store`` on ``localhost:port`` (0: a free port) until Ctrl-C or
     SIGTERM; ``ready(url)`` is called once it listens. Returns after a clean stop: the server
     closed and the worker processes ended."""
     open_result(store)  # a bad store fails here, before anything listens
     ExploreModel(open_result(store), var=var, planet=planet)
+    for path in boundaries:  # a bad curve file fails here, before anything listens
+        open_curve(path)
     workers = Workers()
     server = pn.serve(
-        {"/": lambda: Explorer(store, var=var, planet=planet, workers=workers)},
+        {
+            "/": lambda: Explorer(
+                store, var=var, planet=planet, workers=workers, boundaries=boundaries
+            )
+        },
         port=port,
         address="localhost",
         show=False,
