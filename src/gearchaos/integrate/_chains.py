@@ -261,8 +261,10 @@ class ChainOutput(SampleArrays):
         return self.log_sums / ((ns - 1) * dt)[:, :, None]
 
 
-def run_chains(run: ChainRun, *, single_thread: bool = False) -> ChainOutput:
-    """Run the chains of ``run`` with the compiled Dormand–Prince kernel.
+def run_chains(run: ChainRun, *, single_thread: bool = False, tableau: Any = None) -> ChainOutput:
+    """Run the chains of ``run`` with the compiled Dormand–Prince kernel (or, for
+    experiments, with the explicit FSAL pair ``tableau``:
+    :func:`~gearchaos.integrate.methods.kernels_for`).
 
     The chains are spread over ``numba.get_num_threads()`` threads (blocks of chains taken in
     turn, so a slow chain does not hold up a fixed share of the others); ``single_thread``
@@ -273,7 +275,12 @@ def run_chains(run: ChainRun, *, single_thread: bool = False) -> ChainOutput:
     import numba
 
     from .dopri import dopri_chains
+    from .methods import TABLEAU_OVERRIDE, kernels_for
 
+    if tableau is None and TABLEAU_OVERRIDE:
+        tableau = TABLEAU_OVERRIDE[0]
+    if tableau is not None:
+        dopri_chains = kernels_for(tableau).dopri_chains
     if single_thread:
         numba.set_num_threads(1)
     C, L = run.shape

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 
-from .._numba import njit_noalloc
+import numba
 
 __all__ = ["accepted_step", "pi_alpha", "rejected_step"]
 
@@ -34,7 +34,7 @@ def pi_alpha(order_hat: int) -> float:
     return 1.0 / (order_hat + 1) - 0.75 * BETA
 
 
-@njit_noalloc
+@numba.njit(cache=True, inline="always")
 def rejected_step(err, hs, alpha):  # pragma: no cover - compiled
     """The step to retry with after the step ``hs`` was rejected with scaled error ``err`` > 1
     (or not finite)."""
@@ -43,7 +43,7 @@ def rejected_step(err, hs, alpha):  # pragma: no cover - compiled
     return hs * max(MIN_FACTOR, SAFETY * math.exp(-alpha * math.log(err)))
 
 
-@njit_noalloc
+@numba.njit(cache=True, inline="always")
 def accepted_step(
     err, hs, h, log_err_old, last_rejected, cut, max_step, alpha
 ):  # pragma: no cover - compiled

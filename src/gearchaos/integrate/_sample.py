@@ -65,14 +65,14 @@ def renormalize(kind, t, y, p, obs, K, n, k, lsum, tan_on):  # pragma: no cover 
     return True
 
 
-@njit_noalloc
+@numba.njit(cache=True, inline="always")
 def record_sample(
     kind, j, t, y, p, obs, K, out_t, out_y, out_obs, n_base, n_obs, lsum, tan_on
 ):  # pragma: no cover - compiled
     """Record sample ``j``: time, state (the tangent vectors before renormalising: their
     stretch is readable) and observables; with tangent vectors (``lsum.size`` > 0) renormalise
-    them there. Returns whether the tangents are on."""
-    numba.literally(kind)
+    them there. Returns whether the tangents are on. Inlined into its caller (a sample can
+    come every step), where ``kind`` must be a compile-time literal."""
     out_t[j] = t
     copy_into(out_y[j], y, y.size)
     if lsum.size > 0:
@@ -81,7 +81,7 @@ def record_sample(
     return tan_on
 
 
-@njit_noalloc
+@numba.njit(cache=True, inline="always")
 def start_extrema(obs, n_track, obs_min, obs_max):  # pragma: no cover - compiled
     """Start the running extrema of the tracked observables at the values ``obs``."""
     for k in range(n_track):

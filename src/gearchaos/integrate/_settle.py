@@ -8,6 +8,8 @@ in a row. The newest SETTLE_MAX_PERIOD + 1 section points are kept in a ring.
 
 from __future__ import annotations
 
+import numba
+
 from .._numba import njit_noalloc
 
 __all__ = ["SETTLE_MAX_PERIOD", "first_section", "settled"]
@@ -18,7 +20,7 @@ SETTLE_MIN_MATCHES = 8
 SETTLE_TOL = 1e-7
 
 
-@njit_noalloc
+@numba.njit(cache=True, inline="always")
 def first_section(t, t_rec, period):  # pragma: no cover - compiled
     """The number m of whole periods before ``t_rec`` of the first section point τ_rec − mT
     after ``t``."""

@@ -88,7 +88,7 @@ def _stage_row(yt, y, K, hs, n, s):  # pragma: no cover - compiled
             yt[i] = y[i] + hs * acc
 
 
-@njit_noalloc
+@numba.njit(cache=True, inline="always")
 def stage_input(yt, y, K, hs, n, s):  # pragma: no cover - compiled
     """The argument of stage s ≥ 1: yt[:n] = y + hs Σ_{j<s} a_sj K_j (row s of ``TAB_A``),
     one branch per stage index so that the index is a constant in each sum."""
@@ -116,7 +116,7 @@ def stage_input(yt, y, K, hs, n, s):  # pragma: no cover - compiled
         _stage_row(yt, y, K, hs, n, 11)
 
 
-@njit_noalloc
+@numba.njit(cache=True, inline="always")
 def rk_step(
     kind, t, y, hs, t_new, p, K, yt, obs, n, n_base, n_tan, tan_on, last_level
 ):  # pragma: no cover - compiled
@@ -128,8 +128,11 @@ def rk_step(
     The inner stages ask the right-hand side for no observables (all of them while the
     ``n_tan`` tangent vectors after the ``n_base`` system components are integrated,
     ``tan_on``), the last one for ``last_level`` (``obs`` then holds the observables at the new
-    point). Stage i is evaluated at t + c_i hs."""
-    numba.literally(kind)
+    point). Stage i is evaluated at t + c_i hs.
+
+    Inlined into its caller, where ``kind`` must be a compile-time literal (the right-hand side
+    is chosen by it): a call with a dozen arrays would cost more than the stages' arithmetic.
+    """
     inner = OBS_ALL if tan_on else OBS_NONE
     for s in range(1, STAGES):
         stage_input(yt, y, K, hs, n, s)
@@ -144,7 +147,7 @@ def rk_step(
             tangent(kind, ts, yt, p, obs, K[s], n_base, n_tan)
 
 
-@njit_noalloc
+@numba.njit(cache=True, inline="always")
 def error_norm(y, yt, K, hs, n, n_base, rtol, atol, tan_tol):  # pragma: no cover - compiled
     """The scaled RMS norm of the embedded error estimate hs Σ_j (b_j − b̂_j) K_j with scale
     atol + rtol·max(|y_n|, |y_{n+1}|) (y_{n+1} in ``yt``), multiplied by ``tan_tol`` for the
@@ -167,7 +170,7 @@ def error_norm(y, yt, K, hs, n, n_base, rtol, atol, tan_tol):  # pragma: no cove
     return math.sqrt(acc / n_err)
 
 
-@njit_noalloc
+@numba.njit(cache=True, inline="always")
 def fsal_advance(y, yt, K, n):  # pragma: no cover - compiled
     """Accept the step: y ← y_{n+1} (``yt``), K[0] ← the last stage (first same as last)."""
     for i in range(n):

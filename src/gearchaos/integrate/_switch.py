@@ -296,7 +296,7 @@ def predict_switch(hist, n_pts, t_hist, n_track, sw, h):  # pragma: no cover - c
     return best
 
 
-@njit_noalloc
+@numba.njit(cache=True, inline="always")
 def aim_step(
     h, h_event, t, target, hist, n_pts, t_hist, n_track, sw, has_switch, hmin
 ):  # pragma: no cover - compiled
@@ -323,7 +323,7 @@ def aim_step(
     return hs, clipped, shortened
 
 
-@njit_noalloc
+@numba.njit(cache=True, inline="always")
 def land_switch(hist, obs, hs, h, n_track, sw, hmin):  # pragma: no cover - compiled
     """After a step ``hs`` (proposal ``h``) from ``hist[0]`` to ``obs``: a switch within
     LAND·max(h, hs) of either end counts as landed on (h the proposal: a shortened step must not
@@ -340,7 +340,7 @@ def land_switch(hist, obs, hs, h, n_track, sw, hmin):  # pragma: no cover - comp
     return h_event, where
 
 
-@njit_noalloc
+@numba.njit(cache=True, inline="always")
 def push_point(hist, t_hist, obs, t, n):  # pragma: no cover - compiled
     """Make the accepted point (t, ``obs[:n]``) the newest of the three kept: rows of ``hist``
     one older (row 2 ← 1 ← 0), row 0 ← obs[:n], and their times ``t_hist`` likewise."""

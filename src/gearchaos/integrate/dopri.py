@@ -51,7 +51,7 @@ from .._numba import njit_noalloc
 from ..errors import Status
 from ..model.kernels import OBS_ALL, OBS_TRACK, rhs
 from ._control import LOG_ERR_OLD_MIN, accepted_step, rejected_step
-from ._sample import copy_into, record_sample, start_extrema
+from ._sample import copy_into, record_sample, renormalize, start_extrema
 from ._settle import SETTLE_MAX_PERIOD, first_section, settled
 from ._step import ALPHA, STAGES, error_norm, fsal_advance, initial_step, rk_step
 from ._switch import aim_step, land_switch, push_point, track
@@ -361,7 +361,7 @@ def _guard() -> None:
         os.path.join(here, "interface.py"),
         os.path.join(os.path.dirname(here), "errors.py"),
     ]
-    _numba.guard_cache([dopri_run, dopri_chains, rk_step, record_sample], sources)
+    _numba.guard_cache([dopri_run, dopri_chains, initial_step, renormalize], sources)
 
 
 _guard()
