@@ -1,10 +1,11 @@
 """Benchmark (issue 25): the integrator split into pieces against a baseline revision, paired.
 
 The compiled integrator's loop was split into pieces (one Runge–Kutta step from the tableau as
-data, the error norm and step-size control, switch landing, settling, sampling and extrema:
-``gearchaos.integrate._pieces``). This script checks that the split costs no speed and no
-compile time, against a baseline checkout of the code before it (``--baseline-src``, e.g. a
-``git worktree add /tmp/old_integ <rev>`` and its ``src``), in the same session:
+data and the error norm: ``integrate._step``; step-size control: ``_control``; switch landing
+and extrema: ``_switch``; settling: ``_settle``; sampling: ``_sample``). This script checks
+that the split costs no speed and no compile time, against a baseline checkout of the code
+before it (``--baseline-src``, e.g. a ``git worktree add /tmp/old_integ <rev>`` and its
+``src``), in the same session:
 
 1. **Steps.** ``gearchaos.simulate`` of ``preset("hindawi2021")`` and of the seed's Fig. 4(a)
    gear set (``preset("sheng2016")``, ξ = 0.03, b̄_sp = 3, b̄_rp = 3.5, b̄_s = 2) at a few Ω,
