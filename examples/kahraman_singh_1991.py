@@ -198,14 +198,14 @@ class KahramanSingh1991(UserModel):
     )
     n_track = 3
     default_observables = ("delta", "delta_dot")
+    rhs = rhs
+    tangent = tangent
     #: Figure symbols: variable → (symbol, definition, clearance name, clearance symbol).
     symbols: ClassVar[dict[str, tuple[str, str | None, str | None, str | None]]] = {
         "delta": (r"\bar{\delta}", r"\delta/b_c", "mesh", r"\bar{b}_h"),
         "y_p": (r"\bar{y}_p", r"y_p/b_c", "bearing_p", r"\bar{b}_p"),
         "y_g": (r"\bar{y}_g", r"y_g/b_c", "bearing_g", r"\bar{b}_g"),
     }
-    rhs = rhs
-    tangent = tangent
 
     def __post_init__(self) -> None:
         for name in ("zeta_h", "zeta_p", "zeta_g", "b_h", "b_p", "b_g"):

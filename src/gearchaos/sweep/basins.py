@@ -421,8 +421,10 @@ def basins(
         The other coordinates: a mapping by state name, an array of every state, or None
         (zero).
     params, **values_and_settings
-        Parameter values (``omega=1.2``; dotted names in ``params``) and solver settings
-        (``transient_periods`` 200, ``periods`` 32 recorded section points, ``rtol`` …).
+        The executor (``workers``, ``scheduler``, ``dask_local``: where the integrations
+        run, :class:`~gearchaos.sweep.execute.Execution`), parameter values (``omega=1.2``;
+        dotted names in ``params``) and solver settings (``transient_periods`` 200,
+        ``periods`` 32 recorded section points, ``rtol`` …).
     store, overwrite, progress
         As for :func:`~gearchaos.sweep.bifurcation`: a resumable Zarr store (None: memory).
     sample, seed
@@ -432,8 +434,6 @@ def basins(
         The matching rules (:mod:`gearchaos.dynamics.basins`).
     chunk_points
         Starts per task (one compiled call each).
-    workers, scheduler, dask_local
-        Where the integrations run (:class:`~gearchaos.sweep.execute.Execution`).
 
     Returns
     -------
