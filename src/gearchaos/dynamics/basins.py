@@ -347,7 +347,17 @@ def catalogue_from_sample(
     n = int(np.asarray(starts).shape[1])
     every = np.concatenate(pts) if pts else np.zeros((1, n))
     scale = np.maximum(1.0, np.ptp(every, axis=0))
-    return Catalogue(entries, scale, tol=tol, spread_fraction=spread_fraction)
+    # one attractor, not several: a non-periodic set whose points the rule that assigns the
+    # starts puts on an attractor already kept is that attractor (short sample records of
+    # one chaotic attractor need not overlap enough for the sample's own grouping)
+    kept: list[BasinAttractor] = []
+    for e in entries:
+        if not e.period and kept:
+            trial = Catalogue(kept, scale, tol=tol, spread_fraction=spread_fraction)
+            if trial.match(e.section_states[None], label=e.label)[0] >= 0:
+                continue
+        kept.append(e)
+    return Catalogue(kept, scale, tol=tol, spread_fraction=spread_fraction)
 
 
 def identify(
