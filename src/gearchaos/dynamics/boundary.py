@@ -207,7 +207,29 @@ def boundary_curve(
     for e in curve.events:
         if e["direction"] < 0:
             e["s"] = -abs(e["s"])
+    _assess_landed(curve, [*backward, *forward])
     return save(reasons[0], reasons[1])
+
+
+def _assess_landed(curve: Curve, pts: list[CurvePoint]) -> None:
+    """The uncertainty in λ₁ of every point landed on a value of ``at``: the point is landed
+    on the same λ₂ again with rtol, atol and the corrector's tolerance 100 times tighter, and
+    the shift of λ₁ is its uncertainty (the curve's test function is built from a monodromy
+    matrix accurate to about rtol, so at the default rtol 1e-8 a period-doubling point can be
+    a few 1e-9 off; tests compare curves with events through it)."""
+    landed = [p for p in pts if p.landed and p.tangent is not None and math.isnan(p.uncertainty)]
+    if not landed:
+        return
+    cfg = curve.cfg.replace(rtol=curve.cfg.rtol / 100.0, atol=curve.cfg.atol / 100.0)
+    fine = Curve(
+        curve.target, curve.names, curve.fixed, cfg, curve.n, max(curve.tol / 100.0, 1e-14),
+        curve.fn, curve.bounds, curve.steps,
+    )  # fmt: skip
+    fine.scale = curve.scale
+    for p in landed:
+        q = fine.land(p, -1, float(p.z[-1]))
+        p.uncertainty = math.inf if q is None else abs(float(q.z[-2] - p.z[-2]))
+    curve.evals += fine.evals
 
 
 #: Points between checkpoints of the store.
@@ -283,6 +305,9 @@ def _resume(
                 obs_min=np.asarray(ds.obs_min.values[k]), obs_max=np.asarray(ds.obs_max.values[k]),
                 tangent=np.asarray(ds.tangent.values[k]), s=abs(float(ds.arclength.values[k])),
                 landed=bool(ds.on_grid.values[k]),
+                uncertainty=(
+                    float(ds.uncertainty.values[k]) if "uncertainty" in ds else math.nan
+                ),
             )
         )  # fmt: skip
     direction = np.asarray(ds.direction.values)

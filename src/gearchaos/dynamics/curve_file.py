@@ -17,7 +17,9 @@ per point
     ``stable`` (int8: all multipliers but the critical one inside the unit circle: the orbit is
     stable on one side of the boundary); ``test_value`` (g); ``residual``; ``iterations`` (map
     evaluations of the corrector); ``direction`` (−1 backward, 0 start, +1 forward);
-    ``on_grid`` (int8: landed on a value of ``at``); ``tangent`` (point, unknown); ``obs_min``,
+    ``on_grid`` (int8: landed on a value of ``at``); ``uncertainty`` (of λ₁ at a landed point:
+    its shift when landed again 100 times tighter; NaN elsewhere); ``tangent`` (point,
+    unknown); ``obs_min``,
     ``obs_max`` (point, track) extrema of the tracked observables over the orbit.
 events
     ``event_kind`` (cusp, fold_flip, resonance_1_2, … see
@@ -137,6 +139,11 @@ def curve_dataset(
     ds["iterations"] = ("point", np.array([p.evals for p in pts], dtype=np.int64))
     ds["direction"] = ("point", direction.astype(np.int8))
     ds["on_grid"] = ("point", np.array([p.landed for p in pts], dtype=np.int8))
+    ds["uncertainty"] = ("point", np.array([p.uncertainty for p in pts], dtype=float))
+    ds["uncertainty"].attrs["long_name"] = (
+        f"uncertainty of {n1} at a landed point: its shift when landed again with the "
+        "integrator and corrector 100 times tighter (NaN: not landed)"
+    )
     ds["tangent"] = (("point", "unknown"), np.array([p.tangent for p in pts]))
     ds["obs_min"] = (("point", "track"), np.array([p.obs_min for p in pts]))
     ds["obs_max"] = (("point", "track"), np.array([p.obs_max for p in pts]))

@@ -88,6 +88,9 @@ class CurvePoint:
     s: float = 0.0
     landed: bool = False
     jac: np.ndarray | None = field(default=None, repr=False)
+    #: for a landed point: how far λ₁ moves when the point is landed again with the
+    #: integrator and corrector 100 times tighter (NaN: not assessed)
+    uncertainty: float = math.nan
 
 
 @dataclass(frozen=True)
