@@ -179,3 +179,28 @@ def test_planetary_period_doubling_curve_matches_one_parameter_branches() -> Non
             assert abs(e.value - om) <= e.uncertainty + u, (xi, om, e, u)
             checked += 1
     assert checked == 6
+
+
+def test_grazing_curve_of_the_backlash_oscillator_is_the_closed_form() -> None:
+    """The backlash oscillator with constant stiffness (ε = 0) is a linear forced oscillator
+    while its teeth stay in contact: x = b + F_m + A cos(Ωτ − φ) with
+    A = F_a Ω² / √((1 − Ω²)² + (2ζΩ)²), so contact is first lost (grazing) where A = F_m:
+    for F_a = F_m, Ω² = 1/(2 − 4ζ²). The grazing curve in (Ω, ζ) continued from the grazing
+    event at ζ = 0.05 must lie on that curve (no simulation in the check)."""
+    system = gc.backlash_oscillator(1.0, zeta=0.05, f_alt=0.1, f_mean=0.1)
+    branch = gc.continuation(system, "omega=0.6:0.72")
+    (graze,) = [e for e in events(branch) if e.kind == "grazing"]
+    at = [0.03, 0.08, 0.12]
+    curve = boundary_curve(system, graze, "zeta=0.02:0.15", within="omega=0.6:0.8", at=at)
+    assert curve.attrs["curve_kind"] == "grazing"
+    omega, zeta = curve.omega.values, curve.zeta.values
+    assert zeta.min() <= 0.021 and zeta.max() >= 0.149  # it crossed the whole range
+    exact = 1.0 / np.sqrt(2.0 - 4.0 * zeta**2)
+    assert np.max(np.abs(omega - exact)) < 1e-6
+    landed = curve.on_grid.values == 1
+    assert landed.sum() == len(at)
+    u = curve.uncertainty.values[landed]
+    # each landed point is as far from the truth as it says (u: its shift to the 100 times
+    # tighter landing, whose own error, about u/100, the 1e-9 covers)
+    assert np.all(u < 1e-8)
+    assert np.all(np.abs(omega[landed] - exact[landed]) <= u + 1e-9)
