@@ -41,3 +41,32 @@ def test_disk_cache_is_read_from_the_dispatcher() -> None:
     # a specialisation the cache does not hold (a new planet count, say): the notice is due
     assert _numba._in_disk_cache(dopri_chains, (types.literal(987654),)) is False
     assert _numba._in_disk_cache(object(), cached_sig) is True  # cannot be told: no notice
+
+
+def test_the_first_compile_notice_is_given_once_across_threads() -> None:
+    """A sweep's driver threads compile side by side: each may find the notice pending; it
+    is given once and no thread fails (the second pop raised 'pop from empty list' and
+    failed gearchaos calibrate in a fresh clone)."""
+    import threading
+
+    from gearchaos import _numba
+
+    calls: list[int] = []
+    errors: list[BaseException] = []
+    _numba.on_first_compile(lambda: calls.append(1))
+    start = threading.Barrier(8)
+
+    def worker() -> None:
+        start.wait()
+        try:
+            _numba._first_compile_notice()
+        except BaseException as exc:  # any failure is the finding
+            errors.append(exc)
+
+    threads = [threading.Thread(target=worker) for _ in range(8)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    _numba.on_first_compile(None)
+    assert calls == [1] and not errors

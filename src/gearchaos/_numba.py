@@ -8,6 +8,7 @@ the specialisation once and then calls its entry point directly (sub-microsecond
 
 from __future__ import annotations
 
+import threading
 import warnings
 from typing import Any
 
@@ -30,6 +31,17 @@ njit_noalloc: Any = numba.njit(**_NO_NRT)
 _ENTRIES: dict[tuple[Any, ...], Any] = {}
 #: Called once per process before the first kernel that is not in numba's on-disk cache.
 _FIRST_COMPILE: list[Any] = []
+_FIRST_COMPILE_LOCK = threading.Lock()
+
+
+def _first_compile_notice() -> None:
+    """Call the first-compile callback once, whichever thread gets here first (a sweep's
+    driver threads compile side by side: both saw the callback and the second pop failed,
+    'pop from empty list')."""
+    with _FIRST_COMPILE_LOCK:
+        callback = _FIRST_COMPILE.pop() if _FIRST_COMPILE else None
+    if callback is not None:
+        callback()
 
 
 def on_first_compile(callback: Any) -> None:
@@ -76,7 +88,7 @@ def entry_point(dispatcher: Any, kind: int, *args: Any) -> Any:
     if entry is None:
         sig = (types.literal(kind), *(typeof(a) for a in args))
         if _FIRST_COMPILE and not _in_disk_cache(dispatcher, sig):
-            _FIRST_COMPILE.pop()()
+            _first_compile_notice()
         with warnings.catch_warnings():
             # numba's IR inliner emits an internal "pedantic" NumbaIRAssumptionWarning for the
             # inlined dispatch of the right-hand side; it is harmless and not actionable
