@@ -43,7 +43,7 @@ import numpy as np
 
 from .._checks import check_bool, check_int, check_real
 from ..errors import IntegrationError, ParameterError
-from ..integrate.settings import SolverSettings
+from ..integrate.settings import SolverSettings, split_keywords
 from ..model.system import System
 from ..model.target import OMEGA, resolve
 from . import branch_events as ev
@@ -57,7 +57,6 @@ from .orbits import (
     initial_guess,
     settled_orbit,
     solve_orbit,
-    split_values,
 )
 from .shooting import Problem, Solution, correct, newton_step
 
@@ -428,7 +427,7 @@ def continuation(
     check_bool("overwrite", overwrite)
     check_bool("cascade_every", cascade_every)
     child_range = check_cascade(cascade, cascade_range, max_branches, store, a, b)
-    values, cfg = split_values(values_and_settings, settings, params, ORBIT_SETTINGS)
+    values, cfg = split_keywords(values_and_settings, settings, params, ORBIT_SETTINGS)
     if name in values:
         raise ParameterError(f"{name} is varied and cannot also be fixed")
     lo, hi = min(a, b), max(a, b)

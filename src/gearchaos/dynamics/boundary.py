@@ -18,13 +18,13 @@ import numpy as np
 
 from .._checks import check_bool, check_int, check_real
 from ..errors import IntegrationError, ParameterError, StoreError
-from ..integrate.settings import SolverSettings
+from ..integrate.settings import SolverSettings, split_keywords
 from . import branch_events as ev
 from .arclength import parse_vary
 from .curve_file import RESUMABLE, curve_dataset, open_curve
 from .curve_tests import CURVE_KINDS, TestFunction, grazing_contact
 from .curves import Curve, CurvePoint, CurveSteps, parameter_value
-from .orbits import ORBIT_SETTINGS, check_tol, contact_levels, split_values
+from .orbits import ORBIT_SETTINGS, check_tol, contact_levels
 from .shooting import multipliers_of
 
 __all__ = ["boundary_curve"]
@@ -123,7 +123,7 @@ def boundary_curve(
     check_bool("overwrite", overwrite)
     if store is not None and not (resume and os.path.exists(os.fspath(store))):
         check_store(store, overwrite)
-    values, cfg = split_values(values_and_settings, settings, params, ORBIT_SETTINGS)
+    values, cfg = split_keywords(values_and_settings, settings, params, ORBIT_SETTINGS)
     fixed = {**event.values, **values}
     fixed.pop(name1, None)
     lam2 = float(fixed.pop(name2)) if name2 in fixed else parameter_value(target, name2)

@@ -36,10 +36,10 @@ import numpy as np
 from .._checks import check_int, check_real
 from ..errors import ParameterError
 from ..integrate._chains import ChainRun, run_chains
-from ..integrate.settings import SolverSettings
+from ..integrate.settings import SolverSettings, split_keywords
 from ..model.target import resolve
 from .evidence import Verdict
-from .orbits import PeriodicOrbit, split_values
+from .orbits import PeriodicOrbit
 from .verdict import decide_motion
 
 __all__ = ["ATTRACTOR_SETTINGS", "Attractor", "attractors"]
@@ -247,7 +247,7 @@ def attractors(
     check_int("seed", seed, lo=0)
     check_real("tol", tol, lo=0.0, lo_open=True)
     check_real("spread_fraction", spread_fraction, lo=0.0, hi=1.0, lo_open=True)
-    values, cfg = split_values(values_and_settings, settings, params, ATTRACTOR_SETTINGS)
+    values, cfg = split_keywords(values_and_settings, settings, params, ATTRACTOR_SETTINGS)
     cfg = cfg.replace(samples_per_period=1)
     system = resolve(target, values)
     if initial_states is None:

@@ -28,7 +28,7 @@ from .._checks import check_int
 from ..analysis.summary import format_exponent
 from ..errors import ParameterError, Status
 from ..gearset import GearSet
-from ..integrate.settings import MAX_SAMPLES_PER_PERIOD, SolverSettings
+from ..integrate.settings import MAX_SAMPLES_PER_PERIOD, SolverSettings, split_keywords
 from ..integrate.simulate import integrate
 from ..model.system import System
 from ..model.target import resolve
@@ -172,15 +172,7 @@ def lyapunov_spectrum(
         When the state does not move over the recorded window (an equilibrium): the exponents
         are then those of the equilibrium, not of an attractor.
     """
-    names = set(SolverSettings.field_names())
-    solver = {k: v for k, v in values_and_settings.items() if k in names}
-    values = {k: v for k, v in values_and_settings.items() if k not in names}
-    if params is not None and not isinstance(params, Mapping):
-        raise ParameterError(f"params must be a mapping of names to values: got {params!r}")
-    for key, value in (params or {}).items():
-        if key in values:
-            raise ParameterError(f"parameter {key!r} is given twice (keyword and params)")
-        values[key] = value
+    values, cfg = split_keywords(values_and_settings, settings, params, LYAPUNOV_SETTINGS)
     if not isinstance(system, System | GearSet):
         raise ParameterError(
             f"system must be a System or a GearSet (with omega=): got {type(system).__name__}"
@@ -190,9 +182,7 @@ def lyapunov_spectrum(
     per_period = check_int(
         "renormalizations_per_period", renormalizations_per_period, lo=1, hi=MAX_SAMPLES_PER_PERIOD
     )
-    cfg = SolverSettings.build(
-        LYAPUNOV_SETTINGS if settings is None else settings, **solver
-    ).replace(samples_per_period=per_period)
+    cfg = cfg.replace(samples_per_period=per_period)
     n = system.n_state
     k = n if n_exponents is None else check_int("n_exponents", n_exponents, lo=1, hi=n)
     if cfg.n_samples < 2:

@@ -53,7 +53,6 @@ __all__ = [
     "orbit_contacts",
     "periodic_orbit",
     "solve_orbit",
-    "split_values",
 ]
 
 #: Orbit defaults: the guess simulation from rest runs 50 forcing periods (Newton does the rest).
@@ -321,17 +320,6 @@ def model_attrs(system: System) -> dict[str, Any]:
 
 
 # ------------------------------------------------------------------------------ front door
-def split_values(
-    values_and_settings: Mapping[str, Any],
-    settings: SolverSettings | None,
-    params: Mapping[str, Any] | None,
-    default: SolverSettings,
-) -> tuple[dict[str, Any], SolverSettings]:
-    """Split keyword arguments into parameter values by name and solver settings
-    (:func:`~gearchaos.integrate.settings.split_keywords`, the front doors' vocabulary)."""
-    return split_keywords(values_and_settings, settings, params, default)
-
-
 def default_tol(settings: SolverSettings) -> float:
     """The default Newton tolerance: rtol/10, at least 1e-12 (the map evaluated with and
     without tangents differs by ~rtol/30 relative, its noise floor is far lower)."""
@@ -443,7 +431,7 @@ def periodic_orbit(
     eccentricity errors are not T-periodic (a warning says so).
     """
     n = check_int("period", period, lo=1, hi=10_000)
-    values, cfg = split_values(values_and_settings, settings, params, ORBIT_SETTINGS)
+    values, cfg = split_keywords(values_and_settings, settings, params, ORBIT_SETTINGS)
     system = resolve(target, values)
     gs = getattr(system.model, "gearset", None)
     if gs is not None and gs.has_eccentricity:

@@ -37,11 +37,10 @@ import numpy as np
 from .._checks import check_bool, check_int, check_real
 from .._version import provenance
 from ..dynamics.basins import FAILED, Catalogue, catalogue_from_sample, identify, link_tracks
-from ..dynamics.orbits import split_values
 from ..errors import ParameterError, Status, StoreError
 from ..integrate._chains import ChainRun
 from ..integrate.interface import Info
-from ..integrate.settings import SolverSettings
+from ..integrate.settings import SolverSettings, split_keywords
 from ..model.contract import model_reference
 from ..model.target import resolve, scale_attrs
 from ._basin_store import BasinStore, open_basins
@@ -377,7 +376,7 @@ def _split(
     kwargs: dict[str, Any], settings: Any, params: Any
 ) -> tuple[dict[str, Any], SolverSettings, Execution]:
     where = Execution(**{k: kwargs.pop(k) for k in EXECUTION_OPTIONS if k in kwargs})
-    values, cfg = split_values(kwargs, settings, params, BASIN_SETTINGS)
+    values, cfg = split_keywords(kwargs, settings, params, BASIN_SETTINGS)
     return values, cfg.replace(samples_per_period=1), where
 
 
