@@ -341,6 +341,14 @@ def _panel_title(k: int, name: str, value: Any, *, letters: bool) -> str:
     return f"{prefix}{axis_symbol(name)} = {fmt(value)}"
 
 
+def selection_title(sel: Mapping[str, Any], k: int, n: int) -> str:
+    """The title of panel k of n that shows the selection ``sel`` (family or direction
+    values): ``(b) ξ = 0.05, up``, the letter only when there are several panels."""
+    parts = [f"{axis_symbol(d)} = {fmt(v)}" if d != "direction" else str(v) for d, v in sel.items()]
+    prefix = f"({string.ascii_lowercase[k % 26]}) " if n > 1 else ""
+    return prefix + ", ".join(parts)
+
+
 def panel_grid(n: int) -> tuple[int, int]:
     """(rows, columns) of a figure with n panels."""
     ncols = 1 if n == 1 else 2 if n in (2, 4) else 3

@@ -14,7 +14,6 @@ the motion-regime map of the same store.
 
 from __future__ import annotations
 
-import string
 from collections.abc import Mapping
 from typing import Any
 
@@ -22,7 +21,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..sweep.result import SweepResult
-from ._common import axis_label, axis_symbol, edges, fmt, get_ax, no_offset
+from ._common import axis_label, axis_symbol, edges, get_ax, no_offset
 from .units import PhysicalScales, linear_axis
 
 __all__ = ["IMPACT_COLOURS", "IMPACT_GID", "IMPACT_NAMES", "impact_figure", "impact_map"]
@@ -186,7 +185,7 @@ def impact_figure(
     """
     from matplotlib.figure import Figure
 
-    from .bifurcation import panel_grid, suptitle
+    from .bifurcation import panel_grid, selection_title, suptitle
 
     res = SweepResult.of(ds)
     key = _mesh_key(mesh)
@@ -212,12 +211,7 @@ def impact_figure(
         _physical(ax, "x", lay.vary[0], res, scales)
         _physical(ax, "y", lay.vary[1], res, scales)
         if sel:
-            parts = [
-                f"{axis_symbol(d)} = {fmt(v)}" if d != "direction" else str(v)
-                for d, v in sel.items()
-            ]
-            prefix = f"({string.ascii_lowercase[k % 26]}) " if len(selects) > 1 else ""
-            ax.set_title(prefix + ", ".join(parts), loc="left")
+            ax.set_title(selection_title(sel, k, len(selects)), loc="left")
     for ax in axs[len(selects) :]:
         ax.set_visible(False)
     _legend(fig, codes_all.values, loc="outside lower center", ncol=4)

@@ -10,7 +10,6 @@
 
 from __future__ import annotations
 
-import string
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -21,16 +20,21 @@ from ..errors import ParameterError, Status
 from ..sweep.result import SweepResult
 from ._common import (
     axis_label,
-    axis_symbol,
     corner_note,
     edges,
-    fmt,
     get_ax,
     no_offset,
     resonance_lines,
     var_symbol,
 )
-from .bifurcation import _planet_sel, bifurcation_figure, panel_grid, resolve_var, suptitle
+from .bifurcation import (
+    _planet_sel,
+    bifurcation_figure,
+    panel_grid,
+    resolve_var,
+    selection_title,
+    suptitle,
+)
 from .regimes import regime_categories, regime_legend, regime_map
 
 __all__ = ["distinct_counts", "distinct_map", "sweep_figure"]
@@ -262,12 +266,7 @@ def sweep_figure(
                 resonances=resonances,
             )
         if sel:
-            parts = [
-                f"{axis_symbol(d)} = {fmt(v)}" if d != "direction" else str(v)
-                for d, v in sel.items()
-            ]
-            prefix = f"({string.ascii_lowercase[k % 26]}) " if len(selects) > 1 else ""
-            ax.set_title(prefix + ", ".join(parts), loc="left")
+            ax.set_title(selection_title(sel, k, len(selects)), loc="left")
     for ax in axs[len(selects) :]:
         ax.set_visible(False)
     if regimes:
