@@ -24,7 +24,8 @@ from ..sweep import SweepResult
 from ..sweep.frequency import find_jumps
 from ._common import axis_label, fmt, var_symbol
 from .branch import BRANCH_COLOURS, EVENT_NAMES, EVENT_STYLE, branch_labels
-from .regimes import regime_band, regime_categories, regime_category, regime_legend_below
+from .regimes import regime_band, regime_categories, regime_legend_below
+from .response import periodic_mask
 from .units import PhysicalScales, fit_to_data, linear_axis, var_quantity
 
 __all__ = ["AMPLITUDE_GID", "amplitude_figure", "amplitude_of", "amplitude_var"]
@@ -65,15 +66,6 @@ def amplitude_of(ds: Any, var: str, planet: int = 1) -> Any:
             raise ParameterError(f"planet must be one of {planets}: got {planet!r}")
         amp = amp.sel(planet_all=planet)
     return amp
-
-
-def _periodic(ds: Any, direction: str | None) -> np.ndarray | None:
-    if "motion" not in ds.data_vars:
-        return None
-    cats = regime_categories(ds)
-    if direction is not None:
-        cats = cats.sel(direction=direction)
-    return np.array([regime_category(c).endswith("T") for c in np.ravel(cats.values)])
 
 
 def _draw_branch(ax: Any, br: Any, var: str, planet: int, colour: str, label: str,
@@ -187,7 +179,7 @@ def amplitude_figure(
             gid=f"{AMPLITUDE_GID}:sweep:{d or 'points'}",
             label=f"brute-force sweep{', ' + d if d else ''}",
         )  # fmt: skip
-        periodic = _periodic(sd, d)
+        periodic = periodic_mask(sd, d)
         if periodic is None:
             continue
         for xj in find_jumps(x, y, rel=rel_jump, where=periodic):

@@ -53,7 +53,7 @@ def _meshes(ds: Any) -> list[str]:
     return [m for m in ("sp", "rp", "mesh") if f"force_peak_{m}" in ds]
 
 
-def _periodic(ds: Any, direction: str | None) -> np.ndarray | None:
+def periodic_mask(ds: Any, direction: str | None) -> np.ndarray | None:
     """Per swept value, whether the verdict of ``direction`` is periodic (nT); None without
     motion labels."""
     if "motion" not in ds.data_vars:
@@ -114,7 +114,7 @@ def response_figure(
     xname = lead[0]
     x = np.asarray(ds[xname].values, dtype=float)
     directions = list(ds["direction"].values) if "direction" in ds.dims else [None]
-    periodic = {d: _periodic(ds, d) for d in directions}
+    periodic = {d: periodic_mask(ds, d) for d in directions}
     labelled = all(p is not None for p in periodic.values())
     scales = PhysicalScales.of_sweep(res)
     fig = Figure(figsize=figsize or (7.0, 10.0 if labelled else 9.0), layout="constrained")
