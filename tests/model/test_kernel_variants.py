@@ -9,10 +9,9 @@ stiffness harmonics) too.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
+from planetary_variants import variant_gearset
 
 import gearchaos as gc
 from gearchaos.model import kernels
@@ -23,29 +22,6 @@ from gearchaos.model.layout import (
     planetary_kind,
 )
 from gearchaos.model.planetary import planetary_system
-
-RARE = {
-    "eccentricity.sun": 3e-6,
-    "eccentricity.planet": 2e-6,
-    "eccentricity.ring": 5e-6,
-    "stiffness.sun_planet_harmonics": (0.05, -0.02),
-    "stiffness.planet_ring_harmonics": (0.03,),
-}
-
-
-def _gearset(n: int, rare: bool) -> gc.GearSet:
-    base = gc.preset("hindawi2021")
-    changes: dict[str, object] = {}
-    if n != base.n_planets:
-        # the smallest sun from 35 teeth around which n planets of 31 are equally spaced
-        # ((z_s + z_r)/N whole) and clear each other ((z_s + z_p)·sin(π/N) > z_p + 2)
-        zs = 35
-        while (2 * (zs + 31)) % n or (zs + 31) * math.sin(math.pi / n) <= 33:
-            zs += 1
-        changes = {"geometry.planets": n, "teeth.sun": zs, "teeth.ring": zs + 62}
-    if rare:
-        changes.update(RARE)
-    return base.evolve(changes) if changes else base
 
 
 def test_kinds() -> None:
@@ -58,7 +34,7 @@ def test_kinds() -> None:
 @pytest.mark.parametrize("rare", [False, True])
 @pytest.mark.parametrize("n", PLANETARY_FIXED_N)
 def test_fixed_count_kernel_equals_general_kernel(n: int, rare: bool) -> None:
-    system = planetary_system(_gearset(n, rare), 1.7)
+    system = planetary_system(variant_gearset(n, rare), 1.7)
     assert system.kind == KIND_PLANETARY_FIXED + n
     p = system.params
     rng = np.random.default_rng(n)

@@ -6,13 +6,12 @@ computed in numpy by the independent right-hand side of ``tests/integrate/test_v
 from __future__ import annotations
 
 import importlib.util
-import math
 from pathlib import Path
 
 import numpy as np
 import pytest
+from planetary_variants import variant_gearset
 
-import gearchaos as gc
 from gearchaos.model import layout as L
 from gearchaos.model.planetary import planetary_system
 
@@ -23,28 +22,6 @@ assert _spec is not None and _spec.loader is not None
 _vs_scipy = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(_vs_scipy)
 model_md_rhs = _vs_scipy.model_md_rhs
-
-RARE = {
-    "eccentricity.sun": 3e-6,
-    "eccentricity.planet": 2e-6,
-    "eccentricity.ring": 5e-6,
-    "stiffness.sun_planet_harmonics": (0.05, -0.02),
-    "stiffness.planet_ring_harmonics": (0.03,),
-}
-
-
-def _gearset(n: int, rare: bool) -> gc.GearSet:
-    """hindawi2021 with n equally spaced planets (teeth as in test_kernel_variants)."""
-    base = gc.preset("hindawi2021")
-    changes: dict[str, object] = {}
-    if n != base.n_planets:
-        zs = 35
-        while (2 * (zs + 31)) % n or (zs + 31) * math.sin(math.pi / n) <= 33:
-            zs += 1
-        changes = {"geometry.planets": n, "teeth.sun": zs, "teeth.ring": zs + 62}
-    if rare:
-        changes.update(RARE)
-    return base.evolve(changes) if changes else base
 
 
 def test_names_follow_the_table() -> None:
@@ -71,7 +48,7 @@ def _dot(name: str) -> str:
 @pytest.mark.parametrize(("n", "rare"), [(3, False), (5, True), (6, False), (7, True), (2, False)])
 def test_every_named_observable_is_its_model_md_definition(n: int, rare: bool) -> None:
     omega = 1.3
-    system = planetary_system(_gearset(n, rare), omega)
+    system = planetary_system(variant_gearset(n, rare), omega)
     par = system.model.parameters
     rhs = model_md_rhs(par, omega)
     names = system.obs_names
