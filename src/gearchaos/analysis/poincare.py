@@ -116,16 +116,7 @@ def section_variables(result: Any, var: str | None = None, planet: int = 1) -> t
                 f"planet must be an integer in 1..{system.group_size}: got {planet!r}"
             )
         return system.section_pair(planet)
-    if var not in names and system.group_size:
-        members = system.group_size
-        try:
-            group = system.observable(var)
-        except ParameterError:
-            group = None
-        if group is not None and group.per_planet:
-            if not (isinstance(planet, int | np.integer) and 1 <= planet <= members):
-                raise ParameterError(f"planet must be an integer in 1..{members}: got {planet!r}")
-            var = f"{var}_{planet}"
+    var = system.member(var, planet) or var
     if var not in names:
         raise ParameterError(
             f"var must name a variable of {system.name} ({', '.join(names)}): got {var!r}"

@@ -173,15 +173,31 @@ class System:
     def section_pair(self, planet: int = 1) -> tuple[str, str]:
         """The default section variables as concrete names: :attr:`default_observables`, a
         group's member ``planet`` (``delta_sp`` → ``delta_sp_1``, ``delta_sp_dot_1``)."""
-        out = []
-        for name in self.default_observables:
-            if name in self.state_names or name in self.obs_names:
-                out.append(name)
-                continue
-            ob = self.observable(name, [planet])  # a group: its member
-            names = self.state_names if ob.source == "state" else self.obs_names
-            out.append(names[int(ob.columns[0])])
-        return out[0], out[1]
+        var, dot = self.default_observables
+        return self.member(var, planet) or var, self.member(dot, planet) or dot
+
+    def member(self, name: str, planet: int) -> str | None:
+        """The name of member ``planet`` (1-based) of the per-member group ``name``
+        (``delta_sp`` → ``delta_sp_2``, ``p_dot`` → ``p_2_dot``); None when ``name`` is a
+        variable's own name or no group. A member out of range raises
+        :class:`~gearchaos.errors.ParameterError`."""
+        from ..errors import ParameterError
+
+        if name in self.state_names or name in self.obs_names:
+            return None
+        try:
+            group = self.observable(name)
+        except ParameterError:
+            return None
+        if not group.per_planet:
+            return None
+        count = int(group.columns.size)
+        if isinstance(planet, bool) or not (
+            isinstance(planet, int | np.integer) and 1 <= planet <= count
+        ):
+            raise ParameterError(f"planet must be an integer in 1..{count}: got {planet!r}")
+        names = self.state_names if group.source == "state" else self.obs_names
+        return names[int(group.columns[int(planet) - 1])]
 
     @property
     def group_size(self) -> int:

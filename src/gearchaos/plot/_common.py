@@ -213,30 +213,19 @@ def variable(result: Any, var: str | None = None, planet: int = 1) -> VarInfo:
         if "%d" not in sym:
             dot = f"{var}_dot"
             return VarInfo(var, dot if dot in names else None, sym, definition, clearance, csym)
-        members = system.group_size
-        if not (isinstance(planet, int | np.integer) and 1 <= planet <= members):
-            raise ParameterError(f"planet must be an integer in 1..{members}: got {planet!r}")
-        name = f"{var}_{planet}"
-        member_dot = next(
-            (d for d in (f"{var}_dot_{planet}", f"{var}_{planet}_dot") if d in names), None
-        )
+        name = system.member(var, planet)
+        if name is None:
+            raise ParameterError(f"var {var!r} is no per-planet variable of {system.name}")
+        member_dot = system.member(f"{var}_dot", planet)
         return VarInfo(
             name, member_dot, sym % planet, None if definition is None else definition % planet,
             clearance, csym,
         )  # fmt: skip
-    if var not in names and system.group_size:  # a group without a symbol: its member
-        try:
-            group = system.observable(var, [planet]) if isinstance(planet, int) else None
-        except ParameterError:
-            group = None
-        if group is not None and group.per_planet:
-            member = (system.state_names if group.source == "state" else system.obs_names)[
-                int(group.columns[0])
-            ]
-            member_dot = next(
-                (d for d in (f"{var}_dot_{planet}", f"{member}_dot") if d in names), None
-            )
-            return VarInfo(member, member_dot, _generic_symbol(member), None, None, None)
+    member = system.member(var, planet)  # a group without a symbol: its member
+    if member is not None:
+        member_dot = system.member(f"{var}_dot", planet)
+        member_dot = member_dot or (f"{member}_dot" if f"{member}_dot" in names else None)
+        return VarInfo(member, member_dot, _generic_symbol(member), None, None, None)
     if var not in names:
         raise ParameterError(
             f"var must name a variable of {system.name} ({', '.join(names)}): got {var!r}"
