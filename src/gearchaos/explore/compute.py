@@ -44,18 +44,14 @@ def point_target(res: Any, values: Mapping[str, float]) -> tuple[Any, dict[str, 
     """
     gs = res.gearset
     if gs is None:
-        from ..model import System
-        from ..model.contract import rebuild_model
-
-        model = rebuild_model(res.ds.attrs)
-        if model is None:
+        gs = res.base_target
+        if gs is None:
             raise StoreError(
                 "this store's model is neither a gear set (no gearset_toml) nor a model it can "
                 "build again (no model_class): its stored sections can be explored, but points "
                 "cannot be recomputed from it"
             )
         fixed = {k: v for k, v in res.fixed.items() if k != OMEGA}
-        gs = System(model, 1.0)
         if fixed:
             from ..model.target import resolve
 
@@ -238,13 +234,7 @@ def run_zoom(store: str, axes: Mapping[str, tuple[float, float, int]]) -> str:
 
     res = open_result(store)
     spec = res.spec
-    target: Any = res.base_gearset
-    if target is None:  # a model the store records how to build (the fixed values apply)
-        from ..model import System
-        from ..model.contract import rebuild_model
-
-        model = rebuild_model(res.ds.attrs)
-        target = None if model is None else System(model, 1.0)
+    target = res.base_target  # the fixed values apply through the specification
     if spec is None or target is None:
         raise StoreError(
             "a finer sweep needs a store of a gear set, or of a model it records how to build, "

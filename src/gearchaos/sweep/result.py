@@ -67,6 +67,7 @@ class SweepResult:
     spec: Any
     base_gearset: Any
     _gearset: Any
+    _model: Any
 
     def __init__(self, ds: Any, *, _parsed: SweepResult | None = None):
         import xarray as xr
@@ -81,6 +82,7 @@ class SweepResult:
             self.spec = _parsed.spec
             self.base_gearset = _parsed.base_gearset
             self._gearset = _parsed._gearset
+            self._model = _parsed._model
             return
         from .spec import SweepSpec
 
@@ -101,6 +103,7 @@ class SweepResult:
             except ParameterError as exc:
                 raise StoreError(f"the store's gear set (gearset_toml) is invalid: {exc}") from None
         self._gearset = _UNSET
+        self._model = _UNSET
 
     @classmethod
     def of(cls, obj: Any) -> SweepResult:
@@ -141,6 +144,28 @@ class SweepResult:
                         ) from None
             self._gearset = gs
         return self._gearset
+
+    @property
+    def base_model(self) -> Any:
+        """The model of a store that is not of a gear set, built again from what the store
+        records (``model_class``, ``model_fields``;
+        :func:`~gearchaos.model.contract.rebuild_model`), or ``None``."""
+        if self._model is _UNSET:
+            from ..model.contract import rebuild_model
+
+            self._model = None if self.base_gearset is not None else rebuild_model(self.ds.attrs)
+        return self._model
+
+    @property
+    def base_target(self) -> Any:
+        """What the store was swept on, without its fixed values: its gear set, or a
+        :class:`~gearchaos.model.System` of its model at Ω = 1; ``None`` when it records
+        neither."""
+        if self.base_gearset is not None:
+            return self.base_gearset
+        from ..model import System
+
+        return None if self.base_model is None else System(self.base_model, 1.0)
 
     @property
     def swept_names(self) -> tuple[str, ...]:
@@ -328,10 +353,8 @@ class SweepResult:
         again): the model at every point, with its swept and fixed values, says it."""
         import dataclasses
 
-        from ..model.contract import rebuild_model
-
         try:
-            model = rebuild_model(self.ds.attrs)
+            model = self.base_model
         except ParameterError:
             return None
         if model is None:
