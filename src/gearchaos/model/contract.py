@@ -58,6 +58,7 @@ from typing import Any, ClassVar, Protocol, runtime_checkable
 import numpy as np
 
 from ..errors import ParameterError
+from .layout import FD_MAX_OBS, FD_MAX_STATE
 
 __all__ = [
     "Contact",
@@ -70,10 +71,6 @@ __all__ = [
 
 #: Kinds of models from outside the package start here (built-in kinds are below 1000).
 EXTERNAL_KIND_BASE = 1 << 24
-#: The largest state and observable counts a model without its own tangent may have (the
-#: finite-difference tangent keeps its work arrays on the stack).
-FD_MAX_STATE = 256
-FD_MAX_OBS = 1024
 
 
 @dataclass(frozen=True)

@@ -51,6 +51,8 @@ from .layout import (
     B_SE_SP,
     B_SK_RP,
     B_SK_SP,
+    FD_MAX_OBS,
+    FD_MAX_STATE,
     KIND_BACKLASH_OSCILLATOR,
     KIND_DUFFING,
     KIND_LINEAR,
@@ -500,9 +502,9 @@ def _finite_difference_tangent(f, t, y, p, dydt, n, k):  # pragma: no cover - co
     """dydt[n:] = J(τ, y[:n]) v_j for the k vectors v_j stored after the state in y, J by
     central differences of the right-hand side f, one state component at a time (the
     component restored exactly after each evaluation): 2n evaluations, whatever k is."""
-    fp = stack_array(256)
-    fm = stack_array(256)
-    ob = stack_array(1024)
+    fp = stack_array(FD_MAX_STATE)
+    fm = stack_array(FD_MAX_STATE)
+    ob = stack_array(FD_MAX_OBS)
     for j in range(n, n + n * k):
         dydt[j] = 0.0
     for i in range(n):

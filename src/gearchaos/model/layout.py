@@ -181,3 +181,7 @@ DU_GAMMA = 4
 LZ_SIGMA = 0
 LZ_RHO = 1
 LZ_BETA = 2
+
+# ---------- the finite-difference tangent of a model without its own (work arrays on the stack)
+FD_MAX_STATE = 256  # most states
+FD_MAX_OBS = 1024  # most observables
