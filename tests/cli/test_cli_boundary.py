@@ -46,6 +46,10 @@ def test_boundary_command_writes_the_curve_with_provenance(curve_file) -> None:
     # it starts at the branch's event (ξ = 0.03) and lands on ξ = 0.025 on both sides
     assert np.isclose(ds.omega.values[ds.direction.values == 0][0], pd.value, atol=1e-7)
     assert (ds.on_grid.values == 1).sum() == 2
+    # by default the two landed points state their uncertainty, no other point does
+    assert summary["uncertainty"]["assessed"] == 2 and ds.attrs["assessed"] == "landed"
+    assert np.isfinite(ds.uncertainty.values).sum() == 2
+    assert 0 < summary["uncertainty"]["max"] < 1e-6 and summary["uncertainty"]["max2"] == 0.0
 
 
 def test_boundary_refuses_unknown_events_by_name(curve_file) -> None:
@@ -55,6 +59,12 @@ def test_boundary_refuses_unknown_events_by_name(curve_file) -> None:
               "xi=0.02:0.04", "-o", str(where / "x.nc")],
     )  # fmt: skip
     assert got.exit_code != 0 and "0 fold events" in got.output
+    got = runner.invoke(
+        app, ["boundary", "--from", str(where / "branch.nc"), "--vary", "xi=0.02:0.04",
+              "--assess", "some", "-o", str(where / "y.nc")],
+    )  # fmt: skip
+    assert got.exit_code != 0 and "assess must be one of landed, all, none" in got.output
+    assert "'some'" in got.output
 
 
 @pytest.fixture(scope="module")

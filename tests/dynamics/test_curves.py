@@ -204,3 +204,79 @@ def test_grazing_curve_of_the_backlash_oscillator_is_the_closed_form() -> None:
     # tighter landing, whose own error, about u/100, the 1e-9 covers)
     assert np.all(u < 1e-8)
     assert np.all(np.abs(omega[landed] - exact[landed]) <= u + 1e-9)
+
+
+# ---------------------------------------------------------------- Neimark–Sacker and resonances
+DU_BETA, DU_GAMMA = 0.5, 0.3
+
+
+def _duffing_map(y: np.ndarray, omega: float) -> tuple[np.ndarray, np.ndarray]:
+    """scipy's P(y) and DP(y) of the undamped Duffing x'' + x + βx³ = γ cos Ωτ (δ = 0, where
+    the Neimark–Sacker curve lies), DOP853 at rtol 1e-12 with the variational equations."""
+
+    def f(t, u):
+        x, v = u[0], u[1]
+        phi = u[2:].reshape(2, 2, order="F")
+        a = np.array([[0.0, 1.0], [-(1.0 + 3.0 * DU_BETA * x * x), 0.0]])
+        du = [v, DU_GAMMA * np.cos(omega * t) - x - DU_BETA * x**3]
+        return np.concatenate([du, (a @ phi).ravel(order="F")])
+
+    u0 = np.concatenate([y, np.eye(2).ravel(order="F")])
+    sol = solve_ivp(f, (0.0, 2 * np.pi / omega), u0, method="DOP853", rtol=1e-12, atol=1e-13)
+    u = sol.y[:, -1]
+    return u[:2], u[2:].reshape(2, 2, order="F")
+
+
+def scipy_resonance(guess_y: np.ndarray, guess_omega: float, q: int) -> float:
+    """Ω of the 1:q resonance on the curve δ = 0: there det M = 1, so the multipliers are
+    e^{±iθ} and θ = 2π/q means trace M = 2 cos(2π/q); fsolve on (P(y) − y, tr M − 2cos(2π/q))
+    in (y, Ω)."""
+
+    def eqs(w):
+        p, m = _duffing_map(w[:2], w[2])
+        return np.append(p - w[:2], np.trace(m) - 2.0 * np.cos(2.0 * np.pi / q))
+
+    w, _info, ok, msg = fsolve(eqs, np.append(guess_y, guess_omega), xtol=1e-13, full_output=True)
+    assert ok == 1, msg
+    assert np.max(np.abs(eqs(w))) < 1e-10
+    return float(w[2])
+
+
+def test_neimark_sacker_curve_of_the_duffing_oscillator_and_its_resonances() -> None:
+    """The forced Duffing oscillator x'' + δx' + x + βx³ = γ cos Ωτ has div f = −δ, so by
+    Liouville's formula det M = e^{−δT} for every orbit: a complex pair of multipliers has
+    |μ|² = e^{−δT} and crosses the unit circle exactly at δ = 0, whatever Ω, β and γ. The
+    Neimark–Sacker curve in (Ω, δ), continued from the event of a one-parameter branch in δ at
+    Ω = 3.5, must therefore be the line δ = 0, every point within its stated uncertainty
+    (assess="all"). On it the pair's angle moves with Ω; the 1:3 and 1:4 resonances (θ = 2π/3,
+    π/2) it reports must be where scipy's independent shooting puts them (the nonlinear term
+    moves them off the linear values Ω = 3 and 4)."""
+    system = gc.duffing(3.5, delta=-0.05, alpha=1.0, beta=DU_BETA, gamma=DU_GAMMA)
+    branch = gc.continuation(system, "delta=-0.05:0.05")
+    (ns,) = [e for e in events(branch) if e.kind == "neimark_sacker"]
+    assert abs(ns.value) < 1e-8
+    curve = boundary_curve(
+        system, ns, "omega=2.2:4.5", within="delta=-0.1:0.1", at=[2.5, 3.5, 4.2], assess="all"
+    )
+    assert curve.attrs["curve_kind"] == "neimark_sacker"
+    assert curve.attrs["assessed"] == "all"
+    omega, delta = curve.omega.values, curve.delta.values
+    assert omega.min() == 2.2 and omega.max() == 4.5  # it crossed the whole range
+    u, u2 = curve.uncertainty.values, curve.uncertainty2.values
+    assert np.all(np.isfinite(u)) and np.all(np.isfinite(u2))
+    assert np.all(u < 1e-8)
+    # each point is as far from δ = 0 as it says (u: its shift to the correction 100 times
+    # tighter, whose own error is about u/100)
+    assert np.all(np.abs(delta) <= 1.02 * u + 1e-12)
+    landed = curve.on_grid.values == 1
+    assert sorted(omega[landed]) == [2.5, 3.5, 4.2]  # the start (Ω = 3.5) counts as landed
+    assert np.all(u2[landed] == 0.0)
+    assert np.allclose(curve.multiplier_abs.values, 1.0, atol=1e-8)
+    kinds = [str(k) for k in curve.event_kind.values]
+    assert kinds == ["resonance_1_3", "resonance_1_4"], kinds
+    for k, q in enumerate((3, 4)):
+        located = float(curve.event_value2.values[k])
+        truth = scipy_resonance(curve.event_state.values[k], located, q)
+        assert abs(truth - q) > 1e-4  # the nonlinearity moved it: not the linear value
+        assert abs(located - truth) <= curve.event_uncertainty2.values[k]
+        assert abs(located - truth) < 1e-7

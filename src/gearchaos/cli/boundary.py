@@ -100,6 +100,14 @@ def boundary(
             show_default=False,
         ),
     ] = None,
+    assess: Annotated[
+        str,
+        typer.Option(
+            "--assess",
+            help="Which points state their uncertainty (corrected again 100 times tighter): "
+            "landed (the --at points), all (every point, about twice the cost) or none.",
+        ),
+    ] = "landed",
     max_points: Annotated[
         int, typer.Option("--max-points", help="Most new points per direction.")
     ] = 200,
@@ -165,7 +173,7 @@ def boundary(
         if not quiet and not json_out:
             err.print(Text(f"continuing {chosen!r} in {vary}", style="dim"))
         curve = boundary_curve(
-            target, chosen, vary, within=within, settings=cfg, at=values,
+            target, chosen, vary, within=within, settings=cfg, at=values, assess=assess,
             max_points=max_points, max_step=max_step, store=path, resume=resume,
             overwrite=overwrite, progress=progress,
         )  # fmt: skip
@@ -182,6 +190,13 @@ def boundary(
                 f"{summary['range2'][1]:.6g}"
             )
             out.print(f"ends: {summary['stop_reason']}")
+            u = summary["uncertainty"]
+            if u["assessed"]:
+                out.print(
+                    f"uncertainty ({u['assessed']} points corrected again 100 times tighter): "
+                    f"{summary['parameter']} ± {u['max']:.2g}, {summary['parameter2']} ± "
+                    f"{u['max2']:.2g} at most"
+                )
             for e in summary["codim2"]:
                 out.print(
                     f"  {e['kind']} at {summary['parameter']}={e['value']:.8g}, "
@@ -204,6 +219,7 @@ def curve_summary(ds: Any) -> dict[str, Any]:
         "range": [float(ds[n1].min()), float(ds[n1].max())],
         "range2": [float(ds[n2].min()), float(ds[n2].max())],
         "stop_reason": str(ds.attrs["stop_reason"]),
+        "uncertainty": _uncertainty(ds),
         "codim2": [
             {
                 "kind": str(ds.event_kind.values[k]),
@@ -214,6 +230,20 @@ def curve_summary(ds: Any) -> dict[str, Any]:
             }
             for k in range(ds.sizes.get("event", 0))
         ],
+    }
+
+
+def _uncertainty(ds: Any) -> dict[str, Any]:
+    """How many points state their uncertainty, and the largest of each parameter."""
+    import numpy as np
+
+    u = np.asarray(ds.uncertainty.values) if "uncertainty" in ds else np.zeros(0)
+    u2 = np.asarray(ds.uncertainty2.values) if "uncertainty2" in ds else np.full(u.shape, np.nan)
+    done = ~np.isnan(u)
+    return {
+        "assessed": int(done.sum()),
+        "max": float(u[done].max()) if done.any() else None,
+        "max2": float(np.nan_to_num(u2[done], nan=0.0).max()) if done.any() else None,
     }
 
 

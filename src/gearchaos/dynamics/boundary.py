@@ -45,6 +45,7 @@ def boundary_curve(
     max_corrector: int = 10,
     tol: float | None = None,
     at: Any = None,
+    assess: str = "landed",
     store: str | os.PathLike[str] | None = None,
     resume: bool = False,
     overwrite: bool = False,
@@ -83,6 +84,12 @@ def boundary_curve(
     at
         Values of λ₂ to land on exactly (a point computed there, flagged ``on_grid``): to compare
         with one-parameter branches at fixed λ₂.
+    assess
+        Which points state their uncertainty (variables ``uncertainty``, ``uncertainty2``: the
+        shift of λ₁ and λ₂ when the point is corrected again with rtol, atol and the
+        corrector's tolerance 100 times tighter): ``"landed"`` (default) the points landed on
+        ``at`` (on their own λ₂, so λ₂ shifts by 0), ``"all"`` every point (the others on their
+        own tangent hyperplane; about doubles the cost), ``"none"``.
     store
         A ``.nc`` (or ``.zarr``) path: the curve is written there, every
         :data:`CHECKPOINT_EVERY` points too.
@@ -144,6 +151,8 @@ def boundary_curve(
             "the steps must satisfy min_step <= step <= max_step: got "
             f"{steps.minimum:g}, {steps.initial:g}, {steps.maximum:g}"
         )
+    if assess not in ASSESS:
+        raise ParameterError(f"assess must be one of {', '.join(ASSESS)}: got {assess!r}")
     grid = np.unique(np.asarray([] if at is None else at, dtype=float).reshape(-1))
     if not np.all(np.isfinite(grid)):
         raise ParameterError(f"at must be finite values of {name2}: got {at!r}")
@@ -166,7 +175,7 @@ def boundary_curve(
     if store is not None and resume and os.path.exists(os.fspath(store)):
         backward, forward, reasons = _resume(curve, open_curve(store), extra)
     else:
-        backward, forward, reasons = _start(curve, event, y0, lam2)
+        backward, forward, reasons = _start(curve, event, y0, lam2, bool(np.any(grid == lam2)))
 
     count = [0]
     written = [False]
@@ -207,37 +216,92 @@ def boundary_curve(
     for e in curve.events:
         if e["direction"] < 0:
             e["s"] = -abs(e["s"])
-    _assess_landed(curve, [*backward, *forward])
+    if assess != "none":
+        _assess(curve, [*backward[1:], *forward], everywhere=assess == "all")
+    extra["assessed"] = assess
     return save(reasons[0], reasons[1])
 
 
-def _assess_landed(curve: Curve, pts: list[CurvePoint]) -> None:
-    """The uncertainty in λ₁ of every point landed on a value of ``at``: the point is landed
-    on the same λ₂ again with rtol, atol and the corrector's tolerance 100 times tighter, and
-    the shift of λ₁ is its uncertainty (the curve's test function is built from a monodromy
-    matrix accurate to about rtol, so at the default rtol 1e-8 a period-doubling point can be
-    a few 1e-9 off; tests compare curves with events through it)."""
-    landed = [p for p in pts if p.landed and p.tangent is not None and math.isnan(p.uncertainty)]
-    if not landed:
+def _assess(curve: Curve, pts: list[CurvePoint], everywhere: bool) -> None:
+    """The uncertainty in λ₁ and λ₂ of the points landed on a value of ``at`` (and of all
+    the others when ``everywhere``), and of the codimension-2 points located on the way.
+
+    A point is corrected again with rtol, atol and the corrector's tolerance 100 times tighter
+    — a landed point on the same λ₂, any other on its own tangent hyperplane (the shift is then
+    across the curve) — and the shifts of λ₁ and λ₂ are its uncertainties. The curve's test
+    function is built from a monodromy matrix accurate to about rtol, so at the default rtol
+    1e-8 a period-doubling point can be a few 1e-9 off; tests compare curves with events
+    through this. A codimension-2 point is located again on the tighter curve
+    (:func:`_relocate`) and its shift is added to half its bracket."""
+    todo = [
+        p for p in pts
+        if (p.landed or everywhere) and p.tangent is not None and math.isnan(p.uncertainty)
+    ]  # fmt: skip
+    found = [e for e in curve.events if "bracket" in e and e["located"] and e["p"] is not None]
+    if not todo and not found:
         return
     cfg = curve.cfg.replace(rtol=curve.cfg.rtol / 100.0, atol=curve.cfg.atol / 100.0)
     fine = Curve(
         curve.target, curve.names, curve.fixed, cfg, curve.n, max(curve.tol / 100.0, 1e-14),
-        curve.fn, curve.bounds, curve.steps,
+        replace(curve.fn), curve.bounds, curve.steps,
     )  # fmt: skip
     fine.scale = curve.scale
-    for p in landed:
-        q = fine.land(p, -1, float(p.z[-1]))
-        p.uncertainty = math.inf if q is None else abs(float(q.z[-2] - p.z[-2]))
+    for p in todo:
+        q = fine.land(p, -1, float(p.z[-1])) if p.landed else fine.on_hyperplane(p, 0.0)
+        if q is None:
+            p.uncertainty = p.uncertainty2 = math.inf
+        else:
+            p.uncertainty = abs(float(q.z[-2] - p.z[-2]))
+            p.uncertainty2 = 0.0 if p.landed else abs(float(q.z[-1] - p.z[-1]))
+    for e in found:
+        z = _relocate(fine, e)
+        shift = np.full(2, math.inf) if z is None else np.abs(z[-2:] - e["z"][-2:])
+        e["uncertainty"] = tuple(float(u + d) for u, d in zip(e["uncertainty"], shift, strict=True))
+        del e["bracket"]  # assessed once: a resumed run keeps the stored value
     curve.evals += fine.evals
 
+
+def _relocate(fine: Curve, e: dict[str, Any]) -> np.ndarray | None:
+    """The codimension-2 point ``e`` located again on the tighter curve ``fine``: the Illinois
+    iteration on the same tangent hyperplanes of the point before it, in a bracket around the
+    first location widened until its test changes sign (None: no sign change up to the whole
+    step, or a failed correction)."""
+    from .curve_tests import codim2_tests
+
+    p, key, sigma = e["p"], e["kind"], float(e["sigma"])
+    sign = 1.0 if sigma >= 0 else -1.0
+    centre = abs(sigma)
+    lo, hi = e["bracket"]
+    half = max(0.5 * (hi - lo), 1e-12)
+    if np.isfinite(e["mu"]):
+        fine.fn.mu_ref = complex(e["mu"])
+
+    def fn(x: float) -> float | None:
+        pt = fine.on_hyperplane(p, sign * x)
+        return None if pt is None else codim2_tests(fine.fn, pt.mu)[key]
+
+    tol = max(half * 1e-2, 1e-14)
+    for widen in (4.0, 40.0, 400.0):
+        a, b = max(centre - widen * half, 0.0), centre + widen * half
+        fa, fb = fn(a), fn(b)
+        if fa is None or fb is None:
+            return None
+        if fa * fb < 0:
+            x, _ok, _ = ev.illinois(fn, a, b, fa, fb, tol, max_evaluations=20)
+            pt = fine.on_hyperplane(p, sign * x)
+            return None if pt is None else pt.z
+    return None
+
+
+#: The choices of ``assess``.
+ASSESS = ("landed", "all", "none")
 
 #: Points between checkpoints of the store.
 CHECKPOINT_EVERY = 20
 
 
 def _start(
-    curve: Curve, event: ev.Event, y0: np.ndarray, lam2: float
+    curve: Curve, event: ev.Event, y0: np.ndarray, lam2: float, landed: bool
 ) -> tuple[list[CurvePoint], list[CurvePoint], list[str]]:
     """The start point (corrected at the event's λ₂) and the two directions' point lists."""
     z0 = np.append(y0, [event.value, lam2])
@@ -261,6 +325,7 @@ def _start(
         raise IntegrationError(f"the start point is no {event.kind}: {left}")
     t = curve.tangent(p0, e2)
     p0.tangent = t
+    p0.landed = landed  # the event's λ₂ is a value of ``at``
     back = replace(p0, tangent=-t)
     return [back], [p0], ["running", "running"]
 
@@ -307,6 +372,9 @@ def _resume(
                 landed=bool(ds.on_grid.values[k]),
                 uncertainty=(
                     float(ds.uncertainty.values[k]) if "uncertainty" in ds else math.nan
+                ),
+                uncertainty2=(
+                    float(ds.uncertainty2.values[k]) if "uncertainty2" in ds else math.nan
                 ),
             )
         )  # fmt: skip

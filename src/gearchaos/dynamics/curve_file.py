@@ -17,9 +17,10 @@ per point
     ``stable`` (int8: all multipliers but the critical one inside the unit circle: the orbit is
     stable on one side of the boundary); ``test_value`` (g); ``residual``; ``iterations`` (map
     evaluations of the corrector); ``direction`` (−1 backward, 0 start, +1 forward);
-    ``on_grid`` (int8: landed on a value of ``at``); ``uncertainty`` (of λ₁ at a landed point:
-    its shift when landed again 100 times tighter; NaN elsewhere); ``tangent`` (point,
-    unknown); ``obs_min``,
+    ``on_grid`` (int8: landed on a value of ``at``); ``uncertainty``, ``uncertainty2`` (of λ₁
+    and λ₂: the point's shift when corrected again 100 times tighter, a landed point on its
+    own λ₂, any other on its tangent hyperplane; NaN where not assessed, see the attribute
+    ``assessed``); ``tangent`` (point, unknown); ``obs_min``,
     ``obs_max`` (point, track) extrema of the tracked observables over the orbit.
 events
     ``event_kind`` (cusp, fold_flip, resonance_1_2, … see
@@ -27,12 +28,15 @@ events
     ``event_value2`` (second), ``event_point`` (index of the point before it),
     ``event_arclength``, ``event_multiplier_re``/``_im`` (the critical multiplier there),
     ``event_state``, ``event_vector`` (zeros), ``event_detail``, ``event_located`` (int8),
-    ``event_uncertainty``, ``event_uncertainty2`` (half the final bracket, in each parameter).
+    ``event_uncertainty``, ``event_uncertainty2`` (in each parameter: half the final bracket,
+    plus, unless ``assessed`` is ``none``, the shift when located again on the curve corrected
+    100 times tighter).
 attributes
     ``kind`` = ``boundary_curve``, ``curve_kind`` (fold, period_doubling, neimark_sacker,
     grazing), ``parameter`` and ``parameter2``, ``period``, ``vary`` and ``within`` (the two
     ranges), ``fixed`` (JSON), ``start`` (the event it was started from), ``contact`` (grazing),
-    ``stop_reason_forward``/``_backward``, ``tol``, steps, solver settings, model provenance
+    ``stop_reason_forward``/``_backward``, ``assessed`` (which points state their
+    uncertainty: landed, all or none), ``tol``, steps, solver settings, model provenance
     (gear set TOML …) and versions.
 """
 
@@ -139,11 +143,13 @@ def curve_dataset(
     ds["iterations"] = ("point", np.array([p.evals for p in pts], dtype=np.int64))
     ds["direction"] = ("point", direction.astype(np.int8))
     ds["on_grid"] = ("point", np.array([p.landed for p in pts], dtype=np.int8))
-    ds["uncertainty"] = ("point", np.array([p.uncertainty for p in pts], dtype=float))
-    ds["uncertainty"].attrs["long_name"] = (
-        f"uncertainty of {n1} at a landed point: its shift when landed again with the "
-        "integrator and corrector 100 times tighter (NaN: not landed)"
-    )
+    for var, name, which in (("uncertainty", n1, 0), ("uncertainty2", n2, 1)):
+        ds[var] = ("point", np.array([(p.uncertainty, p.uncertainty2)[which] for p in pts]))
+        ds[var].attrs["long_name"] = (
+            f"uncertainty of {name}: its shift when the point is corrected again with the "
+            "integrator and corrector 100 times tighter (a landed point on its own "
+            f"{n2}; NaN: not assessed)"
+        )
     ds["tangent"] = (("point", "unknown"), np.array([p.tangent for p in pts]))
     ds["obs_min"] = (("point", "track"), np.array([p.obs_min for p in pts]))
     ds["obs_max"] = (("point", "track"), np.array([p.obs_max for p in pts]))

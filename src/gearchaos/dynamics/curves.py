@@ -88,9 +88,11 @@ class CurvePoint:
     s: float = 0.0
     landed: bool = False
     jac: np.ndarray | None = field(default=None, repr=False)
-    #: for a landed point: how far λ₁ moves when the point is landed again with the
-    #: integrator and corrector 100 times tighter (NaN: not assessed)
+    #: how far λ₁ and λ₂ move when the point is corrected again with the integrator and the
+    #: corrector 100 times tighter: a landed point on its own λ₂ (so λ₂ moves by 0), any other
+    #: on its own tangent hyperplane (NaN: not assessed)
     uncertainty: float = math.nan
+    uncertainty2: float = math.nan
 
 
 @dataclass(frozen=True)
@@ -413,7 +415,7 @@ class Curve:
 
                 return codim2_tests(self.fn, pt.mu)[key]
 
-            tol = max(span * 1e-4, 10.0 * self.tol)
+            tol = max(span * 1e-6, 10.0 * self.tol)
             sigma, ok, (lo, hi) = ev.illinois(fn, 0.0, span, fa, fb, tol, max_evaluations=20)
             pt = self.on_hyperplane(p, sign * sigma) or q
             self._record(key, pt, p, sign * sigma, ok, (lo, hi))
@@ -447,6 +449,8 @@ class Curve:
                 "uncertainty": (float(unc[0]), float(unc[1])),
                 "p": p,
                 "direction": self.direction,
+                "sigma": sigma,
+                "bracket": bracket,
             }
         )
 
