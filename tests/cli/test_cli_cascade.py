@@ -74,3 +74,16 @@ def test_plot_draws_impact_maps_and_response_with_branches(tmp_path) -> None:
     out = runner.invoke(app, ["plot", str(resp), "--branch", str(branch), "-o", str(png)])
     assert out.exit_code == 0, out.output
     assert png.stat().st_size > 0
+    force = tmp_path / "force.png"
+    args = ["plot", str(resp), "--branch", str(branch), "-o", str(force), "--quantity"]
+    out = runner.invoke(app, [*args, "force_peak"])
+    assert out.exit_code == 0, out.output
+    assert force.stat().st_size > 0
+    # refused by name where it does not apply or is not a quantity, never ignored
+    for bad, message in (
+        ([*args, "force"], "quantity must be one of amplitude, force_peak"),
+        (["plot", str(resp), "-o", str(force), "--quantity", "force_peak"], "--quantity applies"),
+        (["plot", str(branch), "-o", str(force), "--quantity", "amplitude"], "--quantity applies"),
+    ):
+        out = runner.invoke(app, bad)
+        assert out.exit_code != 0 and message in out.output, out.output

@@ -7,6 +7,10 @@
 * The amplitude curve of a continued branch is max − min of the deflection of the orbit
   simulated independently (gc.simulate from the orbit state) at a few points, and the stable
   branch passes through the brute-force up sweep's periodic points.
+* With ``quantity="force_peak"`` the branch's lines are its stored ``force_peak_mesh`` (solid
+  where stable, dashed where not) and the sweep points the store's; a branch file without the
+  variable (written before branches stored it) still draws its amplitude and is refused by the
+  variable's name for the force.
 """
 
 from __future__ import annotations
@@ -117,3 +121,53 @@ def test_stable_branch_passes_through_the_up_sweeps_periodic_points(oscillator_r
     on_branch = np.interp(up.omega.values, xs[ok][order], ys[ok][order])
     np.testing.assert_allclose(amp, on_branch, rtol=2e-3)
     assert [ln for ln in fig.axes[0].lines if ln.get_gid() == "amplitude:sweep:up"]
+
+
+def _branch_lines(fig):
+    return {
+        ln.get_gid().rsplit(":", 1)[1]: ln
+        for ln in fig.axes[0].lines
+        if str(ln.get_gid()).startswith("amplitude:branch:")
+    }
+
+
+def test_force_figure_draws_the_stored_peak_force_dashed_where_unstable(
+    oscillator_response,
+) -> None:
+    _, res, branch = oscillator_response
+    fig = amplitude_figure(res, [branch], quantity="force_peak")
+    lines = _branch_lines(fig)
+    assert set(lines) == {"stable", "unstable"}
+    stored = branch.force_peak_mesh.values
+    stable = branch.stable.values == 1
+    for which, mask in (("stable", stable), ("unstable", ~stable)):
+        ln = lines[which]
+        np.testing.assert_array_equal(np.asarray(ln.get_xdata(), float), branch.omega.values)
+        y = np.asarray(ln.get_ydata(), float)
+        shown = ~np.isnan(y)
+        assert np.all(shown[mask]) and shown.sum() <= mask.sum() + 2  # + the joins
+        np.testing.assert_array_equal(y[shown], stored[shown])  # the stored values, unchanged
+    assert lines["stable"].get_linestyle() == "-"
+    assert lines["unstable"].get_linestyle() == "--"
+    (up,) = [ln for ln in fig.axes[0].lines if ln.get_gid() == "amplitude:sweep:up"]
+    np.testing.assert_array_equal(
+        np.asarray(up.get_ydata(), float), res.force_peak_mesh.sel(direction="up").values
+    )
+    assert "contact force" in fig.axes[0].get_ylabel()
+    assert any(t.get_text() == "PD" for t in fig.axes[0].texts)  # the event is marked
+
+
+def test_old_branch_without_peak_force_draws_amplitude_and_names_the_variable(
+    oscillator_response, tmp_path
+) -> None:
+    _, res, branch = oscillator_response
+    path = tmp_path / "old.nc"
+    gc.save_branch(branch.drop_vars("force_peak_mesh"), path)
+    old = gc.open_branch(path)
+    assert _branch_lines(amplitude_figure(res, [old], var="x"))
+    with pytest.raises(gc.ParameterError, match=r"old\.nc has no variable force_peak_mesh"):
+        amplitude_figure(res, [old], quantity="force_peak")
+    with pytest.raises(gc.ParameterError, match="quantity must be one of amplitude, force_peak"):
+        amplitude_figure(res, [branch], quantity="force")
+    with pytest.raises(gc.ParameterError, match=r"deflection of a mesh .*\(x\): got 'y'"):
+        amplitude_figure(res, [branch], quantity="force_peak", var="y")

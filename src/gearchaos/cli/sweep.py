@@ -405,6 +405,16 @@ def plot(
             show_default=False,
         ),
     ] = None,
+    quantity: Annotated[
+        str | None,
+        typer.Option(
+            "--quantity",
+            help="For a response store with --branch: amplitude (max − min of --var) or "
+            "force_peak (peak contact force of its mesh, as the response curves name it). "
+            "[default: amplitude]",
+            show_default=False,
+        ),
+    ] = None,
 ) -> None:
     """Draw a sweep store: bifurcation diagrams (one panel per family value, with a band of
     motion labels under each) for a 1-D sweep, maps coloured by motion label (1T, 2T, …, QP,
@@ -443,8 +453,11 @@ def plot(
                 savefig(fig, output)
                 c.wrote(output)
                 return
-            if sections:
-                raise ParameterError("--sections applies to response stores, not branch files")
+            if sections or quantity:
+                raise ParameterError(
+                    f"{'--sections' if sections else '--quantity'} applies to response stores, "
+                    "not branch files"
+                )
             from ..plot.branch import branch_figure
 
             fig = branch_figure(
@@ -466,20 +479,24 @@ def plot(
                 "--branch BRANCH.nc"
             )
         store = stores[0]
+        from ._charts import chart_figure, check_quantity
+
         if _is_basin_store(store):
+            check_quantity(quantity, False)
             _plot_basins(store, output, var=var, planet=planet, branch=branch, sections=sections)
             return
         res = open_store(store)
         branches = [br for b in branch or [] for br in open_cascade(b)]
         response = res.ds.attrs.get("kind") == "response"
+        check_quantity(
+            quantity, bool(branches and response) and not (sections or boundaries or impact)
+        )
         if boundaries:
             from .boundary import boundaries_figure
 
             fig = boundaries_figure(list(boundaries), res)
         elif impact is not None or (branches and response and not sections):
-            from ._charts import chart_figure
-
-            fig = chart_figure(res, impact, branches, var, planet, sections)
+            fig = chart_figure(res, impact, branches, var, planet, sections, quantity)
         elif response and not sections:
             from ..plot import response_figure
 

@@ -19,7 +19,11 @@ per point
     a value of ``grid``);
     the observed variables at the n section points (``delta_sp`` (point, section, planet),
     ``delta_sp_dot`` …, as sweeps store them); extrema over the orbit of the tracked
-    observables (``delta_sp_min`` (point, planet_all) …); ``contact_regime`` (point, contact).
+    observables (``delta_sp_min`` (point, planet_all) …); ``contact_regime`` (point, contact);
+    for models with mesh contact forces, ``force_peak_<mesh>`` (point[, planet_all]): the
+    peak contact force max |F̄ᶜ| over the orbit, from the extrema the integrator tracked
+    while shooting (:func:`gearchaos.model.response.peak_contact_forces`, the definition a
+    response sweep stores under the same name; attributes ``mesh`` and ``deflection``).
 events
     ``event_kind``, ``event_value`` (parameter value), ``event_point`` (index of the point
     before it), ``event_arclength``, ``event_multiplier_re``, ``event_multiplier_im``,
@@ -49,6 +53,7 @@ from .._files import check_path, check_regular_file
 from .._output import check_replaceable, file_has_mark, is_own_zarr, staged_dir, write_file
 from .._version import provenance
 from ..errors import ParameterError, StoreError
+from ..model.response import mesh_groups, peak_contact_forces
 from .orbits import (
     PeriodicOrbit,
     minimal_period,
@@ -131,7 +136,8 @@ def branch_dataset(
     }
     if any(ob.per_planet for ob in observed):
         coords["planet"] = ("planet", np.arange(1, n_planets + 1))
-    if any(per for *_, per in tracked):
+    groups = mesh_groups(ref)
+    if any(per for *_, per in tracked) or any(g.force.per_planet for g in groups):
         coords["planet_all"] = ("planet_all", np.arange(1, n_planets + 1))
     if levels:
         coords["contact"] = ("contact", np.array([lv[0] for lv in levels], dtype="U16"))
@@ -208,8 +214,29 @@ def branch_dataset(
             for p in pts
         ]
         ds["contact_regime"] = (("point", "contact"), np.array(reg, dtype="U16"))
+    _put_force_peaks(ds, br, pts, groups)
     _put_events(ds, events, m)
     return ds
+
+
+def _put_force_peaks(ds: Any, br: Any, pts: list[Any], groups: list[Any]) -> None:
+    """``force_peak_<mesh>``: max |F̄ᶜ| over each point's orbit, from the shot's tracked
+    extrema against that point's clearances (the continued parameter may be one)."""
+    if not groups:
+        return
+    peaks = [
+        peak_contact_forces(br.system(p.lam), p.shot.obs_min[0], p.shot.obs_max[0]) for p in pts
+    ]
+    for g in groups:
+        key = f"force_peak_{g.mesh}"
+        dims = ("point", "planet_all") if g.force.per_planet else ("point",)
+        ds[key] = (dims, np.array([pk[key] for pk in peaks], dtype=np.float64))
+        ds[key].attrs.update(
+            long_name="peak contact force max |F̄ᶜ| over the orbit (tracked in the integrator)",
+            units="1",
+            mesh=g.mesh,
+            deflection=g.deflection.name,
+        )
 
 
 def _put_events(ds: Any, events: list[Any], m: int) -> None:

@@ -39,6 +39,7 @@ __all__ = [
     "MeshGroup",
     "compressive_contact_forces",
     "mesh_groups",
+    "peak_contact_forces",
     "response_quantities",
     "static_mesh_force",
 ]
@@ -137,6 +138,26 @@ def compressive_contact_forces(
     return obs, lo, hi
 
 
+def peak_contact_forces(
+    system: System, obs_min: np.ndarray, obs_max: np.ndarray
+) -> dict[str, np.ndarray]:
+    """The peak contact force max |F̄ᶜ| of each mesh type from the tracked extrema, by
+    ``force_peak_<mesh>``: the extrema reduced to what the flanks carry
+    (:func:`compressive_contact_forces`), then max(|F̄ᶜ_min|, |F̄ᶜ_max|).
+
+    ``obs_min``, ``obs_max`` are (..., n_track): over a recorded window (a sweep point) or over
+    an orbit (a branch point), any leading dimensions. Each value has the leading shape, with
+    a last axis of planets for per-planet meshes."""
+    empty = np.zeros((0, system.n_obs))
+    _, lo, hi = compressive_contact_forces(system, empty, obs_min, obs_max)
+    out: dict[str, np.ndarray] = {}
+    for g in mesh_groups(system):
+        cols = g.force.columns
+        peak = np.maximum(np.abs(lo[..., cols]), np.abs(hi[..., cols]))
+        out[f"force_peak_{g.mesh}"] = peak if g.force.per_planet else peak[..., 0]
+    return out
+
+
 def static_mesh_force(system: System) -> float:
     """F̄_static: T̄_D/N (planetary, MODEL.md §10.1, at this Ω) or F_m (oscillator); NaN when
     the model has no static load."""
@@ -175,17 +196,18 @@ def response_quantities(
         system, observables, obs_min, obs_max
     )
     static = static_mesh_force(system)
+    peaks = peak_contact_forces(system, obs_min, obs_max)
     out: dict[str, np.ndarray] = {}
     for g in mesh_groups(system):
         cols = g.force.columns
-        peak = np.maximum(np.abs(obs_min[cols]), np.abs(obs_max[cols]))
+        peak = peaks[f"force_peak_{g.mesh}"]
         f = observables[:, cols]
         d = observables[:, g.deflection.columns]
         rms = np.sqrt(np.mean(f * f, axis=0))
         dte = np.sqrt(np.mean((d - d.mean(axis=0)) ** 2, axis=0))
         shape: Any = slice(None) if g.force.per_planet else 0
         out[f"force_rms_{g.mesh}"] = rms[shape]
-        out[f"force_peak_{g.mesh}"] = peak[shape]
+        out[f"force_peak_{g.mesh}"] = peak
         out[f"dte_rms_{g.mesh}"] = dte[shape]
         lf = float(np.max(peak)) / static if static > 0 else float("nan")
         out[f"load_factor_{g.mesh}"] = np.asarray(lf)

@@ -10,6 +10,11 @@ the brute-force points of the up and down sweeps of a response store (up ▲, do
 jumps between periodic neighbours as arrows (:func:`~gearchaos.sweep.frequency.find_jumps`),
 and the motion band under it. Where the sweeps settle on a stable periodic orbit the points
 lie on a stable branch; a jump leaves a branch at a fold.
+
+With ``quantity="force_peak"`` the same figure draws the peak contact force max |F̄ᶜ| of one
+mesh instead (the mesh whose deflection is ``var``): ``force_peak_<mesh>`` of every branch
+point (over its orbit) beside the sweeps' ``force_peak_<mesh>`` (over their recorded windows)
+— one definition, :func:`gearchaos.model.response.peak_contact_forces`, for both.
 """
 
 from __future__ import annotations
@@ -25,15 +30,26 @@ from ..sweep.frequency import find_jumps
 from ._common import axis_label, fmt, var_symbol
 from .branch import BRANCH_COLOURS, EVENT_NAMES, EVENT_STYLE, branch_labels
 from .regimes import regime_band, regime_categories, regime_legend_below
-from .response import periodic_mask
+from .response import MESH_LABEL, periodic_mask
 from .units import PhysicalScales, fit_to_data, linear_axis, var_quantity
 
-__all__ = ["AMPLITUDE_GID", "amplitude_figure", "amplitude_of", "amplitude_var"]
+__all__ = [
+    "AMPLITUDE_GID",
+    "QUANTITIES",
+    "amplitude_figure",
+    "amplitude_of",
+    "amplitude_var",
+    "force_mesh",
+    "peak_force_of",
+]
 
 #: ``gid`` prefix of the artists of :func:`amplitude_figure`.
 AMPLITUDE_GID = "amplitude"
 #: Marker and colour of the sweep directions.
 SWEEP_STYLE = {"up": ("^", "0.25"), "down": ("v", "0.6"), None: ("o", "0.4")}
+#: What the figure draws over the swept parameter: the deflection's peak-to-peak amplitude,
+#: or the peak contact force of its mesh (the response sweep's name).
+QUANTITIES = ("amplitude", "force_peak")
 
 
 def amplitude_var(ds: Any, var: str | None = None) -> str:
@@ -59,20 +75,62 @@ def amplitude_var(ds: Any, var: str | None = None) -> str:
 def amplitude_of(ds: Any, var: str, planet: int = 1) -> Any:
     """max − min of ``var`` over the orbit (branch) or recorded window (sweep), of
     ``planet`` for per-planet variables (a DataArray over the other dimensions)."""
-    amp = ds[f"{var}_max"] - ds[f"{var}_min"]
-    if "planet_all" in amp.dims:
-        planets = [int(p) for p in np.asarray(ds["planet_all"].values)]
+    return _planet_of(ds[f"{var}_max"] - ds[f"{var}_min"], planet)
+
+
+def _planet_of(v: Any, planet: int) -> Any:
+    if "planet_all" in v.dims:
+        planets = [int(p) for p in np.asarray(v["planet_all"].values)]
         if planet not in planets:
             raise ParameterError(f"planet must be one of {planets}: got {planet!r}")
-        amp = amp.sel(planet_all=planet)
-    return amp
+        v = v.sel(planet_all=planet)
+    return v
 
 
-def _draw_branch(ax: Any, br: Any, var: str, planet: int, colour: str, label: str,
+def force_mesh(ds: Any, branches: Sequence[Any], var: str | None = None) -> str:
+    """The mesh whose peak contact force is drawn: by default the first of the sweep's
+    (``sp``, ``rp``, ``mesh``), else the mesh whose deflection is ``var`` (as the branches'
+    ``force_peak_<mesh>`` record it)."""
+    meshes = [m for m in MESH_LABEL if f"force_peak_{m}" in ds.data_vars]
+    if not meshes:
+        raise ParameterError(
+            "quantity='force_peak' needs a store of gearchaos response (gc.response): this "
+            "store has no force_peak_* variables"
+        )
+    if var is None:
+        return meshes[0]
+    found = {
+        str(br[f"force_peak_{m}"].attrs.get("deflection")): m
+        for br in branches
+        for m in meshes
+        if f"force_peak_{m}" in br.data_vars
+    }
+    if var not in found:
+        have = ", ".join(sorted(found)) or "none: no branch stores peak contact forces"
+        raise ParameterError(
+            f"var must be the deflection of a mesh with peak contact forces ({have}): got {var!r}"
+        )
+    return found[var]
+
+
+def peak_force_of(ds: Any, mesh: str, planet: int = 1) -> Any:
+    """``force_peak_<mesh>`` of ``ds`` (a branch or a response sweep) of ``planet`` for
+    per-planet meshes; a branch file written before branches stored it is refused by name."""
+    key = f"force_peak_{mesh}"
+    if key not in ds.data_vars:
+        src = ds.encoding.get("source")
+        raise ParameterError(
+            f"{'branch ' + str(src) if src else 'the branch'} has no variable {key} (the peak "
+            "contact force over the orbit; branch files written before gearchaos stored it "
+            "lack it): continue the branch again to draw its peak contact force"
+        )
+    return _planet_of(ds[key], planet)
+
+
+def _draw_branch(ax: Any, br: Any, amp: np.ndarray, colour: str, label: str,
                  named: set[str]) -> np.ndarray:  # fmt: skip
     name = str(br.attrs["parameter"])
     lam = np.asarray(br[name].values, dtype=float)
-    amp = np.asarray(amplitude_of(br, var, planet).values, dtype=float)
     stable = np.asarray(br["stable"].values, dtype=bool)
     for which, style in ((True, "-"), (False, "--")):
         shown = stable == which
@@ -114,10 +172,12 @@ def amplitude_figure(
     *,
     var: str | None = None,
     planet: int = 1,
+    quantity: str = "amplitude",
     rel_jump: float = 0.25,
     figsize: tuple[float, float] | None = None,
 ) -> Any:
-    """The amplitude–frequency figure of a 1-D (response) sweep and continued branches.
+    """The amplitude–frequency figure of a 1-D (response) sweep and continued branches, or
+    (``quantity="force_peak"``) their peak contact force over the swept parameter.
 
     Parameters
     ----------
@@ -128,7 +188,14 @@ def amplitude_figure(
         Continued branches of the swept parameter (:func:`gearchaos.continuation`,
         :func:`gearchaos.dynamics.cascade.open_cascade`).
     var, planet
-        The deflection (default ``delta_sp``; ``x`` for the backlash oscillator) and planet.
+        The deflection (default ``delta_sp``; ``x`` for the backlash oscillator) and planet;
+        with ``quantity="force_peak"``, the deflection of the mesh whose force is drawn
+        (default the sweep's first mesh, :func:`force_mesh`).
+    quantity
+        ``"amplitude"`` (max − min of ``var``) or ``"force_peak"`` (the peak contact force
+        max |F̄ᶜ| of its mesh: ``force_peak_<mesh>`` of the branches and of the response sweep;
+        both store it, branches since they record it — an older branch file is refused by
+        the variable's name).
     rel_jump
         Jump threshold as a fraction of a sweep curve's range (:func:`find_jumps`); only
         jumps between two periodic points are drawn.
@@ -143,22 +210,36 @@ def amplitude_figure(
     """
     from matplotlib.figure import Figure
 
+    if quantity not in QUANTITIES:
+        raise ParameterError(f"quantity must be one of {', '.join(QUANTITIES)}: got {quantity!r}")
     res = SweepResult.of(ds)
     sd = res.ds
-    var = amplitude_var(sd, var)
-    amp = amplitude_of(sd, var, planet)
+    branches = list(branches)
+    force = quantity == "force_peak"
+    if force:
+        mesh = force_mesh(sd, branches, var)
+        amp = peak_force_of(sd, mesh, planet)
+    else:
+        var = amplitude_var(sd, var)
+        amp = amplitude_of(sd, var, planet)
     lead = [d for d in amp.dims if d != "direction"]
     if len(lead) != 1:
         raise ParameterError(f"amplitude_figure draws 1-D sweeps: got dimensions {lead}")
     xname = lead[0]
-    branches = list(branches)
+    values = []
     for br in branches:
         if str(br.attrs.get("parameter")) != xname:
             raise ParameterError(
                 f"branches must continue the swept parameter {xname}: got "
                 f"{br.attrs.get('parameter')!r}"
             )
-        amplitude_var(br, var)  # the branch stores the extrema of var
+        # the branch stores the extrema of var, or the peak force of the mesh
+        of = (
+            peak_force_of(br, mesh, planet)
+            if force
+            else amplitude_of(br, amplitude_var(br, var), planet)
+        )
+        values.append(np.asarray(of.values, dtype=float))
     x = np.asarray(sd[xname].values, dtype=float)
     directions = list(sd["direction"].values) if "direction" in sd.dims else [None]
     labelled = "motion" in sd.data_vars
@@ -195,22 +276,31 @@ def amplitude_figure(
     named: set[str] = set()
     lo, hi = float(np.min(x)), float(np.max(x))
     for k, br in enumerate(branches):
-        a = _draw_branch(ax, br, var, planet, BRANCH_COLOURS[k % len(BRANCH_COLOURS)],
-                         labels[k], named)  # fmt: skip
+        colour = BRANCH_COLOURS[k % len(BRANCH_COLOURS)]
+        a = _draw_branch(ax, br, values[k], colour, labels[k], named)
         lam = np.asarray(br[str(br.attrs["parameter"])].values, dtype=float)
         ys.append(a[(lam >= lo) & (lam <= hi)])
     pad = 0.02 * (hi - lo)
     ax.set_xlim(lo - pad, hi + pad)
     fit_to_data(ax, None, np.concatenate([np.ravel(y) for y in ys]))
-    per = "planet" in sd[f"{var}_max"].dims or "planet_all" in sd[f"{var}_max"].dims
-    sym = var_symbol(var, planet if per else None)
-    ax.set_ylabel(f"amplitude $\\max {sym} - \\min {sym}$")
-    ax.grid(alpha=0.3, lw=0.5)
     scales = PhysicalScales.of_sweep(res)
-    quantity = var_quantity(var)
-    found = scales.factor(quantity) if quantity is not None else None
+    if force:
+        per = "planet_all" in sd[f"force_peak_{mesh}"].dims
+        sub = f"_{{{mesh}{planet}}}" if per else ("" if mesh == "mesh" else f"_{{{mesh}}}")
+        ax.set_ylabel(f"peak contact force $\\max|\\bar F^c{sub}|$")
+        found = scales.factor("force")
+        right = f"peak contact force {found[1]}" if found else ""
+    else:
+        assert var is not None  # amplitude_var chose it
+        per = "planet" in sd[f"{var}_max"].dims or "planet_all" in sd[f"{var}_max"].dims
+        sym = var_symbol(var, planet if per else None)
+        ax.set_ylabel(f"amplitude $\\max {sym} - \\min {sym}$")
+        kind = var_quantity(var)
+        found = scales.factor(kind) if kind is not None else None
+        right = f"amplitude {found[1]}" if found else ""
+    ax.grid(alpha=0.3, lw=0.5)
     if found is not None:
-        linear_axis(ax, "y", found[0], f"amplitude {found[1]}")
+        linear_axis(ax, "y", found[0], right)
     if xname == "omega":
         rpm = scales.factor("omega")
         if rpm is not None:
@@ -231,7 +321,11 @@ def amplitude_figure(
         regime_legend_below(fig, np.asarray(regime_categories(res).values, dtype=object).ravel())
         bottom = band
     bottom.set_xlabel(axis_label(xname))
-    title = str(sd.attrs.get("title", "")).replace("sweep", "amplitude–frequency curves")
+    what = "amplitude–frequency curves"
+    if force:
+        who = f"{MESH_LABEL[mesh]} mesh" + (f", planet {planet}" if per else "")
+        what = "peak contact force curves" + (f" ({who})" if mesh != "mesh" else "")
+    title = str(sd.attrs.get("title", "")).replace("sweep", what)
     rtols = sorted({fmt(br.attrs.get("rtol")) for br in branches if br.attrs.get("rtol")})
     extra = f"continued branches (rtol {', '.join(rtols)}) beside the brute-force sweeps"
     fig.suptitle(f"{title}\n{extra}" if title else extra, fontsize="medium")
