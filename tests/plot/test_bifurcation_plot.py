@@ -349,3 +349,15 @@ def test_axes_follow_an_attractor_beside_the_backlash() -> None:
     notes = [t.get_text() for t in ax.texts if t.get_gid() == CLEARANCE_NOTE_GID]
     assert len(notes) == 1 and "−" in notes[0] and "3" in notes[0]
     assert sorted(float(line.get_ydata()[0]) for line in gid_lines(ax, "clearance")) == [-3, 3]
+
+
+def test_figures_name_the_gear_set_not_the_models_record() -> None:
+    """One name in every figure title: the gear set's (``sheng2016``) where the store or file
+    carries one, else the model's; never the record ``planetary[sheng2016]``."""
+    from gearchaos.gearset.io import to_toml
+    from gearchaos.plot._common import subject
+
+    gs = gc.preset("sheng2016")
+    assert subject({"model": "planetary", "gearset_toml": to_toml(gs)}) == "sheng2016"
+    assert subject({"model": "planetary"}, gs) == "sheng2016"
+    assert subject({"model": "backlash_oscillator", "gearset_toml": ""}) == "backlash_oscillator"

@@ -72,6 +72,7 @@ def test_boundary_is_drawn_where_the_map_changes_colour(chart_data) -> None:
 def test_legend_names_each_boundary_and_physical_axes(chart_data, tmp_path) -> None:
     sweep, curve = chart_data
     fig = stability_figure([curve], sweep)
+    assert fig.get_suptitle() == "backlash_oscillator: stability chart"  # as the diagram's
     ax = fig.axes[0]
     texts = [t.get_text() for t in ax.get_legend().get_texts()]
     assert "period doubling" in texts and "1T" in texts and "2T" in texts

@@ -112,6 +112,7 @@ def test_up_and_down_jumps_are_where_scipy_continuation_puts_them() -> None:
 
 def test_response_figure_axes_follow_the_gear_set(tmp_path) -> None:
     from gearchaos.plot import response_figure
+    from gearchaos.plot.bifurcation import suptitle
 
     gs = gc.preset("sheng2016")
     ds = gc.response(
@@ -147,6 +148,11 @@ def test_response_figure_axes_follow_the_gear_set(tmp_path) -> None:
     right = [c for c in top.child_axes if "[N]" in c.get_ylabel()]
     assert right
     np.testing.assert_allclose(right[0]._functions[0](1.0), force_n, rtol=1e-9)
+    # titled like the bifurcation diagram: the gear set's name, not the model's record
+    # ("gearchaos frequency response of planetary[sheng2016]" before)
+    title = fig.get_suptitle()
+    assert title.splitlines()[0] == "sheng2016: frequency response"
+    assert title == suptitle(ds, "frequency response") and "planetary" not in title
     fig.savefig(tmp_path / "response.png")
 
 

@@ -60,6 +60,21 @@ def axis_label(name: str) -> str:
     return f"${sym}$ {unit}" if unit else f"${sym}$"
 
 
+def subject(attrs: Any, gearset: Any = None) -> str:
+    """What a figure of a store or file is of, as its title names it: the gear set's name
+    (``sheng2016``; ``gearset``, else the one of the attribute ``gearset_toml``), else the
+    model's (``backlash_oscillator``) — not the record's ``planetary[sheng2016]``."""
+    if gearset is None:
+        text = str(attrs.get("gearset_toml", "") or "")
+        if text:
+            from ..gearset.io import from_toml_string
+
+            gearset = from_toml_string(text)
+    if gearset is not None:
+        return str(gearset.name)
+    return str(attrs.get("model", "") or "")
+
+
 def var_symbol(var: str, planet: int | None) -> str:
     """Mathtext symbol (without ``$``) of a section variable: ``delta_sp`` → ``\\bar{X}_{sp1}``,
     ``delta_sp_dot`` → ``\\bar{X}'_{sp1}``; other names become ``head_{tail}``."""

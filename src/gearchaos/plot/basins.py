@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from ._common import _generic_symbol, axis_label, edges, get_ax
+from ._common import _generic_symbol, axis_label, edges, get_ax, subject
 from .regimes import regime_colour
 from .units import PhysicalScales, linear_axis, var_quantity
 
@@ -254,12 +254,12 @@ def basins_figure(ds: Any) -> Any:
     )
     if kind == "basins":
         basin_image(ds, ax)
-        title = f"basins of attraction, {ds.attrs['model']}" + (f" at {point}" if point else "")
+        title = f"{subject(ds.attrs)}: basins of attraction" + (f" at {point}" if point else "")
         n = ds["attractor"].size
         title += f" ({n} starts, {ds.attrs['transient_periods']:g} + {ds.attrs['periods']} periods)"
     elif kind == "basin_fractions":
         fraction_curves(ds, ax)
-        title = f"basin fractions, {ds.attrs['model']}" + (f" at {point}" if point else "")
+        title = f"{subject(ds.attrs)}: basin fractions" + (f" at {point}" if point else "")
     else:
         plt.close(fig)
         raise ParameterError(f"not a basin store: kind {kind!r}")

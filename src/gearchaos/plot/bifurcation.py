@@ -36,6 +36,7 @@ from ._common import (
     get_ax,
     no_offset,
     resonance_lines,
+    subject,
     var_symbol,
 )
 from .branch import BRANCH_COLOURS, branch_labels, branch_matches, branch_overlay
@@ -393,10 +394,7 @@ def suptitle(ds: Any, what: str) -> str:
     the protocol."""
     res = SweepResult.of(ds)
     attrs = res.ds.attrs
-    name = str(attrs.get("model") or "")
-    if res.gearset is not None:
-        name = res.gearset.name
-    lines = [": ".join(p for p in (name, what) if p)]
+    lines = [": ".join(p for p in (subject(attrs, res.gearset), what) if p)]
     given = _given(res)
     if given:
         lines.append("at " + ", ".join(given))

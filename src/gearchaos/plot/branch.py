@@ -23,7 +23,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..gearset.schema import CLEARANCES, FIELDS
-from ._common import axis_label, axis_symbol, fmt, get_ax, resonance_lines, var_symbol
+from ._common import axis_label, axis_symbol, fmt, get_ax, resonance_lines, subject, var_symbol
 from .units import PhysicalScales, clearance_notes, fit_to_data, secondary_axis, var_quantity
 
 __all__ = [
@@ -435,8 +435,7 @@ def _padded(v: np.ndarray) -> tuple[float, float]:
 
 def _title(branches: list[Any], var: str, planet: int) -> str:
     first = branches[0]
-    gs = _gearset(first)
-    model = gs.name if gs is not None else str(first.attrs.get("model", ""))
+    model = subject(first.attrs, _gearset(first))
     periods = sorted({int(br.attrs.get("period", 1)) for br in branches})
     what = (
         f"continued period-{periods[0]} orbit"

@@ -26,6 +26,7 @@ import numpy as np
 
 from ..sweep import SweepResult
 from ..sweep.frequency import find_jumps
+from .bifurcation import suptitle
 from .regimes import regime_band, regime_categories, regime_category, regime_legend_below
 from .units import PhysicalScales, fit_to_data, linear_axis
 
@@ -206,6 +207,5 @@ def response_figure(
             sec.spines["bottom"].set_position(("outward", 34))
             sec.set_xlabel(f"mesh frequency $f_m$ {hz[1]}", fontsize="small")
             sec.tick_params(labelsize="small")
-    title = ds.attrs.get("title", "").replace("sweep", "frequency response")
-    fig.suptitle(title, fontsize="medium")
+    fig.suptitle(suptitle(res, "frequency response"), fontsize="medium")
     return fig

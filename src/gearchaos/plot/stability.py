@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from ._common import axis_label, axis_symbol, get_ax, no_offset
+from ._common import axis_label, axis_symbol, get_ax, no_offset, subject
 from .units import PhysicalScales, linear_axis
 
 __all__ = ["BOUNDARY_STYLES", "boundary_label", "stability_chart", "stability_figure"]
@@ -225,10 +225,11 @@ def stability_figure(
         scales, gs = _scales(curves[0], regimes)
         physical_axis(ax, "x", _label_name(ax.get_xlabel(), curves[0], regimes, 0), scales, gs)
         physical_axis(ax, "y", _label_name(ax.get_ylabel(), curves[0], regimes, 1), scales, gs)
-    model = str(curves[0].attrs.get("model", "")) if curves else ""
+    model = subject(curves[0].attrs) if curves else ""
     fixed = str(curves[0].attrs.get("fixed", "{}")) if curves else ""
     fig.suptitle(
-        f"stability chart — {model}" + (f", fixed {fixed}" if fixed not in ("", "{}") else ""),
+        ": ".join(p for p in (model, "stability chart") if p)
+        + (f", fixed {fixed}" if fixed not in ("", "{}") else ""),
         fontsize="medium",
     )
     return fig
