@@ -76,6 +76,20 @@ def _type_key(a: Any) -> Any:
     return type(a)
 
 
+def _ignore_ir_assumption_warnings() -> None:
+    """Ignore numba's NumbaIRAssumptionWarning, which its IR inliner emits (internal,
+    "pedantic") for the inlined dispatch of the right-hand side: harmless and not actionable.
+
+    A filter put first and left there, not a ``warnings.catch_warnings()`` block around the
+    compile: that block saves the process-wide warning state on entry and puts it back on exit,
+    from whichever thread compiles. A sweep's driver thread still compiling after its sweep was
+    interrupted put back, seconds later, the state of a block long closed — in the middle of
+    another ``catch_warnings`` (a ``pytest.warns`` of a later test), whose recorded warnings
+    then went to the stale recorder: the test failed now and then, depending on what had run
+    before it in the process."""
+    warnings.filterwarnings("ignore", category=NumbaIRAssumptionWarning)
+
+
 def entry_point(dispatcher: Any, kind: int, *args: Any) -> Any:
     """The compiled entry point of ``dispatcher`` specialised on the literal ``kind`` for
     arguments like ``args``: compiled (or loaded from the disk cache) on first use, then
@@ -89,11 +103,8 @@ def entry_point(dispatcher: Any, kind: int, *args: Any) -> Any:
         sig = (types.literal(kind), *(typeof(a) for a in args))
         if _FIRST_COMPILE and not _in_disk_cache(dispatcher, sig):
             _first_compile_notice()
-        with warnings.catch_warnings():
-            # numba's IR inliner emits an internal "pedantic" NumbaIRAssumptionWarning for the
-            # inlined dispatch of the right-hand side; it is harmless and not actionable
-            warnings.simplefilter("ignore", NumbaIRAssumptionWarning)
-            entry = dispatcher.compile(sig)  # compiles or loads the literal specialisation
+        _ignore_ir_assumption_warnings()
+        entry = dispatcher.compile(sig)  # compiles or loads the literal specialisation
         _ENTRIES[fast] = entry
     return entry
 
