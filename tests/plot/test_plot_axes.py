@@ -56,6 +56,15 @@ def test_time_history_other_variables(planetary: gc.SimulationResult) -> None:
     ax = time_history(planetary, "force_sp")
     assert r"\bar{F}_{sp1}" in ax.get_ylabel()
     assert clearance_values(ax, "y") == []
+    # the contact force (the mesh force's compressive part) has the force axis in N opposite,
+    # the scale k_m,sp b_c of the model: 1 on the dimensionless axis is that many newtons
+    for var in ("force_sp", "contact_force_sp"):
+        ax = time_history(planetary, var)
+        (sec,) = [c for c in ax.child_axes if "[N]" in c.get_ylabel()]
+        ax.figure.canvas.draw()
+        lo, hi = ax.get_ylim()
+        scale = planetary.system.model.scales.force
+        assert sec.get_ylim() == pytest.approx((lo * scale, hi * scale))
     with pytest.raises(ParameterError, match="var"):
         time_history(planetary, "nonsense")
     with pytest.raises(ParameterError, match="planet"):

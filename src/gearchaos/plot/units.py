@@ -96,14 +96,15 @@ class PhysicalScales:
 
 def var_quantity(var: str) -> str | None:
     """The physical quantity of a section variable: ``delta_sp`` → ``length``,
-    ``delta_sp_dot`` → ``velocity``, ``force_rp`` → ``force``; ``None`` otherwise."""
+    ``delta_sp_dot`` → ``velocity``, ``force_rp`` and ``contact_force_rp`` → ``force``;
+    ``None`` otherwise."""
     import re
 
     var = re.sub(r"_\d+(_dot)?$", lambda m: m.group(1) or "", var)  # delta_sp_1_dot → …_dot
     var = re.sub(r"_\d+$", "", var)
     base = var[:-4] if var.endswith("_dot") else var
     kind = "velocity" if var.endswith("_dot") else "length"
-    if base.startswith("force_"):
+    if base.startswith(("force_", "contact_force_")):
         return None if var.endswith("_dot") else "force"
     if base in ("delta_sp", "delta_rp", "x_s", "y_s", "p", "sigma"):
         return kind
