@@ -9,8 +9,10 @@ before it (``--baseline-src``, e.g. a ``git worktree add /tmp/old_integ <rev>`` 
 
 1. **Steps.** ``gearchaos.simulate`` of ``preset("hindawi2021")`` and of the seed's Fig. 4(a)
    gear set (``preset("sheng2016")``, ξ = 0.03, b̄_sp = 3, b̄_rp = 3.5, b̄_s = 2) at a few Ω,
-   100 + 100 periods, rtol 1e-8, atol 1e-10, one thread, and a Lyapunov exponent (tangent
-   vectors on) of hindawi2021. Each case: the best process CPU time of ``--reps`` runs in a
+   ``--periods`` transient + ``--periods`` recorded periods (default 2000: a case takes
+   tenths of a second, so the clock's granularity is far below the difference sought),
+   rtol 1e-8, atol 1e-10, one thread, and a Lyapunov exponent (tangent vectors on) of
+   hindawi2021. Each case: the best process CPU time of ``--reps`` runs in a
    child process importing either code (its own ``NUMBA_CACHE_DIR``, warmed first); the
    children alternate (baseline, new, baseline, new, …) for ``--rounds`` rounds and the best
    of all rounds counts. Printed: seconds of both, the ratio new / baseline per case and the
@@ -20,7 +22,7 @@ before it (``--baseline-src``, e.g. a ``git worktree add /tmp/old_integ <rev>`` 
    seconds (best and median).
 
 Run as ``python benchmarks/bench_integrator_split.py --baseline-src /tmp/old_integ/src
-[--rounds 3] [--reps 3] [--cold 2]``.
+[--rounds 3] [--reps 3] [--cold 2] [--periods 2000]``.
 """
 
 from __future__ import annotations
@@ -66,7 +68,8 @@ for name, gs, om in cases:
     best = 1e300
     for _ in range(spec["reps"]):
         c0 = time.process_time()
-        r = gearchaos.simulate(gs, omega=om, transient_periods=100, periods=100, **RT)
+        r = gearchaos.simulate(gs, omega=om, transient_periods=spec["periods"],
+                                periods=spec["periods"], **RT)
         best = min(best, time.process_time() - c0)
     h = hashlib.sha256(r.states.tobytes()).hexdigest()[:16]
     out["cases"][name] = [best, h, int(r.steps_accepted + r.steps_rejected)]
@@ -74,17 +77,19 @@ best = 1e300
 for _ in range(spec["reps"]):
     c0 = time.process_time()
     ly = gearchaos.lyapunov_spectrum(hind, omega=1.5, n_exponents=1, transient_periods=20,
-                                     periods=60, **RT)
+                                     periods=spec["periods"] * 3 // 5, **RT)
     best = min(best, time.process_time() - c0)
 out["cases"]["hindawi2021 Lyapunov Ω=1.5"] = [best, repr(float(ly.exponents[0])), 0]
 print("RESULT" + json.dumps(out))
 """
 
 
-def child(src: Path, cache: str, *, reps: int = 1, cold: bool = False) -> dict[str, Any]:
+def child(
+    src: Path, cache: str, *, reps: int = 1, cold: bool = False, periods: int = 2000
+) -> dict[str, Any]:
     """Run the benchmark child importing gearchaos from ``src`` with numba cache ``cache``."""
     env = dict(os.environ, PYTHONPATH=str(src), NUMBA_CACHE_DIR=cache, NUMBA_NUM_THREADS="1")
-    spec = json.dumps({"reps": reps, "cold": cold})
+    spec = json.dumps({"reps": reps, "cold": cold, "periods": periods})
     proc = subprocess.run(
         [sys.executable, "-c", _CHILD, spec], env=env, capture_output=True, text=True, check=False
     )
@@ -104,6 +109,7 @@ def main() -> None:
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--reps", type=int, default=3)
     ap.add_argument("--cold", type=int, default=0, help="cold-cache compile runs of each")
+    ap.add_argument("--periods", type=int, default=2000, help="transient and recorded periods")
     args = ap.parse_args()
     codes = {"baseline": args.baseline_src.resolve(), "new": args.new_src.resolve()}
     with tempfile.TemporaryDirectory() as d:
@@ -122,7 +128,7 @@ def main() -> None:
         digest: dict[str, dict[str, Any]] = {k: {} for k in codes}
         for _ in range(args.rounds):
             for name, src in codes.items():
-                res = child(src, caches[name], reps=args.reps)["cases"]
+                res = child(src, caches[name], reps=args.reps, periods=args.periods)["cases"]
                 for case, (sec, h, att) in res.items():
                     best[name][case] = min(best[name].get(case, math.inf), sec)
                     digest[name][case] = (h, att)
