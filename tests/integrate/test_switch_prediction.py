@@ -69,3 +69,39 @@ def test_observables_without_a_switch_are_ignored() -> None:
     assert predict_switch(hist, 3, np.array(times), 1, np.array([1.0]), 0.4) == pytest.approx(
         0.1, abs=1e-12
     )
+
+
+def test_no_switch_predicted_ahead_of_an_observable_sitting_on_its_level() -> None:
+    """An observable exactly on ±b (to rounding) leaving the clearance crosses at the start of
+    the step: no shortened step is aimed at it (a step of 1e-13 would not move it off the
+    level in floating point, and the next step would be aimed at it again)."""
+    b = 1.0
+    for v0, d0 in ((b, 1e-5), (-b, -1e-5), (np.nextafter(b, 0.0), 1e-5)):
+        times = [0.0, -1e-9, -2e-9]
+        hist = np.array([[v0 + d0 * t, d0] for t in times])
+        got = predict_switch(hist, 3, np.array(times), 1, np.array([b]), 1e-8)
+        assert got == -1.0, (v0, got)
+    # (one off its level is predicted as before: test_predicted_switch_is_the_polynomials_crossing)
+
+
+def test_an_orbit_grazing_its_clearance_is_integrated_with_its_tangents() -> None:
+    """A period-1 orbit of the backlash oscillator that grazes the clearance (it dips 1e-9
+    into the dead zone: a point of the grazing curve of tests/dynamics/test_curves.py),
+    integrated over one period with its variational equations at rtol 1e-10, once stalled at
+    the exit of the dead zone (x landed exactly on b̄, each step then aimed at a crossing 1e-13
+    ahead) until the step budget ran out. It must finish, and its end state must be the plain
+    run's (the tangents change the step sizes, not the solution beyond the tolerance)."""
+    import gearchaos as gc
+    from gearchaos.dynamics.shooting import shoot
+    from gearchaos.integrate.settings import SolverSettings
+
+    y = np.array([1.1989473899282392, 0.01025968298815881])
+    system = gc.backlash_oscillator(
+        0.7089749308498624, zeta=0.05129841325237217, f_alt=0.1, f_mean=0.1
+    )
+    cfg = SolverSettings(rtol=1e-10, atol=1e-12)
+    plain = shoot([system], y[None], 1, cfg, tangents=False)
+    full = shoot([system], y[None], 1, cfg, tangents=True)
+    assert plain.ok(0) and full.ok(0), (plain.status, full.status)
+    assert abs(plain.obs_min[0, 0] - 1.0) < 1e-8  # it does graze b̄ = 1
+    np.testing.assert_allclose(full.end[0], plain.end[0], rtol=0, atol=1e-9)

@@ -52,6 +52,9 @@ __all__ = [
 LAND = 1e-6
 #: Relative margin by which a predicted or retried step is aimed past the switch.
 AIM = 0.5 * LAND
+#: An observable this close to a level, relative to its magnitude (four units in the last
+#: place), is on the level: no switch is predicted ahead of it.
+ON_LEVEL = 4.0 * 2.220446049250313e-16
 
 
 @numba.njit(cache=True, inline="always")
@@ -236,6 +239,11 @@ def predict_switch(hist, n_pts, t_hist, n_track, sw, h):  # pragma: no cover - c
         d1 = hist[1, n_track + k]
         r0 = _region(v0, b)
         gap = min(abs(v0 - b), abs(v0 + b))
+        if gap <= ON_LEVEL * max(abs(v0), b):
+            # on the level to rounding: the switch is at the start of the step (check_step
+            # lands it there); aiming a step at it would be a step too short to move the
+            # observable in floating point, again and again (a grazing contact stalled so)
+            continue
         # a crossing within h needs |Δv| ≥ gap; |v'| is bounded generously by the two last
         # derivatives and their trend
         reach = h * (abs(d0) + abs(d0 - d1) * (1.0 - h * r1))
