@@ -331,8 +331,7 @@ def _relocate(fine: Curve, e: dict[str, Any]) -> np.ndarray | None:
 
 
 #: How much tighter the assessing solutions are, in order: the next is tried where the first
-#: fails (at rtol 1e-10 the integrator can stall on an orbit that grazes a clearance to within
-#: 1e-9 while the variational equations are integrated too).
+#: fails (its correction does not converge, or an integration runs out of its step budget).
 TIGHTER = (100.0, 10.0)
 
 #: The choices of ``assess``.
