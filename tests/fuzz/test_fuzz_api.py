@@ -131,7 +131,7 @@ def test_memory_is_checked_before_allocating() -> None:
 
 
 # ----------------------------------------------------------------------------- parameters
-PARAMETER_DOORS = ["fixed", "vary", "family", "gallery", "analyse_point"]
+PARAMETER_DOORS = ["fixed", "vary", "family", "gallery", "gallery(fixed)", "analyse_point"]
 
 
 def _parameter_call(door: str, name: str, value: Any) -> Any:
@@ -148,9 +148,16 @@ def _parameter_call(door: str, name: str, value: Any) -> Any:
             BASE, "omega=1:2:2", family={name: [value]}, progress=False, **TINY
         )
     if door == "gallery":
-        return lambda: run_gallery(
-            BASE, name, [value], fixed={"omega": 1.5}, progress=False, **TINY
-        )
+        return lambda: run_gallery(BASE, name, [value], omega=1.5, progress=False, **TINY)
+    if door == "gallery(fixed)":  # the deprecated spelling of params: warns, then refuses
+
+        def old_spelling() -> Any:
+            with pytest.warns(DeprecationWarning, match=r"run_gallery\(fixed=\.\.\.\)"):
+                return run_gallery(
+                    BASE, name, [value], fixed={"omega": 1.5}, progress=False, **TINY
+                )
+
+        return old_spelling
     return lambda: analyse_point(BASE, {"omega": 1.5, name: value}, TINY_SETTINGS)
 
 

@@ -40,7 +40,7 @@ from gearchaos.dynamics.point import analyse_point
 from gearchaos.integrate import integrate, integrate_batch
 from gearchaos.integrate.settings import SolverSettings
 from gearchaos.model.target import parameter_names
-from gearchaos.paper.galleries import MAX_GALLERY_VALUES, run_gallery
+from gearchaos.paper.galleries import GALLERY_KEYWORDS, MAX_GALLERY_VALUES, run_gallery
 from gearchaos.sweep import SweepResult, SweepSpec, classify_store
 
 BASE = gc.preset("hindawi2021")
@@ -151,6 +151,10 @@ def _explore(**kw: Any) -> Any:
 
 def _build(**kw: Any) -> Any:
     return SweepSpec.build(VARY, **kw)
+
+
+#: The arguments of run_gallery that _gallery passes by name.
+_GALLERY_ARGS = ("gs", "param", "values")
 
 
 def _gallery(**kw: Any) -> Any:
@@ -397,6 +401,12 @@ ROWS = [
         "values",
     ),
     Row(
+        "run_gallery",
+        "params",
+        lambda v: _gallery(param="xi", values=[0.05], params=v),
+        NOT_MAPPING,
+    ),
+    Row(  # deprecated spelling of params
         "run_gallery", "fixed", lambda v: _gallery(param="xi", values=[0.05], fixed=v), NOT_MAPPING
     ),
     Row(
@@ -421,6 +431,13 @@ ROWS = [
     ),
     Row("run_gallery", "title", lambda v: _gallery(title=v), NOT_STRING),
     Row("run_gallery", "settings", lambda v: _gallery(settings=v), NOT_SETTINGS),
+    Row(
+        "run_gallery",
+        "<unknown option>",
+        lambda v: _gallery(**{v: 1}),
+        UNKNOWN_OPTION.filter(lambda v: v not in {*_OPTIONS, *GALLERY_KEYWORDS, *_GALLERY_ARGS}),
+        "unknown",
+    ),
     # files and stores
     Row("open_sweep", "path", lambda v: gc.open_sweep(v), NOT_PATH, "path", "store"),
     Row(

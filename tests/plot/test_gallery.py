@@ -119,11 +119,40 @@ def test_runner_labels_every_value_of_a_reference_system() -> None:
 def test_runner_checks_every_point_before_running() -> None:
     gs = gc.preset("hindawi2021")
     with pytest.raises(ParameterError, match=r"backlash\.sun_planet"):
-        run_gallery(gs, "backlash.sun_planet", [1.0, -2.0], fixed={"omega": 1.5}, progress=False)
+        run_gallery(gs, "backlash.sun_planet", [1.0, -2.0], omega=1.5, progress=False)
     with pytest.raises(ParameterError, match="omega"):
         run_gallery(gs, "backlash.sun_planet", [1.0], progress=False)
-    with pytest.raises(ParameterError, match="both varied and fixed"):
-        run_gallery(gs, "omega", [1.0], fixed={"omega": 1.5}, progress=False)
+    for fixed in ({"omega": 1.5}, {"params": {"omega": 1.5}}):
+        with pytest.raises(ParameterError, match="omega is both varied and fixed") as info:
+            run_gallery(gs, "omega", [1.0], progress=False, **fixed)
+        assert info.value.name == "omega"
+    with pytest.warns(DeprecationWarning, match=r"run_gallery\(fixed=\.\.\.\).*use params="):
+        with pytest.raises(ParameterError, match="both varied and fixed"):
+            run_gallery(gs, "omega", [1.0], fixed={"omega": 1.5}, progress=False)
+
+
+def test_runner_speaks_the_front_doors_vocabulary() -> None:
+    """Parameters by name or in params=, settings= and settings by name (issue 25); an unknown
+    name is refused with the closest valid one, as by the sweeps; the old fixed= warns."""
+    gs = gc.preset("hindawi2021")
+    with pytest.raises(ParameterError, match="unknown gallery option 'rtoll'; did you mean 'rtol'"):
+        run_gallery(gs, "xi", [0.05], omega=1.5, rtoll=1e-6, progress=False)
+    with pytest.raises(ParameterError, match="'omgea'; did you mean 'omega'") as info:
+        run_gallery(gs, "xi", [0.05], omgea=1.5, progress=False)
+    assert info.value.name == "omgea"
+    with pytest.raises(ParameterError, match="'planets'; did you mean 'planet'"):
+        run_gallery(gs, "xi", [0.05], omega=1.5, planets=1, progress=False)
+    with pytest.raises(ParameterError, match="given twice") as info:
+        run_gallery(gs, "xi", [0.05], omega=1.5, params={"omega": 1.4}, progress=False)
+    assert info.value.name == "omega"
+    with pytest.raises(ParameterError, match=r"give params= only \(fixed= is its deprecated"):
+        run_gallery(gs, "xi", [0.05], params={"omega": 1.5}, fixed={"omega": 1.5})
+    with pytest.raises(ParameterError, match="fixed must be a mapping"):
+        run_gallery(gs, "xi", [0.05], fixed=[("omega", 1.5)], progress=False)
+    with pytest.raises(ParameterError, match="params must be a mapping"):
+        run_gallery(gs, "xi", [0.05], params=[("omega", 1.5)], progress=False)
+    with pytest.raises(ParameterError, match="settings must be a SolverSettings"):
+        run_gallery(gs, "xi", [0.05], omega=1.5, settings={"rtol": 1e-8}, progress=False)
 
 
 # --------------------------------------------------------------------------- recipes

@@ -122,6 +122,47 @@ def test_sweep_spec_build_takes_the_vocabulary_too() -> None:
     assert new == old
 
 
+# ----------------------------------------------------------------------------- galleries
+def test_run_gallery_takes_params_and_settings_and_the_old_spelling_warns() -> None:
+    import matplotlib.pyplot as plt
+
+    from gearchaos.paper.galleries import run_gallery
+
+    path: tuple[Any, ...] = (GS, "xi", [0.02, 0.05])
+    fixed = {"omega": 1.5, "backlash.sun_planet": 2.5}
+
+    def run(call: Any) -> tuple[list[dict[str, Any]], str]:
+        fig, rows = call(progress=False)
+        title = fig.get_suptitle()
+        plt.close(fig)
+        return rows, title
+
+    new = _quiet(lambda: run(lambda **kw: run_gallery(*path, params=fixed, settings=TINY, **kw)))
+    by_name = _quiet(
+        lambda: run(
+            lambda **kw: run_gallery(
+                *path, omega=1.5, params={"backlash.sun_planet": 2.5}, **TINY.to_record(), **kw
+            )
+        )
+    )
+    mixed = _quiet(
+        lambda: run(
+            lambda **kw: run_gallery(
+                *path,
+                params={"backlash.sun_planet": 2.5},
+                settings=TINY,
+                omega=1.5,
+                periods=3,
+                **kw,
+            )
+        )
+    )
+    with pytest.warns(DeprecationWarning, match=r"run_gallery\(fixed=\.\.\.\).*use params="):
+        old = run(lambda **kw: run_gallery(*path, fixed=fixed, settings=TINY, **kw))
+    assert new == by_name == mixed == old
+    assert [r["value"] for r in new[0]] == [0.02, 0.05]
+
+
 # ----------------------------------------------------------------------------- orbits
 def test_periodic_orbit_takes_settings_and_params() -> None:
     settings = SolverSettings(transient_periods=30, rtol=1e-9)

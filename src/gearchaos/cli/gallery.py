@@ -115,7 +115,7 @@ def poincare(
             gs,
             axis.name,
             axis.values,
-            fixed=fixed,
+            params=fixed,
             with_=extras,
             progress=not (quiet or json_out),
             planet=planet,

@@ -318,10 +318,10 @@ def split_keywords(
 ) -> tuple[dict[str, Any], SolverSettings]:
     """The one keyword vocabulary of the front doors (``simulate``, ``bifurcation``,
     ``response``, ``periodic_orbit``, ``continuation``, ``attractors``,
-    ``lyapunov_spectrum``): ``settings=`` a :class:`SolverSettings` (default ``default``) and
-    setting fields by name (``rtol=1e-10``), which override it; ``params=`` a mapping of dotted
-    parameter names to values (``{"backlash.sun_planet": 2.4}``) and parameters whose names are
-    Python identifiers by name (``omega=1.5``, ``xi=0.05``).
+    ``lyapunov_spectrum``, ``paper.run_gallery``): ``settings=`` a :class:`SolverSettings`
+    (default ``default``) and setting fields by name (``rtol=1e-10``), which override it;
+    ``params=`` a mapping of dotted parameter names to values (``{"backlash.sun_planet": 2.4}``)
+    and parameters whose names are Python identifiers by name (``omega=1.5``, ``xi=0.05``).
 
     ``keywords`` are a door's remaining keyword arguments: setting fields and parameters by
     name. Returns the parameter values by name and the settings."""

@@ -42,7 +42,8 @@ from .._checks import check_bool, check_int, check_real
 from .._output import staged_file, write_file
 from ..errors import ParameterError
 from ..gearset.schema import display_symbol, tex
-from ..integrate.settings import SolverSettings
+from ..integrate.settings import SolverSettings, renamed_keyword, split_keywords
+from ..sweep.spec import check_keyword, check_params
 from .recipes import load_figures, lookup_figure
 
 __all__ = [
@@ -64,6 +65,9 @@ FULL_PERIODS = (100, 500)
 GALLERY_SETTINGS = SolverSettings(transient_periods=100, periods=300)
 #: (transient, recorded) mesh periods of ``quick`` galleries (the 0–1 test needs ≥ 100 points).
 QUICK_PERIODS = (50, 100)
+#: The keywords of :func:`run_gallery` besides parameters and settings by name: the closest of
+#: them is suggested for an unknown name.
+GALLERY_KEYWORDS = ("params", "settings", "with_", "progress", "planet", "title")
 #: Keys of every row of :func:`run_gallery` (and columns of the recipes' CSV), in order.
 ROW_KEYS = (
     "value",
@@ -114,13 +118,14 @@ def run_gallery(
     param: str,
     values: Sequence[float],
     *,
-    fixed: Mapping[str, Any] | None = None,
+    params: Mapping[str, Any] | None = None,
+    settings: SolverSettings | None = None,
     with_: Iterable[str] | str | None = (),
     progress: bool = True,
     planet: int = 1,
     title: str | None = None,
-    settings: Any = None,
-    **solver: Any,
+    fixed: Mapping[str, Any] | None = None,
+    **values_and_settings: Any,
 ) -> tuple[Any, list[dict[str, Any]]]:
     """Simulate, measure and label every value of a parameter path and draw the gallery.
 
@@ -132,9 +137,15 @@ def run_gallery(
     param, values
         The varied parameter by dotted name (``omega``, ``xi``, ``backlash.sun_planet``, …) and
         its values, in panel order.
-    fixed
-        Other parameters by dotted name, ``omega`` included when it is not varied (required for
-        a gear set).
+    params
+        The other parameters by dotted name (``{"backlash.sun_planet": 2.4}``), ``omega``
+        included when it is not varied (required for a gear set); parameters whose names are
+        Python identifiers may also be given by name (``omega=1.5``, ``xi=0.05``).
+    settings
+        A :class:`~gearchaos.integrate.settings.SolverSettings` (default
+        :data:`GALLERY_SETTINGS`: 100 transient and 300 recorded periods) for the simulation
+        and the Lyapunov exponent alike; settings given by name (``transient_periods``,
+        ``periods``, ``rtol``, ``atol``, …) override it.
     with_
         ``"phase"`` and/or ``"spectrum"`` rows under each map; the simulations then record 64
         samples per period (else one, the section points only).
@@ -142,10 +153,13 @@ def run_gallery(
         A progress bar on stderr.
     planet, title
         Planet of X̄_sp; figure title (default: the gallery's own).
-    settings, **solver
-        :class:`~gearchaos.integrate.settings.SolverSettings` (default: 100 transient and 300
-        recorded periods) and/or its fields by name (``transient_periods``, ``periods``,
-        ``rtol``, ``atol``) — for the simulation and the Lyapunov exponent alike.
+    fixed
+        The deprecated spelling of ``params`` (a :class:`DeprecationWarning`; both at once are
+        refused).
+    **values_and_settings
+        Parameters by name and settings by name, as above: the vocabulary of every front door
+        (:func:`~gearchaos.integrate.settings.split_keywords`). Any other name is refused with
+        the closest valid one.
 
     Returns
     -------
@@ -159,7 +173,8 @@ def run_gallery(
     ------
     ParameterError
         An unknown or invalid parameter name, value or setting (checked for every value before
-        anything runs), ``param`` also in ``fixed``, no Ω, or invalid ``with_``.
+        anything runs), ``param`` also among the fixed parameters, a parameter given twice, no
+        Ω, or invalid ``with_``.
     """
     from ..dynamics.point import analyse_point
     from ..model.target import resolve
@@ -169,24 +184,27 @@ def run_gallery(
     if with_ is not None and not isinstance(with_, str | Iterable):
         raise ParameterError(f"with_ must be 'phase', 'spectrum' or both: got {with_!r}")
     extras = parse_extras(with_)
-    base = SolverSettings.build(GALLERY_SETTINGS if settings is None else settings, **solver)
+    if fixed is not None:  # the spelling before the one vocabulary
+        params = renamed_keyword(
+            "run_gallery", "fixed", "params", check_params("fixed", fixed), params
+        )
+    setting_names = SolverSettings.field_names()
+    for key in values_and_settings:
+        if key not in setting_names:
+            check_keyword("gallery", gs, key, (*setting_names, *GALLERY_KEYWORDS))
+    fixed_values, base = split_keywords(values_and_settings, settings, params, GALLERY_SETTINGS)
     settings = base.replace(samples_per_period=64 if extras else 1)
     if not isinstance(param, str):
         raise ParameterError(f"param must be a dotted parameter name: got {param!r}")
-    if fixed is not None and not isinstance(fixed, Mapping):
-        raise ParameterError(
-            f"fixed must be a mapping of dotted names to values: got {type(fixed).__name__}"
-        )
-    fixed = dict(fixed or {})
-    if param in fixed:
-        raise ParameterError(f"{param} is both varied and fixed; choose one")
+    if param in fixed_values:
+        raise ParameterError(f"{param} is both varied and fixed; choose one", name=param)
     vals = _gallery_values(param, values)
     progress = check_bool("progress", progress)
     planet = check_int("planet", planet, lo=1)
     if title is not None and not isinstance(title, str):
         raise ParameterError(f"title must be text or None: got {type(title).__name__}")
     # resolve every point first: a bad name or value fails before anything runs
-    systems = [resolve(gs, {**fixed, param: v}) for v in vals]
+    systems = [resolve(gs, {**fixed_values, param: v}) for v in vals]
     n_planets = systems[0].group_size
     if n_planets and planet > n_planets:
         raise ParameterError(f"planet must be one of 1..{n_planets}: got {planet}")
@@ -219,7 +237,9 @@ def run_gallery(
             )
             bar.advance(task)
     if title is None:
-        given = [f"{axis_symbol(k)} = {_fmt(fv)}" for k, fv in fixed.items() if _is_number(fv)]
+        given = [
+            f"{axis_symbol(k)} = {_fmt(fv)}" for k, fv in fixed_values.items() if _is_number(fv)
+        ]
         from ..plot._common import variable
 
         info = variable(results[0], None, planet) if results else None
@@ -395,7 +415,7 @@ def reproduce_gallery(
         gs,
         g.param,
         g.values,
-        fixed=dict(g.fixed),
+        params=dict(g.fixed),
         transient_periods=tr,
         periods=rec,
         progress=progress,

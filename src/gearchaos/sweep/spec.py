@@ -24,7 +24,7 @@ from __future__ import annotations
 import difflib
 import math
 import numbers
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, fields
 from typing import Any
 
@@ -230,15 +230,33 @@ def check_params(keyword: str, params: Any) -> Any:
     return params
 
 
+def check_keyword(door: str, target: Any, key: str, options: Iterable[str]) -> None:
+    """Refuse ``key``, given to ``door`` by name, unless it is a parameter of ``target``: the
+    refusal names the closest of ``options`` (the door's other keywords) and the target's
+    parameters whose names are Python identifiers."""
+    from ..model.target import parameter_names
+
+    names = parameter_names(target)
+    if key in names:
+        return
+    valid = sorted({*options, *(n for n in names if n.isidentifier())})
+    close = difflib.get_close_matches(key, valid, n=1)
+    hint = f"; did you mean {close[0]!r}?" if close else ""
+    raise ParameterError(
+        f"unknown {door} option {key!r}{hint} (a parameter whose name is not a Python "
+        "identifier goes in params={name: value})",
+        name=key,
+    )
+
+
 def sweep_keywords(
     door: str, target: Any, keywords: Mapping[str, Any], params: Any
 ) -> tuple[dict[str, Any], dict[str, Any]]:
     """A sweep door's keywords in the front doors' vocabulary
     (:func:`~gearchaos.integrate.settings.split_keywords`): the parameter values — ``params``
     and every keyword that is neither a sweep option nor a solver setting, by name — and the
-    sweep options and settings. A name that is none of these is refused with the closest."""
-    from ..model.target import parameter_names
-
+    sweep options and settings. A name that is none of these is refused with the closest
+    (:func:`check_keyword`)."""
     known = {*SPEC_OPTIONS, *SolverSettings.field_names()}
     values = dict(check_params("params", params) or {})
     options: dict[str, Any] = {}
@@ -246,16 +264,7 @@ def sweep_keywords(
         if key in known:
             options[key] = value
             continue
-        names = parameter_names(target)
-        if key not in names:
-            valid = sorted({*known, *EXECUTION_OPTIONS, *(n for n in names if n.isidentifier())})
-            close = difflib.get_close_matches(key, valid, n=1)
-            hint = f"; did you mean {close[0]!r}?" if close else ""
-            raise ParameterError(
-                f"unknown {door} option {key!r}{hint} (a parameter whose name is not a Python "
-                "identifier goes in params={name: value})",
-                name=key,
-            )
+        check_keyword(door, target, key, {*known, *EXECUTION_OPTIONS})
         if key in values:
             raise ParameterError(f"parameter {key!r} is given twice (keyword and params)", name=key)
         values[key] = value
