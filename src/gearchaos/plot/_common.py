@@ -4,6 +4,7 @@ variables of results, axes, cell edges, clearance and resonance lines."""
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -16,13 +17,20 @@ from ..model.planetary import PlanetaryModel
 #: ``gid`` of the vertical lines where a mesh harmonic meets a natural frequency.
 RESONANCE_GID = "resonance"
 
-# symbols of the reference systems' parameters (gearchaos.model.library)
+# symbols of the reference systems' parameters (gearchaos.model.library): the backlash
+# oscillator's, the Duffing oscillator's (x'' + δx' + αx + βx³ = γ cos Ωτ), the Lorenz system's
 _REFERENCE_TEX: dict[str, str] = {
     "zeta": r"\zeta",
     "eps": r"\varepsilon",
     "b": "b",
     "f_mean": "F_m",
     "f_alt": "F_a",
+    "delta": r"\delta",
+    "alpha": r"\alpha",
+    "beta": r"\beta",
+    "gamma": r"\gamma",
+    "sigma": r"\sigma",
+    "rho": r"\rho",
 }
 # definitions shown after a symbol on axes
 _DEFINITIONS: dict[str, str] = {OMEGA: r"\omega/\omega_n"}
@@ -60,6 +68,13 @@ def axis_label(name: str) -> str:
     return f"${sym}$ {unit}" if unit else f"${sym}$"
 
 
+def given(name: str, value: Any) -> str:
+    """``symbol = value`` of a parameter for titles and legends: ``$\\Omega$ = 1.2``,
+    ``$\\delta$ = 0.25``; an unknown name as it is, a value that is no number as written."""
+    number = isinstance(value, int | float | np.number) and not isinstance(value, bool)
+    return f"{axis_symbol(name)} = {fmt(value) if number else value}"
+
+
 def subject(attrs: Any, gearset: Any = None) -> str:
     """What a figure of a store or file is of, as its title names it: the gear set's name
     (``sheng2016``; ``gearset``, else the one of the attribute ``gearset_toml``), else the
@@ -75,12 +90,32 @@ def subject(attrs: Any, gearset: Any = None) -> str:
     return str(attrs.get("model", "") or "")
 
 
-def var_symbol(var: str, planet: int | None) -> str:
-    """Mathtext symbol (without ``$``) of a section variable: ``delta_sp`` → ``\\bar{X}_{sp1}``,
-    ``delta_sp_dot`` → ``\\bar{X}'_{sp1}``; other names become ``head_{tail}``."""
+def model_symbols(attrs: Any) -> Mapping[str, Any]:
+    """The figure symbols of the variables of what a store or branch file records (its
+    attributes): the planetary model's for a gear set; else the model's own ``symbols`` (the
+    optional member of the model contract), the model built again from ``model_class`` and
+    ``model_fields`` (:func:`~gearchaos.model.contract.rebuild_model`); none when it has none
+    or can no longer be built (its file moved)."""
+    if attrs.get("gearset_toml") or attrs.get("model") == "planetary":
+        return PlanetaryModel.symbols
+    from ..model.contract import rebuild_model
+
+    try:
+        model = rebuild_model(attrs)
+    except (ParameterError, ImportError, OSError):
+        return {}
+    return dict(getattr(model, "symbols", None) or {})
+
+
+def var_symbol(var: str, planet: int | None, symbols: Mapping[str, Any] | None = None) -> str:
+    """Mathtext symbol (without ``$``) of a section variable from ``symbols`` (a model's
+    table, :func:`model_symbols`; default the planetary model's): ``delta_sp`` →
+    ``\\bar{X}_{sp1}``, ``delta_sp_dot`` → ``\\bar{X}'_{sp1}``; other names become
+    ``head_{tail}``."""
+    table = _VAR_SYMBOLS if symbols is None else {k: v[0] for k, v in symbols.items()}
     base, prime = (var[:-4], "'") if var.endswith("_dot") else (var, "")
-    if base in _VAR_SYMBOLS:
-        sym = _VAR_SYMBOLS[base]
+    if base in table:
+        sym = table[base]
         if "%d" in sym:
             sym = sym % (planet if planet is not None else 1)
         # prime before the subscript: \bar{X}'_{sp1}

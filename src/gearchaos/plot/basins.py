@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from ._common import _generic_symbol, axis_label, edges, get_ax, subject
+from ._common import axis_label, edges, get_ax, given, model_symbols, subject, var_symbol
 from .regimes import regime_colour
 from .units import PhysicalScales, linear_axis, var_quantity
 
@@ -55,12 +55,9 @@ def attractor_colours(labels: list[str]) -> list[tuple[float, float, float]]:
 
 
 def _symbol(name: str, attrs: Any) -> str:
-    """Mathtext label of a state: the planetary model's symbols, else the generic form."""
-    if attrs.get("model") == "planetary":
-        from ._common import var_symbol
-
-        return f"${var_symbol(name, None)}$"
-    return f"${_generic_symbol(name)}$"
+    """Mathtext label of a state: the model's symbol (:func:`model_symbols`), else the
+    generic form."""
+    return f"${var_symbol(name, None, model_symbols(attrs))}$"
 
 
 def _scales(attrs: Any) -> PhysicalScales:
@@ -77,7 +74,7 @@ def _physical(ax: Any, axis: str, name: str, attrs: Any) -> None:
     q = "omega" if name == "omega" else var_quantity(name)
     found = None if q is None else _scales(attrs).factor(q)
     if found is not None:
-        label = found[1] if q == "omega" else f"{name} {found[1]}"
+        label = found[1] if q == "omega" else f"{_symbol(name, attrs)} {found[1]}"
         linear_axis(ax, axis, found[0], label)
 
 
@@ -141,7 +138,7 @@ def basin_image(ds: Any, ax: Any = None, *, points: bool = True) -> Any:
                 facecolor=col,
                 edgecolor="0.3",
                 linewidth=0.5,
-                label=f"{_legend_text(e, xname, ix)}: {100 * frac:.3g} %",
+                label=f"{_legend_text(e, _symbol(xname, ds.attrs), ix)}: {100 * frac:.3g} %",
             )
         )
         if points:
@@ -197,6 +194,7 @@ def fraction_curves(ds: Any, ax: Any = None, *, confidence: float = 0.95) -> Any
     param = ds.attrs["dims"][0]
     p = np.asarray(fr[param].values, dtype=float)
     labels = [str(v) for v in fr["track_label"].values]
+    state = _symbol(str(ds["state"].values[0]), ds.attrs)
     colours = attractor_colours(labels)
     for j, t in enumerate(np.asarray(fr["track"].values)):
         col = (0.0, 0.0, 0.0) if t == -2 else colours[j]
@@ -204,7 +202,7 @@ def fraction_curves(ds: Any, ax: Any = None, *, confidence: float = 0.95) -> Any
         f = np.where(there, fr["fraction"].values[:, j], np.nan)
         lo = np.where(there, fr["fraction_low"].values[:, j], np.nan)
         hi = np.where(there, fr["fraction_high"].values[:, j], np.nan)
-        name = "failed" if t == -2 else f"{fr['track_legend'].values[j]}"
+        name = "failed" if t == -2 else _track_legend(fr, j, state, param)
         ax.fill_between(p, lo, hi, color=col, alpha=0.2, lw=0)
         ax.errorbar(
             p, f, yerr=[f - lo, hi - f], color=col, marker="o", ms=3, capsize=2, lw=1.2,
@@ -214,7 +212,7 @@ def fraction_curves(ds: Any, ax: Any = None, *, confidence: float = 0.95) -> Any
     if p.size > 1:  # a margin: the end points and their intervals stay visible
         pad = 0.03 * (p.max() - p.min())
         ax.set_xlim(p.min() - pad, p.max() + pad)
-    ax.set_xlabel(_parameter_label(param))
+    ax.set_xlabel(axis_label(param))
     n = int(ds.sizes["start"])
     ax.set_ylabel(f"fraction of {n} starts")
     _physical(ax, "x", param, ds.attrs)
@@ -229,14 +227,13 @@ def fraction_curves(ds: Any, ax: Any = None, *, confidence: float = 0.95) -> Any
     return ax
 
 
-_GREEK = {k: "\\" + k for k in ("alpha", "beta", "gamma", "delta", "zeta", "sigma", "rho")}
-
-
-def _parameter_label(name: str) -> str:
-    """The registry's label of a parameter; a Greek-letter name of a reference system as
-    its letter."""
-    label = axis_label(name)
-    return f"${_GREEK[name]}$" if label == name and name in _GREEK else label
+def _track_legend(fr: Any, j: int, state: str, param: str) -> str:
+    """``1T ($x$ ≈ 1.08 at $\\Omega$ = 0.8)``: the label of track j of :func:`fractions`
+    and where its attractor lies (``state``, a symbol) at the parameter value where it is
+    first found."""
+    where = float(fr["track_position"].values[j])
+    at = given(param, float(fr["track_found_at"].values[j]))
+    return f"{fr['track_label'].values[j]} ({state} ≈ {where:.3g} at {at})"
 
 
 def basins_figure(ds: Any) -> Any:
@@ -248,10 +245,8 @@ def basins_figure(ds: Any) -> Any:
     fig, ax = plt.subplots(figsize=(8.4, 5.2), layout="constrained")
     spec = json.loads(ds.attrs["basin_spec"])
     if "omega" not in spec["values"] and "omega" in ds.attrs and ds.attrs["dims"][0] != "omega":
-        spec["values"] = {"Ω": float(ds.attrs["omega"]), **spec["values"]}
-    point = ", ".join(
-        f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}" for k, v in spec["values"].items()
-    )
+        spec["values"] = {"omega": float(ds.attrs["omega"]), **spec["values"]}
+    point = ", ".join(given(k, v) for k, v in spec["values"].items())
     if kind == "basins":
         basin_image(ds, ax)
         title = f"{subject(ds.attrs)}: basins of attraction" + (f" at {point}" if point else "")
@@ -268,7 +263,6 @@ def basins_figure(ds: Any) -> Any:
         layout = {"kind", "name", "n_state", "n_track", "n_contact_forces"}
         layout |= {"state_names", "obs_names"}
         shown = {k: v for k, v in json.loads(fields).items() if k not in layout}
-        title += "\n" + ", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}"
-                                  for k, v in shown.items())  # fmt: skip
+        title += "\n" + ", ".join(given(k, v) for k, v in shown.items())
     ax.set_title(title, fontsize="medium")
     return fig

@@ -12,6 +12,7 @@ share of starts on each track with its Wilson confidence interval
 from __future__ import annotations
 
 import json
+import math
 import os
 from collections.abc import Mapping
 from typing import Any
@@ -168,8 +169,10 @@ def fractions(ds: Any, *, confidence: float = 0.95) -> Any:
     """Basin fractions of a ``basin_fractions`` store: per parameter value and attractor
     track, the ``count`` of starts, the ``fraction`` and its Wilson interval
     ``fraction_low``/``fraction_high`` (:func:`~gearchaos.analysis.fractions.wilson_interval`),
-    with the coordinates ``track`` (the attractor's track id; −2 the failed starts) and
-    ``track_label``."""
+    with the coordinates ``track`` (the attractor's track id; −2 the failed starts),
+    ``track_label``, ``track_found_at`` (the parameter value where the track's attractor is
+    first found) and ``track_position`` (there, the first state of its first section point, or
+    the median over its set; NaN for the failed starts)."""
     import xarray as xr
 
     from ..analysis.fractions import wilson_interval
@@ -198,20 +201,19 @@ def fractions(ds: Any, *, confidence: float = 0.95) -> Any:
             elif c >= 0:
                 count[p, col[tracks[p][int(c)]]] += int(np.sum(codes[p] == c))
     present = np.zeros(count.shape, dtype=bool)
-    legends: dict[int, str] = {}
+    found: dict[int, tuple[float, float]] = {}  # track -> (parameter value, first state there)
     for p, row in enumerate(tracks):
         for c, t in enumerate(row):
             present[p, col[t]] = True
-            if t not in legends:
+            if t not in found:
                 from ..dynamics.basins import BasinAttractor
 
                 e = BasinAttractor.from_record(cats[str(p)]["entries"][c])
-                first = f"{float(ds[param].values[p]):.3g}"
-                name = str(ds["state"].values[0])
                 where = e.section_states[0, 0] if e.period else np.median(e.section_states[:, 0])
-                legends[t] = f"{e.label} ({name} ≈ {where:.3g} at {param} = {first})"
+                found[t] = (float(ds[param].values[p]), float(where))
     if has_failed:
         present[:, col[FAILED]] = True
+    nan2 = (math.nan, math.nan)
     n = np.sum(codes != -1, axis=1)[:, None]
     low, high = wilson_interval(count, np.broadcast_to(n, count.shape), confidence)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -232,7 +234,8 @@ def fractions(ds: Any, *, confidence: float = 0.95) -> Any:
                 "track",
                 np.array([labels.get(t, "failed") for t in cols], dtype="U10"),
             ),
-            "track_legend": ("track", np.array([legends.get(t, "failed") for t in cols])),
+            "track_found_at": ("track", np.array([found.get(t, nan2)[0] for t in cols])),
+            "track_position": ("track", np.array([found.get(t, nan2)[1] for t in cols])),
         },
     )
     out["fraction"].attrs["confidence"] = float(confidence)
