@@ -276,3 +276,22 @@ def test_sweep_figure_draws_2d_stores_as_regime_maps() -> None:
     fig = sweep_figure(ds, regimes=False)
     assert not [c for ax in fig.axes for c in ax.collections if c.get_gid() == REGIME_GID]
     assert not fig.legends
+
+
+def test_map_legend_covers_no_title() -> None:
+    """The legend of a 2-D map sits under the panel: beside it at the top it covered the end
+    of the title's protocol line (docs/howto/map.png)."""
+    from figure_checks import assert_legends_clear_of_titles
+
+    ds = map_dataset()
+    ds.attrs.update(transient_periods=100.0, periods=100, initial_conditions="fresh")
+    fig = sweep_figure(ds)
+    assert fig.get_suptitle().endswith(
+        "100 transient + 100 recorded periods, fresh initial conditions"
+    )
+    assert_legends_clear_of_titles(fig)
+    (legend,) = fig.legends
+    ax = fig.axes[0]
+    box = legend.get_window_extent()
+    assert box.y1 <= ax.get_tightbbox().y0 + 0.5  # under the panel
+    assert 0 <= box.x0 and box.x1 <= fig.bbox.x1  # and inside the figure: in two rows here

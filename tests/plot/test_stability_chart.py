@@ -76,6 +76,9 @@ def test_legend_names_each_boundary_and_physical_axes(chart_data, tmp_path) -> N
     ax = fig.axes[0]
     texts = [t.get_text() for t in ax.get_legend().get_texts()]
     assert "period doubling" in texts and "1T" in texts and "2T" in texts
+    from figure_checks import assert_legends_clear_of_titles
+
+    assert_legends_clear_of_titles(fig)  # beside the axes, under the title
     fig.savefig(tmp_path / "chart.png")
     # a reference system has no physical scales: no secondary axes
     assert len(fig.axes) == 1

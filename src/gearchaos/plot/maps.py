@@ -23,6 +23,7 @@ from ._common import (
     corner_note,
     edges,
     get_ax,
+    model_symbols,
     no_offset,
     resonance_lines,
     var_symbol,
@@ -35,7 +36,7 @@ from .bifurcation import (
     selection_title,
     suptitle,
 )
-from .regimes import regime_categories, regime_legend, regime_map
+from .regimes import regime_categories, regime_legend_below, regime_map
 
 __all__ = ["distinct_counts", "distinct_map", "sweep_figure"]
 
@@ -166,7 +167,9 @@ def distinct_map(
         cb = fig.colorbar(mesh, ax=ax, ticks=np.arange(0, max_count + 2))
         labels = ["failed", *(f"{n}T" for n in range(1, max_count + 1)), "many"]
         cb.ax.set_yticklabels(labels, fontsize="x-small")
-        sym = var_symbol(var, planet if "planet" in sub[var].dims else None)
+        sym = var_symbol(
+            var, planet if "planet" in sub[var].dims else None, model_symbols(sub.attrs)
+        )
         cb.set_label(f"distinct section points of ${sym}$")
     no_offset(ax.xaxis, ax.yaxis)
     return ax
@@ -211,7 +214,7 @@ def sweep_figure(
 
     With ``regimes`` (default: when the dataset has ``motion`` labels) 1-D sweeps get regime
     bands under their panels and 2-D sweeps are drawn as regime maps
-    (:func:`~gearchaos.plot.regimes.regime_map`, one categorical legend for the figure);
+    (:func:`~gearchaos.plot.regimes.regime_map`, one categorical legend under the panels);
     without, 2-D sweeps are :func:`distinct_map` s. ``clearance_lines`` applies to bifurcation
     diagrams only; ``max_count`` to distinct-point maps only; ``branches`` (continued branches
     of periodic orbits, drawn over the diagrams of their parameter) to 1-D sweeps only.
@@ -270,11 +273,9 @@ def sweep_figure(
     for ax in axs[len(selects) :]:
         ax.set_visible(False)
     if regimes:
-        regime_legend(
-            fig,
-            np.asarray(regime_categories(res).values, dtype=object).ravel(),
-            loc="outside right upper",
-        )
+        # under the panels, as the other figures' regime legends: beside them at the top it
+        # covered the end of a long title
+        regime_legend_below(fig, np.asarray(regime_categories(res).values, dtype=object).ravel())
         fig.suptitle(suptitle(res, "motion regimes"), fontsize="medium")
     else:
         fig.suptitle(suptitle(res, "distinct Poincaré points"), fontsize="medium")

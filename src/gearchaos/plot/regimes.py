@@ -17,6 +17,7 @@ galleries, the CLI's regime tables), so a colour means the same regime everywher
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Mapping
 from types import MappingProxyType
 from typing import Any
@@ -137,12 +138,16 @@ def regime_legend(target: Any, labels: Iterable[Any], **kwargs: Any) -> Any:
 
 
 def regime_legend_below(fig: Any, labels: Iterable[Any], *, title: str = "motion") -> Any:
-    """One legend under all panels of ``fig`` naming exactly the regimes of ``labels``."""
+    """One legend under all panels of ``fig`` naming exactly the regimes of ``labels``: in
+    one row where the figure is wide enough (0.9 inch a regime, 8 at most), else in rows of
+    equal length."""
     handles = regime_handles(labels)
+    widest = max(1, min(8, int(fig.get_figwidth() / 0.9)))
+    rows = math.ceil(len(handles) / widest) if handles else 1
     return fig.legend(
         handles=handles,
         loc="outside lower center",
-        ncols=max(1, min(len(handles), 8)),
+        ncols=max(1, math.ceil(len(handles) / rows)),
         fontsize="small",
         frameon=False,
         title=title,
