@@ -361,3 +361,35 @@ def test_figures_name_the_gear_set_not_the_models_record() -> None:
     assert subject({"model": "planetary", "gearset_toml": to_toml(gs)}) == "sheng2016"
     assert subject({"model": "planetary"}, gs) == "sheng2016"
     assert subject({"model": "backlash_oscillator", "gearset_toml": ""}) == "backlash_oscillator"
+
+
+def test_a_user_models_variable_is_drawn_with_the_models_symbol() -> None:
+    """A store of a user model names its variable by the model's ``symbols`` (the optional
+    member of the model contract): δ̄ of the Kahraman–Singh example, not the name ``delta``
+    (docs/howto/own-model.png); a model without symbols, or one that can no longer be built,
+    keeps the upright name."""
+    from gearchaos.model.contract import load_model_class, model_reference
+
+    cls = load_model_class("examples/kahraman_singh_1991.py:KahramanSingh1991")
+    ds = sweep_dataset(np.array([1, 2, 1]), {"omega": np.array([1.9, 2.0, 2.1])})
+    ds = ds.rename({"delta_sp": "delta", "delta_sp_dot": "delta_dot"}).isel(planet=0)
+    ds.attrs = {k: v for k, v in ds.attrs.items() if not k.startswith(("gearset", "clearance"))}
+    ds.attrs.update(model="kahraman_singh_1991", **model_reference(cls()))
+    fig = bifurcation_figure(ds, var="delta")
+    assert fig.axes[0].get_ylabel() == r"$\bar{\delta}$"
+    ds.attrs["model_class"] = "no/such/file.py:Model"
+    assert bifurcation_figure(ds, var="delta").axes[0].get_ylabel() == r"$\mathrm{delta}$"
+
+
+def test_event_names_over_a_diagram_sit_beside_the_branch() -> None:
+    """Over a bifurcation diagram an event's name goes to the side of its marker that the
+    branch leaves free (docs/howto/own-model.png: "PD" sat on the curve)."""
+    from figure_checks import labels_on_curves, steep_branch
+
+    system = gc.backlash_oscillator(1.0, zeta=0.05, f_alt=0.1, f_mean=0.1)
+    branch = gc.continuation(system, "omega=0.9:1.0", rtol=1e-8)
+    ds = sweep_dataset(np.array([1, 2, 1, 1]), {"omega": np.array([1.0, 1.5, 2.0, 2.5])})
+    steep = steep_branch(branch, "delta_sp", (1.4, 1.6), 3.0, 3.8, kind="period_doubling")
+    fig = bifurcation_figure(ds, branches=[steep])
+    assert [t.get_text() for t in fig.axes[0].texts if t.get_text() == "PD"] == ["PD"]
+    assert labels_on_curves(fig, "branch:") == []

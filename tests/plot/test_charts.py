@@ -72,6 +72,9 @@ def test_impact_figure_has_physical_axes_and_refuses_unknown_meshes(impact_store
     ax = fig.axes[0]
     labels = [c.get_xlabel() for c in ax.child_axes] + [c.get_ylabel() for c in ax.child_axes]
     assert any("rpm" in t for t in labels) and any("µm" in t for t in labels)
+    from figure_checks import assert_legends_clear_of_titles
+
+    assert_legends_clear_of_titles(fig)  # under the panels, as the regime maps'
     with pytest.raises(gc.ParameterError, match="mesh must be one of"):
         impact_figure(impact_store, mesh="sun_ring")
     with pytest.raises(gc.ParameterError, match="planet must be one of"):
@@ -171,3 +174,37 @@ def test_old_branch_without_peak_force_draws_amplitude_and_names_the_variable(
         amplitude_figure(res, [branch], quantity="force")
     with pytest.raises(gc.ParameterError, match=r"deflection of a mesh .*\(x\): got 'y'"):
         amplitude_figure(res, [branch], quantity="force_peak", var="y")
+
+
+def test_event_names_sit_beside_the_curve_not_on_it(oscillator_response) -> None:
+    """An event's name goes to the side of its marker that the curves leave free: written
+    above it, "graze" sat on the steep branch (docs/howto/force.png)."""
+    from figure_checks import labels_on_curves, steep_branch
+
+    _, res, branch = oscillator_response
+    steep = steep_branch(branch, "x", (0.85, 1.15), 0.45, 0.7)
+    for quantity in ("amplitude", "force_peak"):
+        if quantity == "force_peak":
+            steep["force_peak_mesh"] = steep["x_max"]
+        fig = amplitude_figure(res, [steep], quantity=quantity)
+        assert [t.get_text() for t in fig.axes[0].texts if t.get_text() == "graze"] == ["graze"]
+        assert labels_on_curves(fig, "amplitude:") == []
+
+
+def test_amplitude_figure_is_titled_by_the_shared_helper(oscillator_response) -> None:
+    """The title names the model (or gear set) and the figure as the other sweep figures do
+    (bifurcation.suptitle), not the store's "gearchaos … of …" record."""
+    from gearchaos.gearset.io import to_toml
+
+    _, res, branch = oscillator_response
+    title = amplitude_figure(res, [branch]).get_suptitle().splitlines()
+    assert title[0] == "backlash_oscillator: amplitude–frequency curves"
+    assert title[1] == "100 transient + 50 recorded periods, continuation initial conditions"
+    assert title[2] == "continued branches (rtol 1e-10) beside the brute-force sweeps"
+    force = amplitude_figure(res, [branch], quantity="force_peak").get_suptitle()
+    assert force.startswith("backlash_oscillator: peak contact force curves\n")
+    geared = res.copy()
+    geared.attrs["gearset_toml"] = to_toml(gc.preset("sheng2016"))
+    title = amplitude_figure(geared, [branch]).get_suptitle().splitlines()
+    assert title[0] == "sheng2016: amplitude–frequency curves"
+    assert title[1].startswith(r"at $\bar b_{sp}$ = ")

@@ -27,8 +27,10 @@ import numpy as np
 from ..errors import ParameterError
 from ..sweep import SweepResult
 from ..sweep.frequency import find_jumps
-from ._common import axis_label, fmt, var_symbol
-from .branch import BRANCH_COLOURS, EVENT_NAMES, EVENT_STYLE, branch_labels
+from ._common import axis_label, fmt, model_symbols, var_symbol
+from .bifurcation import suptitle
+from .branch import BRANCH_COLOURS, branch_labels, mark_event
+from .placement import place_event_labels
 from .regimes import regime_band, regime_categories, regime_legend_below
 from .response import MESH_LABEL, periodic_mask
 from .units import PhysicalScales, fit_to_data, linear_axis, var_quantity
@@ -144,25 +146,13 @@ def _draw_branch(ax: Any, br: Any, amp: np.ndarray, colour: str, label: str,
         )  # fmt: skip
     s = np.asarray(br["arclength"].values, dtype=float)
     for k in range(br.sizes.get("event", 0)):
-        kind = str(br.event_kind.values[k])
-        marker, ec, short = EVENT_STYLE.get(kind, ("o", "k", kind))
         i = min(max(int(br.event_point.values[k]), 0), lam.size - 1)
         a = amp[i]
         if i + 1 < lam.size and s[i + 1] > s[i]:
             f = (float(br.event_arclength.values[k]) - s[i]) / (s[i + 1] - s[i])
             a = amp[i] + min(max(f, 0.0), 1.0) * (amp[i + 1] - amp[i])
-        filled = marker in ("x", "P")
-        ax.scatter(
-            [float(br.event_value.values[k])], [a], marker=marker, s=42, linewidths=1.3,
-            zorder=5, gid=f"{AMPLITUDE_GID}:event:{kind}",
-            **({"c": ec} if filled else {"facecolors": "none", "edgecolors": ec}),
-            label=EVENT_NAMES.get(kind, kind) if kind not in named else None,
-        )  # fmt: skip
-        named.add(kind)
-        ax.annotate(
-            short, (float(br.event_value.values[k]), a), xytext=(0, 6), color=ec,
-            textcoords="offset points", ha="center", fontsize="x-small",
-        )  # fmt: skip
+        mark_event(ax, str(br.event_kind.values[k]), float(br.event_value.values[k]), a, named,
+                   AMPLITUDE_GID)  # fmt: skip
     return amp
 
 
@@ -293,7 +283,7 @@ def amplitude_figure(
     else:
         assert var is not None  # amplitude_var chose it
         per = "planet" in sd[f"{var}_max"].dims or "planet_all" in sd[f"{var}_max"].dims
-        sym = var_symbol(var, planet if per else None)
+        sym = var_symbol(var, planet if per else None, model_symbols(sd.attrs))
         ax.set_ylabel(f"amplitude $\\max {sym} - \\min {sym}$")
         kind = var_quantity(var)
         found = scales.factor(kind) if kind is not None else None
@@ -325,8 +315,8 @@ def amplitude_figure(
     if force:
         who = f"{MESH_LABEL[mesh]} mesh" + (f", planet {planet}" if per else "")
         what = "peak contact force curves" + (f" ({who})" if mesh != "mesh" else "")
-    title = str(sd.attrs.get("title", "")).replace("sweep", what)
     rtols = sorted({fmt(br.attrs.get("rtol")) for br in branches if br.attrs.get("rtol")})
     extra = f"continued branches (rtol {', '.join(rtols)}) beside the brute-force sweeps"
-    fig.suptitle(f"{title}\n{extra}" if title else extra, fontsize="medium")
+    fig.suptitle(f"{suptitle(res, what)}\n{extra}", fontsize="medium")
+    place_event_labels(fig)
     return fig

@@ -34,12 +34,15 @@ from ._common import (
     corner_note,
     fmt,
     get_ax,
+    given,
+    model_symbols,
     no_offset,
     resonance_lines,
     subject,
     var_symbol,
 )
 from .branch import BRANCH_COLOURS, branch_labels, branch_matches, branch_overlay
+from .placement import place_event_labels
 from .regimes import regime_band, regime_categories, regime_legend_below
 from .units import (
     PhysicalScales,
@@ -316,7 +319,9 @@ def bifurcation(
                 if line.get_gid() == CLEARANCE_GID:
                     line.set_label("_nolegend_")
     ax.set_xlabel(axis_label(x_name))
-    symbol = var_symbol(var, planet if "planet" in sub[var].dims else None)
+    symbol = var_symbol(
+        var, planet if "planet" in sub[var].dims else None, model_symbols(sub.attrs)
+    )
     if relative:
         symbol += f" - {clear_sym}"
     ax.set_ylabel(f"${symbol}$")
@@ -339,13 +344,13 @@ def bifurcation(
 
 def _panel_title(k: int, name: str, value: Any, *, letters: bool) -> str:
     prefix = f"({string.ascii_lowercase[k % 26]}) " if letters else ""
-    return f"{prefix}{axis_symbol(name)} = {fmt(value)}"
+    return f"{prefix}{given(name, value)}"
 
 
 def selection_title(sel: Mapping[str, Any], k: int, n: int) -> str:
     """The title of panel k of n that shows the selection ``sel`` (family or direction
     values): ``(b) ξ = 0.05, up``, the letter only when there are several panels."""
-    parts = [f"{axis_symbol(d)} = {fmt(v)}" if d != "direction" else str(v) for d, v in sel.items()]
+    parts = [given(d, v) if d != "direction" else str(v) for d, v in sel.items()]
     prefix = f"({string.ascii_lowercase[k % 26]}) " if n > 1 else ""
     return prefix + ", ".join(parts)
 
@@ -364,7 +369,7 @@ def _given(res: SweepResult) -> list[str]:
     shown: set[str] = set()
     for k, v in res.fixed.items():
         if _is_number(v) and k not in swept:
-            out.append(f"{axis_symbol(k)} = {fmt(v)}")
+            out.append(given(k, v))
             shown.add(k)
     gs = res.gearset
     if gs is None:
@@ -376,7 +381,7 @@ def _given(res: SweepResult) -> list[str]:
         ("clearance.sun_bearing", gs.sun_bearing_clearance_bar()),
     ):
         if name not in swept and name not in shown:
-            out.append(f"{axis_symbol(name)} = {fmt(value)}")
+            out.append(given(name, value))
     d = gs.damping
     damping_swept = swept & {
         "xi",
@@ -385,7 +390,7 @@ def _given(res: SweepResult) -> list[str]:
         "damping.sun_bearing",
     }
     if not damping_swept and "xi" not in shown and d.sun_planet == d.planet_ring == d.sun_bearing:
-        out.append(f"{axis_symbol('xi')} = {fmt(d.sun_planet)}")
+        out.append(given("xi", d.sun_planet))
     return out
 
 
@@ -395,9 +400,9 @@ def suptitle(ds: Any, what: str) -> str:
     res = SweepResult.of(ds)
     attrs = res.ds.attrs
     lines = [": ".join(p for p in (subject(attrs, res.gearset), what) if p)]
-    given = _given(res)
-    if given:
-        lines.append("at " + ", ".join(given))
+    values = _given(res)
+    if values:
+        lines.append("at " + ", ".join(values))
     t, p = attrs.get("transient_periods"), attrs.get("periods")
     if t is not None and p is not None:
         ic = attrs.get("initial_conditions")
@@ -507,4 +512,5 @@ def bifurcation_figure(
         suptitle(res, "bifurcation diagram" + ("s" if len(values) > 1 else "")),
         fontsize="medium",
     )
+    place_event_labels(fig)  # last: the layout is final
     return fig

@@ -23,12 +23,24 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..gearset.schema import CLEARANCES, FIELDS
-from ._common import axis_label, axis_symbol, fmt, get_ax, resonance_lines, subject, var_symbol
+from ._common import (
+    axis_label,
+    axis_symbol,
+    fmt,
+    get_ax,
+    given,
+    model_symbols,
+    resonance_lines,
+    subject,
+    var_symbol,
+)
+from .placement import EVENT_LABEL_GID, LABEL_PLACES, place_event_labels
 from .units import PhysicalScales, clearance_notes, fit_to_data, secondary_axis, var_quantity
 
 __all__ = [
     "BRANCH_COLOURS",
     "BRANCH_GID",
+    "EVENT_LABEL_GID",
     "EVENT_NAMES",
     "EVENT_STYLE",
     "branch_clearance",
@@ -36,6 +48,7 @@ __all__ = [
     "branch_labels",
     "branch_matches",
     "branch_overlay",
+    "mark_event",
 ]
 
 #: ``gid`` prefix of the artists drawn by :func:`branch_overlay`.
@@ -257,37 +270,50 @@ def branch_overlay(
 def _draw_events(ax: Any, branch: Any, y: np.ndarray, named: set[str]) -> None:
     s = np.asarray(branch["arclength"].values, dtype=np.float64)
     for k in range(branch.sizes["event"]):
-        kind = str(branch.event_kind.values[k])
-        marker, colour, short = EVENT_STYLE.get(kind, ("o", "k", kind))
-        value = float(branch.event_value.values[k])
         i = min(max(int(branch.event_point.values[k]), 0), y.shape[0] - 1)
         ys = y[i]
         if i + 1 < y.shape[0] and s[i + 1] > s[i]:  # between the two points, in arclength
             f = (float(branch.event_arclength.values[k]) - s[i]) / (s[i + 1] - s[i])
             ys = y[i] + min(max(f, 0.0), 1.0) * (y[i + 1] - y[i])
-        filled = marker in ("x", "P")  # line markers take one colour, the others a rim
-        ax.scatter(
-            np.full(ys.size, value),
-            ys,
-            marker=marker,
-            s=40,
-            **({"c": colour} if filled else {"facecolors": "none", "edgecolors": colour}),
-            linewidths=1.3,
-            zorder=4,
-            gid=f"{BRANCH_GID}:event:{kind}",
-            label=EVENT_NAMES.get(kind, kind) if kind not in named else None,
-        )
-        named.add(kind)
-        ax.annotate(
-            short,
-            (value, float(np.nanmax(ys))),
-            xytext=(0, 6),
-            textcoords="offset points",
-            ha="center",
-            fontsize="x-small",
-            color=colour,
-            gid=f"{BRANCH_GID}:event-label",
-        )
+        mark_event(
+            ax, str(branch.event_kind.values[k]), float(branch.event_value.values[k]), ys,
+            named, BRANCH_GID,
+        )  # fmt: skip
+
+
+def mark_event(ax: Any, kind: str, x: float, ys: Any, named: set[str], gid: str) -> None:
+    """Mark an event of ``kind`` at the parameter value ``x`` and the values ``ys`` (one per
+    section point): its marker (``gid`` ``<gid>:event:<kind>``), its full name in the legend
+    once per kind (``named``, updated) and its short name (``PD``, ``fold`` …) beside the
+    highest marker — above it until
+    :func:`~gearchaos.plot.placement.place_event_labels` moves it clear of the curves."""
+    marker, colour, short = EVENT_STYLE.get(kind, ("o", "k", kind))
+    ys = np.atleast_1d(np.asarray(ys, dtype=np.float64))
+    filled = marker in ("x", "P")  # line markers take one colour, the others a rim
+    ax.scatter(
+        np.full(ys.size, x),
+        ys,
+        marker=marker,
+        s=40,
+        **({"c": colour} if filled else {"facecolors": "none", "edgecolors": colour}),
+        linewidths=1.3,
+        zorder=5,
+        gid=f"{gid}:event:{kind}",
+        label=EVENT_NAMES.get(kind, kind) if kind not in named else None,
+    )
+    named.add(kind)
+    ax.annotate(
+        short,
+        (x, float(np.nanmax(ys))),
+        xytext=LABEL_PLACES[0][:2],
+        textcoords="offset points",
+        ha=LABEL_PLACES[0][2],
+        va=LABEL_PLACES[0][3],
+        fontsize="x-small",
+        color=colour,
+        zorder=6,
+        gid=EVENT_LABEL_GID,
+    )
 
 
 def _given(branch: Any) -> list[str]:
@@ -297,7 +323,7 @@ def _given(branch: Any) -> list[str]:
     out, shown = [], {name}
     for k, v in _fixed(branch).items():
         if isinstance(v, int | float) and not isinstance(v, bool) and k not in shown:
-            out.append(f"{axis_symbol(k)} = {fmt(v)}")
+            out.append(given(k, v))
             shown.add(k)
     gs = _gearset(branch)
     if gs is None:  # a reference system: its parameters with a symbol, from its repr
@@ -306,7 +332,7 @@ def _given(branch: Any) -> list[str]:
         text = str(branch.attrs.get("model_parameters", ""))
         for k, v in re.findall(r"(\w+)=([-+0-9.eE]+)[,)]", text):
             if k not in shown and axis_symbol(k) != k:
-                out.append(f"{axis_symbol(k)} = {fmt(float(v))}")
+                out.append(given(k, float(v)))
         return out
     bsp, brp = gs.backlash_bar()
     for key, value in (
@@ -315,11 +341,11 @@ def _given(branch: Any) -> list[str]:
         ("clearance.sun_bearing", gs.sun_bearing_clearance_bar()),
     ):
         if key not in shown:
-            out.append(f"{axis_symbol(key)} = {fmt(value)}")
+            out.append(given(key, value))
     d = gs.damping
     damping = {"xi", "damping.sun_planet", "damping.planet_ring", "damping.sun_bearing"}
     if not damping & shown and d.sun_planet == d.planet_ring == d.sun_bearing:
-        out.append(f"{axis_symbol('xi')} = {fmt(d.sun_planet)}")
+        out.append(given("xi", d.sun_planet))
     return out
 
 
@@ -413,7 +439,8 @@ def branch_figure(
     if resonances and name == "omega":
         resonance_lines(ax, gs, *ax.get_xlim())
     ax.set_xlabel(axis_label(name))
-    ylabel = var_symbol(var, planet if "planet" in branches[0][var].dims else None)
+    per = "planet" in branches[0][var].dims
+    ylabel = var_symbol(var, planet if per else None, model_symbols(branches[0].attrs))
     ax.set_ylabel(f"${ylabel} - {sym}$" if relative else f"${ylabel}$")
     if physical and gs is not None:
         from ..model.planetary import PlanetaryModel
@@ -424,6 +451,7 @@ def branch_figure(
             secondary_axis(ax, "x", "omega", scales)
     ax.legend(loc="best", fontsize="small")
     fig.suptitle(_title(branches, var, planet), fontsize="medium")
+    place_event_labels(fig)  # last: the layout is final
     return fig
 
 
@@ -443,9 +471,9 @@ def _title(branches: list[Any], var: str, planet: int) -> str:
         else "continued branches of period " + ", ".join(str(n) for n in periods)
     )
     lines = [f"{model}: {what}, section values against {axis_symbol(first.attrs['parameter'])}"]
-    given = _given(first)
-    if given:
-        lines.append("at " + ", ".join(given))
+    values = _given(first)
+    if values:
+        lines.append("at " + ", ".join(values))
     rtol = first.attrs.get("rtol")
     u = [
         float(x)
