@@ -139,10 +139,10 @@ def regime_legend(target: Any, labels: Iterable[Any], **kwargs: Any) -> Any:
 
 def regime_legend_below(fig: Any, labels: Iterable[Any], *, title: str = "motion") -> Any:
     """One legend under all panels of ``fig`` naming exactly the regimes of ``labels``: in
-    one row where the figure is wide enough (0.9 inch a regime, 8 at most), else in rows of
+    one row where the figure is wide enough (0.85 inch a regime, 8 at most), else in rows of
     equal length."""
     handles = regime_handles(labels)
-    widest = max(1, min(8, int(fig.get_figwidth() / 0.9)))
+    widest = max(1, min(8, int(fig.get_figwidth() / 0.85)))
     rows = math.ceil(len(handles) / widest) if handles else 1
     return fig.legend(
         handles=handles,
