@@ -14,6 +14,7 @@ so an input that slipped through would finish at once and fail as "accepted".
 from __future__ import annotations
 
 import dataclasses
+import inspect
 import math
 from collections.abc import Callable
 from pathlib import Path
@@ -40,7 +41,7 @@ from gearchaos.dynamics.point import analyse_point
 from gearchaos.integrate import integrate, integrate_batch
 from gearchaos.integrate.settings import SolverSettings
 from gearchaos.model.target import parameter_names
-from gearchaos.paper.galleries import GALLERY_KEYWORDS, MAX_GALLERY_VALUES, run_gallery
+from gearchaos.paper.galleries import MAX_GALLERY_VALUES, run_gallery
 from gearchaos.sweep import SweepResult, SweepSpec, classify_store
 
 BASE = gc.preset("hindawi2021")
@@ -154,7 +155,8 @@ def _build(**kw: Any) -> Any:
 
 
 #: The arguments of run_gallery that _gallery passes by name.
-_GALLERY_ARGS = ("gs", "param", "values")
+#: every keyword run_gallery names in its signature
+_GALLERY_KEYWORDS = tuple(inspect.signature(run_gallery).parameters)
 
 
 def _gallery(**kw: Any) -> Any:
@@ -435,7 +437,7 @@ ROWS = [
         "run_gallery",
         "<unknown option>",
         lambda v: _gallery(**{v: 1}),
-        UNKNOWN_OPTION.filter(lambda v: v not in {*_OPTIONS, *GALLERY_KEYWORDS, *_GALLERY_ARGS}),
+        UNKNOWN_OPTION.filter(lambda v: v not in {*_OPTIONS, *_GALLERY_KEYWORDS}),
         "unknown",
     ),
     # files and stores

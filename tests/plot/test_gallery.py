@@ -135,7 +135,8 @@ def test_runner_speaks_the_front_doors_vocabulary() -> None:
     """Parameters by name or in params=, settings= and settings by name (issue 25); an unknown
     name is refused with the closest valid one, as by the sweeps; the old fixed= warns."""
     gs = gc.preset("hindawi2021")
-    with pytest.raises(ParameterError, match="unknown gallery option 'rtoll'; did you mean 'rtol'"):
+    wrong = "unknown run_gallery option 'rtoll'; did you mean 'rtol'"
+    with pytest.raises(ParameterError, match=wrong):
         run_gallery(gs, "xi", [0.05], omega=1.5, rtoll=1e-6, progress=False)
     with pytest.raises(ParameterError, match="'omgea'; did you mean 'omega'") as info:
         run_gallery(gs, "xi", [0.05], omgea=1.5, progress=False)

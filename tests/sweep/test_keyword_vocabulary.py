@@ -198,3 +198,30 @@ def test_attractors_take_settings_and_params() -> None:
     assert len(by_name) == len(new)
     for a, b in zip(by_name, new, strict=True):
         assert a.sections.tobytes() == b.sections.tobytes()
+
+
+UNKNOWN_NAMES = [
+    ("simulate", lambda gs: gc.simulate(gs, omega=1.5, rtoll=1e-9), "rtoll", "rtol"),
+    ("periodic_orbit", lambda gs: gc.periodic_orbit(gs, omega=1.5, perod=2), "perod", "period"),
+    ("continuation", lambda gs: gc.continuation(gs, "omega=1:2", cascde=1), "cascde", "cascade"),
+    ("attractors", lambda gs: gc.attractors(gs, omega=1.5, strats=4), "strats", "starts"),
+    (
+        "lyapunov_spectrum",
+        lambda gs: gc.lyapunov_spectrum(gs, omega=1.5, n_exponent=2),
+        "n_exponent",
+        "n_exponents",
+    ),
+    ("simulate", lambda gs: gc.simulate(gs, omega=1.5, xii=0.05), "xii", "xi"),
+]
+
+
+@pytest.mark.parametrize(("door", "call", "wrong", "meant"), UNKNOWN_NAMES)
+def test_a_misspelt_keyword_is_refused_naming_the_closest(door, call, wrong, meant) -> None:
+    """A keyword that is neither a setting, a parameter nor one of the door's own keywords is
+    refused before anything runs, naming the door and the closest of the three (the door's
+    keywords read from its signature: `period` for periodic_orbit, not the setting `periods`)."""
+    with pytest.raises(gc.ParameterError) as info:
+        call(gc.preset("sheng2016"))
+    text = str(info.value)
+    assert f"unknown {door} option {wrong!r}; did you mean {meant!r}?" in text
+    assert info.value.name == wrong

@@ -427,7 +427,9 @@ def continuation(
     check_bool("overwrite", overwrite)
     check_bool("cascade_every", cascade_every)
     child_range = check_cascade(cascade, cascade_range, max_branches, store, a, b)
-    values, cfg = split_keywords(values_and_settings, settings, params, ORBIT_SETTINGS)
+    values, cfg = split_keywords(
+        values_and_settings, settings, params, ORBIT_SETTINGS, door=continuation, target=target
+    )
     if name in values:
         raise ParameterError(f"{name} is varied and cannot also be fixed")
     lo, hi = min(a, b), max(a, b)

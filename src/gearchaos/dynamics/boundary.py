@@ -130,7 +130,9 @@ def boundary_curve(
     check_bool("overwrite", overwrite)
     if store is not None and not (resume and os.path.exists(os.fspath(store))):
         check_store(store, overwrite)
-    values, cfg = split_keywords(values_and_settings, settings, params, ORBIT_SETTINGS)
+    values, cfg = split_keywords(
+        values_and_settings, settings, params, ORBIT_SETTINGS, door=boundary_curve, target=target
+    )
     fixed = {**event.values, **values}
     fixed.pop(name1, None)
     lam2 = float(fixed.pop(name2)) if name2 in fixed else parameter_value(target, name2)

@@ -247,7 +247,9 @@ def attractors(
     check_int("seed", seed, lo=0)
     check_real("tol", tol, lo=0.0, lo_open=True)
     check_real("spread_fraction", spread_fraction, lo=0.0, hi=1.0, lo_open=True)
-    values, cfg = split_keywords(values_and_settings, settings, params, ATTRACTOR_SETTINGS)
+    values, cfg = split_keywords(
+        values_and_settings, settings, params, ATTRACTOR_SETTINGS, door=attractors, target=target
+    )
     cfg = cfg.replace(samples_per_period=1)
     system = resolve(target, values)
     if initial_states is None:

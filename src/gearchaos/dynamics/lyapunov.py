@@ -172,7 +172,10 @@ def lyapunov_spectrum(
         When the state does not move over the recorded window (an equilibrium): the exponents
         are then those of the equilibrium, not of an attractor.
     """
-    values, cfg = split_keywords(values_and_settings, settings, params, LYAPUNOV_SETTINGS)
+    values, cfg = split_keywords(
+        values_and_settings, settings, params, LYAPUNOV_SETTINGS, door=lyapunov_spectrum,
+        target=system,
+    )  # fmt: skip
     if not isinstance(system, System | GearSet):
         raise ParameterError(
             f"system must be a System or a GearSet (with omega=): got {type(system).__name__}"

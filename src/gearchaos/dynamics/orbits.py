@@ -431,7 +431,9 @@ def periodic_orbit(
     eccentricity errors are not T-periodic (a warning says so).
     """
     n = check_int("period", period, lo=1, hi=10_000)
-    values, cfg = split_keywords(values_and_settings, settings, params, ORBIT_SETTINGS)
+    values, cfg = split_keywords(
+        values_and_settings, settings, params, ORBIT_SETTINGS, door=periodic_orbit, target=target
+    )
     system = resolve(target, values)
     gs = getattr(system.model, "gearset", None)
     if gs is not None and gs.has_eccentricity:

@@ -13,7 +13,7 @@ import dataclasses
 import difflib
 import math
 import warnings
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -315,6 +315,9 @@ def split_keywords(
     settings: SolverSettings | None,
     params: Mapping[str, Any] | None,
     default: SolverSettings,
+    *,
+    door: Any = "",
+    target: Any = None,
 ) -> tuple[dict[str, Any], SolverSettings]:
     """The one keyword vocabulary of the front doors (``simulate``, ``bifurcation``,
     ``response``, ``periodic_orbit``, ``continuation``, ``attractors``,
@@ -324,10 +327,18 @@ def split_keywords(
     and parameters whose names are Python identifiers by name (``omega=1.5``, ``xi=0.05``).
 
     ``keywords`` are a door's remaining keyword arguments: setting fields and parameters by
-    name. Returns the parameter values by name and the settings."""
+    name. With ``target`` (the door's gear set or system) a keyword that is neither a setting
+    nor one of its parameters is refused as an option of ``door`` (the door function itself,
+    or its name), naming the closest of the door's own keywords, the settings and the
+    parameters (:func:`check_keyword`). Returns the parameter values by name and the
+    settings."""
     names = set(SolverSettings.field_names())
     changes = {k: v for k, v in keywords.items() if k in names}
     values = {k: v for k, v in keywords.items() if k not in names}
+    if target is not None and values:
+        name, options = _door(door)
+        for key in values:
+            check_keyword(name, target, key, {*names, *options})
     if params is not None and not isinstance(params, Mapping):
         raise ParameterError(
             f"params must be a mapping of names to values: got {params!r}", name="params"
@@ -337,6 +348,37 @@ def split_keywords(
             raise ParameterError(f"parameter {k!r} is given twice (keyword and params)", name=k)
         values[k] = v
     return values, SolverSettings.build(default if settings is None else settings, **changes)
+
+
+def _door(door: Any) -> tuple[str, list[str]]:
+    """The name of a front door and its named keywords (from its signature when ``door`` is
+    the function itself)."""
+    if not callable(door):
+        return str(door), []
+    import inspect
+
+    kinds = (inspect.Parameter.KEYWORD_ONLY, inspect.Parameter.POSITIONAL_OR_KEYWORD)
+    params = inspect.signature(door).parameters.values()
+    return door.__name__, [p.name for p in params if p.kind in kinds]
+
+
+def check_keyword(door: str, target: Any, key: str, options: Iterable[str]) -> None:
+    """Refuse ``key``, given to ``door`` by name, unless it is a parameter of ``target``: the
+    refusal names the closest of ``options`` (the door's other keywords) and the target's
+    parameters whose names are Python identifiers."""
+    from ..model.target import parameter_names  # the model layer, below this one
+
+    names = parameter_names(target)
+    if key in names:
+        return
+    valid = sorted({*options, *(n for n in names if n.isidentifier())})
+    close = difflib.get_close_matches(key, valid, n=1)
+    hint = f"; did you mean {close[0]!r}?" if close else ""
+    raise ParameterError(
+        f"unknown {door} option {key!r}{hint} (a parameter whose name is not a Python "
+        "identifier goes in params={name: value})",
+        name=key,
+    )
 
 
 def renamed_keyword(door: str, old: str, new: str, value: Any, current: Any = None) -> Any:

@@ -182,7 +182,9 @@ def simulate(
         Samples, extrema, status and step statistics; ``.to_dataset()`` gives an
         :class:`xarray.Dataset` with units and the full gear set in its attributes.
     """
-    values, cfg = split_keywords(values_and_settings, settings, params, _DEFAULT)
+    values, cfg = split_keywords(
+        values_and_settings, settings, params, _DEFAULT, door=simulate, target=system_or_gearset
+    )
     raise_on_failure = check_bool("check", check)
     system = resolve(system_or_gearset, values)
     return run_simulation(system, cfg, y0=y0, check=raise_on_failure)

@@ -43,7 +43,7 @@ from .._output import staged_file, write_file
 from ..errors import ParameterError
 from ..gearset.schema import display_symbol, tex
 from ..integrate.settings import SolverSettings, renamed_keyword, split_keywords
-from ..sweep.spec import check_keyword, check_params
+from ..sweep.spec import check_params
 from .recipes import load_figures, lookup_figure
 
 __all__ = [
@@ -65,9 +65,6 @@ FULL_PERIODS = (100, 500)
 GALLERY_SETTINGS = SolverSettings(transient_periods=100, periods=300)
 #: (transient, recorded) mesh periods of ``quick`` galleries (the 0–1 test needs ≥ 100 points).
 QUICK_PERIODS = (50, 100)
-#: The keywords of :func:`run_gallery` besides parameters and settings by name: the closest of
-#: them is suggested for an unknown name.
-GALLERY_KEYWORDS = ("params", "settings", "with_", "progress", "planet", "title")
 #: Keys of every row of :func:`run_gallery` (and columns of the recipes' CSV), in order.
 ROW_KEYS = (
     "value",
@@ -188,11 +185,9 @@ def run_gallery(
         params = renamed_keyword(
             "run_gallery", "fixed", "params", check_params("fixed", fixed), params
         )
-    setting_names = SolverSettings.field_names()
-    for key in values_and_settings:
-        if key not in setting_names:
-            check_keyword("gallery", gs, key, (*setting_names, *GALLERY_KEYWORDS))
-    fixed_values, base = split_keywords(values_and_settings, settings, params, GALLERY_SETTINGS)
+    fixed_values, base = split_keywords(
+        values_and_settings, settings, params, GALLERY_SETTINGS, door=run_gallery, target=gs
+    )
     settings = base.replace(samples_per_period=64 if extras else 1)
     if not isinstance(param, str):
         raise ParameterError(f"param must be a dotted parameter name: got {param!r}")

@@ -24,7 +24,7 @@ from __future__ import annotations
 import difflib
 import math
 import numbers
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, fields
 from typing import Any
 
@@ -32,7 +32,7 @@ import numpy as np
 
 from .._checks import check_bool, check_choice, check_int
 from ..errors import ParameterError, StoreError
-from ..integrate.settings import SolverSettings, renamed_keyword
+from ..integrate.settings import SolverSettings, check_keyword, renamed_keyword
 from ..model.target import OMEGA, check_omega
 from .execute import EXECUTION_OPTIONS
 
@@ -228,25 +228,6 @@ def check_params(keyword: str, params: Any) -> Any:
             name=keyword,
         )
     return params
-
-
-def check_keyword(door: str, target: Any, key: str, options: Iterable[str]) -> None:
-    """Refuse ``key``, given to ``door`` by name, unless it is a parameter of ``target``: the
-    refusal names the closest of ``options`` (the door's other keywords) and the target's
-    parameters whose names are Python identifiers."""
-    from ..model.target import parameter_names
-
-    names = parameter_names(target)
-    if key in names:
-        return
-    valid = sorted({*options, *(n for n in names if n.isidentifier())})
-    close = difflib.get_close_matches(key, valid, n=1)
-    hint = f"; did you mean {close[0]!r}?" if close else ""
-    raise ParameterError(
-        f"unknown {door} option {key!r}{hint} (a parameter whose name is not a Python "
-        "identifier goes in params={name: value})",
-        name=key,
-    )
 
 
 def sweep_keywords(
