@@ -212,6 +212,18 @@ UNKNOWN_NAMES = [
         "n_exponents",
     ),
     ("simulate", lambda gs: gc.simulate(gs, omega=1.5, xii=0.05), "xii", "xi"),
+    (
+        "basins",
+        lambda gs: gc.basins(gs, "x=-1:1:2", "x_dot=-1:1:2", omega=1.2, worker=2),
+        "worker",
+        "workers",
+    ),
+    (
+        "basin_fractions",
+        lambda gs: gc.basin_fractions(gs, "omega=1:1.2:2", strats=3),
+        "strats",
+        "starts",
+    ),
 ]
 
 

@@ -318,6 +318,7 @@ def split_keywords(
     *,
     door: Any = "",
     target: Any = None,
+    options: Iterable[str] = (),
 ) -> tuple[dict[str, Any], SolverSettings]:
     """The one keyword vocabulary of the front doors (``simulate``, ``bifurcation``,
     ``response``, ``periodic_orbit``, ``continuation``, ``attractors``,
@@ -329,16 +330,16 @@ def split_keywords(
     ``keywords`` are a door's remaining keyword arguments: setting fields and parameters by
     name. With ``target`` (the door's gear set or system) a keyword that is neither a setting
     nor one of its parameters is refused as an option of ``door`` (the door function itself,
-    or its name), naming the closest of the door's own keywords, the settings and the
-    parameters (:func:`check_keyword`). Returns the parameter values by name and the
-    settings."""
+    or its name), naming the closest of the door's own keywords (and ``options``, those it
+    takes through ``**``), the settings and the parameters (:func:`check_keyword`). Returns
+    the parameter values by name and the settings."""
     names = set(SolverSettings.field_names())
     changes = {k: v for k, v in keywords.items() if k in names}
     values = {k: v for k, v in keywords.items() if k not in names}
     if target is not None and values:
-        name, options = _door(door)
+        name, own = _door(door)
         for key in values:
-            check_keyword(name, target, key, {*names, *options})
+            check_keyword(name, target, key, {*names, *own, *options})
     if params is not None and not isinstance(params, Mapping):
         raise ParameterError(
             f"params must be a mapping of names to values: got {params!r}", name="params"

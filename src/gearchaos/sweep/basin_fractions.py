@@ -118,7 +118,7 @@ def basin_fractions(
         Wilson interval at ``confidence``.
     """
     kw = dict(values_and_settings)
-    values, cfg, where = _split(kw, settings, params)
+    values, cfg, where = _split(kw, settings, params, basin_fractions, target)
     ax = parse_axis(vary)
     if ax.name in values:
         raise ParameterError(f"{ax.name} is both varied and fixed; choose one")

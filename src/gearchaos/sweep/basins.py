@@ -373,10 +373,18 @@ def _state_axis(system: Any, item: Any, which: str) -> Axis:
 
 
 def _split(
-    kwargs: dict[str, Any], settings: Any, params: Any
+    kwargs: dict[str, Any], settings: Any, params: Any, door: Any, target: Any
 ) -> tuple[dict[str, Any], SolverSettings, Execution]:
     where = Execution(**{k: kwargs.pop(k) for k in EXECUTION_OPTIONS if k in kwargs})
-    values, cfg = split_keywords(kwargs, settings, params, BASIN_SETTINGS)
+    values, cfg = split_keywords(
+        kwargs,
+        settings,
+        params,
+        BASIN_SETTINGS,
+        door=door,
+        target=target,
+        options=EXECUTION_OPTIONS,
+    )
     return values, cfg.replace(samples_per_period=1), where
 
 
@@ -442,7 +450,7 @@ def basins(
         the model or gear set, ``basin_spec``, the settings and versions.
     """
     kw = dict(values_and_settings)
-    values, cfg, where = _split(kw, settings, params)
+    values, cfg, where = _split(kw, settings, params, basins, target)
     system = resolve(target, values)
     ax, ay = _state_axis(system, x, "x"), _state_axis(system, y, "y")
     if ax.name == ay.name:
