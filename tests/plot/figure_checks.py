@@ -44,24 +44,19 @@ def assert_legends_clear_of_titles(fig: Any) -> None:
             assert not overlap(box, title.get_window_extent()), (title.get_text(), box)
 
 
-def segments_crossing(box: Any, xy: np.ndarray) -> int:
-    """How many segments of the display polyline ``xy`` (n × 2; NaN breaks it) enter ``box``
-    (Liang–Barsky clipping of every segment)."""
-    p, q = xy[:-1], xy[1:]
-    ok = np.all(np.isfinite(p), axis=1) & np.all(np.isfinite(q), axis=1)
-    p, q = p[ok], q[ok]
-    d = q - p
-    t0, t1 = np.zeros(len(p)), np.ones(len(p))
-    inside = np.ones(len(p), dtype=bool)
-    for k, lo, hi in ((0, box.x0, box.x1), (1, box.y0, box.y1)):
-        for pk, qk in ((-d[:, k], p[:, k] - lo), (d[:, k], hi - p[:, k])):
-            parallel = pk == 0
-            inside &= ~(parallel & (qk < 0))
-            with np.errstate(divide="ignore", invalid="ignore"):
-                r = qk / pk
-            t0 = np.where(~parallel & (pk < 0), np.maximum(t0, r), t0)
-            t1 = np.where(~parallel & (pk > 0), np.minimum(t1, r), t1)
-    return int(np.sum(inside & (t0 <= t1)))
+def curve_enters(box: Any, xy: np.ndarray) -> bool:
+    """Whether the display polyline ``xy`` (n × 2; NaN breaks it) enters ``box``: matplotlib's
+    own path–rectangle test, independent of the label placement it checks."""
+    from matplotlib.path import Path
+
+    xy = np.asarray(xy, dtype=float)
+    finite = np.all(np.isfinite(xy), axis=1)
+    cuts = np.flatnonzero(~finite)
+    for run in np.split(xy, cuts):
+        run = run[np.all(np.isfinite(run), axis=1)]
+        if len(run) >= 2 and Path(run).intersects_bbox(box, filled=False):
+            return True
+    return False
 
 
 def steep_branch(branch: Any, var: str, omega: tuple[float, float], low: float, high: float,
@@ -104,8 +99,8 @@ def labels_on_curves(fig: Any, prefix: str) -> list[str]:
             if text.get_text() not in EVENT_SHORT_NAMES:
                 continue
             box = text.get_window_extent()
-            crossed = sum(
-                segments_crossing(box, ln.get_transform().transform(np.asarray(ln.get_xydata())))
+            crossed = any(
+                curve_enters(box, ln.get_transform().transform(np.asarray(ln.get_xydata())))
                 for ln in ax.lines
                 if str(ln.get_gid()).startswith(prefix) and ln.get_linestyle() != "None"
             )
