@@ -42,8 +42,10 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 HOWTO = ROOT / "docs" / "howto"
 sys.path.insert(0, str(ROOT / "tests" / "docs"))
+sys.path.insert(0, str(ROOT / "tests" / "explore"))
 sys.path.insert(0, str(ROOT / "docs"))
 
+from bokeh_page import PIXEL_OF  # noqa: E402
 from make_tutorial_figures import shrink  # noqa: E402
 from tutorial_blocks import blocks  # noqa: E402
 
@@ -208,7 +210,7 @@ def screenshot(command: str, target: Path, work: Path, env: dict[str, str]) -> N
             page.set_default_timeout(300_000)
             page.goto(url)
             page.wait_for_function(_PIXEL_READY, arg=["diagram-figure", omega, y])
-            xy = page.evaluate(_PIXEL_OF, ["diagram-figure", omega, y])
+            xy = page.evaluate(PIXEL_OF, ["diagram-figure", omega, y])
             page.mouse.click(*xy)
             page.get_by_text(f"computed at omega = {omega:.6g}").wait_for()
             page.locator("img").first.wait_for()
@@ -237,23 +239,9 @@ def _url(proc: subprocess.Popen[str], timeout: float = 300) -> str:
     raise RuntimeError("gearchaos explore printed no address")
 
 
-#: The page position of data coordinates (x, y) of a named Bokeh figure (null until laid out).
-_PIXEL_OF = """([name, x, y]) => {
-  const model = Bokeh.documents[0].get_model_by_name(name);
-  function find(v) {
-    if (v.model === model) return v;
-    for (const c of (v.child_views ?? [])) { const r = find(c); if (r) return r; }
-    return null;
-  }
-  let view = null;
-  for (const root of Object.values(Bokeh.index)) { view = find(root); if (view) break; }
-  if (view === null) return null;
-  const box = view.canvas_view.el.getBoundingClientRect();
-  return [box.left + view.frame.x_scale.compute(x), box.top + view.frame.y_scale.compute(y)];
-}"""
 _PIXEL_READY = (
     "(args) => window.Bokeh && Bokeh.documents.length > 0 && "
-    f"Bokeh.documents[0].get_model_by_name(args[0]) !== null && ({_PIXEL_OF})(args) !== null"
+    f"Bokeh.documents[0].get_model_by_name(args[0]) !== null && ({PIXEL_OF})(args) !== null"
 )
 
 

@@ -25,6 +25,7 @@ from urllib.parse import urlparse
 import numpy as np
 import pytest
 import xarray as xr
+from bokeh_page import PIXEL_OF
 
 CHROMIUM = next(
     (
@@ -57,20 +58,6 @@ LOAD_MS = 120_000
 CLICK_MS = 120_000  # generous: the machine may be shared with other test workers
 COMPUTE_MS = 300_000
 
-#: The page position of data coordinates (x, y) of a named Bokeh figure.
-PIXEL_OF = """([name, x, y]) => {
-  const model = Bokeh.documents[0].get_model_by_name(name);
-  function find(v) {
-    if (v.model === model) return v;
-    for (const c of (v.child_views ?? [])) { const r = find(c); if (r) return r; }
-    return null;
-  }
-  let view = null;
-  for (const root of Object.values(Bokeh.index)) { view = find(root); if (view) break; }
-  if (view === null) return null;
-  const box = view.canvas_view.el.getBoundingClientRect();
-  return [box.left + view.frame.x_scale.compute(x), box.top + view.frame.y_scale.compute(y)];
-}"""
 MODEL = "([name, attr]) => Bokeh.documents[0].get_model_by_name(name)[attr]"
 SECTION_SIZE = "() => Bokeh.documents[0].get_model_by_name('poincare-source').data.x.length"
 TITLE = "() => Bokeh.documents[0].get_model_by_name('poincare-figure').title.text"
