@@ -32,7 +32,7 @@ def test_basin_image_names_parameters_and_states_by_symbols(twin_well) -> None:
     title, legend, xlabel, ylabel = texts(basins_figure(ds))
     first, second = title.splitlines()
     assert first.startswith(r"duffing: basins of attraction at $\Omega$ = 1 (36 starts")
-    assert second == r"$\delta$ = 0.3, $\alpha$ = -1, $\beta$ = 1, $\gamma$ = 0.1"
+    assert second == r"$\delta$ = 0.3, $\alpha$ = −1, $\beta$ = 1, $\gamma$ = 0.1"
     assert (xlabel, ylabel) == ("$x$", "$x'$")
     assert legend and all(t.startswith("1T ($x$ ≈ ") for t in legend)
     for text in (title, *legend):
@@ -45,12 +45,12 @@ def test_basin_fractions_name_parameters_and_states_by_symbols(twin_well) -> Non
     title, legend, xlabel, _ = texts(basins_figure(ds))
     assert title.splitlines() == [
         "duffing: basin fractions",
-        r"$\delta$ = 0.3, $\alpha$ = -1, $\beta$ = 1, $\gamma$ = 0.1",
+        r"$\delta$ = 0.3, $\alpha$ = −1, $\beta$ = 1, $\gamma$ = 0.1",  # a true minus
     ]
     assert xlabel == r"$\Omega = \omega/\omega_n$"
     attractors = [t for t in legend if t != "failed"]
     assert attractors and all(
-        re.fullmatch(r"1T \(\$x\$ ≈ -?[0-9.]+ at \$\\Omega\$ = 0\.9\)", t) for t in attractors
+        re.fullmatch(r"1T \(\$x\$ ≈ −?[0-9.]+ at \$\\Omega\$ = 0\.9\)", t) for t in attractors
     ), attractors
     for text in (title, *legend):
         assert not RAW.search(text), text

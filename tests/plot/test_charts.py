@@ -21,6 +21,7 @@ from matplotlib.colors import to_rgba
 
 import gearchaos as gc
 from gearchaos.plot.amplitude import amplitude_figure
+from gearchaos.plot.branch import branch_figure
 from gearchaos.plot.impact import IMPACT_COLOURS, IMPACT_GID, impact_figure, impact_map
 
 TIGHT = {"rtol": 1e-10, "atol": 1e-12}
@@ -79,6 +80,33 @@ def test_impact_figure_has_physical_axes_and_refuses_unknown_meshes(impact_store
         impact_figure(impact_store, mesh="sun_ring")
     with pytest.raises(gc.ParameterError, match="planet must be one of"):
         impact_map(impact_store, planet=9)
+
+
+def _physical_labels(fig) -> list[str]:
+    """The labels of the secondary (physical) axes of a figure's first panel."""
+    ax = fig.axes[0]
+    return sorted(t for c in ax.child_axes for t in (c.get_xlabel(), c.get_ylabel()) if t)
+
+
+def test_regime_map_has_the_physical_axes_of_the_impact_map(impact_store) -> None:
+    """The 2-D regime map (``gearchaos plot MAP.zarr``) has the physical axes of the impact
+    map and the stability chart over the same store (one helper): the sun speed in rpm
+    opposite Ω, µm opposite b̄_sp; the distinct-point map too."""
+    from gearchaos.plot.maps import sweep_figure
+
+    fig = sweep_figure(impact_store)
+    regime = _physical_labels(fig)
+    assert regime == _physical_labels(impact_figure(impact_store))
+    assert regime == ["$b_{sp}$ [µm]", "sun speed [rpm]"]
+    assert _physical_labels(sweep_figure(impact_store, regimes=False)) == regime
+    fig.draw_without_rendering()  # secondary axes take their limits when drawn
+    ax = fig.axes[0]
+    (top,) = [c for c in ax.child_axes if c.get_xlabel()]
+    (right,) = [c for c in ax.child_axes if c.get_ylabel()]
+    gs = gc.preset("sheng2016")
+    np.testing.assert_allclose(top.get_xlim(), np.multiply(ax.get_xlim(), gs.sun_speed_rpm(1.0)))
+    um = gs.clearance.characteristic_length * 1e6
+    np.testing.assert_allclose(right.get_ylim(), np.multiply(ax.get_ylim(), um))
 
 
 @pytest.fixture(scope="module")
@@ -199,10 +227,14 @@ def test_amplitude_figure_is_titled_by_the_shared_helper(oscillator_response) ->
     _, res, branch = oscillator_response
     title = amplitude_figure(res, [branch]).get_suptitle().splitlines()
     assert title[0] == "backlash_oscillator: amplitude–frequency curves"
-    assert title[1] == "100 transient + 50 recorded periods, continuation initial conditions"
-    assert title[2] == "continued branches (rtol 1e-10) beside the brute-force sweeps"
+    # a reference system's parameters, as the branch figure writes them (one helper)
+    given = r"at $\zeta$ = 0.05, $\varepsilon$ = 0, $b$ = 1, $F_m$ = 0.1, $F_a$ = 0.1"
+    assert title[1] == given
+    assert title[2] == "100 transient + 50 recorded periods, continuation initial conditions"
+    assert title[3] == "continued branches (rtol 1e−10) beside the brute-force sweeps"
+    assert branch_figure([branch]).get_suptitle().splitlines()[1] == given
     force = amplitude_figure(res, [branch], quantity="force_peak").get_suptitle()
-    assert force.startswith("backlash_oscillator: peak contact force curves\n")
+    assert force.startswith(f"backlash_oscillator: peak contact force curves\n{given}\n")
     geared = res.copy()
     geared.attrs["gearset_toml"] = to_toml(gc.preset("sheng2016"))
     title = amplitude_figure(geared, [branch]).get_suptitle().splitlines()

@@ -7,6 +7,8 @@ cells), is at most one cell.
 
 from __future__ import annotations
 
+import json
+
 import matplotlib
 
 matplotlib.use("Agg")
@@ -72,7 +74,7 @@ def test_boundary_is_drawn_where_the_map_changes_colour(chart_data) -> None:
 def test_legend_names_each_boundary_and_physical_axes(chart_data, tmp_path) -> None:
     sweep, curve = chart_data
     fig = stability_figure([curve], sweep)
-    assert fig.get_suptitle() == "backlash_oscillator: stability chart"  # as the diagram's
+    assert fig.get_suptitle().splitlines()[0] == "backlash_oscillator: stability chart"
     ax = fig.axes[0]
     texts = [t.get_text() for t in ax.get_legend().get_texts()]
     assert "period doubling" in texts and "1T" in texts and "2T" in texts
@@ -89,6 +91,23 @@ def test_legend_names_each_boundary_and_physical_axes(chart_data, tmp_path) -> N
     assert boundary_label(grazing) == "grazing: sun–planet contact loss"
     grazing.attrs.update(contact="planet_ring_2:back")
     assert boundary_label(grazing) == "grazing: planet–ring contact loss (back flank)"
+
+
+def test_title_writes_the_fixed_values_as_symbols(chart_data) -> None:
+    """The values the curves hold fixed are written as the other figures write them (the
+    shared helper: symbol = value, a true minus), not as the file's JSON ("fixed {…}")."""
+    sweep, curve = chart_data
+    title = stability_figure([curve], sweep).get_suptitle().splitlines()
+    # the model's parameters but the two of the chart (Ω, ε), as the diagrams' titles
+    assert title == [
+        "backlash_oscillator: stability chart",
+        r"at $\zeta$ = 0.05, $b$ = 1, $F_m$ = 0.1, $F_a$ = 0.1",
+    ]
+    other = curve.copy()
+    other.attrs["fixed"] = json.dumps({"f_mean": -0.05, "zeta": 0.07})
+    title = stability_figure([other]).get_suptitle().splitlines()
+    assert title[1] == r"at $F_m$ = −0.05, $\zeta$ = 0.07, $b$ = 1, $F_a$ = 0.1"
+    assert not any(c in "\n".join(title) for c in '{}"')
 
 
 def test_chart_refuses_a_map_of_other_parameters(chart_data) -> None:

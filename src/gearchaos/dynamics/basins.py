@@ -35,7 +35,7 @@ fractions across a parameter): same label and nearest section set, within ``link
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -105,19 +105,25 @@ class BasinAttractor:
     evidence: str
     section_states: np.ndarray
 
-    def legend(self, name: str | None = None, column: int = 0) -> str:
+    def legend(
+        self,
+        name: str | None = None,
+        column: int = 0,
+        number: Callable[[float, str], str] = format,
+    ) -> str:
         """``1T (x ≈ 0.962, |μ| 0.91)`` or ``chaos (λ₁ 0.071)``: the label with the evidence
         (max |μ| of an orbit, else λ₁) and, given a state ``name`` and its ``column``, where
-        the attractor lies (its first section point, or the middle of its set)."""
+        the attractor lies (its first section point, or the middle of its set). ``number``
+        writes a value with a format spec (figures pass theirs, which writes a true minus)."""
         parts = []
         if name is not None:
             x = self.section_states[:, column]
             where = x[0] if self.period else 0.5 * (np.min(x) + np.max(x))
-            parts.append(f"{name} ≈ {where:.3g}")
+            parts.append(f"{name} ≈ {number(float(where), '.3g')}")
         if self.period and math.isfinite(self.max_multiplier):
-            parts.append(f"|μ| {self.max_multiplier:.2f}")
+            parts.append(f"|μ| {number(float(self.max_multiplier), '.2f')}")
         elif math.isfinite(self.lle):
-            parts.append(f"λ₁ {self.lle:.2g}")
+            parts.append(f"λ₁ {number(float(self.lle), '.2g')}")
         return f"{self.label} ({', '.join(parts)})" if parts else self.label
 
     def to_record(self) -> dict[str, Any]:

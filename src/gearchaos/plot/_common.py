@@ -3,7 +3,9 @@ variables of results, axes, cell edges, clearance and resonance lines."""
 
 from __future__ import annotations
 
+import json
 import math
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -80,14 +82,75 @@ def subject(attrs: Any, gearset: Any = None) -> str:
     (``sheng2016``; ``gearset``, else the one of the attribute ``gearset_toml``), else the
     model's (``backlash_oscillator``) — not the record's ``planetary[sheng2016]``."""
     if gearset is None:
-        text = str(attrs.get("gearset_toml", "") or "")
-        if text:
-            from ..gearset.io import from_toml_string
-
-            gearset = from_toml_string(text)
+        gearset = stored_gearset(attrs)
     if gearset is not None:
         return str(gearset.name)
     return str(attrs.get("model", "") or "")
+
+
+def stored_gearset(attrs: Any) -> Any:
+    """The gear set a store, branch or curve file records (attribute ``gearset_toml``), or
+    ``None`` (a reference system)."""
+    text = str(attrs.get("gearset_toml", "") or "")
+    if not text:
+        return None
+    from ..gearset.io import from_toml_string
+
+    return from_toml_string(text)
+
+
+def stored_fixed(attrs: Any) -> dict[str, Any]:
+    """The fixed values a branch or curve file records (attribute ``fixed``, JSON); ``{}``
+    when it has none or they cannot be read."""
+    raw = attrs.get("fixed", "{}")
+    try:
+        data = json.loads(raw) if isinstance(raw, str) else dict(raw)
+    except (TypeError, ValueError):
+        return {}
+    return data if isinstance(data, dict) else {}
+
+
+_DAMPING = frozenset({"xi", "damping.sun_planet", "damping.planet_ring", "damping.sun_bearing"})
+
+
+def given_values(
+    attrs: Any,
+    *,
+    fixed: Mapping[str, Any],
+    gearset: Any = None,
+    leave_out: Any = (),
+) -> list[str]:
+    """``symbol = value`` of what a figure holds fixed, for its title's ``at …`` line: the
+    numeric ``fixed`` values, then b̄_sp, b̄_rp, b̄_s and ξ of ``gearset`` (with the fixed
+    values applied) or, for a reference system, its parameters that have a symbol (from the
+    attribute ``model_parameters``, the model's repr); the names in ``leave_out`` (the swept
+    or continued parameters) are left out. One helper for the titles of sweeps, branches
+    and stability charts."""
+    shown = {str(n) for n in leave_out}
+    out: list[str] = []
+    for k, v in fixed.items():
+        if isinstance(v, int | float | np.number) and not isinstance(v, bool) and k not in shown:
+            out.append(given(k, v))
+            shown.add(k)
+    if gearset is None:  # a reference system: its parameters with a symbol
+        text = str(attrs.get("model_parameters", "") or "")
+        for k, v in re.findall(r"(\w+)=([-+0-9.eE]+)[,)]", text):
+            if k not in shown and axis_symbol(k) != k:
+                out.append(given(k, float(v)))
+                shown.add(k)
+        return out
+    bsp, brp = gearset.backlash_bar()
+    for key, value in (
+        ("backlash.sun_planet", bsp),
+        ("backlash.planet_ring", brp),
+        ("clearance.sun_bearing", gearset.sun_bearing_clearance_bar()),
+    ):
+        if key not in shown:
+            out.append(given(key, value))
+    d = gearset.damping
+    if not _DAMPING & shown and d.sun_planet == d.planet_ring == d.sun_bearing:
+        out.append(given("xi", d.sun_planet))
+    return out
 
 
 def model_symbols(attrs: Any) -> Mapping[str, Any]:
@@ -124,11 +187,12 @@ def var_symbol(var: str, planet: int | None, symbols: Mapping[str, Any] | None =
     return _generic_symbol(base) + prime
 
 
-def fmt(v: Any) -> str:
-    """A coordinate value for titles: strings as they are, numbers with ``%g``."""
+def fmt(v: Any, spec: str = "g") -> str:
+    """A value for figure text (titles, legends, notes): strings as they are, numbers with
+    ``spec`` (default ``%g``) and a true minus (U+2212), not a hyphen: ``−1``, ``1e−08``."""
     if isinstance(v, str):
         return v
-    return f"{float(v):g}"
+    return format(float(v), spec).replace("-", "\N{MINUS SIGN}")
 
 
 def edges(v: np.ndarray) -> np.ndarray:

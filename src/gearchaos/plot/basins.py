@@ -22,9 +22,9 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from ._common import axis_label, edges, get_ax, given, model_symbols, subject, var_symbol
+from ._common import axis_label, edges, fmt, get_ax, given, model_symbols, subject, var_symbol
 from .regimes import regime_colour
-from .units import PhysicalScales, linear_axis, var_quantity
+from .units import PhysicalScales, physical_axis, var_quantity
 
 __all__ = ["attractor_colours", "basin_image", "basins_figure", "fraction_curves"]
 
@@ -71,11 +71,7 @@ def _scales(attrs: Any) -> PhysicalScales:
 
 
 def _physical(ax: Any, axis: str, name: str, attrs: Any) -> None:
-    q = "omega" if name == "omega" else var_quantity(name)
-    found = None if q is None else _scales(attrs).factor(q)
-    if found is not None:
-        label = found[1] if q == "omega" else f"{_symbol(name, attrs)} {found[1]}"
-        linear_axis(ax, axis, found[0], label)
+    physical_axis(ax, axis, name, _scales(attrs), symbol=_symbol(name, attrs))
 
 
 def _catalogue(ds: Any, group: int = 0) -> list[dict[str, Any]]:
@@ -92,7 +88,7 @@ def _catalogue(ds: Any, group: int = 0) -> list[dict[str, Any]]:
 def _legend_text(e: dict[str, Any], name: str, column: int) -> str:
     from ..dynamics.basins import BasinAttractor
 
-    return BasinAttractor.from_record(e).legend(name, column)
+    return BasinAttractor.from_record(e).legend(name, column, fmt)
 
 
 def basin_image(ds: Any, ax: Any = None, *, points: bool = True) -> Any:
@@ -233,7 +229,7 @@ def _track_legend(fr: Any, j: int, state: str, param: str) -> str:
     first found."""
     where = float(fr["track_position"].values[j])
     at = given(param, float(fr["track_found_at"].values[j]))
-    return f"{fr['track_label'].values[j]} ({state} ≈ {where:.3g} at {at})"
+    return f"{fr['track_label'].values[j]} ({state} ≈ {fmt(where, '.3g')} at {at})"
 
 
 def basins_figure(ds: Any) -> Any:

@@ -35,6 +35,7 @@ from ._common import (
     fmt,
     get_ax,
     given,
+    given_values,
     model_symbols,
     no_offset,
     resonance_lines,
@@ -362,36 +363,12 @@ def panel_grid(n: int) -> tuple[int, int]:
 
 
 def _given(res: SweepResult) -> list[str]:
-    """``symbol = value`` of the seed's figure captions: Ω and the fixed overrides, then b̄_sp,
-    b̄_rp, b̄_s and ξ of the (fixed-applied) gear set, leaving out the swept parameters."""
-    swept = set(res.swept_names)
-    out: list[str] = []
-    shown: set[str] = set()
-    for k, v in res.fixed.items():
-        if _is_number(v) and k not in swept:
-            out.append(given(k, v))
-            shown.add(k)
-    gs = res.gearset
-    if gs is None:
-        return out
-    bsp, brp = gs.backlash_bar()
-    for name, value in (
-        ("backlash.sun_planet", bsp),
-        ("backlash.planet_ring", brp),
-        ("clearance.sun_bearing", gs.sun_bearing_clearance_bar()),
-    ):
-        if name not in swept and name not in shown:
-            out.append(given(name, value))
-    d = gs.damping
-    damping_swept = swept & {
-        "xi",
-        "damping.sun_planet",
-        "damping.planet_ring",
-        "damping.sun_bearing",
-    }
-    if not damping_swept and "xi" not in shown and d.sun_planet == d.planet_ring == d.sun_bearing:
-        out.append(given("xi", d.sun_planet))
-    return out
+    """``symbol = value`` of the seed's figure captions (:func:`given_values`): Ω and the
+    fixed overrides, then b̄_sp, b̄_rp, b̄_s and ξ of the (fixed-applied) gear set or a reference
+    system's parameters, leaving out the swept parameters."""
+    return given_values(
+        res.ds.attrs, fixed=res.fixed, gearset=res.gearset, leave_out=res.swept_names
+    )
 
 
 def suptitle(ds: Any, what: str) -> str:
@@ -411,10 +388,6 @@ def suptitle(ds: Any, what: str) -> str:
             + (f", {ic} initial conditions" if ic else "")
         )
     return "\n".join(lines)
-
-
-def _is_number(v: Any) -> bool:
-    return isinstance(v, int | float | np.integer | np.floating) and not isinstance(v, bool)
 
 
 def bifurcation_figure(

@@ -14,7 +14,6 @@ grows with b̄ and the branch would otherwise be a line along the diagonal.
 
 from __future__ import annotations
 
-import json
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -28,9 +27,11 @@ from ._common import (
     axis_symbol,
     fmt,
     get_ax,
-    given,
+    given_values,
     model_symbols,
     resonance_lines,
+    stored_fixed,
+    stored_gearset,
     subject,
     var_symbol,
 )
@@ -77,25 +78,6 @@ EVENT_NAMES: dict[str, str] = {
 }
 
 
-def _fixed(branch: Any) -> dict[str, Any]:
-    raw = branch.attrs.get("fixed", "{}")
-    try:
-        data = json.loads(raw) if isinstance(raw, str) else dict(raw)
-    except (TypeError, ValueError):
-        return {}
-    return data if isinstance(data, dict) else {}
-
-
-def _gearset(branch: Any) -> Any:
-    """The gear set of a branch (at its start, with its fixed values), or ``None``."""
-    text = str(branch.attrs.get("gearset_toml", "") or "")
-    if not text:
-        return None
-    from ..gearset.io import from_toml_string
-
-    return from_toml_string(text)
-
-
 def branch_clearance(branch: Any, var: str) -> np.ndarray | None:
     """b̄ of the clearance acting on ``var`` at every point of ``branch`` — the continued
     value when the clearance itself is continued, else the gear set's (or the reference
@@ -106,7 +88,7 @@ def branch_clearance(branch: Any, var: str) -> np.ndarray | None:
     lam = np.asarray(branch[name].values, dtype=np.float64)
     if var in CLEARANCES:
         parameter, _, key = CLEARANCES[var]
-        gs = _gearset(branch)
+        gs = stored_gearset(branch.attrs)
         if gs is None:
             return None
         if name == parameter:
@@ -167,7 +149,7 @@ def branch_matches(branch: Any, x_name: str, select: Mapping[str, Any] | None) -
     branch fixes agrees (to 1e-9 relative)."""
     if str(branch.attrs.get("parameter")) != x_name:
         return False
-    fixed = _fixed(branch)
+    fixed = stored_fixed(branch.attrs)
     for name, value in (select or {}).items():
         if name in fixed and isinstance(value, int | float | np.number):
             if not np.isclose(float(fixed[name]), float(value), rtol=1e-9, atol=0.0):
@@ -317,36 +299,14 @@ def mark_event(ax: Any, kind: str, x: float, ys: Any, named: set[str], gid: str)
 
 
 def _given(branch: Any) -> list[str]:
-    """``symbol = value`` of the values the branch holds fixed: its fixed values, then b̄_sp,
-    b̄_rp, b̄_s and ξ of its gear set, leaving out the continued parameter."""
-    name = str(branch.attrs.get("parameter", ""))
-    out, shown = [], {name}
-    for k, v in _fixed(branch).items():
-        if isinstance(v, int | float) and not isinstance(v, bool) and k not in shown:
-            out.append(given(k, v))
-            shown.add(k)
-    gs = _gearset(branch)
-    if gs is None:  # a reference system: its parameters with a symbol, from its repr
-        import re
-
-        text = str(branch.attrs.get("model_parameters", ""))
-        for k, v in re.findall(r"(\w+)=([-+0-9.eE]+)[,)]", text):
-            if k not in shown and axis_symbol(k) != k:
-                out.append(given(k, float(v)))
-        return out
-    bsp, brp = gs.backlash_bar()
-    for key, value in (
-        ("backlash.sun_planet", bsp),
-        ("backlash.planet_ring", brp),
-        ("clearance.sun_bearing", gs.sun_bearing_clearance_bar()),
-    ):
-        if key not in shown:
-            out.append(given(key, value))
-    d = gs.damping
-    damping = {"xi", "damping.sun_planet", "damping.planet_ring", "damping.sun_bearing"}
-    if not damping & shown and d.sun_planet == d.planet_ring == d.sun_bearing:
-        out.append(given("xi", d.sun_planet))
-    return out
+    """``symbol = value`` of the values the branch holds fixed (:func:`given_values`), leaving
+    out the continued parameter."""
+    return given_values(
+        branch.attrs,
+        fixed=stored_fixed(branch.attrs),
+        gearset=stored_gearset(branch.attrs),
+        leave_out=(str(branch.attrs.get("parameter", "")),),
+    )
 
 
 def branch_figure(
@@ -435,7 +395,7 @@ def branch_figure(
                 if b is not None:
                     x = np.asarray(br[name].values, dtype=float)
                     ax.plot(x, -2.0 * b, color="0.35", ls=":", lw=0.9, zorder=1, gid="clearance")
-    gs = _gearset(branches[0])
+    gs = stored_gearset(branches[0].attrs)
     if resonances and name == "omega":
         resonance_lines(ax, gs, *ax.get_xlim())
     ax.set_xlabel(axis_label(name))
@@ -463,7 +423,7 @@ def _padded(v: np.ndarray) -> tuple[float, float]:
 
 def _title(branches: list[Any], var: str, planet: int) -> str:
     first = branches[0]
-    model = subject(first.attrs, _gearset(first))
+    model = subject(first.attrs, stored_gearset(first.attrs))
     periods = sorted({int(br.attrs.get("period", 1)) for br in branches})
     what = (
         f"continued period-{periods[0]} orbit"
@@ -484,7 +444,7 @@ def _title(branches: list[Any], var: str, planet: int) -> str:
     ]
     solver = f"shooting + pseudo-arclength continuation, rtol {fmt(rtol)}" if rtol else ""
     if u:
-        solver += f"; events located to ±{max(u):.0e} or better"
+        solver += f"; events located to ±{fmt(max(u), '.0e')} or better"
     if solver:
         lines.append(solver)
     return "\n".join(lines)

@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from ._common import axis_symbol, message, period_name, variable
+from ._common import axis_symbol, fmt, message, period_name, variable
 from .phase import phase_portrait, poincare_map
 from .regimes import regime_colour, regime_legend_below
 from .timeseries import spectrum
@@ -30,23 +30,19 @@ __all__ = ["GALLERY_EXTRAS", "gallery_title", "parse_extras", "poincare_gallery"
 GALLERY_EXTRAS = ("phase", "spectrum")
 
 
-def _minus(text: str) -> str:
-    return text.replace("-", "−")
-
-
 def gallery_title(param: str, value: float, summary: dict[str, Any] | None) -> str:
     """Panel title ``Ω = 1.875 · 2T · λ₁ = −0.012`` (mathtext symbols; the LLE only when
     the summary has one, with its standard error when the verdict estimated it —
     ``λ₁ = 0.065 ± 0.005`` —, ``failed`` for a failed integration)."""
-    parts = [f"{axis_symbol(param)} = {_minus(f'{float(value):g}')}"]
+    parts = [f"{axis_symbol(param)} = {fmt(value)}"]
     if summary is not None:
         parts.append(str(summary.get("motion", "?")))
         lle = summary.get("lle")
         if lle is not None and math.isfinite(float(lle)):
-            text = rf"$\lambda_1$ = {_minus(f'{float(lle):.2g}')}"
+            text = rf"$\lambda_1$ = {fmt(lle, '.2g')}"
             err = summary.get("lle_error")
             if err is not None and math.isfinite(float(err)) and err > 0:
-                text += f" ± {float(err):.1g}"
+                text += f" ± {fmt(err, '.1g')}"
             parts.append(text)
     return " · ".join(parts)
 

@@ -21,8 +21,8 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..sweep.result import SweepResult
-from ._common import axis_label, axis_symbol, edges, get_ax, no_offset
-from .units import PhysicalScales, linear_axis
+from ._common import axis_label, edges, get_ax, no_offset
+from .units import PhysicalScales, physical_axis
 
 __all__ = ["IMPACT_COLOURS", "IMPACT_GID", "IMPACT_NAMES", "impact_figure", "impact_map"]
 
@@ -151,22 +151,6 @@ def _legend(target: Any, codes: Any, **kwargs: Any) -> Any:
                          title_fontsize="small", **kwargs)  # fmt: skip
 
 
-def _physical(ax: Any, axis: str, name: str, res: SweepResult, scales: PhysicalScales) -> None:
-    """rpm opposite Ω, µm opposite a clearance given in units of b_c."""
-    if name == "omega":
-        found = scales.factor("omega")
-    elif name.startswith(("backlash.", "clearance.")):
-        gs = res.gearset
-        group = getattr(gs, name.partition(".")[0], None) if gs is not None else None
-        units = getattr(group, "units", None)
-        found = scales.factor("length") if units == "dimensionless" else None
-    else:
-        found = None
-    if found is not None:
-        sym = axis_symbol(name).replace("\\bar ", "")
-        linear_axis(ax, axis, found[0], found[1] if name == "omega" else f"{sym} {found[1]}")
-
-
 def impact_figure(
     ds: Any,
     *,
@@ -208,8 +192,8 @@ def impact_figure(
     scales = PhysicalScales.of_sweep(res) if physical else PhysicalScales()
     for k, sel in enumerate(selects):
         ax = impact_map(res, axs[k], mesh=key, planet=planet, select=sel or None, legend=False)
-        _physical(ax, "x", lay.vary[0], res, scales)
-        _physical(ax, "y", lay.vary[1], res, scales)
+        physical_axis(ax, "x", lay.vary[0], scales, res.gearset)
+        physical_axis(ax, "y", lay.vary[1], scales, res.gearset)
         if sel:
             ax.set_title(selection_title(sel, k, len(selects)), loc="left")
     for ax in axs[len(selects) :]:

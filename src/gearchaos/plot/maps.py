@@ -37,6 +37,7 @@ from .bifurcation import (
     suptitle,
 )
 from .regimes import regime_categories, regime_legend_below, regime_map
+from .units import PhysicalScales, physical_axis
 
 __all__ = ["distinct_counts", "distinct_map", "sweep_figure"]
 
@@ -215,9 +216,12 @@ def sweep_figure(
     With ``regimes`` (default: when the dataset has ``motion`` labels) 1-D sweeps get regime
     bands under their panels and 2-D sweeps are drawn as regime maps
     (:func:`~gearchaos.plot.regimes.regime_map`, one categorical legend under the panels);
-    without, 2-D sweeps are :func:`distinct_map` s. ``clearance_lines`` applies to bifurcation
-    diagrams only; ``max_count`` to distinct-point maps only; ``branches`` (continued branches
-    of periodic orbits, drawn over the diagrams of their parameter) to 1-D sweeps only.
+    without, 2-D sweeps are :func:`distinct_map` s. Maps of a gear set get the physical axes
+    opposite the dimensionless ones (:func:`~gearchaos.plot.units.physical_axis`: sun speed
+    in rpm opposite Ω, µm opposite a clearance in units of b_c). ``clearance_lines`` applies
+    to bifurcation diagrams only; ``max_count`` to distinct-point maps only; ``branches``
+    (continued branches of periodic orbits, drawn over the diagrams of their parameter) to 1-D
+    sweeps only.
 
     Returns
     -------
@@ -255,6 +259,7 @@ def sweep_figure(
         figsize = (6.5 * ncols, 4.5 * nrows + 0.8)
     fig = Figure(figsize=figsize, layout="constrained")
     axs = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False)).ravel()
+    scales = PhysicalScales.of_sweep(res)
     for k, sel in enumerate(selects):
         if regimes:
             ax = regime_map(res, axs[k], select=sel or None, legend=False, resonances=resonances)
@@ -268,6 +273,9 @@ def sweep_figure(
                 select=sel or None,
                 resonances=resonances,
             )
+        # rpm opposite Ω, µm opposite a clearance …, as the impact map and stability chart
+        physical_axis(ax, "x", lay.vary[0], scales, res.gearset)
+        physical_axis(ax, "y", lay.vary[1], scales, res.gearset)
         if sel:
             ax.set_title(selection_title(sel, k, len(selects)), loc="left")
     for ax in axs[len(selects) :]:

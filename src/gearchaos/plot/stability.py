@@ -17,8 +17,16 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from ._common import axis_label, axis_symbol, get_ax, no_offset, subject
-from .units import PhysicalScales, linear_axis
+from ._common import (
+    axis_label,
+    get_ax,
+    given_values,
+    no_offset,
+    stored_fixed,
+    stored_gearset,
+    subject,
+)
+from .units import PhysicalScales, physical_axis
 
 __all__ = ["BOUNDARY_STYLES", "boundary_label", "stability_chart", "stability_figure"]
 
@@ -186,28 +194,12 @@ def _scales(curve: Any, regimes: Any) -> tuple[PhysicalScales, Any]:
 
         res = SweepResult.of(regimes)
         return PhysicalScales.of_sweep(res), res.gearset
-    text = str(curve.attrs.get("gearset_toml", ""))
-    if not text:
+    gs = stored_gearset(curve.attrs)
+    if gs is None:
         return PhysicalScales(), None
-    from ..gearset import GearSet
     from ..model.planetary import PlanetaryModel
 
-    gs = GearSet.from_toml_string(text)
     return PhysicalScales.of_model(PlanetaryModel.from_gearset(gs)), gs
-
-
-def physical_axis(ax: Any, axis: str, name: str, scales: PhysicalScales, gs: Any) -> None:
-    """rpm opposite Ω, µm opposite a clearance given in units of b_c (nothing otherwise)."""
-    found = None
-    if name == "omega":
-        found = scales.factor("omega")
-    elif name.startswith(("backlash.", "clearance.")) and gs is not None:
-        group = getattr(gs, name.partition(".")[0], None)
-        if getattr(group, "units", None) == "dimensionless":
-            found = scales.factor("length")
-    if found is not None:
-        sym = axis_symbol(name).replace("\\bar ", "")
-        linear_axis(ax, axis, found[0], found[1] if name == "omega" else f"{sym} {found[1]}")
 
 
 def stability_figure(
@@ -225,14 +217,22 @@ def stability_figure(
         scales, gs = _scales(curves[0], regimes)
         physical_axis(ax, "x", _label_name(ax.get_xlabel(), curves[0], regimes, 0), scales, gs)
         physical_axis(ax, "y", _label_name(ax.get_ylabel(), curves[0], regimes, 1), scales, gs)
-    model = subject(curves[0].attrs) if curves else ""
-    fixed = str(curves[0].attrs.get("fixed", "{}")) if curves else ""
-    fig.suptitle(
-        ": ".join(p for p in (model, "stability chart") if p)
-        + (f", fixed {fixed}" if fixed not in ("", "{}") else ""),
-        fontsize="medium",
-    )
+    fig.suptitle(_title(curves[0].attrs), fontsize="medium")
     return fig
+
+
+def _title(attrs: Any) -> str:
+    """``sheng2016: stability chart`` and, below, the values the curves hold fixed as symbols
+    (``at b̄_sp = 3, …``, :func:`given_values`), not the file's JSON."""
+    gearset = stored_gearset(attrs)
+    values = given_values(
+        attrs,
+        fixed=stored_fixed(attrs),
+        gearset=gearset,
+        leave_out=(str(attrs.get("parameter", "")), str(attrs.get("parameter2", ""))),
+    )
+    head = ": ".join(p for p in (subject(attrs, gearset), "stability chart") if p)
+    return head + ("\nat " + ", ".join(values) if values else "")
 
 
 def _label_name(label: str, curve: Any, regimes: Any, k: int) -> str:

@@ -3,11 +3,12 @@
 Every dimensionless quantity of the model has a physical counterpart fixed by the gear set
 (MODEL.md §7): lengths x = b_c x̄, velocities ẋ = b_c ω_n x̄', forces F = k_m,sp b_c F̄, time
 t = τ/ω_n, the mesh frequency f_m = Ω ω_n/2π and the sun speed n_s = 60 f_m (z_s + z_r)/(z_s z_r).
-:class:`PhysicalScales` holds these factors (from a simulation or a sweep store) and
-:func:`secondary_axis` adds the physical axis opposite the dimensionless one. :func:`fit_to_data`
-sets limits from the data alone (clearance lines never widen them), :func:`clearance_notes`
-marks the clearances that fall outside, and :func:`section_style` sizes Poincaré points so that
-structure shows for a hundred and for ten thousand points.
+:class:`PhysicalScales` holds these factors (from a simulation or a sweep store),
+:func:`secondary_axis` adds the physical axis opposite the dimensionless one and
+:func:`physical_axis` that of a swept parameter or state (rpm opposite Ω, µm opposite b̄ …).
+:func:`fit_to_data` sets limits from the data alone (clearance lines never widen them),
+:func:`clearance_notes` marks the clearances that fall outside, and :func:`section_style`
+sizes Poincaré points so that structure shows for a hundred and for ten thousand points.
 """
 
 from __future__ import annotations
@@ -18,6 +19,9 @@ from typing import Any
 
 import numpy as np
 
+from ..gearset.schema import OMEGA
+from ._common import axis_symbol, fmt
+
 __all__ = [
     "CLEARANCE_NOTE_GID",
     "PhysicalScales",
@@ -25,6 +29,7 @@ __all__ = [
     "fit_to_data",
     "linear_axis",
     "notes_clear_of",
+    "physical_axis",
     "secondary_axis",
     "section_points",
     "section_style",
@@ -124,6 +129,33 @@ def secondary_axis(
     return linear_axis(ax, axis, found[0], f"{symbol} {found[1]}".strip())
 
 
+def physical_axis(
+    ax: Any,
+    axis: str,
+    name: str,
+    scales: PhysicalScales,
+    gearset: Any = None,
+    *,
+    symbol: str | None = None,
+) -> Any:
+    """The physical axis opposite the dimensionless axis of ``name`` (top for x, right for
+    y), for every map and chart over parameters or states: the sun speed in rpm opposite Ω,
+    µm opposite a clearance that ``gearset`` gives in units of b_c (``backlash.*``,
+    ``clearance.*``), µm, mm/s or N opposite a state (:func:`var_quantity`, labelled
+    ``symbol``); nothing where the scales do not define it (a reference system) or the axis
+    is physical already (a torque in N m, a clearance in metres). Returns the axis or None."""
+    if name == OMEGA:
+        found = scales.factor("omega")
+        return None if found is None else linear_axis(ax, axis, found[0], found[1])
+    if name.startswith(("backlash.", "clearance.")):
+        group = getattr(gearset, name.partition(".")[0], None) if gearset is not None else None
+        if getattr(group, "units", None) != "dimensionless":
+            return None
+        sym = symbol or axis_symbol(name).replace("\\bar ", "")
+        return secondary_axis(ax, axis, "length", scales, symbol=sym)
+    return secondary_axis(ax, axis, var_quantity(name), scales, symbol=symbol or "")
+
+
 def linear_axis(ax: Any, axis: str, k: float, label: str) -> Any:
     """A secondary axis (top for x, right for y) showing ``k`` times the primary values."""
 
@@ -202,7 +234,7 @@ def clearance_notes(
         if lo <= v <= hi:
             continue
         sign = "−" if v < 0 else "+"
-        edges[v < lo].append(text or f"{sign}${symbol}$ = {v:g}".replace("-", "−"))
+        edges[v < lo].append(text or f"{sign}${symbol}$ = {fmt(v)}")
     notes = []
     for below, texts in edges.items():
         if not texts:
