@@ -116,6 +116,18 @@ def test_runner_labels_every_value_of_a_reference_system() -> None:
         assert r["max_multiplier"] == pytest.approx(math.exp(-0.1 * T), rel=1e-3)
 
 
+def test_runner_title_writes_fixed_values_with_symbols_and_a_true_minus() -> None:
+    """The title's "at …" line is written by the figures' shared helper: symbols, and a
+    negative value with U+2212 (a hyphen outside mathtext reads as a dash)."""
+    system = gc.duffing(1.2, delta=0.25, alpha=-1.0, beta=1.0, gamma=0.1)
+    fig, _ = run_gallery(
+        system, "omega", [1.2], alpha=-1.0, transient_periods=5, periods=8, progress=False
+    )
+    title = fig._suptitle.get_text()
+    assert "\nat $\\alpha$ = \N{MINUS SIGN}1" in title, title
+    assert "= -1" not in title
+
+
 def test_runner_checks_every_point_before_running() -> None:
     gs = gc.preset("hindawi2021")
     with pytest.raises(ParameterError, match=r"backlash\.sun_planet"):

@@ -232,10 +232,10 @@ def run_gallery(
             )
             bar.advance(task)
     if title is None:
-        given = [
-            f"{axis_symbol(k)} = {_fmt(fv)}" for k, fv in fixed_values.items() if _is_number(fv)
-        ]
+        from ..plot._common import given as given_text
         from ..plot._common import variable
+
+        given = [given_text(k, fv) for k, fv in fixed_values.items() if _is_number(fv)]
 
         info = variable(results[0], None, planet) if results else None
         symbol, dot = (info.symbol, info.dot_symbol) if info else (rf"\bar{{X}}_{{sp{planet}}}", "")
@@ -278,6 +278,7 @@ def _gallery_values(param: str, values: Any) -> list[float]:
 
 
 def _fmt(v: Any) -> str:
+    """A value inside a mathtext title (where "-" is typeset as a minus)."""
     return f"{float(v):g}"
 
 
