@@ -15,6 +15,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from matplotlib.colors import to_rgba
@@ -240,3 +242,33 @@ def test_amplitude_figure_is_titled_by_the_shared_helper(oscillator_response) ->
     title = amplitude_figure(geared, [branch]).get_suptitle().splitlines()
     assert title[0] == "sheng2016: amplitude–frequency curves"
     assert title[1].startswith(r"at $\bar b_{sp}$ = ")
+
+
+def test_no_physical_axis_where_a_swept_parameter_changes_its_scale(
+    tmp_path: Path, impact_store
+) -> None:
+    """The sun speed in rpm per unit Ω is ω_n-dependent: over (Ω, mesh stiffness) one rpm
+    axis opposite Ω would be right on one row only, so the map draws none (and no force in
+    N, k_m,sp b_c); b_c does not depend on the stiffness, so lengths keep their µm. Over
+    (Ω, b̄_sp) nothing changes the scales and the rpm axis stays (the impact store)."""
+    from gearchaos.plot.maps import sweep_figure
+    from gearchaos.plot.units import PhysicalScales
+    from gearchaos.sweep.result import SweepResult
+
+    gs = gc.preset("sheng2016")
+    k = gs.stiffness.sun_planet_mean
+    res = gc.bifurcation(
+        gs, ["omega=1:2:3", f"stiffness.sun_planet_mean={k}:{2 * k}:2"],
+        transient_periods=2, periods=2, progress=False, store=tmp_path / "k.zarr",
+    )  # fmt: skip
+    scales = PhysicalScales.of_sweep(SweepResult.of(res))
+    assert scales.rpm_per_omega is None and scales.omega_n is None and scales.force_n is None
+    assert scales.length_m == pytest.approx(gs.clearance.characteristic_length)
+    assert "sun speed [rpm]" not in _physical_labels(sweep_figure(res))
+    kept = PhysicalScales.of_sweep(SweepResult.of(impact_store))
+    assert kept.rpm_per_omega == pytest.approx(gs.sun_speed_rpm(1.0))
+    # the same rule for a boundary curve drawn alone (its two parameters' ranges)
+    assert PhysicalScales.over(gs, {"stiffness.sun_planet_mean": [k, 2 * k]}).omega_n is None
+    assert PhysicalScales.over(gs, {"xi": [0.01, 0.05], "omega": [1, 3]}) == PhysicalScales.over(
+        gs, {}
+    )

@@ -197,9 +197,8 @@ def _scales(curve: Any, regimes: Any) -> tuple[PhysicalScales, Any]:
     gs = stored_gearset(curve.attrs)
     if gs is None:
         return PhysicalScales(), None
-    from ..model.planetary import PlanetaryModel
-
-    return PhysicalScales.of_model(PlanetaryModel.from_gearset(gs)), gs
+    names = (str(curve.attrs["parameter"]), str(curve.attrs["parameter2"]))
+    return PhysicalScales.over(gs, {n: curve[n].values for n in names}), gs
 
 
 def stability_figure(

@@ -13,7 +13,9 @@ sizes Poincaré points so that structure shows for a hundred and for ten thousan
 
 from __future__ import annotations
 
+import dataclasses
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -70,13 +72,35 @@ class PhysicalScales:
 
     @classmethod
     def of_sweep(cls, res: Any) -> PhysicalScales:
-        """From a :class:`~gearchaos.sweep.SweepResult`: its gear set with the fixed values."""
-        gs = res.gearset
-        if gs is None:
+        """From a :class:`~gearchaos.sweep.SweepResult`: its gear set with the fixed values,
+        over the ranges of its swept parameters (:meth:`over`)."""
+        if res.gearset is None:
             return cls()
+        ranges = {
+            name: np.asarray(res.ds[name].values, dtype=np.float64)
+            for name in res.swept_names
+            if name in res.ds.coords
+        }
+        return cls.over(res.gearset, ranges)
+
+    @classmethod
+    def over(cls, gs: Any, ranges: Mapping[str, Any]) -> PhysicalScales:
+        """The scales of gear set ``gs`` where parameters take the values ``ranges`` (name →
+        values): a scale that one of them changes (ω_n along a stiffness or a mass, b_c along
+        the characteristic length …) is left undefined, since a physical axis linear in the
+        dimensionless one would be wrong along it (checked at both ends of each range)."""
         from ..model.planetary import PlanetaryModel
 
-        return cls.of_model(PlanetaryModel.from_gearset(gs))
+        base = cls.of_model(PlanetaryModel.from_gearset(gs))
+        varying: set[str] = set()
+        for name, values in ranges.items():
+            if name == OMEGA:
+                continue
+            values = np.asarray(values, dtype=np.float64)
+            for v in (float(np.nanmin(values)), float(np.nanmax(values))):
+                end = cls.of_model(PlanetaryModel.from_gearset(gs.evolve({name: v})))
+                varying |= {f for f in SCALE_FIELDS if not _same(getattr(base, f), getattr(end, f))}
+        return dataclasses.replace(base, **dict.fromkeys(varying))
 
     def factor(self, quantity: str) -> tuple[float, str] | None:
         """(factor, axis label) of a quantity: ``length`` (µm), ``velocity`` (mm/s),
@@ -97,6 +121,16 @@ class PhysicalScales:
     def period_ms(self, omega: float) -> float | None:
         """One forcing (mesh) period at Ω in milliseconds: 2π/(Ω ω_n)."""
         return 2e3 * math.pi / (omega * self.omega_n) if self.omega_n else None
+
+
+#: The fields of :class:`PhysicalScales`.
+SCALE_FIELDS = tuple(f.name for f in dataclasses.fields(PhysicalScales))
+
+
+def _same(a: float | None, b: float | None) -> bool:
+    return (a is None and b is None) or (
+        a is not None and b is not None and math.isclose(a, b, rel_tol=1e-9)
+    )
 
 
 def var_quantity(var: str) -> str | None:
