@@ -255,7 +255,7 @@ def test_invalid_arguments_are_named(sheng: gc.GearSet) -> None:
         gc.periodic_orbit(sheng, omega=1.5, period=0)
     with pytest.raises(gc.ParameterError, match="omega is required"):
         gc.periodic_orbit(sheng)
-    with pytest.raises(gc.ParameterError, match=r"unknown parameter 'omgea'"):
+    with pytest.raises(gc.ParameterError, match=r"'omgea'; did you mean 'omega'"):
         gc.periodic_orbit(gc.duffing(1.0), omgea=1.2)
     with pytest.raises(gc.ParameterError, match="guess"):
         gc.periodic_orbit(sheng, omega=1.5, guess=[1.0, 2.0])

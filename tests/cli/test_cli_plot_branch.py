@@ -149,7 +149,7 @@ def test_plot_draws_a_branch_file_on_its_own(files, tmp_path) -> None:
     assert ax.get_ylabel() == "$x$"
     title = fig.get_suptitle()
     assert "backlash_oscillator" in title and r"$\zeta$ = 0.05" in title
-    assert "rtol 1e-10" in title  # the branch's solver setting
+    assert "rtol 1e\N{MINUS SIGN}10" in title  # the branch's solver setting (a true minus)
 
 
 def test_plot_draws_several_branch_files_apart(files, tmp_path) -> None:
