@@ -152,6 +152,16 @@ def test_curve_file_round_trip_resume_and_refusal(folds, tmp_path) -> None:
     # the resumed curve starts with the stored points
     n = first.sizes["point"]
     assert np.allclose(more.omega.values[:n], first.omega.values)
+    # a finished curve read back is assessed everywhere on request (its stored points hold no
+    # monodromy: the borders of the test function are computed again for each)
+    assert np.isnan(more.uncertainty.values).all()  # nothing landed, nothing assessed
+    assessed = boundary_curve(
+        system, upper, "eps=0:0.4", store=path, resume=True, assess="all", **TIGHT
+    )
+    assert assessed.attrs["assessed"] == "all"
+    assert np.array_equal(assessed.omega.values, more.omega.values)
+    assert np.all(np.isfinite(assessed.uncertainty.values))
+    assert np.all(assessed.uncertainty.values < 1e-8)
     with pytest.raises(gc.ParameterError, match="event kind"):
         bp = type(upper)(**{**upper.__dict__, "kind": "branch_point"})
         boundary_curve(system, bp, "eps=0:0.4")

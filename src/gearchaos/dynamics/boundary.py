@@ -248,6 +248,7 @@ def _assess(curve: Curve, pts: list[CurvePoint], everywhere: bool) -> None:
     fines = [_tighter(curve, f) for f in TIGHTER]
     for p in todo:
         for fine in fines:
+            _adapt(fine, p)
             q = fine.land(p, -1, float(p.z[-1])) if p.landed else fine.on_hyperplane(p, 0.0)
             if q is not None:
                 u = _shift(fine, curve, q.z, p.z)
@@ -266,6 +267,22 @@ def _assess(curve: Curve, pts: list[CurvePoint], everywhere: bool) -> None:
         e["uncertainty"] = tuple(float(u + d) for u, d in zip(e["uncertainty"], shift, strict=True))
         del e["bracket"]  # assessed once: a resumed run keeps the stored value
     curve.evals += sum(fine.evals for fine in fines)
+
+
+def _adapt(fine: Curve, p: CurvePoint) -> None:
+    """The test function's borders (fold, period doubling) or followed multiplier
+    (Neimark–Sacker) at p, as the continuation had them there: those of the curve's last
+    point may suit a point far from it badly. A point read back from a file holds no
+    monodromy (the identity in its place): its map is evaluated once for it."""
+    monodromy = p.monodromy
+    if fine.fn.kind in ("fold", "period_doubling") and np.array_equal(
+        monodromy, np.eye(monodromy.shape[0])
+    ):
+        shot, _ = fine.shots(p.z[None])
+        if shot is None or shot.monodromy is None:
+            return
+        monodromy = shot.monodromy[0]
+    fine.fn.adapt(monodromy, p.mu)
 
 
 def _shift(fine: Curve, curve: Curve, z_fine: np.ndarray, z: np.ndarray) -> tuple[float, float]:
@@ -312,6 +329,7 @@ def _relocate(fine: Curve, e: dict[str, Any]) -> np.ndarray | None:
     centre = abs(sigma)
     lo, hi = e["bracket"]
     half = max(0.5 * (hi - lo), 1e-12)
+    _adapt(fine, p)
     if np.isfinite(e["mu"]):
         fine.fn.mu_ref = complex(e["mu"])
 
