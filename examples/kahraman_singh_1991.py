@@ -206,6 +206,22 @@ class KahramanSingh1991(UserModel):
         "y_p": (r"\bar{y}_p", r"y_p/b_c", "bearing_p", r"\bar{b}_p"),
         "y_g": (r"\bar{y}_g", r"y_g/b_c", "bearing_g", r"\bar{b}_g"),
     }
+    #: Figure symbols of the parameters (the module docstring's): field → mathtext symbol.
+    parameter_symbols: ClassVar[dict[str, str]] = {
+        "zeta_h": r"\zeta_h",
+        "zeta_p": r"\zeta_p",
+        "zeta_g": r"\zeta_g",
+        "mu_p": r"\mu_p",
+        "mu_g": r"\mu_g",
+        "kappa_p": r"\kappa_p",
+        "kappa_g": r"\kappa_g",
+        "b_h": r"\bar{b}_h",
+        "b_p": r"\bar{b}_p",
+        "b_g": r"\bar{b}_g",
+        "eps": r"\varepsilon",
+        "f_mean": r"\bar{F}_m",
+        "f_alt": r"\bar{F}_a",
+    }
 
     def __post_init__(self) -> None:
         for name in ("zeta_h", "zeta_p", "zeta_g", "b_h", "b_p", "b_g"):

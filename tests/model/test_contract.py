@@ -14,9 +14,11 @@ outside the package as a :class:`~gearchaos.model.contract.UserModel` (here and 
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any, ClassVar
 
 import numba
 import numpy as np
@@ -186,6 +188,41 @@ def test_a_broken_model_is_refused_naming_the_member() -> None:
         build_model(Pendulum, {"zta": "0.2"})
     model = build_model(Pendulum, {"zeta": "0.2"})  # text from --set, converted
     assert model.zeta == 0.2
+
+
+def test_parameter_symbols_must_name_fields_with_strings() -> None:
+    """``parameter_symbols`` (field → mathtext) is refused, naming the member, the key and
+    the rule, where a key is no field of the model or a value no string; the example's pass."""
+
+    @dataclass(frozen=True)
+    class Named(Pendulum):
+        parameter_symbols: ClassVar[dict[str, Any]] = {"zeta": r"\zeta", "b": r"\bar{b}"}
+
+    check_model(Named())
+
+    @dataclass(frozen=True)
+    class NoField(Pendulum):
+        parameter_symbols: ClassVar[dict[str, Any]] = {"zeta": r"\zeta", "omega": r"\Omega"}
+
+    with pytest.raises(gc.ParameterError, match=r"parameter_symbols: key 'omega'.*field"):
+        check_model(NoField())
+
+    @dataclass(frozen=True)
+    class NoString(Pendulum):
+        parameter_symbols: ClassVar[dict[str, Any]] = {"force": 1.0}
+
+    with pytest.raises(gc.ParameterError, match=r"parameter_symbols\['force'\].*string"):
+        check_model(NoString())
+
+    @dataclass(frozen=True)
+    class NoMapping(Pendulum):
+        parameter_symbols: ClassVar[Any] = ("zeta",)
+
+    with pytest.raises(gc.ParameterError, match="parameter_symbols must map field names"):
+        check_model(NoMapping())
+    example = load_model_class(f"{EXAMPLE}:KahramanSingh1991")
+    check_model(example())
+    assert set(example.parameter_symbols) == {f.name for f in dataclasses.fields(example)}
 
 
 def test_a_user_models_kind_follows_its_source() -> None:

@@ -8,6 +8,8 @@ runs a short sweep of the backlash oscillator through :func:`gearchaos.bifurcati
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 import xarray as xr
@@ -379,6 +381,32 @@ def test_a_user_models_variable_is_drawn_with_the_models_symbol() -> None:
     assert fig.axes[0].get_ylabel() == r"$\bar{\delta}$"
     ds.attrs["model_class"] = "no/such/file.py:Model"
     assert bifurcation_figure(ds, var="delta").axes[0].get_ylabel() == r"$\mathrm{delta}$"
+
+
+def test_a_user_models_parameters_are_named_by_its_parameter_symbols() -> None:
+    """A sweep of a user model's own parameter (ζ_h of the Kahraman–Singh example, three
+    points, a few periods) labels its x axis and writes the title's ``at …`` line with the
+    model's ``parameter_symbols``, not the field names (``zeta_h``), and lists parameters
+    that no reference system shares (μ_p, κ_g, b̄_h), over two lines (one ran past both
+    edges of docs/howto/own-model.png)."""
+    from gearchaos.model import System
+    from gearchaos.model.contract import load_model_class
+
+    cls = load_model_class("examples/kahraman_singh_1991.py:KahramanSingh1991")
+    sweep = gc.bifurcation(
+        System(cls(), 2.5), "zeta_h=0.04:0.06:3", transient_periods=2, periods=2, progress=False
+    )
+    fig = bifurcation_figure(sweep)
+    assert [ax.get_xlabel() for ax in fig.axes if ax.get_xlabel()] == [r"$\zeta_h$"]
+    lines = fig.get_suptitle().split("\n")
+    assert lines[1].startswith("at ") and "periods" in lines[-1]
+    assert len(lines) == 4  # thirteen values: the at line broken in two, inside the figure
+    at = " ".join(lines[1:-1])
+    assert not re.search(r"(?<!\\)\b(zeta_|mu_|kappa_|b_h|eps|f_mean)", at)  # no field names
+    assert r"$\zeta_h$" not in at  # the swept one is left out
+    for shown in (r"$\zeta_p$ = 0.05", r"$\mu_p$ = 0.35", r"$\kappa_g$ = 1", r"$\bar{b}_h$ = 1"):
+        assert shown in at
+    assert r"$\bar{F}_m$ = 0.1" in at and r"$\varepsilon$ = 0.3" in at
 
 
 def test_event_names_over_a_diagram_sit_beside_the_branch() -> None:

@@ -7,8 +7,9 @@ from __future__ import annotations
 
 import numpy as np
 
+import gearchaos as gc
 from gearchaos.dynamics.basins import BasinAttractor
-from gearchaos.plot._common import fmt, given, given_values
+from gearchaos.plot._common import fmt, given, given_values, parameter_symbols
 from gearchaos.plot.gallery import gallery_title
 
 MINUS = "\N{MINUS SIGN}"
@@ -42,3 +43,22 @@ def test_given_values_of_a_reference_system_leave_out_the_swept() -> None:
     ]
     # a fixed value overrides the model's, once
     assert given_values(attrs, fixed={"alpha": 1.0})[:2] == [r"$\alpha$ = 1", r"$\delta$ = 0.25"]
+
+
+def test_parameter_symbols_are_the_models_own_or_none() -> None:
+    """The parameter symbols of what a store records: none for a gear set (the registry names
+    its parameters), a reference system (no ``parameter_symbols``) or a model that can no
+    longer be built; the model's own for a user model (the Kahraman–Singh example)."""
+    from gearchaos.gearset.io import to_toml
+    from gearchaos.model.contract import load_model_class, model_reference
+
+    gs = gc.preset("sheng2016")
+    assert parameter_symbols({"model": "planetary", "gearset_toml": to_toml(gs)}) == {}
+    oscillator = gc.backlash_oscillator(1.0).model
+    assert parameter_symbols({"model": "backlash_oscillator", **model_reference(oscillator)}) == {}
+    cls = load_model_class("examples/kahraman_singh_1991.py:KahramanSingh1991")
+    attrs = {"model": "kahraman_singh_1991", **model_reference(cls())}
+    assert parameter_symbols(attrs)["f_mean"] == r"\bar{F}_m"
+    assert given("zeta_h", 0.05, parameter_symbols(attrs)) == r"$\zeta_h$ = 0.05"
+    attrs["model_class"] = "no/such/file.py:KahramanSingh1991"
+    assert parameter_symbols(attrs) == {}

@@ -1,4 +1,4 @@
-"""The model contract: what a model gives gearchaos, and models written outside the package.
+r"""The model contract: what a model gives gearchaos, and models written outside the package.
 
 Every analysis of gearchaos — simulations, sweeps and stores, motion verdicts, periodic orbits,
 continuation, Lyapunov exponents, attractors, plots, the explorer and the command line — works on
@@ -35,6 +35,17 @@ description of a dimensionless system that provides (:class:`Model`):
     its derivative).
 ``scales`` (optional)
     Physical scales (``omega_n``, ``length`` …) for axes in SI units.
+``symbols`` (optional)
+    Figure symbols of its variables: variable (or group) name → (mathtext symbol without
+    ``$``, its definition or ``None``, the name of its clearance in ``clearances`` or
+    ``None``, the clearance's symbol or ``None``), e.g. ``{"delta": (r"\bar{\delta}",
+    r"\delta/b_c", "mesh", r"\bar{b}_h")}``; axes and labels of its variables use them.
+``parameter_symbols`` (optional)
+    Figure symbols of its parameters: field name → mathtext symbol without ``$``, e.g.
+    ``{"zeta_h": r"\zeta_h", "f_mean": r"\bar F_m"}``; the axis of a swept or continued
+    parameter and the ``at …`` line of figure titles use them (a parameter without one is
+    named by its field, or left out of titles). Keys must be fields of the model, values
+    strings (:func:`check_model`).
 
 The right-hand side is a compiled function ``rhs(t, y, p, dydt, obs, level)`` writing dy/dτ
 into ``dydt[:n_state]`` and the observables into ``obs`` (at least the first ``2 n_track``;
@@ -200,7 +211,8 @@ class UserModel:
       signatures of the module docstring,
     * ``pack(self, omega)``: the parameter vector ``rhs`` reads,
     * optionally ``switch_widths``, ``clearances``, ``contacts``, ``n_contact_forces``,
-      ``default_observables``, ``scales``.
+      ``default_observables``, ``scales``, ``symbols`` (of its variables) and
+      ``parameter_symbols`` (of its fields).
 
     ``System(MyModel(...), omega)`` then runs in every analysis; parameters are changed by
     field name (``params={"zeta": 0.1}``, ``--set zeta=0.1``).
@@ -247,7 +259,8 @@ class UserModel:
 
 def check_model(model: Any) -> None:
     """Raise :class:`~gearchaos.errors.ParameterError` naming the member of ``model`` that
-    breaks the contract (names, sizes, packed parameters, switch widths, contacts)."""
+    breaks the contract (names, sizes, packed parameters, switch widths, contacts, parameter
+    symbols)."""
     what = type(model).__name__
     for attr in ("name", "state_names", "obs_names", "n_track", "pack", "kind"):
         if not hasattr(model, attr):
@@ -275,6 +288,7 @@ def check_model(model: Any) -> None:
                 f"{what}.contacts: {c.name} must be judged on a tracked observable (column in "
                 f"[0, {n_track})) and be a mesh or a bearing: got {c}"
             )
+    _check_parameter_symbols(model, what)
     if getattr(model, "tangent", None) is None and (
         len(states) > FD_MAX_STATE or len(obs) > FD_MAX_OBS
     ):
@@ -283,6 +297,38 @@ def check_model(model: Any) -> None:
             f"finite-difference tangent handles at most {FD_MAX_STATE} / {FD_MAX_OBS}; give "
             "the model a tangent"
         )
+
+
+def _check_parameter_symbols(model: Any, what: str) -> None:
+    """Refuse ``parameter_symbols`` that are no mapping of the model's field names to
+    mathtext strings."""
+    import dataclasses
+    from collections.abc import Mapping
+
+    table = getattr(model, "parameter_symbols", None)
+    if table is None:
+        return
+    if not isinstance(table, Mapping):
+        raise ParameterError(
+            f"{what}.parameter_symbols must map field names to mathtext symbols: got "
+            f"{type(table).__name__}"
+        )
+    fields = (
+        [f.name for f in dataclasses.fields(model) if f.init]
+        if dataclasses.is_dataclass(model)
+        else []
+    )
+    for key, value in table.items():
+        if key not in fields:
+            raise ParameterError(
+                f"{what}.parameter_symbols: key {key!r} must be a field of the model (its "
+                f"fields: {', '.join(fields) or 'none'})"
+            )
+        if not isinstance(value, str):
+            raise ParameterError(
+                f"{what}.parameter_symbols[{key!r}] must be a mathtext string (without $): "
+                f"got {value!r}"
+            )
 
 
 # ------------------------------------------------------------------ loading a model by name

@@ -3,6 +3,7 @@ variables of results, axes, cell edges, clearance and resonance lines."""
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import re
@@ -43,23 +44,30 @@ _VAR_SYMBOLS: dict[str, str] = {k: v[0] for k, v in PlanetaryModel.symbols.items
 
 
 # --------------------------------------------------------------------------- names and labels
-def _tex(name: str) -> str | None:
+def _tex(name: str, symbols: Mapping[str, str] | None = None) -> str | None:
+    if symbols and name in symbols:
+        return str(symbols[name])
     field = describe(name)
     if field is not None:
         return field.tex
     return _REFERENCE_TEX.get(name)
 
 
-def axis_symbol(name: str) -> str:
-    """Mathtext symbol (with ``$``) of a parameter, e.g. ``$\\xi$``; else the name."""
-    sym = _tex(name)
+def axis_symbol(name: str, symbols: Mapping[str, str] | None = None) -> str:
+    """Mathtext symbol (with ``$``) of a parameter, e.g. ``$\\xi$``; else the name.
+    ``symbols``: a model's own parameter symbols (:func:`parameter_symbols`), which come
+    first."""
+    sym = _tex(name, symbols)
     return f"${sym}$" if sym is not None else name
 
 
-def axis_label(name: str) -> str:
+def axis_label(name: str, symbols: Mapping[str, str] | None = None) -> str:
     """Axis label of a parameter from the registry: ``omega`` → ``$\\Omega = \\omega/\\omega_n$``,
-    ``backlash.sun_planet`` → ``$\\bar b_{sp}$``, ``torque.input`` → ``$T_D$ [N m]``; an
+    ``backlash.sun_planet`` → ``$\\bar b_{sp}$``, ``torque.input`` → ``$T_D$ [N m]``; a
+    parameter of a model's own ``symbols`` (:func:`parameter_symbols`) → its symbol; an
     unknown name labels itself."""
+    if symbols and name in symbols:
+        return f"${symbols[name]}$"
     sym = _tex(name)
     if sym is None:
         return name
@@ -70,11 +78,12 @@ def axis_label(name: str) -> str:
     return f"${sym}$ {unit}" if unit else f"${sym}$"
 
 
-def given(name: str, value: Any) -> str:
+def given(name: str, value: Any, symbols: Mapping[str, str] | None = None) -> str:
     """``symbol = value`` of a parameter for titles and legends: ``$\\Omega$ = 1.2``,
-    ``$\\delta$ = 0.25``; an unknown name as it is, a value that is no number as written."""
+    ``$\\delta$ = 0.25``; an unknown name as it is, a value that is no number as written.
+    ``symbols`` as for :func:`axis_symbol`."""
     number = isinstance(value, int | float | np.number) and not isinstance(value, bool)
-    return f"{axis_symbol(name)} = {fmt(value) if number else value}"
+    return f"{axis_symbol(name, symbols)} = {fmt(value) if number else value}"
 
 
 def subject(attrs: Any, gearset: Any = None) -> str:
@@ -128,15 +137,16 @@ def given_values(
     and stability charts."""
     shown = {str(n) for n in leave_out}
     out: list[str] = []
+    symbols = parameter_symbols(attrs) if gearset is None else {}
     for k, v in fixed.items():
         if isinstance(v, int | float | np.number) and not isinstance(v, bool) and k not in shown:
-            out.append(given(k, v))
+            out.append(given(k, v, symbols))
             shown.add(k)
-    if gearset is None:  # a reference system: its parameters with a symbol
+    if gearset is None:  # a reference system or a user model: its parameters with a symbol
         text = str(attrs.get("model_parameters", "") or "")
         for k, v in re.findall(r"(\w+)=([-+0-9.eE]+)[,)]", text):
-            if k not in shown and axis_symbol(k) != k:
-                out.append(given(k, float(v)))
+            if k not in shown and axis_symbol(k, symbols) != k:
+                out.append(given(k, float(v), symbols))
                 shown.add(k)
         return out
     bsp, brp = gearset.backlash_bar()
@@ -153,21 +163,67 @@ def given_values(
     return out
 
 
+def at_line(values: list[str], width: int = 80) -> str:
+    """The title's ``at …`` line of ``values`` (:func:`given_values`), broken after a comma
+    where it would run past ``width`` visible characters (mathtext counted as drawn: ``$``,
+    braces and ``_`` none, ``\\zeta`` one), so that a model with many parameters keeps its
+    title inside the figure; ``""`` for no values."""
+    lines: list[str] = []
+    line, used = "at", 2
+    for k, v in enumerate(values):
+        text = v + ("," if k < len(values) - 1 else "")
+        n = len(re.sub(r"[${}_^]", "", re.sub(r"\\[A-Za-z]+ ?", "x", text)))
+        if k and used + 1 + n > width:
+            lines.append(line)
+            line, used = text, n
+        else:
+            line, used = f"{line} {text}", used + 1 + n
+    return "\n".join([*lines, line]) if values else ""
+
+
 def model_symbols(attrs: Any) -> Mapping[str, Any]:
     """The figure symbols of the variables of what a store or branch file records (its
     attributes): the planetary model's for a gear set; else the model's own ``symbols`` (the
     optional member of the model contract), the model built again from ``model_class`` and
-    ``model_fields`` (:func:`~gearchaos.model.contract.rebuild_model`); none when it has none
-    or can no longer be built (its file moved)."""
+    ``model_fields`` (:func:`stored_model`); none when it has none or can no longer be built
+    (its file moved)."""
     if attrs.get("gearset_toml") or attrs.get("model") == "planetary":
         return PlanetaryModel.symbols
+    return dict(getattr(stored_model(attrs), "symbols", None) or {})
+
+
+def parameter_symbols(attrs: Any) -> Mapping[str, str]:
+    """The figure symbols of the parameters of the model a store, branch or curve file
+    records (its attributes): the model's own ``parameter_symbols`` (the optional member of
+    the model contract; field name → mathtext without ``$``), the model built again by
+    :func:`stored_model`; none for a gear set (the registry names its parameters), a model
+    without them or one that can no longer be built. For ``symbols=`` of
+    :func:`axis_label`, :func:`axis_symbol` and :func:`given`."""
+    if attrs.get("gearset_toml") or attrs.get("model") == "planetary":
+        return {}
+    table = getattr(stored_model(attrs), "parameter_symbols", None) or {}
+    return {str(k): str(v) for k, v in table.items()}
+
+
+def stored_model(attrs: Any) -> Any:
+    """The model a store's, branch file's or curve file's ``model_class``/``model_fields``
+    attributes describe, built again once per pair
+    (:func:`~gearchaos.model.contract.rebuild_model`); ``None`` when they are absent or it can
+    no longer be built (its file moved)."""
+    spec, fields = attrs.get("model_class"), attrs.get("model_fields")
+    if not spec or fields is None:
+        return None
+    return _rebuilt(str(spec), str(fields))
+
+
+@functools.lru_cache(maxsize=16)
+def _rebuilt(spec: str, fields: str) -> Any:
     from ..model.contract import rebuild_model
 
     try:
-        model = rebuild_model(attrs)
+        return rebuild_model({"model_class": spec, "model_fields": fields})
     except (ParameterError, ImportError, OSError):
-        return {}
-    return dict(getattr(model, "symbols", None) or {})
+        return None
 
 
 def var_symbol(var: str, planet: int | None, symbols: Mapping[str, Any] | None = None) -> str:

@@ -27,7 +27,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..sweep import SweepResult
 from ..sweep.frequency import find_jumps
-from ._common import axis_label, fmt, model_symbols, var_symbol
+from ._common import axis_label, fmt, model_symbols, parameter_symbols, var_symbol
 from .bifurcation import suptitle
 from .branch import BRANCH_COLOURS, branch_labels, mark_event
 from .placement import place_event_labels
@@ -310,7 +310,7 @@ def amplitude_figure(
         ax.tick_params(axis="x", labelbottom=False)
         regime_legend_below(fig, np.asarray(regime_categories(res).values, dtype=object).ravel())
         bottom = band
-    bottom.set_xlabel(axis_label(xname))
+    bottom.set_xlabel(axis_label(xname, parameter_symbols(sd.attrs)))
     what = "amplitude–frequency curves"
     if force:
         who = f"{MESH_LABEL[mesh]} mesh" + (f", planet {planet}" if per else "")

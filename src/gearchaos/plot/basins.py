@@ -17,12 +17,23 @@ shade of it. Failed starts are black, starts not computed white.
 from __future__ import annotations
 
 import json
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 
 from ..errors import ParameterError
-from ._common import axis_label, edges, fmt, get_ax, given, model_symbols, subject, var_symbol
+from ._common import (
+    axis_label,
+    edges,
+    fmt,
+    get_ax,
+    given,
+    model_symbols,
+    parameter_symbols,
+    subject,
+    var_symbol,
+)
 from .regimes import regime_colour
 from .units import PhysicalScales, physical_axis, var_quantity
 
@@ -191,6 +202,7 @@ def fraction_curves(ds: Any, ax: Any = None, *, confidence: float = 0.95) -> Any
     p = np.asarray(fr[param].values, dtype=float)
     labels = [str(v) for v in fr["track_label"].values]
     state = _symbol(str(ds["state"].values[0]), ds.attrs)
+    psym = parameter_symbols(ds.attrs)
     colours = attractor_colours(labels)
     for j, t in enumerate(np.asarray(fr["track"].values)):
         col = (0.0, 0.0, 0.0) if t == -2 else colours[j]
@@ -198,7 +210,7 @@ def fraction_curves(ds: Any, ax: Any = None, *, confidence: float = 0.95) -> Any
         f = np.where(there, fr["fraction"].values[:, j], np.nan)
         lo = np.where(there, fr["fraction_low"].values[:, j], np.nan)
         hi = np.where(there, fr["fraction_high"].values[:, j], np.nan)
-        name = "failed" if t == -2 else _track_legend(fr, j, state, param)
+        name = "failed" if t == -2 else _track_legend(fr, j, state, param, psym)
         ax.fill_between(p, lo, hi, color=col, alpha=0.2, lw=0)
         ax.errorbar(
             p, f, yerr=[f - lo, hi - f], color=col, marker="o", ms=3, capsize=2, lw=1.2,
@@ -208,7 +220,7 @@ def fraction_curves(ds: Any, ax: Any = None, *, confidence: float = 0.95) -> Any
     if p.size > 1:  # a margin: the end points and their intervals stay visible
         pad = 0.03 * (p.max() - p.min())
         ax.set_xlim(p.min() - pad, p.max() + pad)
-    ax.set_xlabel(axis_label(param))
+    ax.set_xlabel(axis_label(param, psym))
     n = int(ds.sizes["start"])
     ax.set_ylabel(f"fraction of {n} starts")
     _physical(ax, "x", param, ds.attrs)
@@ -223,12 +235,14 @@ def fraction_curves(ds: Any, ax: Any = None, *, confidence: float = 0.95) -> Any
     return ax
 
 
-def _track_legend(fr: Any, j: int, state: str, param: str) -> str:
+def _track_legend(
+    fr: Any, j: int, state: str, param: str, symbols: Mapping[str, str] | None = None
+) -> str:
     """``1T ($x$ ≈ 1.08 at $\\Omega$ = 0.8)``: the label of track j of :func:`fractions`
     and where its attractor lies (``state``, a symbol) at the parameter value where it is
     first found."""
     where = float(fr["track_position"].values[j])
-    at = given(param, float(fr["track_found_at"].values[j]))
+    at = given(param, float(fr["track_found_at"].values[j]), symbols)
     return f"{fr['track_label'].values[j]} ({state} ≈ {fmt(where, '.3g')} at {at})"
 
 
@@ -242,7 +256,8 @@ def basins_figure(ds: Any) -> Any:
     spec = json.loads(ds.attrs["basin_spec"])
     if "omega" not in spec["values"] and "omega" in ds.attrs and ds.attrs["dims"][0] != "omega":
         spec["values"] = {"omega": float(ds.attrs["omega"]), **spec["values"]}
-    point = ", ".join(given(k, v) for k, v in spec["values"].items())
+    psym = parameter_symbols(ds.attrs)
+    point = ", ".join(given(k, v, psym) for k, v in spec["values"].items())
     if kind == "basins":
         basin_image(ds, ax)
         title = f"{subject(ds.attrs)}: basins of attraction" + (f" at {point}" if point else "")
@@ -259,6 +274,6 @@ def basins_figure(ds: Any) -> Any:
         layout = {"kind", "name", "n_state", "n_track", "n_contact_forces"}
         layout |= {"state_names", "obs_names"}
         shown = {k: v for k, v in json.loads(fields).items() if k not in layout}
-        title += "\n" + ", ".join(given(k, v) for k, v in shown.items())
+        title += "\n" + ", ".join(given(k, v, psym) for k, v in shown.items())
     ax.set_title(title, fontsize="medium")
     return fig

@@ -29,6 +29,7 @@ from ..sweep.result import SweepResult
 from ._common import (
     _CLEARANCE_STYLE,
     CLEARANCE_GID,
+    at_line,
     axis_label,
     axis_symbol,
     corner_note,
@@ -38,6 +39,7 @@ from ._common import (
     given_values,
     model_symbols,
     no_offset,
+    parameter_symbols,
     resonance_lines,
     subject,
     var_symbol,
@@ -191,6 +193,7 @@ def bifurcation(
     var = resolve_var(sub, var)
     lay = res.layout(var)
     x_name = res.line_axis("a bifurcation diagram", var)
+    psym = parameter_symbols(sub.attrs)
     ax = get_ax(ax)
     x = np.asarray(sub[x_name].values, dtype=np.float64)
     found = res.clearance(var)
@@ -237,7 +240,7 @@ def bifurcation(
         else:
             c = _DIRECTION_COLOURS.get(direction, "C2") if color is None else color
             arrow = "increasing" if direction == "up" else "decreasing"
-            label = f"{direction} ({arrow} {axis_symbol(x_name)})"
+            label = f"{direction} ({arrow} {axis_symbol(x_name, psym)})"
         ax.scatter(
             xs,
             ys,
@@ -319,7 +322,7 @@ def bifurcation(
             for line in ax.get_lines():  # both lines off the axes: the notes replace them
                 if line.get_gid() == CLEARANCE_GID:
                     line.set_label("_nolegend_")
-    ax.set_xlabel(axis_label(x_name))
+    ax.set_xlabel(axis_label(x_name, psym))
     symbol = var_symbol(
         var, planet if "planet" in sub[var].dims else None, model_symbols(sub.attrs)
     )
@@ -343,15 +346,21 @@ def bifurcation(
     return ax
 
 
-def _panel_title(k: int, name: str, value: Any, *, letters: bool) -> str:
+def _panel_title(
+    k: int, name: str, value: Any, *, letters: bool, symbols: Mapping[str, str] | None = None
+) -> str:
     prefix = f"({string.ascii_lowercase[k % 26]}) " if letters else ""
-    return f"{prefix}{given(name, value)}"
+    return f"{prefix}{given(name, value, symbols)}"
 
 
-def selection_title(sel: Mapping[str, Any], k: int, n: int) -> str:
+def selection_title(
+    sel: Mapping[str, Any], k: int, n: int, symbols: Mapping[str, str] | None = None
+) -> str:
     """The title of panel k of n that shows the selection ``sel`` (family or direction
-    values): ``(b) ξ = 0.05, up``, the letter only when there are several panels."""
-    parts = [given(d, v) if d != "direction" else str(v) for d, v in sel.items()]
+    values): ``(b) ξ = 0.05, up``, the letter only when there are several panels;
+    ``symbols``: the model's parameter symbols
+    (:func:`~gearchaos.plot._common.parameter_symbols`)."""
+    parts = [given(d, v, symbols) if d != "direction" else str(v) for d, v in sel.items()]
     prefix = f"({string.ascii_lowercase[k % 26]}) " if n > 1 else ""
     return prefix + ", ".join(parts)
 
@@ -379,7 +388,7 @@ def suptitle(ds: Any, what: str) -> str:
     lines = [": ".join(p for p in (subject(attrs, res.gearset), what) if p)]
     values = _given(res)
     if values:
-        lines.append("at " + ", ".join(values))
+        lines.append(at_line(values))
     t, p = attrs.get("transient_periods"), attrs.get("periods")
     if t is not None and p is not None:
         ic = attrs.get("initial_conditions")
@@ -471,7 +480,16 @@ def bifurcation_figure(
             branches=branches,
         )
         if family:
-            ax.set_title(_panel_title(k, family, value, letters=len(values) > 1), loc="left")
+            ax.set_title(
+                _panel_title(
+                    k,
+                    family,
+                    value,
+                    letters=len(values) > 1,
+                    symbols=parameter_symbols(res.ds.attrs),
+                ),
+                loc="left",
+            )
         if regimes:
             regime_band(res, bands[k], select=select)
             ax.set_xlabel("")

@@ -23,12 +23,14 @@ import numpy as np
 from ..errors import ParameterError
 from ..gearset.schema import CLEARANCES, FIELDS
 from ._common import (
+    at_line,
     axis_label,
     axis_symbol,
     fmt,
     get_ax,
     given_values,
     model_symbols,
+    parameter_symbols,
     resonance_lines,
     stored_fixed,
     stored_gearset,
@@ -126,7 +128,8 @@ def branch_labels(branches: Sequence[Any]) -> list[str]:
             pname, _, value = where.split(" (")[0].partition("=")
             short = EVENT_STYLE[kind][2] if kind in EVENT_STYLE else kind.replace("_", " ")
             try:
-                text += f" from {short} at {axis_symbol(pname)} = {fmt(float(value))}"
+                sym = axis_symbol(pname, parameter_symbols(br.attrs))
+                text += f" from {short} at {sym} = {fmt(float(value))}"
             except ValueError:
                 text += f" from {short} at {where.split(' (')[0]}"
         if source and source not in seen:
@@ -398,7 +401,7 @@ def branch_figure(
     gs = stored_gearset(branches[0].attrs)
     if resonances and name == "omega":
         resonance_lines(ax, gs, *ax.get_xlim())
-    ax.set_xlabel(axis_label(name))
+    ax.set_xlabel(axis_label(name, parameter_symbols(branches[0].attrs)))
     per = "planet" in branches[0][var].dims
     ylabel = var_symbol(var, planet if per else None, model_symbols(branches[0].attrs))
     ax.set_ylabel(f"${ylabel} - {sym}$" if relative else f"${ylabel}$")
@@ -430,10 +433,13 @@ def _title(branches: list[Any], var: str, planet: int) -> str:
         if len(branches) == 1
         else "continued branches of period " + ", ".join(str(n) for n in periods)
     )
-    lines = [f"{model}: {what}, section values against {axis_symbol(first.attrs['parameter'])}"]
+    lines = [
+        f"{model}: {what}, section values against "
+        f"{axis_symbol(first.attrs['parameter'], parameter_symbols(first.attrs))}"
+    ]
     values = _given(first)
     if values:
-        lines.append("at " + ", ".join(values))
+        lines.append(at_line(values))
     rtol = first.attrs.get("rtol")
     u = [
         float(x)

@@ -21,7 +21,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..sweep.result import SweepResult
-from ._common import axis_label, edges, get_ax, no_offset
+from ._common import axis_label, edges, get_ax, no_offset, parameter_symbols
 from .units import PhysicalScales, physical_axis
 
 __all__ = ["IMPACT_COLOURS", "IMPACT_GID", "IMPACT_NAMES", "impact_figure", "impact_map"]
@@ -128,8 +128,9 @@ def impact_map(
         edges(x[ox]), edges(y[oy]), codes, cmap=cmap, norm=norm, rasterized=True,
         edgecolors="none", gid=IMPACT_GID,
     )  # fmt: skip
-    ax.set_xlabel(axis_label(xname))
-    ax.set_ylabel(axis_label(yname))
+    psym = parameter_symbols(res.ds.attrs)
+    ax.set_xlabel(axis_label(xname, psym))
+    ax.set_ylabel(axis_label(yname, psym))
     no_offset(ax.xaxis, ax.yaxis)
     if legend:
         _legend(ax, codes, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)
@@ -195,7 +196,9 @@ def impact_figure(
         physical_axis(ax, "x", lay.vary[0], scales, res.gearset)
         physical_axis(ax, "y", lay.vary[1], scales, res.gearset)
         if sel:
-            ax.set_title(selection_title(sel, k, len(selects)), loc="left")
+            ax.set_title(
+                selection_title(sel, k, len(selects), parameter_symbols(res.ds.attrs)), loc="left"
+            )
     for ax in axs[len(selects) :]:
         ax.set_visible(False)
     _legend(fig, codes_all.values, loc="outside lower center", ncol=4)

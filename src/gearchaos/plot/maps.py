@@ -25,6 +25,7 @@ from ._common import (
     get_ax,
     model_symbols,
     no_offset,
+    parameter_symbols,
     resonance_lines,
     var_symbol,
 )
@@ -156,8 +157,9 @@ def distinct_map(
     norm = BoundaryNorm(np.arange(-0.5, max_count + 2.0, 1.0), cmap.N)
     ax = get_ax(ax)
     mesh = ax.pcolormesh(edges(x), edges(y), c, cmap=cmap, norm=norm, rasterized=True)
-    ax.set_xlabel(axis_label(xname))
-    ax.set_ylabel(axis_label(yname))
+    psym = parameter_symbols(sub.attrs)
+    ax.set_xlabel(axis_label(xname, psym))
+    ax.set_ylabel(axis_label(yname, psym))
     if resonances and xname == "omega" and x.size:
         resonance_lines(ax, res.gearset, float(np.min(x)), float(np.max(x)))
     n_missing = int(np.ma.count_masked(c))
@@ -277,7 +279,9 @@ def sweep_figure(
         physical_axis(ax, "x", lay.vary[0], scales, res.gearset)
         physical_axis(ax, "y", lay.vary[1], scales, res.gearset)
         if sel:
-            ax.set_title(selection_title(sel, k, len(selects)), loc="left")
+            ax.set_title(
+                selection_title(sel, k, len(selects), parameter_symbols(res.ds.attrs)), loc="left"
+            )
     for ax in axs[len(selects) :]:
         ax.set_visible(False)
     if regimes:

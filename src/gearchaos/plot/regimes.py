@@ -26,7 +26,7 @@ import numpy as np
 
 from ..errors import ParameterError, Status
 from ..sweep.result import SweepResult
-from ._common import axis_label, edges, get_ax, no_offset, resonance_lines
+from ._common import axis_label, edges, get_ax, no_offset, parameter_symbols, resonance_lines
 
 __all__ = [
     "NOT_RUN",
@@ -268,7 +268,7 @@ def regime_band(
         ax.tick_params(axis="y", labelsize="x-small", length=0)
     else:
         ax.set_yticks([])
-    ax.set_xlabel(axis_label(x_name))
+    ax.set_xlabel(axis_label(x_name, parameter_symbols(sub.attrs)))
     no_offset(ax.xaxis)
     if legend:
         regime_legend(ax, seen, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
@@ -325,8 +325,9 @@ def regime_map(
         rasterized=True,
         gid=REGIME_GID,
     )
-    ax.set_xlabel(axis_label(xname))
-    ax.set_ylabel(axis_label(yname))
+    psym = parameter_symbols(sub.attrs)
+    ax.set_xlabel(axis_label(xname, psym))
+    ax.set_ylabel(axis_label(yname, psym))
     if resonances and xname == "omega" and x.size:
         resonance_lines(ax, res.gearset, float(np.min(x)), float(np.max(x)))
     no_offset(ax.xaxis, ax.yaxis)

@@ -18,10 +18,12 @@ import numpy as np
 
 from ..errors import ParameterError
 from ._common import (
+    at_line,
     axis_label,
     get_ax,
     given_values,
     no_offset,
+    parameter_symbols,
     stored_fixed,
     stored_gearset,
     subject,
@@ -176,8 +178,9 @@ def stability_chart(
                 handles.append(mark)
                 seen.add(name)
     if regimes is None:
-        ax.set_xlabel(axis_label(names[0]))
-        ax.set_ylabel(axis_label(names[1]))
+        psym = parameter_symbols(curves[0].attrs)
+        ax.set_xlabel(axis_label(names[0], psym))
+        ax.set_ylabel(axis_label(names[1], psym))
         no_offset(ax.xaxis, ax.yaxis)
     if legend:
         ax.legend(
@@ -231,7 +234,7 @@ def _title(attrs: Any) -> str:
         leave_out=(str(attrs.get("parameter", "")), str(attrs.get("parameter2", ""))),
     )
     head = ": ".join(p for p in (subject(attrs, gearset), "stability chart") if p)
-    return head + ("\nat " + ", ".join(values) if values else "")
+    return head + ("\n" + at_line(values) if values else "")
 
 
 def _label_name(label: str, curve: Any, regimes: Any, k: int) -> str:
