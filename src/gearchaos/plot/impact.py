@@ -22,7 +22,6 @@ import numpy as np
 from ..errors import ParameterError
 from ..sweep.result import SweepResult
 from ._common import axis_label, edges, get_ax, no_offset, parameter_symbols
-from .units import PhysicalScales, physical_axis
 
 __all__ = ["IMPACT_COLOURS", "IMPACT_GID", "IMPACT_NAMES", "impact_figure", "impact_map"]
 
@@ -168,9 +167,8 @@ def impact_figure(
     -------
     matplotlib.figure.Figure
     """
-    from matplotlib.figure import Figure
-
-    from .bifurcation import panel_grid, selection_title, suptitle
+    from .bifurcation import suptitle
+    from .maps import map_panels
 
     res = SweepResult.of(ds)
     key = _mesh_key(mesh)
@@ -180,27 +178,11 @@ def impact_figure(
         raise ParameterError(
             f"an impact map needs a 2-D sweep: the store varies {', '.join(lay.vary) or 'nothing'}"
         )
-    selects: list[dict[str, Any]] = [{}]
-    if lay.directions:
-        selects = [{"direction": d} for d in lay.directions]
-    if lay.family:
-        selects = [
-            {**s, lay.family: v} for s in selects for v in np.asarray(res.ds[lay.family].values)
-        ]
-    nrows, ncols = panel_grid(len(selects))
-    fig = Figure(figsize=figsize or (6.5 * ncols, 4.6 * nrows + 0.8), layout="constrained")
-    axs = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False)).ravel()
-    scales = PhysicalScales.of_sweep(res) if physical else PhysicalScales()
-    for k, sel in enumerate(selects):
-        ax = impact_map(res, axs[k], mesh=key, planet=planet, select=sel or None, legend=False)
-        physical_axis(ax, "x", lay.vary[0], scales, res.gearset)
-        physical_axis(ax, "y", lay.vary[1], scales, res.gearset)
-        if sel:
-            ax.set_title(
-                selection_title(sel, k, len(selects), parameter_symbols(res.ds.attrs)), loc="left"
-            )
-    for ax in axs[len(selects) :]:
-        ax.set_visible(False)
+
+    def draw(ax: Any, sel: dict[str, Any] | None) -> Any:
+        return impact_map(res, ax, mesh=key, planet=planet, select=sel, legend=False)
+
+    fig = map_panels(res, lay, draw, figsize, height=4.6, physical=physical)
     _legend(fig, codes_all.values, loc="outside lower center", ncol=4)
     who = "the most severe planet" if planet is None else f"planet {planet}"
     fig.suptitle(

@@ -10,7 +10,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -229,8 +229,6 @@ def sweep_figure(
     -------
     matplotlib.figure.Figure
     """
-    from matplotlib.figure import Figure
-
     res = SweepResult.of(ds)
     _check_options(planet, clearance_lines, resonances, max_count, regimes, figsize)
     ds = res.ds
@@ -251,39 +249,16 @@ def sweep_figure(
         )
     if regimes is None:
         regimes = "motion" in ds.data_vars
-    selects: list[dict[str, Any]] = [{}]
-    if lay.directions:
-        selects = [{"direction": d} for d in lay.directions]
-    if lay.family:
-        selects = [{**s, lay.family: v} for s in selects for v in np.asarray(ds[lay.family].values)]
-    nrows, ncols = panel_grid(len(selects))
-    if figsize is None:
-        figsize = (6.5 * ncols, 4.5 * nrows + 0.8)
-    fig = Figure(figsize=figsize, layout="constrained")
-    axs = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False)).ravel()
-    scales = PhysicalScales.of_sweep(res)
-    for k, sel in enumerate(selects):
+
+    def draw(ax: Any, sel: dict[str, Any] | None) -> Any:
         if regimes:
-            ax = regime_map(res, axs[k], select=sel or None, legend=False, resonances=resonances)
-        else:
-            ax = distinct_map(
-                res,
-                axs[k],
-                var=var,
-                planet=planet,
-                max_count=max_count,
-                select=sel or None,
-                resonances=resonances,
-            )
-        # rpm opposite Ω, µm opposite a clearance …, as the impact map and stability chart
-        physical_axis(ax, "x", lay.vary[0], scales, res.gearset)
-        physical_axis(ax, "y", lay.vary[1], scales, res.gearset)
-        if sel:
-            ax.set_title(
-                selection_title(sel, k, len(selects), parameter_symbols(res.ds.attrs)), loc="left"
-            )
-    for ax in axs[len(selects) :]:
-        ax.set_visible(False)
+            return regime_map(res, ax, select=sel, legend=False, resonances=resonances)
+        return distinct_map(
+            res, ax, var=var, planet=planet, max_count=max_count, select=sel,
+            resonances=resonances,
+        )  # fmt: skip
+
+    fig = map_panels(res, lay, draw, figsize, height=4.5)
     if regimes:
         # under the panels, as the other figures' regime legends: beside them at the top it
         # covered the end of a long title
@@ -291,4 +266,42 @@ def sweep_figure(
         fig.suptitle(suptitle(res, "motion regimes"), fontsize="medium")
     else:
         fig.suptitle(suptitle(res, "distinct Poincaré points"), fontsize="medium")
+    return fig
+
+
+def map_panels(
+    res: SweepResult,
+    lay: Any,
+    draw: Callable[[Any, dict[str, Any] | None], Any],
+    figsize: tuple[float, float] | None,
+    *,
+    height: float,
+    physical: bool = True,
+) -> Any:
+    """The figure of a 2-D map over ``lay.vary`` (regimes, distinct points, impact): one panel
+    per direction and family value, each drawn by ``draw(ax, selection or None)``, with the
+    physical axes opposite the dimensionless ones (rpm opposite Ω, µm opposite a clearance …:
+    :func:`~gearchaos.plot.units.physical_axis`, as the stability chart) and its selection as
+    its title; spare panels hidden. ``height``: inches a row of panels."""
+    from matplotlib.figure import Figure
+
+    selects: list[dict[str, Any]] = [{}]
+    if lay.directions:
+        selects = [{"direction": d} for d in lay.directions]
+    if lay.family:
+        values = np.asarray(res.ds[lay.family].values)
+        selects = [{**s, lay.family: v} for s in selects for v in values]
+    nrows, ncols = panel_grid(len(selects))
+    fig = Figure(figsize=figsize or (6.5 * ncols, height * nrows + 0.8), layout="constrained")
+    axs = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False)).ravel()
+    scales = PhysicalScales.of_sweep(res) if physical else PhysicalScales()
+    symbols = parameter_symbols(res.ds.attrs)
+    for k, sel in enumerate(selects):
+        ax = draw(axs[k], sel or None)
+        physical_axis(ax, "x", lay.vary[0], scales, res.gearset)
+        physical_axis(ax, "y", lay.vary[1], scales, res.gearset)
+        if sel:
+            ax.set_title(selection_title(sel, k, len(selects), symbols), loc="left")
+    for ax in axs[len(selects) :]:
+        ax.set_visible(False)
     return fig
