@@ -304,14 +304,16 @@ def sweep_target(
     omega: float | None,
     changes: Mapping[str, object],
     quiet: bool,
+    verb: str = "swept",
 ) -> tuple[Any, dict[str, Any]]:
-    """(target, fixed values) of a sweep command: a ``--model``'s parameters are set on the
-    model itself (its fields), a gear set's changes are fixed values of the sweep."""
+    """(target, fixed values) of a command over a parameter (a sweep, a gallery, a
+    continuation: ``verb``, for the messages): a ``--model``'s parameters are set on the model
+    itself (its fields), a gear set's changes are fixed values (:func:`sweep_fixed`)."""
     if model is not None:
         return load_target(preset, gearset_file, model, changes), sweep_fixed(
-            swept, omega, {}, quiet
+            swept, omega, {}, quiet, verb
         )
-    return load_gearset(preset, gearset_file), sweep_fixed(swept, omega, changes, quiet)
+    return load_gearset(preset, gearset_file), sweep_fixed(swept, omega, changes, quiet, verb)
 
 
 def default_omega_note(quiet: bool, what: str = "swept") -> None:
@@ -326,20 +328,27 @@ def default_omega_note(quiet: bool, what: str = "swept") -> None:
 
 
 def sweep_fixed(
-    swept: set[str], omega: float | None, changes: Mapping[str, Any], quiet: bool
+    swept: set[str],
+    omega: float | None,
+    changes: Mapping[str, Any],
+    quiet: bool,
+    verb: str = "swept",
+    note: str | None = None,
 ) -> dict[str, Any]:
-    """The fixed values of a sweep from ``--set``: refuse a name both swept and set, and fix Ω
-    (the default, with a note, when it is neither swept nor set)."""
+    """The fixed values of a command over the parameters ``swept`` from ``--set``: refuse a
+    name both swept and set, and fix Ω (the default, with a note, when it is neither swept nor
+    set). ``verb`` names what the command does to them in the messages (swept, varied,
+    continued), ``note`` in the default-Ω note (default ``verb``)."""
     fixed: dict[str, Any] = dict(changes)
     for name in sorted(swept & set(fixed)):
-        raise ParameterError(f"{name} is both swept and set with --set; choose one")
+        raise ParameterError(f"{name} is both {verb} and set with --set; choose one")
     if OMEGA not in swept:
         if omega is None:
             omega = DEFAULT_OMEGA
-            default_omega_note(quiet)
+            default_omega_note(quiet, verb if note is None else note)
         fixed[OMEGA] = omega
     elif omega is not None:
-        raise ParameterError("omega is both swept and set with --set; choose one")
+        raise ParameterError(f"omega is both {verb} and set with --set; choose one")
     return fixed
 
 

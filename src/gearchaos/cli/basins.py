@@ -265,14 +265,7 @@ def basin_fractions(
         omega, changes = c.parse_sets(set_ or [])
         target = c.load_target(preset, gearset, model, changes)
         name = vary.partition("=")[0].strip()
-        values: dict[str, Any] = {}
-        if name != "omega":
-            if omega is None:
-                omega = c.DEFAULT_OMEGA
-                c.default_omega_note(quiet or json_out, "swept or set")
-            values["omega"] = omega
-        elif omega is not None:
-            raise ParameterError("omega is both varied and set with --set; choose one")
+        values = c.sweep_fixed({name}, omega, {}, quiet or json_out, "varied", "swept or set")
         settings = c.solver_settings(transient, periods, rtol, atol)
         t0 = time.perf_counter()
         with c.warnings_to_stderr():

@@ -4,12 +4,11 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated
 
 import typer
 
 from ..errors import ParameterError
-from ..model.target import DEFAULT_OMEGA
 from ..paper.galleries import GALLERY_SETTINGS
 from . import _common as c
 from ._render import gallery_rows_table
@@ -89,19 +88,9 @@ def poincare(
             ) from None
         axis = parse_axis(vary)
         omega, changes = c.parse_sets(set_ or [])
-        fixed: dict[str, Any] = {} if model is not None else dict(changes)
-        if axis.name in fixed or (axis.name == "omega" and omega is not None):
-            raise ParameterError(f"{axis.name} is both varied and set with --set; choose one")
-        if axis.name != "omega":
-            if omega is None:
-                omega = DEFAULT_OMEGA
-                c.default_omega_note(quiet or json_out, "varied")
-            fixed["omega"] = omega
         settings = c.solver_settings(transient, periods, rtol, atol)
-        gs = (
-            c.load_target(preset, gearset, model, changes)
-            if model is not None
-            else c.load_gearset(preset, gearset)
+        gs, fixed = c.sweep_target(
+            preset, gearset, model, {axis.name}, omega, changes, quiet or json_out, "varied"
         )
 
         import matplotlib

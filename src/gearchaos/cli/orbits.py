@@ -300,18 +300,10 @@ def continue_(
             raise ParameterError(f"{name} is both continued and set with --set; choose one")
         if from_ is None:
             omega, changes = c.parse_sets(set_ or [])
-            if model is not None:  # the model's parameters are set on it
-                gs = c.load_target(preset, gearset, model, changes)
-                changes = {}
-            else:
-                gs = c.load_gearset(preset, gearset)
-            values: dict[str, Any] = dict(changes)
+            gs, values = c.sweep_target(
+                preset, gearset, model, {name}, omega, changes, quiet or json_out, "continued"
+            )
             start = None
-            if name != "omega":
-                if omega is None:
-                    omega = c.DEFAULT_OMEGA
-                    c.default_omega_note(quiet or json_out, "continued")
-                values["omega"] = omega
         else:
             gs, values, start = _start_values(from_, at, preset, gearset, set_ or [], model)
         settings = c.solver_settings(transient, 1, rtol, atol)
