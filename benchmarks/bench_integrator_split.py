@@ -28,15 +28,14 @@ Run as ``python benchmarks/bench_integrator_split.py --baseline-src /tmp/old_int
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import os
 import statistics
-import subprocess
-import sys
 import tempfile
 from pathlib import Path
 from typing import Any
+
+from child import run_child
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -88,18 +87,8 @@ def child(
     src: Path, cache: str, *, reps: int = 1, cold: bool = False, periods: int = 2000
 ) -> dict[str, Any]:
     """Run the benchmark child importing gearchaos from ``src`` with numba cache ``cache``."""
-    env = dict(os.environ, PYTHONPATH=str(src), NUMBA_CACHE_DIR=cache, NUMBA_NUM_THREADS="1")
-    spec = json.dumps({"reps": reps, "cold": cold, "periods": periods})
-    proc = subprocess.run(
-        [sys.executable, "-c", _CHILD, spec], env=env, capture_output=True, text=True, check=False
-    )
-    for line in proc.stdout.splitlines():
-        if line.startswith("RESULT"):
-            out = dict(json.loads(line[6:]))
-            if not str(out["file"]).startswith(str(src)):
-                raise RuntimeError(f"the child imported {out['file']}, not the code in {src}")
-            return out
-    raise RuntimeError(f"benchmark child failed ({src}):\n{proc.stderr[-3000:]}")
+    spec = {"reps": reps, "cold": cold, "periods": periods}
+    return run_child(_CHILD, spec, src, NUMBA_CACHE_DIR=cache, NUMBA_NUM_THREADS="1")
 
 
 def main() -> None:

@@ -34,7 +34,6 @@ Printed, in one run:
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import os
 import shutil
@@ -44,6 +43,8 @@ import tempfile
 import time
 from pathlib import Path
 from typing import Any
+
+from child import run_child
 
 ROOT = Path(__file__).resolve().parents[1]
 RTOL = 1e-8
@@ -96,18 +97,7 @@ def run_sweep(src: Path, points: int, tr: int, rec: int, settle: bool, npy: str)
         "points": points, "tr": tr, "rec": rec, "lo": FIG4_RANGE[0], "hi": FIG4_RANGE[1],
         "rtol": RTOL, "atol": ATOL, "fixed": FIG4_FIXED, "settle": settle, "npy": npy,
     }  # fmt: skip
-    env = dict(os.environ, PYTHONPATH=str(src))
-    proc = subprocess.run(
-        [sys.executable, "-c", _SWEEP_CHILD, json.dumps(spec)],
-        env=env, capture_output=True, text=True, check=False,
-    )  # fmt: skip
-    for line in proc.stdout.splitlines():
-        if line.startswith("RESULT"):
-            out = dict(json.loads(line[6:]))
-            if not str(out["file"]).startswith(str(src)):
-                raise RuntimeError(f"the child imported {out['file']}, not the code in {src}")
-            return out
-    raise RuntimeError(f"sweep child failed ({src}):\n{proc.stderr[-3000:]}")
+    return run_child(_SWEEP_CHILD, spec, src)
 
 
 def _diff_1t(a: Any, b: Any) -> tuple[float, int]:
