@@ -340,11 +340,7 @@ def split_keywords(
         name, own = _door(door)
         for key in values:
             check_keyword(name, target, key, {*names, *own, *options})
-    if params is not None and not isinstance(params, Mapping):
-        raise ParameterError(
-            f"params must be a mapping of names to values: got {params!r}", name="params"
-        )
-    for k, v in (params or {}).items():
+    for k, v in (check_params("params", params) or {}).items():
         if k in values:
             raise ParameterError(f"parameter {k!r} is given twice (keyword and params)", name=k)
         values[k] = v
@@ -361,6 +357,17 @@ def _door(door: Any) -> tuple[str, list[str]]:
     kinds = (inspect.Parameter.KEYWORD_ONLY, inspect.Parameter.POSITIONAL_OR_KEYWORD)
     params = inspect.signature(door).parameters.values()
     return door.__name__, [p.name for p in params if p.kind in kinds]
+
+
+def check_params(keyword: str, params: Any) -> Any:
+    """``params`` (given as ``keyword``): None or a mapping of dotted names to values."""
+    if params is not None and not isinstance(params, Mapping):
+        raise ParameterError(
+            f"{keyword} must be a mapping of dotted names to values "
+            f"(e.g. {{'omega': 1.5}}): got {params!r}",
+            name=keyword,
+        )
+    return params
 
 
 def check_keyword(door: str, target: Any, key: str, options: Iterable[str]) -> None:

@@ -42,8 +42,7 @@ from .._checks import check_bool, check_int, check_real
 from .._output import staged_file, write_file
 from ..errors import ParameterError
 from ..gearset.schema import display_symbol, tex
-from ..integrate.settings import SolverSettings, renamed_keyword, split_keywords
-from ..sweep.spec import check_params
+from ..integrate.settings import SolverSettings, check_params, renamed_keyword, split_keywords
 from .recipes import load_figures, lookup_figure
 
 __all__ = [

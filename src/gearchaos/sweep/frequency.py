@@ -25,9 +25,8 @@ import numpy as np
 
 from .._checks import check_real
 from ..errors import ParameterError
-from ..integrate.settings import SolverSettings, renamed_keyword
+from ..integrate.settings import SolverSettings, check_params, renamed_keyword
 from .run import bifurcation
-from .spec import check_params
 
 __all__ = ["find_jumps", "response"]
 

@@ -23,7 +23,7 @@ from .._version import provenance
 from ..errors import ParameterError, Status, StoreError
 from ..integrate._chains import ChainOutput, ChainRun
 from ..integrate.interface import Info
-from ..integrate.settings import SolverSettings, renamed_keyword
+from ..integrate.settings import SolverSettings, check_params, renamed_keyword
 from ..integrate.threads import abandon, resume
 from ..model.contract import model_reference
 from ..model.target import scale_attrs
@@ -33,7 +33,7 @@ from .grid import Grid, Task
 from .integrity import StoreLock
 from .orbits import ORBIT_VARIABLES, status_attrs, task_orbits
 from .progress import _Bar
-from .spec import DEFAULT_OBSERVE, SweepSpec, check_params, sweep_keywords
+from .spec import DEFAULT_OBSERVE, SweepSpec, sweep_keywords
 from .store import SweepStore
 from .verdicts import VERDICT_VARIABLES, task_verdicts, verdict_attrs
 

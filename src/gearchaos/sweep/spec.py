@@ -32,7 +32,7 @@ import numpy as np
 
 from .._checks import check_bool, check_choice, check_int
 from ..errors import ParameterError, StoreError
-from ..integrate.settings import SolverSettings, check_keyword, renamed_keyword
+from ..integrate.settings import SolverSettings, check_keyword, check_params, renamed_keyword
 from ..model.target import OMEGA, check_omega
 from .execute import EXECUTION_OPTIONS
 
@@ -217,17 +217,6 @@ SPEC_OPTIONS = (
     "verdicts",
     "response",
 )
-
-
-def check_params(keyword: str, params: Any) -> Any:
-    """``params`` (given as ``keyword``): None or a mapping of dotted names to values."""
-    if params is not None and not isinstance(params, Mapping):
-        raise ParameterError(
-            f"{keyword} must be a mapping of dotted names to values "
-            f"(e.g. {{'omega': 1.5}}): got {params!r}",
-            name=keyword,
-        )
-    return params
 
 
 def sweep_keywords(
