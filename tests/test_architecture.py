@@ -34,7 +34,7 @@ LAYERS = (
     "cli",
     "facade",
 )
-BASE_MODULES = {"errors", "_checks", "_version", "_numba", "_files", "_output"}
+BASE_MODULES = {"errors", "_checks", "_version", "_numba", "_files", "_output", "_text"}
 MAX_LINES = 600
 
 
