@@ -90,8 +90,9 @@ class Status(enum.IntEnum):
 _MESSAGES = {
     Status.OK: "integration reached the requested end time",
     Status.MAX_STEPS: (
-        "the step budget (max_steps) was exhausted before the end time; "
-        "raise max_steps or loosen rtol/atol"
+        "the step budget was exhausted before the end time (by default 100 000 steps + "
+        "50 000 per simulated period); loosen rtol/atol (--rtol, --atol), simulate fewer "
+        "periods, or give a larger max_steps (a solver setting of the Python API)"
     ),
     Status.STEP_UNDERFLOW: (
         "the step size fell below the floating-point resolution of the time variable; "

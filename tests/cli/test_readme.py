@@ -61,3 +61,15 @@ def test_quickstart_figure_is_committable() -> None:
     png = ROOT / "docs" / "quickstart.png"
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert png.stat().st_size < 300_000
+
+
+def test_every_command_is_in_the_synopsis() -> None:
+    """Issue 35: `export` (and `explore`) were missing from the README's command synopsis."""
+    from typer.main import get_command
+
+    from gearchaos.cli import app
+
+    synopsis = next(b for b in _blocks("text") if b.startswith("gearchaos simulate"))
+    names = sorted(get_command(app).commands)  # type: ignore[attr-defined]
+    missing = [n for n in names if not re.search(rf"^gearchaos {re.escape(n)}\b", synopsis, re.M)]
+    assert not missing, f"commands missing from the README's synopsis: {missing}"

@@ -374,7 +374,10 @@ def solver_settings(
             atol=atol,
             settle=settle,
         )
-        return settings if perturbation is None else settings.replace(perturbation=perturbation)
+        if perturbation is not None:
+            settings = settings.replace(perturbation=perturbation)
+        settings.check_span()
+        return settings
     except ParameterError as exc:
         option = setting_option(exc.name)
         raise ParameterError(f"{option}: {exc}" if option else str(exc), name=exc.name) from None

@@ -15,7 +15,8 @@ def export(
     source: Annotated[
         Path,
         typer.Argument(
-            help="Sweep store (RUN.zarr) or simulation file (simulation.nc).", show_default=False
+            help="Sweep, response or basin store (RUN.zarr) or simulation file (simulation.nc).",
+            show_default=False,
         ),
     ],
     output: Annotated[
@@ -26,22 +27,34 @@ def export(
         str | None,
         typer.Option(
             "--to",
-            help="csv (a tidy table: one row per point and section sample) or mat (MATLAB, "
-            "every variable). Default: from the suffix of --output.",
+            help="csv (TABLE.csv: one row per point; TABLE.sections.csv: the section samples; "
+            "TABLE.csv.json: the provenance and every column's unit) or mat (MATLAB, every "
+            "variable). Default: from the suffix of --output.",
             show_default=False,
         ),
     ] = None,
 ) -> None:
-    """Export a result for other tools: a tidy CSV table (swept parameters, section index,
-    planet, then one column per variable; provenance in # header lines) or a MATLAB .mat file
-    (every variable and coordinate, dimension names, attributes).
+    """Export a result for spreadsheets and other tools: CSV tables or a MATLAB .mat file.
 
-    Example: **gearchaos export fig4.zarr --to csv -o fig4.csv**
+    The CSV has one row per point, with the units in the column names: the swept parameters,
+    omega, sun_rpm and mesh_hz (for a gear set), then motion, lle, max_multiplier, the contact
+    regimes per planet, load factors and peak forces (also in N) of a response... Section
+    samples go to a long table beside it (TABLE.sections.csv: one row per point and sample);
+    the provenance (versions, gear set, sweep, solver settings, protocol) and the unit and
+    meaning of every column to the sidecar TABLE.csv.json. pandas.read_csv and spreadsheets
+    open both tables as they are. The .mat file holds every variable and coordinate, dimension
+    names and attributes.
+
+    Exports sweep stores (bifurcation), response stores, basin and basin-fraction stores and
+    simulation files.
+
+    Example: **gearchaos export resp.zarr -o resp.csv**
     """
-    from ..sweep.exports import export as run_export
+    from ..sweep.exports import write_export
 
     with c.reported_errors():
         path = c.output_path(output)
         assert path is not None
-        written = run_export(source, path, to=to)
-    c.wrote(written)
+        written = write_export(source, path, to=to)
+    for p in written:
+        c.wrote(p)

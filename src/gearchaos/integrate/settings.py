@@ -41,6 +41,15 @@ MAX_PERIODS = 10**9
 MIN_TRANSIENT = 1e-6
 MAX_SAMPLES_PER_PERIOD = 10**6
 MAX_STEP_BUDGET = 2**62
+#: The finest time step the integrator takes where the time is τ, relative to τ: below
+#: ``STEP_RESOLUTION·|τ|`` it stops with ``Status.STEP_UNDERFLOW`` (the kernel's ``hmin``).
+STEP_RESOLUTION = 16.0 * 2.220446049250313e-16
+#: The time variable must resolve this fraction of a forcing period T until a run ends: the
+#: first step from rest of the sheng2016 gear set is about 1e-6 T, steps at contacts shorter.
+TIME_RESOLUTION = 1e-8
+#: The most forcing periods one run may span (start, transient, section phase and record):
+#: ``STEP_RESOLUTION · span · T <= TIME_RESOLUTION · T``, about 2.8 million.
+MAX_SPAN_PERIODS = TIME_RESOLUTION / STEP_RESOLUTION
 #: Values of ``settle``.
 SETTLE_CHOICES = ("off", "auto")
 #: Default size of the perturbation of a start from rest, and the largest allowed.
@@ -205,11 +214,38 @@ class SolverSettings:
         total = float(self.transient_periods) + int(self.periods)
         return int(100_000 + 50_000 * max(total, 1.0))
 
+    def check_span(self, start_periods: float = 0.0) -> None:
+        """Refuse a run that would end where the time variable no longer resolves
+        :data:`TIME_RESOLUTION` of a forcing period: it spans ``start_periods`` (the start
+        time in periods), ``transient_periods``, ``section_phase``/2π and ``periods``, and at
+        τ = span·T the integrator's finest step is ``STEP_RESOLUTION``·τ (then it stops with
+        ``STEP_UNDERFLOW``, from the first step on). The message names the largest part."""
+        parts = {
+            "start time": abs(float(start_periods)),
+            "transient_periods": float(self.transient_periods),
+            "section_phase": abs(float(self.section_phase)) / (2.0 * math.pi),
+            "periods": float(self.periods),
+        }
+        span = sum(parts.values())
+        if span <= MAX_SPAN_PERIODS:
+            return
+        name = max(parts, key=lambda k: parts[k])
+        shown = f"{self.section_phase:g} rad" if name == "section_phase" else f"{parts[name]:g}"
+        raise ParameterError(
+            f"{name} = {shown} makes a run span {span:.3g} forcing periods T; at its end the "
+            f"time variable resolves only {STEP_RESOLUTION * span:.2g} T (16 ε τ, the "
+            f"integrator's finest step there), coarser than the {TIME_RESOLUTION:g} T its "
+            f"steps need: at most {MAX_SPAN_PERIODS:.3g} periods in all; make {name} smaller",
+            name=None if name == "start time" else name,
+        )
+
     def sample_times(self, period: Any, t0: Any = 0.0) -> SampleTimes:
         """Sample times of a run with forcing period T (a float, or an array of one T per
         point) starting at τ = ``t0``: the first sample after the transient,
         τ_rec = t0 + transient_periods·T + φT/2π, then every T/samples_per_period."""
         T = period
+        start = np.max(np.abs(np.asarray(t0, dtype=float) / np.asarray(T, dtype=float)))
+        self.check_span(float(start))
         phase = float(self.section_phase)
         t_rec = t0 + self.transient_periods * T
         if phase != 0.0:

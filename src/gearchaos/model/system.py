@@ -57,6 +57,54 @@ class Observable:
         return values if self.per_planet else values[..., 0]
 
 
+def _packed(model: Any, omega: float) -> np.ndarray:
+    """``model.pack(omega)`` as a vector of float64; anything else is refused naming the
+    model's ``pack``."""
+    from ..errors import ParameterError
+
+    what = f"{type(model).__name__}.pack(omega)"
+    raw = model.pack(omega)
+    try:
+        p = np.ascontiguousarray(raw, dtype=np.float64)
+    except (TypeError, ValueError, OverflowError) as exc:
+        shown = repr(raw) if len(repr(raw)) <= 80 else repr(raw)[:77] + "..."
+        raise ParameterError(
+            f"{what} must return a vector of numbers (the parameters the right-hand side "
+            f"reads): got {shown} ({type(exc).__name__}: {exc})"
+        ) from None
+    if p.ndim != 1 or np.asarray(raw).dtype.kind not in "fiu":
+        raise ParameterError(
+            f"{what} must return a vector of numbers: got an array of shape {p.shape} and "
+            f"dtype {np.asarray(raw).dtype}"
+        )
+    return p
+
+
+def _not_finite(model: Any, p: np.ndarray) -> str:
+    """The refusal of packed parameters that are not all finite: the model's fields (a
+    dataclass model's parameters) that are NaN or infinite, else the positions in the vector."""
+    import dataclasses
+    import numbers
+
+    bad = []
+    if dataclasses.is_dataclass(model):
+        for f in dataclasses.fields(model):
+            value = getattr(model, f.name, None)
+            if isinstance(value, numbers.Real) and not isinstance(value, bool):
+                if not math.isfinite(float(value)):
+                    bad.append(f"{f.name} = {value!r}")
+    if bad:
+        return (
+            f"{model.name}: the parameter {', '.join(bad)} must be a finite number; give "
+            "it a finite value"
+        )
+    where = ", ".join(str(int(k)) for k in np.flatnonzero(~np.isfinite(p))[:8])
+    return (
+        f"{model.name}: pack(omega) gave NaN or inf at position {where} of the packed "
+        f"parameters (a parameter it derives from the model's fields is not finite)"
+    )
+
+
 @dataclass(frozen=True, eq=False)
 class System:
     """A model at one forcing frequency, ready for the compiled integrator.
@@ -89,9 +137,9 @@ class System:
                 f"model must be a gearchaos model: got {type(self.model).__name__}"
             )
         object.__setattr__(self, "omega", om)
-        p = np.ascontiguousarray(self.model.pack(om), dtype=np.float64)
+        p = _packed(self.model, om)
         if not np.all(np.isfinite(p)):
-            raise ParameterError(f"{self.model.name}: packed parameters contain NaN or inf")
+            raise ParameterError(_not_finite(self.model, p))
         p.setflags(write=False)
         object.__setattr__(self, "params", p)
 

@@ -1,25 +1,29 @@
-"""Export of results to the formats other tools read: a tidy CSV table and a MATLAB file.
+"""Export of results to the formats other tools read: CSV tables and a MATLAB file.
 
-:func:`export` takes a sweep store (``RUN.zarr``), a simulation file (``simulation.nc``) or an
-open :class:`xarray.Dataset` of either kind and writes
+:func:`export` takes a sweep store (``RUN.zarr`` of ``gearchaos bifurcation``), a response
+store (``gearchaos response``), a basin or basin-fraction store (``gearchaos basins``,
+``basin-fractions``), a simulation file (``simulation.nc``) or an open
+:class:`xarray.Dataset` of one of these, and writes
 
-* ``csv`` — one row per point and section sample (a tidy table): the swept parameters, the
-  section index (and ``tau`` for a simulation), the planet where a variable is per planet, then
-  one column per variable; per-point variables (``status``, ``motion``, ``lle`` …) repeat on the
-  rows of their point, and those over every planet or state get one column per planet or state
-  (``contact_sp_p1`` … ``contact_sp_p5``, ``delta_sp_min_p1``, ``final_state_x_s``). A
-  header of ``#`` lines carries the provenance (gear set name, settings, versions), which
-  ``pandas.read_csv(..., comment="#")`` skips.
+* ``csv`` — a table a spreadsheet and ``pandas.read_csv(path)`` open as they are: one row
+  per point with the units in the column names (``omega``, ``sun_rpm``, ``mesh_hz``,
+  ``motion``, ``lle``, ``load_factor_sp``, ``contact_sp_p1`` …; :mod:`.export_table`), the
+  section samples in a separate long table ``RUN.sections.csv`` (one row per point and
+  sample), and the provenance and the meaning and unit of every column in the sidecar
+  ``RUN.csv.json`` (:mod:`.export_files`);
 * ``mat`` — every variable and coordinate as a MATLAB array (``scipy.io.savemat``, format 5),
   names with ``.`` turned into ``_`` (``backlash.sun_planet`` → ``backlash_sun_planet``), the
   dimension names of each variable in ``dims_<name>`` and the attributes in the struct
   ``attrs``; label arrays become cell arrays of strings.
 
-The write is atomic (a temporary file renamed into place).
+Branch files of ``gearchaos continue``, boundary curves and orbit files are refused, naming
+what they are and the kinds :func:`export` writes. Every write is atomic (a temporary file
+renamed into place); an existing file is replaced only when gearchaos wrote it.
 """
 
 from __future__ import annotations
 
+import json
 import os
 import re
 from pathlib import Path
@@ -27,36 +31,127 @@ from typing import Any
 
 import numpy as np
 
-from .._files import check_output_file, check_path
+from .._files import check_output_file, check_path, load_netcdf, read_text_file
 from .._output import check_replaceable, file_has_mark, staged_file
-from .._version import __version__
+from .._text import escape_path
 from ..errors import ParameterError, StoreError
+from .export_files import sections_path, sidecar_path, write_csv_export
+from .export_table import ExportTables, export_tables
 
-__all__ = ["FORMATS", "export", "open_result", "table"]
+__all__ = ["FORMATS", "KINDS", "export", "open_result", "result_kind", "table", "write_export"]
 
 #: The formats :func:`export` writes.
 FORMATS = ("csv", "mat")
 
-#: Attributes written into the CSV header (when present).
-_HEADER_ATTRS = (
-    "title",
-    "model",
-    "omega",
-    "transient_periods",
-    "periods",
-    "samples_per_period",
-    "rtol",
-    "atol",
-    "initial_conditions",
-    "status",
-    "version",
-    "numba_version",
-    "numpy_version",
+#: The kinds of results :func:`export` writes, with the command that makes each.
+KINDS = {
+    "sweep": "sweep stores (gearchaos bifurcation)",
+    "response": "response stores (gearchaos response)",
+    "basins": "basin stores (gearchaos basins)",
+    "basin_fractions": "basin-fraction stores (gearchaos basin-fractions)",
+    "simulation": "simulation files (gearchaos simulate -o DIR)",
+}
+
+_EXPORTS = (
+    "export writes sweep stores (gearchaos bifurcation), response stores (gearchaos response), "
+    "basin stores (gearchaos basins, basin-fractions) and simulation files (gearchaos "
+    "simulate -o DIR)"
 )
 
 
+def _refuse(path: str, what: str, hint: str) -> StoreError:
+    return StoreError(f"'{escape_path(path)}' is {what}: {_EXPORTS}; {hint}")
+
+
+def result_kind(ds: Any) -> str:
+    """The kind of a result dataset (a key of :data:`KINDS`); a branch, a boundary curve, an
+    orbit or anything else raises :class:`~gearchaos.errors.StoreError` saying what it is."""
+    from ..dynamics.orbit_file import ORBIT_TITLE
+    from ..integrate.result import SIMULATION_TITLE
+    from ._basin_store import KINDS as BASIN_KINDS
+
+    attrs = ds.attrs
+    kind = attrs.get("kind")
+    title = str(attrs.get("title", ""))
+    if kind in BASIN_KINDS and "attractor" in ds.data_vars:
+        return str(kind)
+    if title.startswith(SIMULATION_TITLE):
+        return "simulation"
+    if "status" in ds.data_vars and isinstance(attrs.get("sweep_toml"), str):
+        return "response" if kind == "response" else "sweep"
+    name = "the dataset"
+    if kind == "boundary_curve":
+        raise _refuse(name, "a boundary curve of gearchaos boundary", _CURVE_HINT)
+    if "parameter" in attrs:
+        raise _refuse(name, "a branch of gearchaos continue", _BRANCH_HINT)
+    if title.startswith(ORBIT_TITLE):
+        raise _refuse(name, "an orbit file of gearchaos orbit", _ORBIT_HINT)
+    raise _refuse(name, "no result gearchaos exports", "check the path")
+
+
+_BRANCH_HINT = (
+    "draw it with gearchaos plot BRANCH, or read it in Python with "
+    "gearchaos.dynamics.open_branch (an xarray.Dataset)"
+)
+_CURVE_HINT = "draw it with gearchaos plot CURVE, or read it with gearchaos.dynamics.open_branch"
+_ORBIT_HINT = (
+    "read it with gearchaos.dynamics.open_orbit, or continue it with gearchaos continue --from"
+)
+
+
+def _store_kind(path: str) -> str | None:
+    """The ``kind`` attribute of a Zarr directory's root (``None`` when unreadable or absent;
+    the store's own reader then reports what is wrong)."""
+    try:
+        text = read_text_file(
+            os.path.join(path, ".zattrs"), what="store attributes", max_bytes=1 << 26
+        )
+        attrs = json.loads(text)
+    except (StoreError, ParameterError, ValueError):
+        return None
+    if not isinstance(attrs, dict):
+        return None
+    if "parameter" in attrs:
+        return "boundary_curve" if attrs.get("kind") == "boundary_curve" else "branch"
+    kind = attrs.get("kind")
+    return kind if isinstance(kind, str) else None
+
+
+def _open_store(path: str) -> Any:
+    from ._basin_store import KINDS as BASIN_KINDS
+    from ._basin_store import open_basins
+    from .store import open_sweep
+
+    kind = _store_kind(path)
+    if kind in BASIN_KINDS:
+        return open_basins(path).load()
+    if kind == "branch":
+        raise _refuse(path, "a branch store of gearchaos continue", _BRANCH_HINT)
+    if kind == "boundary_curve":
+        raise _refuse(path, "a boundary curve of gearchaos boundary", _CURVE_HINT)
+    return open_sweep(path).load()
+
+
+def _open_file(path: str) -> Any:
+    from ..dynamics.orbit_file import ORBIT_TITLE
+    from ..integrate.result import SIMULATION_TITLE
+
+    name, ds = load_netcdf(path, what="result file")
+    title = str(ds.attrs.get("title", ""))
+    if title.startswith(SIMULATION_TITLE):
+        return ds
+    if ds.attrs.get("kind") == "boundary_curve":
+        raise _refuse(name, "a boundary curve of gearchaos boundary", _CURVE_HINT)
+    if "parameter" in ds.attrs:
+        raise _refuse(name, "a branch of gearchaos continue", _BRANCH_HINT)
+    if title.startswith(ORBIT_TITLE):
+        raise _refuse(name, "an orbit file of gearchaos orbit", _ORBIT_HINT)
+    raise _refuse(name, "a netCDF file gearchaos did not write as a result", "check the path")
+
+
 def open_result(source: Any) -> Any:
-    """A dataset from a sweep store, a simulation file or a dataset (returned as it is)."""
+    """A result dataset from a store or file path, a result object or a dataset (returned
+    as it is); see the module docstring for the kinds."""
     import xarray as xr
 
     if isinstance(source, xr.Dataset):
@@ -66,123 +161,56 @@ def open_result(source: Any) -> Any:
     if hasattr(source, "ds") and isinstance(source.ds, xr.Dataset):
         return source.ds
     path = check_path(
-        source, f"source must be a sweep store, a simulation file or a Dataset: got {source!r}"
+        source, f"source must be a result store or file, or a Dataset: got {source!r}"
     )
     if os.path.isdir(path):
-        from .store import open_sweep
+        return _open_store(path)
+    if not os.path.lexists(path):
+        raise StoreError(f"no result at '{escape_path(path)}' (no such file or directory)")
+    return _open_file(path)
 
-        return open_sweep(path).load()
-    if not os.path.exists(path):
-        raise StoreError(f"no result at {path!r} (no such file or directory)")
-    from ..integrate.result import open_simulation
 
+def _gearset_of(ds: Any, kind: str) -> tuple[Any, dict[str, Any]]:
+    """(the result's gear set with its fixed values applied, or ``None`` for a model's
+    result; the fixed values of a sweep)."""
+    from ..gearset import GearSet
+    from ..gearset.schema import OMEGA
+    from .result import SweepResult
+
+    if kind in ("sweep", "response"):
+        res = SweepResult(ds)
+        return res.gearset, res.fixed
+    text = ds.attrs.get("gearset_toml")
+    if not isinstance(text, str) or not text.strip():
+        return None, {}
     try:
-        return open_simulation(path)
-    except StoreError as exc:
-        if "open_branch" in str(exc):  # a branch file of `gearchaos continue`
-            raise StoreError(
-                f"{path!r} is a branch of `gearchaos continue`, not a sweep store or a "
-                "simulation file: draw it with `gearchaos plot STORE --branch` or read it with "
-                "gearchaos.dynamics.open_branch"
-            ) from None
-        raise StoreError(
-            f"{path!r} is neither a sweep store nor a simulation file: {exc}"
-        ) from None
-    except Exception as exc:  # h5netcdf / h5py raise many types for a file that is no netCDF
-        raise StoreError(
-            f"{path!r} is neither a sweep store nor a simulation file ({type(exc).__name__})"
-        ) from None
+        gs = GearSet.from_toml_string(text)
+        if kind in ("basins", "basin_fractions"):
+            spec = json.loads(str(ds.attrs.get("basin_spec", "{}")))
+            values = spec.get("values", {}) if isinstance(spec, dict) else {}
+            changes = {k: v for k, v in dict(values).items() if k != OMEGA}
+            gs = gs.evolve(changes) if changes else gs
+    except (ParameterError, ValueError, TypeError) as exc:
+        raise StoreError(f"the result's gear set (gearset_toml) is invalid: {exc}") from None
+    return gs, {}
 
 
-def _provenance_lines(ds: Any, columns: list[str]) -> list[str]:
-    """The header lines that make a CSV stand alone: the legend of every coded column
-    (``status``, ``verdict``, ``record``, ``orbit_status`` …: code = meaning, from the
-    variable's ``flag_values``/``flag_meanings``), then the whole gear set and sweep
-    specification as TOML — every parameter value, the changed ones too."""
-    lines = []
-    for name in columns:
-        if name not in ds.variables:
-            continue
-        attrs = ds[name].attrs
-        values, meanings = attrs.get("flag_values"), attrs.get("flag_meanings")
-        if values is None or not isinstance(meanings, str):
-            continue
-        pairs = ", ".join(
-            f"{int(v)} = {m}" for v, m in zip(np.ravel(values), meanings.split(), strict=False)
-        )
-        lines.append(f"# {name}: {pairs}")
-    for key, title in (("gearset_toml", "gear set"), ("sweep_toml", "sweep")):
-        text = ds.attrs.get(key)
-        if isinstance(text, str) and text.strip():
-            lines.append(f"# {title} (TOML, every value):")
-            lines += [f"#   {ln}" if ln else "#" for ln in text.strip().splitlines()]
-    return lines
-
-
-def _is_sweep(ds: Any) -> bool:
-    return "status" in ds.data_vars and "section" in ds.dims and "tau" not in ds.coords
-
-
-def table(source: Any) -> Any:
-    """The tidy table of a result as a :class:`pandas.DataFrame` (see the module docstring)."""
+def tables(source: Any) -> ExportTables:
+    """The point and section tables of a result (:mod:`.export_table`)."""
     ds = open_result(source)
-    if "section" not in ds.dims:
-        raise StoreError("the result has no section dimension: nothing to tabulate")
-    lead = [str(d) for d in ds["status"].dims] if _is_sweep(ds) else []
-    keep_dims = {*lead, "section", "planet"}
-    names = [
-        str(n)
-        for n, v in ds.data_vars.items()
-        if set(v.dims) <= keep_dims and (set(v.dims) & ({"section"} | set(lead)))
-    ]
-    if not names:
-        raise StoreError("the result has no variables over its points and sections")
-    sub = ds[names]
-    df = sub.to_dataframe().reset_index()
-    order = [*lead, "section", *(["tau"] if "tau" in df.columns else [])]
-    order += [c for c in ("planet",) if c in df.columns]
-    df = df[[*order, *(c for c in df.columns if c not in order)]]
-    wide = _wide_columns(ds, lead, names)
-    if wide:
-        import pandas as pd
-
-        extra = pd.DataFrame(wide)
-        if lead:  # per point: repeated on the rows of the point, matched by its coordinates
-            keys = {d: np.asarray(ds[d].values) for d in lead}
-            grid = np.meshgrid(*keys.values(), indexing="ij")
-            for d, g in zip(keys, grid, strict=True):
-                extra[d] = g.reshape(-1)
-            df = df.merge(extra, on=lead, how="left", sort=False)
-        else:
-            for col, values in wide.items():
-                df[col] = values[0]
-    return df
+    kind = result_kind(ds)
+    gs, fixed = _gearset_of(ds, kind)
+    return export_tables(ds, kind, gearset=gs, fixed=fixed)
 
 
-#: Dimensions spread over one column per value (planets, state components).
-_WIDE_DIMS = ("planet_all", "planet", "state")
+def table(source: Any, *, sections: bool = False) -> Any:
+    """The point table of a result (or with ``sections`` its section table) as a
+    :class:`pandas.DataFrame`, with the columns of the CSV export."""
+    import pandas as pd
 
-
-def _wide_columns(ds: Any, lead: list[str], skip: list[str]) -> dict[str, np.ndarray]:
-    """The per-point variables over one more dimension (the extrema and contact regimes of every
-    planet over ``planet_all``, the final state over ``state``) as one column per value of that
-    dimension: ``contact_sp_p3``, ``delta_sp_min_p1``, ``final_state_x_s``; values flattened in
-    the order of the lead dimensions."""
-    out: dict[str, np.ndarray] = {}
-    for name, var in ds.data_vars.items():
-        if name in skip or "section" in var.dims:
-            continue
-        extra = [d for d in var.dims if d not in lead]
-        if len(extra) != 1 or [d for d in var.dims if d in lead] != lead:
-            continue
-        (dim,) = extra
-        if dim not in _WIDE_DIMS:  # e.g. the time samples of a simulation: not one per column
-            continue
-        values = var.transpose(*lead, dim).values.reshape(-1, var.sizes[dim])
-        prefix = "p" if dim in ("planet_all", "planet") else ""
-        for k, label in enumerate(np.asarray(ds[dim].values)):
-            out[f"{name}_{prefix}{label}"] = values[:, k]
-    return out
+    t = tables(source)
+    cols = t.sections if sections else t.points
+    return pd.DataFrame({c.name: c.values for c in cols})
 
 
 def _mat_name(name: str) -> str:
@@ -218,19 +246,32 @@ def _write_mat(ds: Any, path: str) -> None:
 
 
 def export(source: Any, path: str | os.PathLike[str], *, to: str | None = None) -> Path:
-    """Write a result as CSV or MATLAB ``.mat`` (see the module docstring); returns the path.
+    """Write a result as CSV tables or a MATLAB ``.mat`` file (see the module docstring).
 
     Parameters
     ----------
     source
-        A sweep store path, a simulation file path (``simulation.nc``) or a dataset of either.
+        A sweep, response, basin or basin-fraction store path, a simulation file path
+        (``simulation.nc``) or a dataset of one of these.
     path
-        The file to write.
+        The file to write: the point table of a CSV export (its section table and sidecar
+        are written beside it: ``RUN.sections.csv``, ``RUN.csv.json``), or the ``.mat`` file.
     to
         ``csv`` or ``mat``; default: from the suffix of ``path``.
+
+    Returns
+    -------
+    Path
+        ``path`` (the point table of a CSV export); :func:`write_export` returns every file.
     """
+    return write_export(source, path, to=to)[0]
+
+
+def write_export(source: Any, path: str | os.PathLike[str], *, to: str | None = None) -> list[Path]:
+    """:func:`export`, returning every file written (the point table, the section table when
+    the result has sections, the sidecar; or the ``.mat`` file)."""
     if isinstance(path, str | os.PathLike) and os.path.isdir(path):
-        raise ParameterError(f"the output must be a file: {os.fspath(path)!r} is a directory")
+        raise ParameterError(f"the output must be a file: '{escape_path(path)}' is a directory")
     out = Path(check_output_file(path, what="the output"))
     fmt = to if to is not None else out.suffix.lower().lstrip(".")
     if fmt not in FORMATS:
@@ -238,26 +279,23 @@ def export(source: Any, path: str | os.PathLike[str], *, to: str | None = None) 
             f"the export format must be one of {', '.join(FORMATS)} (or a path ending in "
             f".csv or .mat): got {to if to is not None else out.name!r}"
         )
-    if out.is_dir():
-        raise ParameterError(f"the output must be a file: {str(out)!r} is a directory")
     ds = open_result(source)
+    kind = result_kind(ds)
     out.parent.mkdir(parents=True, exist_ok=True)
-    # an existing export is replaced only if gearchaos wrote it (its header, the .mat's text)
+    if fmt == "csv":
+        gs, fixed = _gearset_of(ds, kind)
+        for extra in (sections_path(str(out)), sidecar_path(str(out))):
+            check_output_file(extra, what="the output")
+        written = write_csv_export(
+            export_tables(ds, kind, gearset=gs, fixed=fixed),
+            str(out),
+            attrs=dict(ds.attrs),
+            source=os.fsdecode(source) if isinstance(source, str | bytes | os.PathLike) else None,
+            gearset=gs,
+        )
+        return [Path(p) for p in written]
+    # an existing .mat is replaced only if gearchaos wrote it
     check_replaceable(str(out), what="export", ours=file_has_mark)
     with staged_file(str(out), what="export") as staged:
-        tmp = Path(staged)
-        if fmt == "csv":
-            df = table(ds)
-            header = [f"# {k} = {ds.attrs[k]}" for k in _HEADER_ATTRS if k in ds.attrs]
-            if ds.attrs.get("gearset_toml"):
-                name = re.search(r'^name = "(.*)"', str(ds.attrs["gearset_toml"]), re.M)
-                if name:
-                    header.insert(0, f"# gearset = {name.group(1)}")
-            header.insert(0, f"# gearchaos {__version__} export of {os.fspath(source)}")
-            header += _provenance_lines(ds, [*map(str, df.columns), *map(str, ds.data_vars)])
-            with open(tmp, "w", encoding="utf-8", newline="") as f:
-                f.write("\n".join(header) + ("\n" if header else ""))
-                df.to_csv(f, index=False)  # floats as repr: the shortest exact text
-        else:
-            _write_mat(ds, os.fspath(tmp))
-    return out
+        _write_mat(ds, os.fspath(staged))
+    return [out]

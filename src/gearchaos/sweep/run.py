@@ -358,8 +358,9 @@ def _run_locked(
 
 
 def _check_sizes(grid: Grid, variables: dict[str, Any], path: str | None) -> None:
-    """Refuse, before anything is written, a sweep whose task outputs do not fit in memory or
-    whose store (uncompressed, the worst case) does not fit on the disk."""
+    """Refuse, before anything is written, a sweep whose task outputs do not fit in memory,
+    whose runs span more forcing periods than the time variable resolves, or whose store
+    (uncompressed, the worst case) does not fit on the disk."""
     import shutil
 
     from .._checks import check_memory
@@ -370,6 +371,7 @@ def _check_sizes(grid: Grid, variables: dict[str, Any], path: str | None) -> Non
     )
     largest = int(np.prod(grid.chunks))  # points of the largest task
     check_memory(f"one task of the sweep ({largest} points)", 8.0 * per_point * largest)
+    grid.spec.solver.check_span()
     total = sum(
         float(np.prod(shape)) * np.dtype(dtype).itemsize
         for _, (shape, dtype), _, _ in variables.values()
