@@ -43,7 +43,7 @@ def _escape_char(ch: str) -> str:
     return f"\\U{code:08x}"
 
 
-def escape_text(value: object) -> str:
+def escape_text(value: object, *, keep: str = "") -> str:
     r"""``value`` as text that only prints: every control character is shown as an escape.
 
     Parameters
@@ -51,6 +51,9 @@ def escape_text(value: object) -> str:
     value : object
         Usually a ``str`` read from a file, a store or the command line; anything else is
         converted with ``str`` first (a path: :func:`escape_path`).
+    keep : str, optional
+        Characters left as they are (``"\n"`` for a message of several lines whose parts
+        were escaped where they came from a file).
 
     Returns
     -------
@@ -75,7 +78,7 @@ def escape_text(value: object) -> str:
         return text
     out = []
     for ch in text:
-        if ch.isprintable() or unicodedata.category(ch) not in _ACTING:
+        if ch.isprintable() or ch in keep or unicodedata.category(ch) not in _ACTING:
             out.append(ch)
         else:
             out.append(_escape_char(ch))

@@ -109,8 +109,9 @@ def test_sweep_store_rebuilds_the_model_for_starts_and_the_explorer(
     ds = gc.open_sweep(store)
     assert ds.attrs["model_class"].endswith("twin_well_cli.py:TwinWell")
     assert json.loads(ds.attrs["model_fields"])["gamma"] == 0.3
-    # a start from the store's point: the orbit of the built-in system at that point
-    out = _json(runner, ["orbit", "--from", str(store), "--at", "omega=1.2"])
+    # a start from the store's point (the model named: a file alone never runs code): the
+    # orbit of the built-in system at that point
+    out = _json(runner, ["orbit", "--from", str(store), "--at", "omega=1.2", "--model", model_file])
     ref = gc.periodic_orbit(_builtin(1.2, 0.3), period=out["period"])
     assert out["converged"] and ref.converged
     np.testing.assert_allclose(out["x_sp1"], ref.section("x"), atol=1e-8)

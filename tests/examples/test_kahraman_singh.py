@@ -23,7 +23,8 @@ from scipy.integrate import solve_ivp
 
 import gearchaos as gc
 from gearchaos.model import System
-from gearchaos.model.contract import build_model, check_model, load_model_class
+from gearchaos.model.contract import check_model
+from gearchaos.model.loading import build_model, load_model_class
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "kahraman_singh_1991.py"

@@ -29,7 +29,8 @@ from gearchaos.dynamics.shooting import shoot
 from gearchaos.integrate.settings import SolverSettings
 from gearchaos.integrate.simulate import integrate
 from gearchaos.model import System
-from gearchaos.model.contract import UserModel, build_model, check_model, load_model_class
+from gearchaos.model.contract import UserModel, check_model
+from gearchaos.model.loading import build_model, load_model_class
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "kahraman_singh_1991.py"

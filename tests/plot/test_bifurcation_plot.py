@@ -370,7 +370,7 @@ def test_a_user_models_variable_is_drawn_with_the_models_symbol() -> None:
     member of the model contract): δ̄ of the Kahraman–Singh example, not the name ``delta``
     (docs/howto/own-model.png); a model without symbols, or one that can no longer be built,
     keeps the upright name."""
-    from gearchaos.model.contract import load_model_class, model_reference
+    from gearchaos.model.loading import load_model_class, model_reference
 
     cls = load_model_class("examples/kahraman_singh_1991.py:KahramanSingh1991")
     ds = sweep_dataset(np.array([1, 2, 1]), {"omega": np.array([1.9, 2.0, 2.1])})
@@ -390,7 +390,7 @@ def test_a_user_models_parameters_are_named_by_its_parameter_symbols() -> None:
     that no reference system shares (μ_p, κ_g, b̄_h), over two lines (one ran past both
     edges of docs/howto/own-model.png)."""
     from gearchaos.model import System
-    from gearchaos.model.contract import load_model_class
+    from gearchaos.model.loading import load_model_class
 
     cls = load_model_class("examples/kahraman_singh_1991.py:KahramanSingh1991")
     sweep = gc.bifurcation(

@@ -47,10 +47,10 @@ def test_given_values_of_a_reference_system_leave_out_the_swept() -> None:
 
 def test_parameter_symbols_are_the_models_own_or_none() -> None:
     """The parameter symbols of what a store records: none for a gear set (the registry names
-    its parameters), a reference system (no ``parameter_symbols``) or a model that can no
-    longer be built; the model's own for a user model (the Kahraman–Singh example)."""
+    its parameters), a reference system (no ``parameter_symbols``) or a model the user has not
+    named; the model's own for a user model (the Kahraman–Singh example)."""
     from gearchaos.gearset.io import to_toml
-    from gearchaos.model.contract import load_model_class, model_reference
+    from gearchaos.model.loading import load_model_class, model_reference
 
     gs = gc.preset("sheng2016")
     assert parameter_symbols({"model": "planetary", "gearset_toml": to_toml(gs)}) == {}
@@ -60,5 +60,9 @@ def test_parameter_symbols_are_the_models_own_or_none() -> None:
     attrs = {"model": "kahraman_singh_1991", **model_reference(cls())}
     assert parameter_symbols(attrs)["f_mean"] == r"\bar{F}_m"
     assert given("zeta_h", 0.05, parameter_symbols(attrs)) == r"$\zeta_h$ = 0.05"
+    # the file moved: the class the user named (load_model_class) is the one it records
     attrs["model_class"] = "no/such/file.py:KahramanSingh1991"
+    assert parameter_symbols(attrs)["f_mean"] == r"\bar{F}_m"
+    # a model the user never named is never imported: no symbols
+    attrs["model_class"] = "no/such/file.py:NeverNamed1991"
     assert parameter_symbols(attrs) == {}

@@ -79,7 +79,7 @@ def _model_reference_issue_25(new: dict[str, object], ref: dict[str, object]) ->
     """Issue 25 records how to build a model that is not a gear set again (``model_class``,
     ``model_fields``): the model they build must be the one the reference recorded by its
     repr (``model_parameters``); then take them."""
-    from gearchaos.model.contract import rebuild_model
+    from gearchaos.model.loading import rebuild_model
 
     out = dict(ref)
     if "model_class" in new:

@@ -25,6 +25,7 @@ import typer.core
 from rich.console import Console
 from rich.text import Text
 
+from .._text import escape_path, escape_text
 from .._version import __version__
 from ..errors import IntegrationError, ParameterError, StoreError
 from ..gearset.parsing import parse_text
@@ -122,17 +123,22 @@ def stderr() -> Console:
 
 
 def fail(message: str, code: int) -> NoReturn:
-    stderr().print(Text("error: ", style="bold red") + Text(message), soft_wrap=True)
+    """``error: MESSAGE`` on stderr (control characters of paths and names in it shown as
+    escapes, :func:`~gearchaos._text.escape_text`), then exit with ``code``."""
+    text = escape_text(message, keep="\n")
+    stderr().print(Text("error: ", style="bold red") + Text(text), soft_wrap=True)
     raise typer.Exit(code)
 
 
 def warn(message: str) -> None:
-    stderr().print(Text("warning: ", style="bold yellow") + Text(message), soft_wrap=True)
+    text = escape_text(message, keep="\n")
+    stderr().print(Text("warning: ", style="bold yellow") + Text(text), soft_wrap=True)
 
 
 def wrote(path: Path | str) -> None:
-    """``wrote PATH`` on stdout, never wrapped (paths must stay copyable)."""
-    stdout().print(Text.assemble(("wrote ", "dim"), (str(path), "bold")), soft_wrap=True)
+    """``wrote PATH`` on stdout, never wrapped (paths must stay copyable; control characters
+    shown as escapes)."""
+    stdout().print(Text.assemble(("wrote ", "dim"), (escape_path(path), "bold")), soft_wrap=True)
 
 
 @contextlib.contextmanager
@@ -291,7 +297,7 @@ def load_target(
     if preset is not None or gearset_file is not None:
         raise ParameterError("--model excludes --preset and --gearset: give one of them")
     from ..model import System
-    from ..model.contract import build_model, load_model_class
+    from ..model.loading import build_model, load_model_class
 
     return System(build_model(load_model_class(model), dict(changes or {})), DEFAULT_OMEGA)
 
@@ -424,7 +430,19 @@ ModelOpt = Annotated[
         "-m",
         help="Your own model instead of a gear set: FILE.py:CLASS, MODULE:CLASS or an installed "
         "name (see docs/howto/own-model.md); --set NAME=VALUE sets its parameters. Excludes "
-        "--preset and --gearset.",
+        "--preset and --gearset. With --from, the model the file records: naming it is your "
+        "consent to run its code, which a file alone never gets.",
+        show_default=False,
+    ),
+]
+FromModelOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--model",
+        "-m",
+        help="The model a file records, when it is your own (FILE.py:CLASS, MODULE:CLASS or an "
+        "installed name; see docs/howto/own-model.md): naming it is your consent to run its "
+        "code, which a file alone never gets.",
         show_default=False,
     ),
 ]

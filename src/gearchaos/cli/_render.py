@@ -9,10 +9,11 @@ from typing import Any
 
 import numpy as np
 from rich.columns import Columns
-from rich.markup import escape
+from rich.markup import escape as escape_markup
 from rich.table import Table
 from rich.text import Text
 
+from .._text import escape_text
 from ..analysis.summary import format_exponent
 from ..gearset.mapping import flatten
 from ..gearset.schema import display_symbol as symbol
@@ -119,6 +120,12 @@ _UNIT_SUFFIXES = (
     ("_m", "m"),
     ("_N", "N"),
 )
+
+
+def escape(text: str) -> str:
+    """Text for a table: control characters (of names and titles read from files) shown as
+    escapes (:func:`~gearchaos._text.escape_text`), rich markup characters escaped."""
+    return escape_markup(escape_text(text))
 
 
 def label(path: str) -> str:
@@ -302,7 +309,7 @@ def format_summary(summary: dict[str, Any], *, title: str | None = None) -> Any:
     if title is None:
         gs = summary.get("gearset")
         title = f"gearchaos simulation{f' of {gs}' if gs else ''}"
-    table = Table(title=title, show_header=True, header_style="bold")
+    table = Table(title=escape(title), show_header=True, header_style="bold")
     table.add_column("quantity")
     table.add_column("value", justify="right")
     labels = {

@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from .._text import escape_path, escape_text
 from ..errors import ParameterError, StoreError
 
 OMEGA = "omega"
@@ -63,13 +64,43 @@ def _number(name: str, text: str) -> float:
     return value
 
 
-def load_start(path: str, at: str | None) -> Start:
-    """The start at ``--at`` in the sweep store, branch file or orbit file ``path``."""
+def name_model(model: str | None) -> type | None:
+    """The class ``--model`` names, or ``None``: naming it is the user's consent to build it
+    again from the files the command reads
+    (:func:`~gearchaos.model.loading.load_model_class`); a file's own record never imports
+    anything."""
+    if model is None:
+        return None
+    from ..model.loading import load_model_class
+
+    return load_model_class(model)
+
+
+def load_start(path: str, at: str | None, model: str | None = None) -> Start:
+    """The start at ``--at`` in the sweep store, branch file or orbit file ``path``; a model
+    the file records is built again only when it is a reference system of gearchaos, or the
+    one ``model`` (``--model``) names, or an installed one
+    (:func:`~gearchaos.model.loading.rebuild_model`)."""
     if not isinstance(path, str) or not path:
         raise ParameterError(f"--from must be a path: got {path!r}")
     where = parse_at(at)
+    named = name_model(model)
     if not os.path.lexists(path):
-        raise ParameterError(f"--from {path}: no such file or directory")
+        raise ParameterError(f"--from {escape_path(path)}: no such file or directory")
+    start = _load(path, where)
+    if named is not None:
+        target = start.gearset
+        own = getattr(target, "model", None) if not hasattr(target, "evolve") else None
+        if type(own) is not named:
+            what = "a gear set" if own is None else f"the model {type(own).__qualname__}"
+            raise ParameterError(
+                f"--model {escape_text(model)} does not apply: --from {escape_path(path)} is of "
+                f"{what}; drop --model"
+            )
+    return start
+
+
+def _load(path: str, where: dict[str, str]) -> Start:
     from ..sweep.store import is_sweep_store
 
     if os.path.isdir(path) and is_sweep_store(path):
@@ -86,24 +117,26 @@ def load_start(path: str, at: str | None) -> Start:
         ds = open_orbit(path)
     except StoreError:
         raise StoreError(
-            f"--from {path} is no sweep store, branch file or orbit file of gearchaos"
+            f"--from {escape_path(path)} is no sweep store, branch file or orbit file of gearchaos"
         ) from None
     return _from_orbit(path, ds, where)
 
 
 def _gearset(attrs: Any, path: str) -> Any:
+    """The gear set a file records, or a :class:`~gearchaos.model.System` of the model it
+    records (built only with the user's consent: ``--model``)."""
     from ..gearset import GearSet
 
     text = str(attrs.get("gearset_toml", ""))
     if not text:
         from ..model import System
-        from ..model.contract import rebuild_model
+        from ..model.loading import rebuild_model
 
-        model = rebuild_model(attrs)
+        model = rebuild_model(attrs, where=f"--from {escape_path(path)}")
         if model is None:
             raise StoreError(
-                f"--from {path}: its model is neither a gear set (no gearset_toml) nor one it "
-                "records how to build (no model_class); start it from Python "
+                f"--from {escape_path(path)}: its model is neither a gear set (no gearset_toml) "
+                "nor one it records how to build (no model_class); start it from Python "
                 "(periodic_orbit(system, guess=state))"
             )
         return System(model, 1.0)
@@ -116,6 +149,10 @@ def _from_store(path: str, where: dict[str, str]) -> Start:
 
     res = SweepResult.open(path)
     ds = res.ds
+    if res.base_gearset is None:  # a model the user has not named is refused, naming the file
+        from ..model.loading import rebuild_model
+
+        rebuild_model(ds.attrs, where=f"--from {escape_path(path)}")
     if "final_state" not in ds:
         raise StoreError(f"--from {path}: the store holds no final states to start from")
     index: dict[str, Any] = {}
@@ -176,7 +213,8 @@ def _from_store(path: str, where: dict[str, str]) -> Start:
         values=values,
         state=state,
         period=int(match.group(1)) if match else None,
-        source=f"{os.path.basename(path)} at {text}" + (f" ({label})" if label else ""),
+        source=f"{escape_path(os.path.basename(path))} at {text}"
+        + (f" ({escape_text(label)})" if label else ""),
         section=section,
     )
 
@@ -186,6 +224,7 @@ def _section(attrs: Any) -> dict[str, float]:
 
 
 def _from_branch(path: str, ds: Any, where: dict[str, str]) -> Start:
+    target = _gearset(ds.attrs, path)  # a model the user has not named: refused first
     name = str(ds.attrs["parameter"])
     if set(where) != {name}:
         raise ParameterError(
@@ -203,11 +242,12 @@ def _from_branch(path: str, ds: Any, where: dict[str, str]) -> Start:
     values = {str(key): _value(v) for key, v in json.loads(str(ds.attrs["fixed"])).items()}
     values[name] = value
     return Start(
-        gearset=_gearset(ds.attrs, path),
+        gearset=target,
         values=values,
         state=np.asarray(ds["orbit_state"].values[k], dtype=np.float64),
         period=int(ds.attrs["period"]),
-        source=f"{os.path.basename(path)} at {name}={value:g} (branch point {k})",
+        source=f"{escape_path(os.path.basename(path))} at {escape_text(name)}={value:g} "
+        f"(branch point {k})",
         section=_section(ds.attrs),
     )
 
@@ -218,6 +258,7 @@ def _value(v: Any) -> Any:
 
 
 def _from_orbit(path: str, ds: Any, where: dict[str, str]) -> Start:
+    target = _gearset(ds.attrs, path)  # a model the user has not named: refused first
     if where:
         raise ParameterError(f"--at does not apply to an orbit file ({path}): drop it")
     values = {
@@ -227,11 +268,11 @@ def _from_orbit(path: str, ds: Any, where: dict[str, str]) -> Start:
     }
     values[OMEGA] = float(ds.attrs["omega"])
     return Start(
-        gearset=_gearset(ds.attrs, path),
+        gearset=target,
         values=values,
         state=np.asarray(ds["orbit_state"].values, dtype=np.float64),
         period=int(ds.attrs["period"]),
-        source=f"{os.path.basename(path)} (period-{int(ds.attrs['period'])} orbit at Ω = "
-        f"{values[OMEGA]:g})",
+        source=f"{escape_path(os.path.basename(path))} (period-{int(ds.attrs['period'])} orbit "
+        f"at Ω = {values[OMEGA]:g})",
         section=_section(ds.attrs),
     )

@@ -118,6 +118,7 @@ def boundary(
         bool,
         typer.Option("--resume", help="Extend the unfinished ends of an existing CURVE.nc."),
     ] = False,
+    model: c.FromModelOpt = None,
     overwrite: c.OverwriteOpt = False,
     quiet: c.QuietOpt = False,
     json_out: c.JsonOpt = False,
@@ -134,18 +135,19 @@ def boundary(
     from ..dynamics.branch import open_branch
     from ..dynamics.branch_events import events
     from ..integrate.settings import SolverSettings
-    from ._start import _gearset
+    from ._start import _gearset, name_model
 
     with c.reported_errors():
         path = c.output_path(output)
         assert path is not None
         if path.suffix.lower() not in (".nc", ".zarr"):
             raise ParameterError(f"--output must end in .nc or .zarr: got {output!r}")
+        name_model(model)  # the consent to build the branch's own model again
         branch = open_branch(from_)
         if branch.attrs.get("kind") == "boundary_curve":
             raise ParameterError(f"--from {from_} is a boundary curve, not a one-parameter branch")
+        target = _gearset(branch.attrs, str(from_))  # its model, before anything else
         chosen = pick_event(events(branch), event)
-        target = _gearset(branch.attrs, str(from_))
         cfg = SolverSettings.from_record(branch.attrs)
         name = str(branch.attrs["parameter"])
         if within is None:

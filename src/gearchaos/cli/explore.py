@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 from rich.text import Text
 
+from .._text import escape_path
 from ..errors import ParameterError
 from . import _common as c
 
@@ -41,6 +42,7 @@ def explore(
             show_default=False,
         ),
     ] = None,
+    model: c.FromModelOpt = None,
 ) -> None:
     """Explore a sweep store in the browser: its bifurcation diagram with the band of motion
     labels (or the regime map of a 2-D sweep). Click a point, or move the slider, to see its
@@ -51,9 +53,11 @@ def explore(
 
     Example: **gearchaos explore fig4.zarr --no-browser**
     """
+    from ._start import name_model
     from .sweep import open_store
 
     with c.reported_errors():
+        name_model(model)  # a finer sweep of your own model's store: only with your consent
         if not 0 <= port <= 65535:
             raise ParameterError(f"--port must be an integer in 0..65535: got {port}")
         open_store(store)
@@ -62,7 +66,9 @@ def explore(
         def ready(url: str) -> None:
             out = c.stdout()
             out.print(
-                Text.assemble(("explorer of ", "dim"), (str(store), "bold"), (" at ", "dim")),
+                Text.assemble(
+                    ("explorer of ", "dim"), (escape_path(store), "bold"), (" at ", "dim")
+                ),
                 soft_wrap=True,
                 end="",
             )

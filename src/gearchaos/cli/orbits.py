@@ -88,14 +88,12 @@ def _start_values(
             raise ParameterError(f"--at picks a point of --from, which is missing: got --at {at}")
         values: dict[str, Any] = {} if omega is None else {OMEGA: omega}
         return c.load_target(preset, gearset, model, changes), values, None
-    if model is not None:
-        raise ParameterError("--from brings the model it was computed for: drop --model")
     if preset is not None or gearset is not None:
         raise ParameterError(
             "--from brings the gear set it was computed for: drop --preset/--gearset (change "
             "values with --set)"
         )
-    start = load_start(from_, at)
+    start = load_start(from_, at, model)
     values = {**start.values, **changes}
     if omega is not None:
         values[OMEGA] = omega

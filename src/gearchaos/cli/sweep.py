@@ -415,6 +415,7 @@ def plot(
             show_default=False,
         ),
     ] = None,
+    model: c.FromModelOpt = None,
 ) -> None:
     """Draw a sweep store: bifurcation diagrams (one panel per family value, with a band of
     motion labels under each) for a 1-D sweep, maps coloured by motion label (1T, 2T, …, QP,
@@ -431,8 +432,10 @@ def plot(
     branch.nc -o branch.png**, **gearchaos plot map.zarr --boundaries pd.nc -o chart.png**
     """
     from ..plot.figure import SAVE_FORMATS
+    from ._start import name_model
 
     with c.reported_errors():
+        name_model(model)  # symbols of your own model's variables: only with your consent
         if output.suffix.lower() not in SAVE_FORMATS:
             raise ParameterError(
                 f"--output must end in one of {', '.join(SAVE_FORMATS)}: got {str(output)!r}"

@@ -39,7 +39,7 @@ from .._version import provenance
 from ..analysis.contact import contact_regime
 from ..errors import IntegrationError, ParameterError, Status
 from ..integrate.settings import SolverSettings, split_keywords
-from ..model.contract import model_reference
+from ..model.loading import model_reference
 from ..model.system import System
 from ..model.target import resolve, scale_attrs
 from .shooting import Problem, Solution, correct, section_time

@@ -31,6 +31,7 @@ from bokeh.plotting import figure
 from ..analysis.summary import format_exponent
 from ..dynamics.curve_file import open_curve
 from ..errors import ParameterError
+from ..model.loading import named_models
 from ..plot.regimes import REGIME_COLOURS
 from ..plot.stability import boundary_label
 from ..sweep.result import open_result
@@ -428,8 +429,9 @@ class Explorer(pn.viewable.Viewer):
         values = {k: v for k, v in point.values.items()}
         key = self._point_key(point)
         self.workers.submit(
-            "point", key, compute_point, self.model.store, values, self.var, self.planet
-        )
+            "point", key, compute_point, self.model.store, values, self.var, self.planet, 10.0,
+            named_models(),
+        )  # fmt: skip
         self._poll()
 
     def _poll(self) -> None:
@@ -480,7 +482,7 @@ class Explorer(pn.viewable.Viewer):
         self.zoom_note.object = ", ".join(
             f"{k} {lo:.6g} … {hi:.6g}" for k, (lo, hi, _) in axes.items()
         )
-        self.workers.submit("zoom", self._zoom_key, run_zoom, m.store, axes)
+        self.workers.submit("zoom", self._zoom_key, run_zoom, m.store, axes, named_models())
 
 
 def readable_range(v: np.ndarray, rel: float = 1e-3) -> tuple[float, float]:

@@ -74,6 +74,7 @@ def compute_point(
     var: str | None = None,
     planet: int = 1,
     history_periods: float = 10.0,
+    models: tuple[str, ...] = (),
 ) -> dict[str, Any]:
     """Examine one point of a sweep store: simulate, λ₁, motion, multipliers, one figure.
 
@@ -97,6 +98,10 @@ def compute_point(
         variable is no mesh deflection).
     history_periods
         Forcing periods shown in the time histories (the last ones recorded).
+    models
+        The models the user named in the calling process
+        (:func:`~gearchaos.model.loading.named_models`): a worker process names them again,
+        so that a store of the user's own model is built again only with that consent.
 
     Returns
     -------
@@ -108,8 +113,10 @@ def compute_point(
         (a 2×2 figure: phase portrait, X̄ and contact force against time, spectrum).
     """
     from ..dynamics.point import analyse_point
+    from ..model.loading import name_models
     from ..sweep.result import open_result
 
+    name_models(models)
     res = open_result(store)
     target, vals = point_target(res, values)
     settings = res.spec.solver.replace(samples_per_period=POINT_SAMPLES)
@@ -220,18 +227,23 @@ def zoom_path(store: str, axes: Mapping[str, tuple[float, float, int]]) -> str:
     return os.path.join(parent, f"{stem}.zoom", "__".join(parts) + ".zarr")
 
 
-def run_zoom(store: str, axes: Mapping[str, tuple[float, float, int]]) -> str:
+def run_zoom(
+    store: str, axes: Mapping[str, tuple[float, float, int]], models: tuple[str, ...] = ()
+) -> str:
     """A finer sweep of ``store`` over the ranges ``axes`` (name → (lo, hi, count)) of its
     varied parameters, into the sibling store :func:`zoom_path` (resumable: an interrupted
     zoom continues when asked again). Every other setting — family, fixed values, observed
     variables, initial conditions, protocol, tolerances, Lyapunov — is the store's own.
 
-    Returns the path of the finer store.
+    ``models``: the models the user named, as for :func:`compute_point`. Returns the path of
+    the finer store.
     """
+    from ..model.loading import name_models
     from ..sweep.result import open_result
     from ..sweep.run import run_sweep
     from ..sweep.spec import Axis
 
+    name_models(models)  # the user's consent, named again in a worker (compute_point)
     res = open_result(store)
     spec = res.spec
     target = res.base_target  # the fixed values apply through the specification

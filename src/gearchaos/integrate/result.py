@@ -27,7 +27,7 @@ from .._files import check_output_file, load_netcdf
 from .._output import check_replaceable, file_has_mark, write_file
 from .._version import provenance
 from ..errors import ParameterError, StoreError
-from ..model.contract import model_reference
+from ..model.loading import model_reference
 from .trajectory import Trajectory
 
 __all__ = ["SimulationResult", "open_simulation"]

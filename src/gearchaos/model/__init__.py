@@ -7,7 +7,7 @@ reference systems (single-mesh backlash oscillator, linear systems, Duffing, Lor
 model written outside the package (docs/howto/own-model.md).
 """
 
-from .contract import Contact, UserModel, check_model, load_model_class
+from .contract import Contact, UserModel, check_model
 from .library import (
     backlash_oscillator,
     duffing,
@@ -15,6 +15,7 @@ from .library import (
     linear_system,
     lorenz,
 )
+from .loading import load_model_class
 from .planetary import (
     PlanetaryModel,
     PlanetaryParameters,

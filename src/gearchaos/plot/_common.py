@@ -3,7 +3,6 @@ variables of results, axes, cell edges, clearance and resonance lines."""
 
 from __future__ import annotations
 
-import functools
 import json
 import math
 import re
@@ -13,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from .._text import escape_text
 from ..errors import ParameterError
 from ..gearset.schema import OMEGA, describe
 from ..model.planetary import PlanetaryModel
@@ -93,8 +93,15 @@ def subject(attrs: Any, gearset: Any = None) -> str:
     if gearset is None:
         gearset = stored_gearset(attrs)
     if gearset is not None:
-        return str(gearset.name)
-    return str(attrs.get("model", "") or "")
+        return figure_text(gearset.name)
+    return figure_text(attrs.get("model", "") or "")
+
+
+def figure_text(text: Any) -> str:
+    """Text read from a file (a name, a title) as figure text that only prints: control
+    characters as escapes (:func:`~gearchaos._text.escape_text`), a ``$`` kept literal (no
+    mathtext from a file)."""
+    return escape_text(text).replace("$", r"\$")
 
 
 def stored_gearset(attrs: Any) -> Any:
@@ -208,22 +215,28 @@ def parameter_symbols(attrs: Any) -> Mapping[str, str]:
 def stored_model(attrs: Any) -> Any:
     """The model a store's, branch file's or curve file's ``model_class``/``model_fields``
     attributes describe, built again once per pair
-    (:func:`~gearchaos.model.contract.rebuild_model`); ``None`` when they are absent or it can
-    no longer be built (its file moved)."""
+    (:func:`~gearchaos.model.loading.rebuild_model`); ``None`` when they are absent, when it is
+    the user's own model and the user has not named it (``--model``: a file's record never
+    imports anything) or when it cannot be built."""
     spec, fields = attrs.get("model_class"), attrs.get("model_fields")
     if not spec or fields is None:
         return None
-    return _rebuilt(str(spec), str(fields))
+    key = (str(spec), str(fields))
+    if key not in _REBUILT:
+        from ..model.loading import rebuild_model
+
+        try:  # only a model the user named or gearchaos's own: never an import by the record
+            model = rebuild_model({"model_class": key[0], "model_fields": key[1]})
+        except ParameterError:
+            return None  # not named (yet): the figure draws names, not symbols
+        if len(_REBUILT) >= 16:
+            _REBUILT.pop(next(iter(_REBUILT)))
+        _REBUILT[key] = model
+    return _REBUILT[key]
 
 
-@functools.lru_cache(maxsize=16)
-def _rebuilt(spec: str, fields: str) -> Any:
-    from ..model.contract import rebuild_model
-
-    try:
-        return rebuild_model({"model_class": spec, "model_fields": fields})
-    except (ParameterError, ImportError, OSError):
-        return None
+#: Models built again for figures, by (model_class, model_fields): at most 16.
+_REBUILT: dict[tuple[str, str], Any] = {}
 
 
 def var_symbol(var: str, planet: int | None, symbols: Mapping[str, Any] | None = None) -> str:

@@ -41,7 +41,7 @@ from ..errors import ParameterError, Status, StoreError
 from ..integrate._chains import ChainRun
 from ..integrate.interface import Info
 from ..integrate.settings import SolverSettings, split_keywords
-from ..model.contract import model_reference
+from ..model.loading import model_reference
 from ..model.target import resolve, scale_attrs
 from ._basin_store import BasinStore, open_basins
 from .execute import EXECUTION_OPTIONS, Execution, InProcess, executor

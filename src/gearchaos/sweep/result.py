@@ -149,11 +149,15 @@ class SweepResult:
     def base_model(self) -> Any:
         """The model of a store that is not of a gear set, built again from what the store
         records (``model_class``, ``model_fields``;
-        :func:`~gearchaos.model.contract.rebuild_model`), or ``None``."""
+        :func:`~gearchaos.model.loading.rebuild_model`), or ``None``."""
         if self._model is _UNSET:
-            from ..model.contract import rebuild_model
+            from ..model.loading import rebuild_model
 
-            self._model = None if self.base_gearset is not None else rebuild_model(self.ds.attrs)
+            self._model = (
+                None
+                if self.base_gearset is not None
+                else rebuild_model(self.ds.attrs, where="the sweep store")
+            )
         return self._model
 
     @property

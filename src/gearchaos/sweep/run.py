@@ -25,7 +25,7 @@ from ..integrate._chains import ChainOutput, ChainRun
 from ..integrate.interface import Info
 from ..integrate.settings import SolverSettings, check_params, renamed_keyword
 from ..integrate.threads import abandon, resume
-from ..model.contract import model_reference
+from ..model.loading import model_reference
 from ..model.target import scale_attrs
 from ._response_store import response_extract, response_variables
 from .execute import EXECUTION_OPTIONS, Execution, InProcess, executor
