@@ -67,6 +67,7 @@ __all__ = [
     "response",
     "save_branch",
     "simulate",
+    "summarize",
 ]
 
 if TYPE_CHECKING:
@@ -79,6 +80,7 @@ if TYPE_CHECKING:
     from .dynamics.lyapunov import lyapunov_spectrum, max_lyapunov
     from .dynamics.orbit_batch import periodic_orbits
     from .dynamics.orbits import PeriodicOrbit, periodic_orbit
+    from .dynamics.point import summarize
     from .explore import explore
     from .sweep.basin_fractions import basin_fractions
     from .sweep.basins import basins
@@ -98,6 +100,7 @@ _LAZY_ATTRIBUTES = {
     "max_lyapunov": "dynamics.lyapunov",
     "periodic_orbits": "dynamics.orbit_batch",
     "attractors": "dynamics.coexistence",
+    "summarize": "dynamics.point",
     "basins": "sweep.basins",
     "basin_fractions": "sweep.basin_fractions",
 }

@@ -19,7 +19,7 @@ from .classify import classify_motion
 from .contact import contact_regimes, separation_fraction
 from .poincare import count_distinct, section_points, section_variables
 
-__all__ = ["SUMMARY_KEYS", "format_exponent", "motion_name", "summarize"]
+__all__ = ["SUMMARY_KEYS", "format_exponent", "motion_name", "motion_text", "summarize"]
 
 #: Keys every summary of a planetary result has (in this order); extras follow them.
 SUMMARY_KEYS = (
@@ -78,16 +78,18 @@ def summarize(
         The motion verdict's fields (:meth:`gearchaos.dynamics.verdict.Verdict.to_dict`):
         then ``motion`` is its label, ``lle``/``lle_error`` its λ₁ and error, and
         ``evidence``, ``max_multiplier``, ``extra_periods`` and ``motion_note`` (its reason)
-        say what decided it. Without it the label comes from the record alone
-        (:func:`~gearchaos.analysis.classify.classify_motion`) and ``evidence`` is
-        ``record``.
+        say what decided it. Without it ``motion`` is None: the label from the record alone
+        (:func:`~gearchaos.analysis.classify.classify_motion`) is ``record_label``, never the
+        motion, and ``evidence`` is ``record``. :func:`gearchaos.summarize` decides the
+        motion of a result with the verdict, as ``gearchaos simulate`` does.
 
     Returns
     -------
     dict
         ``omega`` (Ω), ``omega_n_rad_s`` (ω_n), ``sun_speed_rpm``, ``distinct_section_points``
-        (``max_count + 1`` means many), ``motion`` (``1T``, ``2T``, …, ``QP``, ``chaos``,
-        ``unresolved``; :func:`~gearchaos.analysis.classify.classify_motion`) with ``lle``,
+        (``max_count + 1`` means many), ``motion`` (the verdict's ``1T``, ``2T``, …, ``QP``,
+        ``chaos``, ``unresolved``; None without a verdict), ``record_label`` (the record-only
+        label of :func:`~gearchaos.analysis.classify.classify_motion`) with ``lle``,
         ``k01`` (0–1 test), ``indicators_agree`` and ``motion_note``,
         ``x_sp1_section_min``/``_max`` (range of the X̄_sp1 section values), ``contact`` (a list
         of ``{"mesh": "sun_planet_1", "regime": "none|single_sided|double_sided"}``, sun–planet
@@ -135,7 +137,9 @@ def summarize(
         "omega_n_rad_s": _num(scales.omega_n) if scales is not None else None,
         "sun_speed_rpm": _num(gs.sun_speed_rpm(omega)) if gs is not None else None,
         "distinct_section_points": int(n),
-        "motion": mc.label,
+        # the motion is the verdict's; the record alone gives only a record label
+        "motion": None,
+        "record_label": mc.label,
         "x_sp1_section_min": _num(finite.min()) if finite.size else None,
         "x_sp1_section_max": _num(finite.max()) if finite.size else None,
         "contact": contact,
@@ -185,6 +189,15 @@ def summarize(
     out["periods"] = int(s.periods)
     out["samples_per_period"] = int(s.samples_per_period)
     return out
+
+
+def motion_text(summary: dict[str, Any]) -> str:
+    """The motion of a summary as shown: the verdict's label, or the record-only label named
+    as such."""
+    motion = summary.get("motion")
+    if motion is not None:
+        return str(motion)
+    return f"record label {summary.get('record_label', '—')} (no verdict)"
 
 
 def format_exponent(value: float | None, error: float | None) -> str:

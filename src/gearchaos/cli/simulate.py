@@ -128,7 +128,7 @@ def simulate(
             result.save(nc)
             written.append(nc)
             if plot:
-                written.append(_save_figure(result, output / "simulation.png"))
+                written.append(_save_figure(result, summary, output / "simulation.png"))
 
     if json_out:
         c.print_json(summary)
@@ -152,7 +152,8 @@ def simulate(
         c.wrote(path)
 
 
-def _save_figure(result: Any, path: Path) -> Path:
+def _save_figure(result: Any, summary: dict[str, Any], path: Path) -> Path:
+    """The summary figure of ``result`` showing the printed ``summary`` (its verdict)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -160,7 +161,7 @@ def _save_figure(result: Any, path: Path) -> Path:
 
     from ..plot import savefig, summary_figure
 
-    fig = summary_figure(result)
+    fig = summary_figure(result, summary=summary)
     try:
         savefig(fig, path)
     finally:

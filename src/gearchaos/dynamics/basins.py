@@ -44,7 +44,7 @@ import numpy as np
 from .._checks import check_int, check_real
 from ..errors import ParameterError
 from ..integrate.settings import SolverSettings
-from .verdict import VerdictSettings, decide_motion
+from .verdict import VerdictSettings, confirmed_settings, decide_motion
 
 __all__ = [
     "FAILED",
@@ -409,7 +409,7 @@ def identify(
             fin[take],
             np.ones(take.size, dtype=bool),
             settings,
-            verdict,
+            confirmed_settings() if verdict is None else verdict,
         )
         for k, v in zip(take, verdicts, strict=True):
             if v.label == "failed":

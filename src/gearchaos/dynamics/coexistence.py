@@ -40,7 +40,7 @@ from ..integrate.settings import SolverSettings, split_keywords
 from ..model.target import resolve
 from .evidence import Verdict
 from .orbits import PeriodicOrbit
-from .verdict import decide_motion
+from .verdict import CONFIRM_PERIODS, confirmed_settings, decide_motion
 
 __all__ = ["ATTRACTOR_SETTINGS", "Attractor", "attractors"]
 
@@ -206,6 +206,7 @@ def attractors(
     tol: float = 1e-4,
     spread_fraction: float = 0.25,
     initial_states: Any = None,
+    confirm_periods: int = CONFIRM_PERIODS,
     **values_and_settings: Any,
 ) -> list[Attractor]:
     """Distinct attractors at one operating point, from several initial conditions.
@@ -233,6 +234,10 @@ def attractors(
         (K, n_state) explicit starts instead of the rest start and the random ones (``starts``
         and ``seed`` are then unused); the basins of :mod:`gearchaos.dynamics.basins` find
         their catalogue of attractors from a sample of their own starts this way.
+    confirm_periods
+        A chaotic or quasi-periodic run is listed only after a last window of at least this
+        many periods confirms it (default 2000): a chaotic transient that ends on an orbit
+        within it is that orbit's run, and is merged with it.
 
     Returns
     -------
@@ -264,7 +269,14 @@ def attractors(
     obs = out.observables[:, 0].copy()
     finals = out.final_state[:, 0, :m].copy()
     verdicts = decide_motion(
-        target, [values] * k, [system] * k, states, finals, out.status[:, 0] == 0, cfg
+        target,
+        [values] * k,
+        [system] * k,
+        states,
+        finals,
+        out.status[:, 0] == 0,
+        cfg,
+        confirmed_settings(confirm_periods),
     )
     for j, v in enumerate(verdicts):
         if v.record is not None:  # the finished record the verdict is about

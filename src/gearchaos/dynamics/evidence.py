@@ -25,6 +25,7 @@ EVIDENCE = {
     "ambiguous": 4,  # unresolved: the λ₁ interval straddles the threshold
     "unstable_orbit": 5,  # unresolved: near an unstable orbit, not left within the budget
     "failed": 6,  # the integration failed
+    "converging": 7,  # unresolved: approaching a stable orbit, not reached within the budget
 }
 
 
@@ -58,6 +59,12 @@ class Verdict:
         (integrated from its state for as many periods).
     orbit_state
         The confirmed orbit's state on the section (``floquet`` only).
+    window_start, window_periods
+        The window λ₁ was measured over: its first period counted after the protocol's record,
+        and its length (−1, 0 when no window ran: a confirmed orbit's λ₁ is exact).
+    coexisting
+        ((period, max |μ|), …) the stable orbits found by shooting that the recorded motion
+        does not approach: attractors beside it, evidence and not its label.
     """
 
     label: str
@@ -71,6 +78,9 @@ class Verdict:
     reason: str = ""
     record: VerdictRecord | None = field(default=None, repr=False)
     orbit_state: np.ndarray | None = field(default=None, repr=False)
+    window_start: int = -1
+    window_periods: int = 0
+    coexisting: tuple[tuple[int, float], ...] = ()
 
     @property
     def code(self) -> int:
@@ -103,5 +113,10 @@ class Verdict:
             "k01": num(self.k01),
             "extra_periods": int(self.extra_periods),
             "record": self.record.source if self.record is not None else "protocol",
+            "window_start": int(self.window_start),
+            "window_periods": int(self.window_periods),
+            "coexisting": [
+                {"period": int(d), "max_multiplier": num(mu)} for d, mu in self.coexisting
+            ],
             "reason": self.reason,
         }

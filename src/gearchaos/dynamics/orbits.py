@@ -27,6 +27,7 @@ Two levels (STYLE principle 8): :func:`periodic_orbit` for users;
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
@@ -43,6 +44,7 @@ from ..model.loading import model_reference
 from ..model.system import System
 from ..model.target import resolve, scale_attrs
 from .shooting import Problem, Solution, correct, section_time
+from .stability import STABILITY_MARGIN, stability_of, structural_multipliers
 
 __all__ = [
     "ORBIT_SETTINGS",
@@ -166,15 +168,28 @@ class PeriodicOrbit:
         """τ_s, the section time of ``state`` within [0, T)."""
         return section_time(self.settings, self.system)
 
+    @functools.cached_property
+    def structural(self) -> np.ndarray:
+        """Mask of the multipliers equal to 1 for a structural reason (a free direction,
+        :func:`~gearchaos.dynamics.stability.structural_multipliers`)."""
+        if not self.multipliers.size or not np.all(np.isfinite(self.monodromy)):
+            return np.zeros(self.multipliers.size, dtype=bool)
+        return structural_multipliers(
+            self.system, self.state, self.period, self.monodromy, self.settings
+        )
+
     @property
     def max_multiplier(self) -> float:
-        """max |μ| (NaN when the multipliers are unknown)."""
-        return float(np.max(np.abs(self.multipliers))) if self.multipliers.size else math.nan
+        """max |μ| over the non-structural multipliers (NaN when they are unknown)."""
+        if not self.multipliers.size:
+            return math.nan
+        return stability_of(self.multipliers, self.structural)[1]
 
     @property
     def stable(self) -> bool:
-        """Converged and every |μ| < 1 (asymptotically stable)."""
-        return bool(self.converged and self.max_multiplier < 1.0)
+        """Converged and every non-structural |μ| < 1 − 10⁻⁴: the one stability criterion of
+        :mod:`gearchaos.dynamics.stability`, the motion verdict's."""
+        return bool(self.converged and stability_of(self.multipliers, self.structural)[0])
 
     @property
     def minimal_period(self) -> int:
@@ -210,6 +225,7 @@ class PeriodicOrbit:
             "max_multiplier": float(self.max_multiplier),
             "residual": float(self.residual),
             "stable": bool(self.stable),
+            "stability_margin": STABILITY_MARGIN,
             "multipliers": [
                 {"re": float(m.real), "im": float(m.imag), "abs": float(abs(m))}
                 for m in self.multipliers

@@ -20,8 +20,8 @@ from typing import Any
 import numpy as np
 
 from .._checks import check_bool
-from ..analysis.summary import summarize
-from ..errors import Status
+from ..analysis.summary import summarize as record_summary
+from ..errors import ParameterError, Status
 from ..integrate.result import SimulationResult
 from ..integrate.settings import SIMULATION, SolverSettings
 from ..integrate.simulate import run_simulation
@@ -31,7 +31,7 @@ from .lyapunov import lyapunov_spectrum
 from .shooting import section_fraction
 from .verdict import VerdictSettings, decide_motion
 
-__all__ = ["PointAnalysis", "analyse_point", "point_verdict"]
+__all__ = ["PointAnalysis", "analyse_point", "point_verdict", "summarize"]
 
 
 @dataclass(frozen=True)
@@ -117,39 +117,79 @@ def analyse_point(
             lstatus = lr.status
             if lr.status.ok and math.isfinite(lr.largest):
                 lle = float(lr.largest)
-        summary = summarize(result, lle=lle)
+        summary = record_summary(result, lle=lle)
         if not result.status.ok:
             summary["motion"] = "failed"
         return PointAnalysis(result, lle, lstatus, summary)
     v = point_verdict(target, values, result, vs)
-    if v.record is not None and v.label != "failed":
-        result = _finished(system, cfg, v, check)
+    result, summary = _decided(result, v, check)
     lle = v.lle if math.isfinite(v.lle) else None
-    summary = summarize(result, verdict=v.to_dict())
+    return PointAnalysis(result, lle, Status.OK, summary, v)
+
+
+def _decided(
+    result: SimulationResult, v: Verdict, check: bool
+) -> tuple[SimulationResult, dict[str, Any]]:
+    """The result the verdict is about (the continuation's record where the run was
+    continued) and its summary with the verdict."""
+    if v.record is not None and v.label != "failed":
+        result = _finished(result.system, result.solver, v, check)
+    summary = record_summary(result, verdict=v.to_dict())
     if not result.status.ok:
         summary["motion"] = "failed"
-    return PointAnalysis(result, lle, Status.OK, summary, v)
+    return result, summary
+
+
+def summarize(
+    result: SimulationResult,
+    values: Mapping[str, Any] | None = None,
+    *,
+    verdict: VerdictSettings | bool = True,
+) -> dict[str, Any]:
+    """The summary of a simulation result with its motion verdict — the same as
+    ``gearchaos simulate`` prints for the same call (``gearchaos.summarize(
+    gearchaos.simulate(gs, omega=1.5))``).
+
+    The verdict is decided from the result's record as :func:`analyse_point` decides it; where
+    it continues the run, the summary's record quantities (section range, load factors, RMS
+    transmission error, contact) are those of the continuation, as the command line's. With
+    ``verdict=False`` the record alone is summarised: ``motion`` is None and the record's own
+    label is ``record_label`` (:func:`gearchaos.analysis.summary.summarize`).
+
+    Parameters
+    ----------
+    result
+        A :class:`~gearchaos.SimulationResult` of :func:`gearchaos.simulate`.
+    values
+        Parameter values by name, for the verdict's record (Ω is read from the result).
+    verdict
+        True, False or :class:`~gearchaos.dynamics.verdict.VerdictSettings`.
+    """
+    if not isinstance(result, SimulationResult):
+        raise ParameterError(
+            f"summarize needs a SimulationResult (gearchaos.simulate): got {type(result).__name__}"
+        )
+    vs = _verdict_settings(verdict)
+    if vs is None or not result.status.ok:
+        summary = record_summary(result)
+        if not result.status.ok:
+            summary["motion"] = "failed"
+        return summary
+    v = point_verdict(result.system, values, result, vs)
+    return _decided(result, v, False)[1]
 
 
 def _finished(system: Any, cfg: SolverSettings, v: Verdict, check: bool) -> SimulationResult:
     """The record the verdict is about, with the protocol's samples: the recorded window
-    integrated again from where the verdict's record starts — on the confirmed orbit (a
-    record that was still converging onto it), or ``periods`` sections before the end of the
-    extension — at the section time; its settings say the transient the record follows."""
+    integrated again from ``periods`` sections before the end of the verdict's continuation of
+    the run, at the section time; its settings say the transient the record follows."""
     assert v.record is not None
     m = int(cfg.periods)
-    if v.record.source == "orbit" and v.orbit_state is not None:
-        start = v.orbit_state
-        origin = (
-            "on the periodic orbit the motion verdict confirmed (its run started from rest, "
-            f"perturbed by {cfg.perturbation:g})"
-        )
-    else:
-        start = v.record.states[max(0, v.record.states.shape[0] - m)]
-        origin = (
-            "the state the motion verdict's extension reached from rest (perturbed by "
-            f"{cfg.perturbation:g})"
-        )
+    start = v.record.states[max(0, v.record.states.shape[0] - m)]
+    origin = (
+        "the state the motion verdict's continuation of the run reached from rest (perturbed "
+        f"by {cfg.perturbation:g})"
+    )
     window = cfg.replace(transient_periods=0.0, section_phase=0.0)
     tau_s = section_fraction(cfg) * system.period
     result = run_simulation(system, window, y0=start, t0=tau_s, check=check)

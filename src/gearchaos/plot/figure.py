@@ -11,6 +11,7 @@ import numpy as np
 from .._files import check_output_file
 from .._output import check_replaceable, file_has_mark, staged_file
 from .._version import __version__
+from ..analysis.summary import motion_text
 from ..errors import ParameterError
 from ._common import message, variable
 from .phase import phase_portrait, poincare_map, sun_orbit
@@ -37,7 +38,7 @@ def _text_lines(result: Any, summary: dict[str, Any]) -> list[str]:
     gs = summary.get("gearset")
     owner = f"gear set: {gs}" if gs else f"model: {result.system.name}"
     n = summary["distinct_section_points"]
-    motion = summary["motion"]
+    motion = motion_text(summary)
     recorded = summary.get("recorded_section_points")
     points = f"{n} of {recorded}" if recorded else str(n)
     lines = [
@@ -200,7 +201,7 @@ def summary_figure(
     title = f"{gs}: Ω = {result.system.omega:g}"
     if rpm is not None:
         title += f" (sun {rpm:.0f} rpm)"
-    title += f" — motion {summary['motion']}, status {summary['status']}"
+    title += f" — motion {motion_text(summary)}, status {summary['status']}"
     fig.suptitle(title, fontsize=14)
     return fig
 

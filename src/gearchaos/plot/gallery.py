@@ -150,7 +150,8 @@ def poincare_gallery(
         if summary is None:
             summary = summarize(result)
         failed = summary.get("status", "ok") != "ok" or summary.get("motion") == "failed"
-        label = "failed" if failed else str(summary.get("motion", "unresolved"))
+        # a record-only summary has no motion: the panel is unresolved, never its record label
+        label = "failed" if failed else str(summary.get("motion") or "unresolved")
         labels.append(label)
         shown = {**summary, "motion": label}
         r0, c = (k // cols) * block, k % cols

@@ -11,9 +11,12 @@ integrating them (in the worker, all points of a period together), and writes pe
   confirmed orbit);
 * ``k01`` — the 0–1 test of the record behind a QP, chaos or unresolved label;
 * ``extra_periods`` — periods the verdict added to finish a transient;
+* ``window_start``, ``window_periods`` — the window λ₁ was measured over (chaos holds in it
+  and in the window before it);
 * ``record`` — where the stored section record comes from: ``protocol`` (the sweep's own
-  run), ``extension`` (that run continued by ``extra_periods``) or ``orbit`` (the confirmed
-  orbit, integrated from its state, onto which the run was still converging).
+  run) or ``extension`` (that run continued by ``extra_periods``: a transient finished, or a
+  record brought onto the orbit it approached); ``orbit`` marks stores of earlier versions,
+  which showed a confirmed orbit's own points.
 
 Where the verdict extended a run, the point's stored section values and final state are those
 of the extension (the finished record), so the diagram never shows a label beside the
@@ -51,6 +54,13 @@ VERDICT_VARIABLES: dict[str, tuple[str, str, Any]] = {
     ),
     "k01": ("0–1 test for chaos K of the record (non-periodic labels)", "float64", np.nan),
     "extra_periods": ("periods added by the verdict to finish a transient", "int64", -1),
+    "window_start": (
+        "first period of the window λ_1 was measured over, counted after the recorded ones "
+        "(-1: none, λ_1 exact from the multipliers)",
+        "int64",
+        -1,
+    ),
+    "window_periods": ("length of the window λ_1 was measured over, in periods", "int64", 0),
     "record": ("where the stored section record comes from (see flag_meanings)", "int8", -1),
 }
 
@@ -99,6 +109,8 @@ def task_verdicts(
         data["lle_error"][pos] = v.lle_error
         data["k01"][pos] = v.k01
         data["extra_periods"][pos] = v.extra_periods
+        data["window_start"][pos] = v.window_start
+        data["window_periods"][pos] = v.window_periods
         rec = v.record
         if rec is None or spp != 1:
             data["record"][pos] = RECORD_SOURCES["protocol"]
