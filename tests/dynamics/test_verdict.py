@@ -191,12 +191,13 @@ def test_point_verdict_of_a_result() -> None:
     assert v.label == "2T"
 
 
-def test_a_record_longer_than_the_budget_is_still_decided() -> None:
-    # an extension as long as the record (500 periods) exceeds the 400-period budget: one
-    # extension runs all the same, since an undecided point needs λ₁
+def test_chaos_holds_in_two_windows() -> None:
+    # the first window is as long as the record (500 periods), the next twice as long; chaos
+    # is decided only when both say so (a chaotic transient ending between them is not chaos)
     cfg = SolverSettings(transient_periods=50, periods=500, perturbation=1e-6)
     v, _ = _verdict(2.0, cfg)
-    assert v.label == "chaos" and v.extra_periods == 500 and v.lle - 2 * v.lle_error > 0
+    assert v.label == "chaos" and v.lle - 2 * v.lle_error > 0
+    assert (v.window_start, v.window_periods, v.extra_periods) == (500, 1000, 1500)
 
 
 def test_the_explorer_computes_the_label_the_sweep_stored(tmp_path) -> None:

@@ -28,6 +28,7 @@ SUMMARY_KEYS = (
     "sun_speed_rpm",
     "distinct_section_points",
     "motion",
+    "record_label",
     "x_sp1_section_min",
     "x_sp1_section_max",
     "contact",

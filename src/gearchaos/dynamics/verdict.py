@@ -283,11 +283,14 @@ def _floquet(p: _Point, f: Found, system: System, how: str) -> Verdict:
 def _reach(f: Found, record: np.ndarray, settings: SolverSettings, vs: VerdictSettings) -> float:
     """How close every recorded section must lie to orbit f for the record to be on it:
     ``reach`` · max(1, ‖y*‖), and at most half the recurrence tolerance of the record
-    (period_rtol · S + ε, S the orbit's size): a record on its orbit then also repeats with
-    its period by the record's own test, so its figure shows n points."""
+    (period_rtol · S + ε, S the orbit's size, ε the noise floor at unit magnitude): a record
+    on its orbit then also repeats with its period by the record's own test, so its figure
+    shows n points."""
     scale = max(1.0, float(np.max(np.abs(f.state))))
     size = float(np.max(np.ptp(f.sections, axis=0))) if f.sections.shape[0] > 1 else 0.0
-    eps = float(noise_floor(record[None], settings, vs.noise_factor)[0])
+    # the noise floor at unit magnitude: a figure's observable (a mesh deflection of order
+    # one) must repeat by its own test too, whatever the largest state component
+    eps = vs.noise_factor * (settings.atol + settings.rtol)
     return min(vs.reach * scale, 0.5 * (vs.period_rtol * size + eps))
 
 
