@@ -160,6 +160,9 @@ def summarize(
         out["extra_periods"] = verdict["extra_periods"]
         out["record"] = verdict["record"]
         out["indicators_agree"] = True
+        out["window_start"] = verdict.get("window_start", -1)
+        out["window_periods"] = verdict.get("window_periods", 0)
+        out["coexisting"] = list(verdict.get("coexisting", []))
         out["motion_note"] = verdict["reason"]
     else:
         out["lle"] = _num(mc.lle) if mc.lle is not None else None

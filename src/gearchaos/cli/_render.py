@@ -239,6 +239,20 @@ def add_motion_rows(table: Table, summary: Mapping[str, Any]) -> None:
         table.add_row(
             "indicators agree", Text("yes" if agree else "no", style="" if agree else "bold red")
         )
+    if summary.get("motion") is None and summary.get("record_label"):
+        table.add_row("record label (no verdict)", escape(str(summary["record_label"])))
+    if summary.get("window_periods"):
+        start = int(summary.get("window_start", 0))
+        end = start + int(summary["window_periods"])
+        table.add_row("λ₁ measured over", f"periods {start}–{end} after the record")
+    for orb in summary.get("coexisting") or []:
+        mu = orb.get("max_multiplier")
+        table.add_row(
+            "coexisting stable orbit",
+            f"{int(orb['period'])}T, max |μ| = {mu:.6g} (not the recorded motion)"
+            if mu is not None
+            else f"{int(orb['period'])}T (not the recorded motion)",
+        )
     note = summary.get("motion_note")
     if note:
         table.add_row("motion note", escape(str(note)))

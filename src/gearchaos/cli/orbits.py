@@ -16,6 +16,7 @@ from rich.text import Text
 
 from ..dynamics.coexistence import ATTRACTOR_SETTINGS
 from ..dynamics.orbits import ORBIT_SETTINGS
+from ..dynamics.verdict import CONFIRM_PERIODS
 from ..errors import IntegrationError, ParameterError
 from . import _common as c
 from ._render import pairs_table
@@ -446,6 +447,15 @@ def attractors(
         ),
     ] = 8,
     seed: Annotated[int, typer.Option("--seed", help="Seed of the random starts.")] = 0,
+    confirm: Annotated[
+        int,
+        typer.Option(
+            "--confirm-periods",
+            help="A chaotic or quasi-periodic attractor is listed only after a last window of "
+            "this many periods confirms it (a chaotic transient that ends on an orbit within "
+            "it is that orbit's run).",
+        ),
+    ] = CONFIRM_PERIODS,
     transient: c.TransientOpt = ATTRACTOR_SETTINGS.transient_periods,
     periods: c.PeriodsOpt = ATTRACTOR_SETTINGS.periods,
     rtol: c.RtolOpt = ATTRACTOR_SETTINGS.rtol,
@@ -457,7 +467,8 @@ def attractors(
     Each start is simulated (TRANSIENT + PERIODS mesh periods, with the largest Lyapunov
     exponent λ₁) and labelled as a sweep labels its points; runs that end on the same
     attractor are grouped. A periodic attractor is confirmed by shooting its orbit, whose
-    Floquet multipliers say how stable it is. **--json** prints a list of {label, lle, starts,
+    Floquet multipliers say how stable it is; a chaotic or quasi-periodic one by a last window
+    of at least CONFIRM_PERIODS periods (2000). **--json** prints a list of {label, lle, starts,
     x_sp1, orbit: {period, converged, residual, max_multiplier, stable} or null}.
 
     Example (a stable 1T orbit beside a chaotic attractor): **gearchaos attractors --set
@@ -474,7 +485,14 @@ def attractors(
         settings = c.solver_settings(transient, periods, rtol, atol)
         with _spinner(f"simulating {starts} starts at Ω = {omega:g}…", json_out):
             with c.warnings_to_stderr():
-                found = find(gs, starts=starts, seed=seed, settings=settings, omega=omega)
+                found = find(
+                    gs,
+                    starts=starts,
+                    seed=seed,
+                    settings=settings,
+                    omega=omega,
+                    confirm_periods=confirm,
+                )
     items = [a.summary() for a in found]
     if json_out:
         c.print_json(items)

@@ -82,7 +82,7 @@ class SectionTests:
         parts = []
         for n, ks in self.k01.items():
             vals = ", ".join(f"{k:.2f}" for k in ks)
-            parts.append(f"K = {vals}" if n == 1 else f"every {n}th: {vals}")
+            parts.append(f"K = {vals}" if n == 1 else f"every {_ordinal(n)} point: {vals}")
         k = "0–1 test " + "; ".join(parts) if parts else "no 0–1 test (record too short)"
         t = (
             f"the section keeps its cyclic order in {self.torus_stride} curve(s)"
@@ -90,6 +90,12 @@ class SectionTests:
             else "no closed curve found"
         )
         return f"{k}; {t}"
+
+
+def _ordinal(n: int) -> str:
+    """2nd, 3rd, 4th, 11th, 21st …"""
+    tail = "th" if 10 <= n % 100 <= 20 else {1: "st", 2: "nd", 3: "rd"}.get(n % 10, "th")
+    return f"{n}{tail}"
 
 
 def _principal(x: np.ndarray) -> np.ndarray:
@@ -140,7 +146,8 @@ def _chaotic_window(w: Window, tests: SectionTests | None, c: float) -> str | No
         return f"λ₁ − {c:g}σ > θ"
     if lo > 0 and tests is not None and tests.chaotic():
         n = tests.chaotic()
-        return f"λ₁ − {c:g}σ > 0 and the 0–1 test K > {K_CHAOS} on every {n}th section point"
+        where = "the section" if n == 1 else f"every {_ordinal(n)} section point (each band)"
+        return f"λ₁ − {c:g}σ > 0 and the 0–1 test K > {K_CHAOS} on {where}"
     return None
 
 
