@@ -64,8 +64,10 @@ def _principal(x: np.ndarray, k: int = 2) -> np.ndarray:
     c = z - z.mean(axis=0)
     if c.shape[1] <= 1:
         return c
-    _, _, vt = np.linalg.svd(c, full_matrices=False)
-    return c @ vt[: min(k, vt.shape[0])].T
+    # the eigenvectors of the small d × d scatter matrix (cheaper than an SVD of the m × d
+    # sequence), largest eigenvalues first
+    _, vecs = np.linalg.eigh(c.T @ c)
+    return c @ vecs[:, ::-1][:, : min(k, vecs.shape[1])]
 
 
 def band_count(x: np.ndarray, max_bands: int = 8, *, max_points: int = 1200) -> int:

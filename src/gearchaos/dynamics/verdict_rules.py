@@ -40,6 +40,9 @@ __all__ = ["SectionTests", "Window", "decide_by_exponent", "section_tests"]
 K01_STRIDES = (1, 2, 3, 4)
 #: Fraction of rank shifts in one window for the rotation test to pass.
 MIN_ORDER = 0.9
+#: Points of a subsequence the 0–1 test uses (its last ones): the test's cost grows with the
+#: square of the length, and a few hundred points decide it.
+K01_POINTS = 400
 
 
 @dataclass(frozen=True)
@@ -54,36 +57,58 @@ class Window:
     theta: float
 
 
-@dataclass(frozen=True)
 class SectionTests:
-    """The 0–1 test and the rotation test of a window's section sequence: ``k01`` {n: K of
-    each subsequence x_{j::n}}, ``torus_stride`` the smallest n ≤ max_bands whose every
-    subsequence keeps its cyclic order (0: none)."""
+    """The 0–1 test and the rotation test of a window's section sequence x (m, d), each
+    computed when first asked for (the 0–1 test costs far more than the rotation test, and
+    most windows are decided without it): :meth:`k01` (K of every subsequence x_{j::n} of a
+    stride n, on its last :data:`K01_POINTS` points), :attr:`torus_stride` (the smallest
+    n ≤ ``max_bands`` whose every subsequence keeps its cyclic order; 0: none)."""
 
-    k01: dict[int, tuple[float, ...]]
-    torus_stride: int
+    def __init__(self, x: np.ndarray, max_bands: int) -> None:
+        self.x = np.asarray(x, dtype=np.float64)
+        self._k01: dict[int, tuple[float, ...]] = {}
+        self.torus_stride = 0
+        for n in range(1, max_bands + 1):
+            orders = [circle_order(self.x[j::n]) for j in range(n)]
+            if not all(math.isfinite(o) for o in orders):
+                break
+            if all(o >= MIN_ORDER for o in orders):
+                self.torus_stride = n
+                break
+
+    def k01(self, n: int) -> tuple[float, ...] | None:
+        """K of each subsequence x_{j::n} (None: too short for the 0–1 test)."""
+        if n not in self._k01:
+            if self.x.shape[0] // n < MIN_LENGTH_01:
+                return None
+            self._k01[n] = tuple(chaos01(_principal(self.x[j::n][-K01_POINTS:])) for j in range(n))
+        return self._k01[n]
 
     def chaotic(self) -> int:
         """The smallest stride n whose every subsequence has K > K_CHAOS (0: none)."""
-        for n, ks in self.k01.items():
-            if ks and all(math.isfinite(k) and k > K_CHAOS for k in ks):
+        for n in K01_STRIDES:
+            ks = self.k01(n)
+            if ks is None:
+                break
+            if all(math.isfinite(k) and k > K_CHAOS for k in ks):
                 return n
         return 0
 
     def regular(self) -> bool:
         """K < K_REGULAR for every subsequence of every stride of :data:`K01_STRIDES` (all
         of them tested: bands visited in turn hide chaos from the shorter strides)."""
-        if set(self.k01) != set(K01_STRIDES):
-            return False
-        ks = [k for v in self.k01.values() for k in v]
-        return all(math.isfinite(k) and k < K_REGULAR for k in ks)
+        for n in K01_STRIDES:
+            ks = self.k01(n)
+            if ks is None or not all(math.isfinite(k) and k < K_REGULAR for k in ks):
+                return False
+        return True
 
     def text(self) -> str:
         parts = []
-        for n, ks in self.k01.items():
+        for n, ks in sorted(self._k01.items()):
             vals = ", ".join(f"{k:.2f}" for k in ks)
             parts.append(f"K = {vals}" if n == 1 else f"every {_ordinal(n)} point: {vals}")
-        k = "0–1 test " + "; ".join(parts) if parts else "no 0–1 test (record too short)"
+        k = "0–1 test " + "; ".join(parts) if parts else "no 0–1 test needed"
         t = (
             f"the section keeps its cyclic order in {self.torus_stride} curve(s)"
             if self.torus_stride
@@ -105,28 +130,13 @@ def _principal(x: np.ndarray) -> np.ndarray:
 
 
 def section_tests(x: np.ndarray, max_bands: int) -> SectionTests:
-    """The 0–1 test (on the two principal directions of every subsequence x_{j::n}, n in
-    :data:`K01_STRIDES`, each long enough) and the rotation test (n ≤ ``max_bands``) of the
-    section sequence x (m, d)."""
-    x = np.asarray(x, dtype=np.float64)
-    k01: dict[int, tuple[float, ...]] = {}
-    for n in K01_STRIDES:
-        if x.shape[0] // n < MIN_LENGTH_01:
-            break
-        k01[n] = tuple(chaos01(_principal(x[j::n])) for j in range(n))
-    stride = 0
-    for n in range(1, max_bands + 1):
-        orders = [circle_order(x[j::n]) for j in range(n)]
-        if not all(math.isfinite(o) for o in orders):
-            break
-        if all(o >= MIN_ORDER for o in orders):
-            stride = n
-            break
-    return SectionTests(k01, stride)
+    """The :class:`SectionTests` of the section sequence x (m, d)."""
+    return SectionTests(x, max_bands)
 
 
 def _common(p: Any, w: Window, tests: SectionTests | None) -> dict[str, Any]:
-    k1 = tests.k01.get(1, (math.nan,))[0] if tests is not None else math.nan
+    ks = tests.k01(1) if tests is not None else None
+    k1 = ks[0] if ks else math.nan
     return {
         "lle": w.lle,
         "lle_error": w.err,
