@@ -12,6 +12,14 @@ in short slices:
 The block that is running goes on in its daemon thread until the process exits, which then
 does not wait for it. Results are never affected: a block's numbers are the same whichever
 thread runs it.
+
+**Readiness.** With the environment variable :data:`READY_ENV` (``GEARCHAOS_READY_LINE``) set
+to anything but ``""`` or ``0``, a process writes :data:`READY_LINE` to stderr once, when it
+first waits for compiled blocks: its kernels are compiled (or loaded from the cache) and the
+computation runs, so a signal is handled at once from there on. A script or a test that must
+interrupt a computation rather than its start-up waits for this line, not for a time (a fresh
+clone compiles for a minute or more on a loaded machine). Worker processes inherit the variable
+and write the line too.
 """
 
 from __future__ import annotations
@@ -22,12 +30,44 @@ import queue
 import threading
 from typing import Any
 
-__all__ = ["DaemonPool", "abandon", "abandoned", "pool", "resume", "wait_all"]
+__all__ = [
+    "READY_ENV",
+    "READY_LINE",
+    "DaemonPool",
+    "abandon",
+    "abandoned",
+    "pool",
+    "resume",
+    "wait_all",
+]
 
 #: Set when the waits of other threads must end (an interrupted sweep).
 _ABANDON = threading.Event()
 #: The slice, in seconds, in which a waiting thread looks at :func:`abandoned`.
 WAIT_SLICE = 0.1
+
+#: The environment variable that asks for :data:`READY_LINE` (see the module docstring).
+READY_ENV = "GEARCHAOS_READY_LINE"
+#: The line written to stderr when a process first waits for compiled blocks.
+READY_LINE = "gearchaos: kernels ready, computing"
+#: The process that wrote the line (a forked child writes its own).
+_READY_PID: list[int] = []
+_READY_LOCK = threading.Lock()
+
+
+def _announce_ready() -> None:
+    """Write :data:`READY_LINE` once per process when :data:`READY_ENV` asks for it."""
+    if os.environ.get(READY_ENV, "") in ("", "0"):
+        return
+    pid = os.getpid()
+    with _READY_LOCK:
+        if _READY_PID == [pid]:
+            return
+        _READY_PID[:] = [pid]
+    try:
+        os.write(2, f"{READY_LINE}\n".encode())  # unbuffered: seen before the wait begins
+    except OSError:
+        pass
 
 
 def abandon() -> None:
@@ -88,6 +128,7 @@ def wait_all(futures: list[cf.Future[Any]]) -> None:
     main thread's wait at once, :func:`abandon` any other thread's within a slice; then the
     blocks not yet started are cancelled and ``KeyboardInterrupt`` is raised."""
     main = threading.current_thread() is threading.main_thread()
+    _announce_ready()
     try:
         pending = set(futures)
         while pending:
