@@ -174,11 +174,14 @@ def boundary(
 
         if not quiet and not json_out:
             err.print(Text(f"continuing {chosen!r} in {vary}", style="dim"))
-        curve = boundary_curve(
-            target, chosen, vary, within=within, settings=cfg, at=values, assess=assess,
-            max_points=max_points, max_step=max_step, store=path, resume=resume,
-            overwrite=overwrite, progress=progress,
-        )  # fmt: skip
+        try:
+            curve = boundary_curve(
+                target, chosen, vary, within=within, settings=cfg, at=values, assess=assess,
+                max_points=max_points, max_step=max_step, store=path, resume=resume,
+                overwrite=overwrite, progress=progress,
+            )  # fmt: skip
+        except ParameterError as exc:
+            raise as_option(exc) from None
         summary = curve_summary(curve)
         if json_out:
             c.print_json(summary)
@@ -207,6 +210,15 @@ def boundary(
             out.print(Text(f"next: gearchaos plot MAP.zarr --boundaries {path} -o chart.png",
                            style="dim"))  # fmt: skip
     c.wrote(path)
+
+
+def as_option(exc: ParameterError) -> ParameterError:
+    """A refusal of boundary_curve's keyword ``vary``, ``within`` or ``at`` (its message starts
+    with the keyword) as one of the option ``--vary``, ``--within`` or ``--at``."""
+    text = str(exc)
+    if exc.name in ("vary", "within", "at") and text.startswith(exc.name):
+        return ParameterError("--" + text, name=exc.name)
+    return exc
 
 
 def curve_summary(ds: Any) -> dict[str, Any]:

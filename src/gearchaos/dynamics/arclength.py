@@ -41,7 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from .._checks import check_bool, check_int, check_real
+from .._checks import check_bool, check_int, check_real, got
 from ..errors import IntegrationError, ParameterError
 from ..integrate.settings import SolverSettings, split_keywords
 from ..model.system import System
@@ -64,40 +64,54 @@ __all__ = ["continuation", "parse_vary"]
 
 
 # ------------------------------------------------------------------------------ arguments
-def parse_vary(vary: Any) -> tuple[str, float, float]:
-    """``"omega=0.2:4"``, ``("omega", 0.2, 4)`` or ``{"omega": (0.2, 4)}`` → (name, a, b)."""
+def parse_vary(vary: Any, what: str = "vary") -> tuple[str, float, float]:
+    """``"omega=0.2:4"``, ``("omega", 0.2, 4)`` or ``{"omega": (0.2, 4)}`` → (name, a, b).
+
+    ``what`` is the keyword the range was given as (``vary``, ``within``): every refusal starts
+    with it and carries it as its :attr:`~gearchaos.errors.ParameterError.name`, so that a
+    front end can name its own option."""
+    example = f"{what} must look like 'omega=0.2:4' (NAME=START:STOP): got {vary!r}"
     if isinstance(vary, str):
         name, sep, rng = vary.partition("=")
         parts = rng.split(":")
         if not sep or len(parts) != 2 or not name.strip():
-            raise ParameterError(
-                f"vary must look like 'omega=0.2:4' (NAME=START:STOP): got {vary!r}"
-            )
+            raise ParameterError(example, name=what)
         try:
             a, b = float(parts[0]), float(parts[1])
         except ValueError:
-            raise ParameterError(
-                f"vary must look like 'omega=0.2:4' (NAME=START:STOP): got {vary!r}"
-            ) from None
+            raise ParameterError(example, name=what) from None
         name = name.strip()
     elif isinstance(vary, Mapping) and len(vary) == 1:
         ((name, rng),) = vary.items()
         if not isinstance(rng, tuple | list) or len(rng) != 2:
-            raise ParameterError(f"vary must map one name to (start, stop): got {vary!r}")
+            raise ParameterError(
+                f"{what} must map one name to (start, stop): got {vary!r}", name=what
+            )
         a, b = rng
     elif isinstance(vary, tuple | list) and len(vary) == 3:
         name, a, b = vary
     else:
         raise ParameterError(
-            f"vary must be 'NAME=START:STOP', (NAME, START, STOP) or {{NAME: (START, STOP)}}: "
-            f"got {vary!r}"
+            f"{what} must be 'NAME=START:STOP', (NAME, START, STOP) or {{NAME: (START, STOP)}}: "
+            f"got {vary!r}",
+            name=what,
         )
     if not isinstance(name, str) or not name.strip():
-        raise ParameterError(f"vary must name a parameter: got {vary!r}")
-    a = check_real("vary start", a)
-    b = check_real("vary stop", b)
+        raise ParameterError(f"{what} must name a parameter: got {vary!r}", name=what)
+    ends = []
+    for which, value in (("start", a), ("stop", b)):
+        try:
+            ends.append(check_real(which, value))
+        except ParameterError:
+            raise ParameterError(
+                f"{what} {name}: its {which} must be a finite number: {got(value)} (in {vary!r})",
+                name=what,
+            ) from None
+    a, b = ends
     if a == b:
-        raise ParameterError(f"vary start and stop must differ: got {a!r} and {b!r}")
+        raise ParameterError(
+            f"{what} {name}: its start and stop must differ: got {a!r} twice", name=what
+        )
     return str(name), a, b
 
 

@@ -124,7 +124,15 @@ def boundary_curve(
     name2, a2, b2 = parse_vary(vary)
     name1 = event.parameter
     if name2 == name1:
-        raise ParameterError(f"vary must name a second parameter, not the event's {name1}")
+        raise ParameterError(
+            f"vary must name a second parameter, not the event's {name1}", name="vary"
+        )
+    if a2 > b2:  # the curve is continued both ways from the event: a direction means nothing
+        raise ParameterError(
+            f"vary {name2}={a2:g}:{b2:g} is reversed: a boundary curve is continued both ways "
+            f"from the event, within the range from low to high; give {name2}={b2:g}:{a2:g}",
+            name="vary",
+        )
     lo1, hi1 = (-math.inf, math.inf) if within is None else _within(within, name1)
     check_bool("resume", resume)
     check_bool("overwrite", overwrite)
@@ -136,10 +144,12 @@ def boundary_curve(
     fixed = {**event.values, **values}
     fixed.pop(name1, None)
     lam2 = float(fixed.pop(name2)) if name2 in fixed else parameter_value(target, name2)
-    lo2, hi2 = min(a2, b2), max(a2, b2)
+    lo2, hi2 = a2, b2
     if not lo2 <= lam2 <= hi2:
         raise ParameterError(
-            f"the event's {name2}={lam2:g} lies outside vary's range [{lo2:g}, {hi2:g}]"
+            f"vary {name2}={lo2:g}:{hi2:g}: the event's {name2}={lam2:g} lies outside it; "
+            "the range must hold the event",
+            name="vary",
         )
     steps = CurveSteps(
         initial=_pos("step", step, 0.01),
@@ -155,9 +165,7 @@ def boundary_curve(
         )
     if assess not in ASSESS:
         raise ParameterError(f"assess must be one of {', '.join(ASSESS)}: got {assess!r}")
-    grid = np.unique(np.asarray([] if at is None else at, dtype=float).reshape(-1))
-    if not np.all(np.isfinite(grid)):
-        raise ParameterError(f"at must be finite values of {name2}: got {at!r}")
+    grid = _landing_values(at, name2, lo2, hi2)
     fn = TestFunction(event.kind)
     curve = Curve(
         target, (name1, name2), fixed, cfg, int(event.period), check_tol(tol, cfg), fn,
@@ -474,18 +482,44 @@ def _fixed(values: Mapping[str, Any]) -> str:
     return fixed_json(values)
 
 
+def _landing_values(at: Any, name2: str, lo2: float, hi2: float) -> np.ndarray:
+    """The sorted distinct values of ``at`` (None: none), each a finite number inside the
+    range [lo2, hi2] of ``vary``: a value outside it would never be landed on."""
+    try:
+        grid = np.unique(np.asarray([] if at is None else at, dtype=float).reshape(-1))
+    except (TypeError, ValueError):
+        raise ParameterError(
+            f"at must be values of {name2} (numbers): got {at!r}", name="at"
+        ) from None
+    if not np.all(np.isfinite(grid)):
+        raise ParameterError(f"at must be finite values of {name2}: got {at!r}", name="at")
+    outside = grid[(grid < lo2) | (grid > hi2)]
+    if outside.size:
+        raise ParameterError(
+            f"at {', '.join(f'{v:g}' for v in outside)} lie outside vary's range "
+            f"{name2}={lo2:g}:{hi2:g}, so the curve would never land on them; give values "
+            "inside it or widen vary",
+            name="at",
+        )
+    return grid
+
+
 def _within(within: Any, name1: str) -> tuple[float, float]:
     if isinstance(within, str):
-        name, a, b = parse_vary(within)
+        name, a, b = parse_vary(within, "within")
         if name != name1:
-            raise ParameterError(f"within must range the event's parameter {name1}: got {name}")
+            raise ParameterError(
+                f"within must range the event's parameter {name1}: got {name}", name="within"
+            )
     elif isinstance(within, tuple | list) and len(within) == 2:
         a = check_real("within start", within[0])
         b = check_real("within stop", within[1])
     else:
-        raise ParameterError(f"within must be '{name1}=LO:HI' or (lo, hi): got {within!r}")
+        raise ParameterError(
+            f"within must be '{name1}=LO:HI' or (lo, hi): got {within!r}", name="within"
+        )
     if a == b:
-        raise ParameterError(f"within's ends must differ: got {a!r} and {b!r}")
+        raise ParameterError(f"within's ends must differ: got {a!r} and {b!r}", name="within")
     return min(a, b), max(a, b)
 
 
