@@ -99,8 +99,13 @@ def test_non_omega_sweep_fixes_default_omega(runner: CliRunner, tmp_path: Path) 
         (["--vary", "omega=1,2", "--vary", "xi=0.03", "--vary", "torque.input=1"], "once or twice"),
         (["--vary", "omgea=1:2:3"], "omega"),
         (["--vary", "omega=1:2"], "start:stop:count"),
-        (["--vary", "omega=1,2", "--direction", "both"], "--ic continuation"),
-        (["--vary", "omega=1,2", "--ic", "warm"], "--ic"),
+        (["--vary", "omega=1,2", "--direction", "both"], "--initial-conditions continuation"),
+        (["--vary", "omega=1,2", "--initial-conditions", "warm"], "--initial-conditions"),
+        (["--vary", "omega=1,2", "--ic", "warm"], "--ic must be"),
+        (
+            ["--vary", "omega=1,2", "--ic", "fresh", "--initial-conditions", "fresh"],
+            "--ic is its deprecated spelling",
+        ),
         (["--vary", "omega=1,2", "--set", "omega=1.5"], "both swept and set"),
         (["--vary", "omega=1,2", "--planets", "0"], "--planets"),
     ],
@@ -113,6 +118,26 @@ def test_bifurcation_invalid_input_exits_2(
     assert message in result.stderr
     assert "Traceback" not in result.output
     assert not (tmp_path / "x.zarr").exists() or message == "omega"
+
+
+def test_initial_conditions_is_spelt_as_in_python_and_ic_is_deprecated(
+    runner: CliRunner, tmp_path: Path
+) -> None:
+    """Issue 35: ``--ic`` on the command line was ``initial_conditions=`` in Python (and in the
+    store); the option is now ``--initial-conditions``, ``--ic`` warns for one release."""
+    args = ["bifurcation", "--vary", "omega=1,1.2", "--direction", "both", *SHORT, "--quiet"]
+    new = runner.invoke(
+        app, [*args, "--initial-conditions", "continuation", "-o", str(tmp_path / "a.zarr")]
+    )
+    assert new.exit_code == 0, new.output
+    assert "deprecated" not in new.stderr
+    old = runner.invoke(app, [*args, "--ic", "continuation", "-o", str(tmp_path / "b.zarr")])
+    assert old.exit_code == 0, old.output
+    assert "--ic is deprecated" in old.stderr and "--initial-conditions" in old.stderr
+    for name in ("a.zarr", "b.zarr"):
+        assert gc.open_sweep(tmp_path / name).attrs["initial_conditions"] == "continuation"
+    help_text = runner.invoke(app, ["bifurcation", "--help"], env={"COLUMNS": "200"}).output
+    assert "--initial-conditions" in help_text and "--ic " not in help_text
 
 
 def test_interrupt_exits_130_with_resume_hint(

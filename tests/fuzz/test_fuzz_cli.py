@@ -128,9 +128,9 @@ OPTION_ROWS: list[tuple[str, str, Any, tuple[str, ...]]] = [
     ),
     (
         "bifurcation",
-        "--ic",
+        "--initial-conditions",
         st.text(max_size=10).filter(lambda s: s not in ("fresh", "continuation")),
-        ("--ic",),
+        ("--initial-conditions",),
     ),
     (
         "bifurcation",

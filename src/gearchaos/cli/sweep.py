@@ -18,6 +18,26 @@ from . import _common as c
 from ._render import regime_table, sweep_summary
 
 
+def _initial_conditions(value: str | None, old: str | None) -> str:
+    """``--initial-conditions`` (the name of the Python keyword ``initial_conditions=`` and of
+    the store attribute), or its deprecated spelling ``--ic`` with a warning; both refused."""
+    option = "--initial-conditions"
+    if old is not None:
+        if value is not None:
+            raise ParameterError(
+                "give --initial-conditions only (--ic is its deprecated spelling): got both"
+            )
+        c.warn(
+            "--ic is deprecated and will be removed in the next release; use "
+            "--initial-conditions (the spelling of the Python keyword initial_conditions=)"
+        )
+        option, value = "--ic", old
+    value = "fresh" if value is None else value
+    if value not in ("fresh", "continuation"):
+        raise ParameterError(f"{option} must be fresh or continuation: got {value!r}")
+    return value
+
+
 def _parse_planets(raw: str | None) -> tuple[int, ...]:
     if raw is None:
         return (1,)
@@ -105,16 +125,22 @@ def bifurcation(
             "--planets", help="Observed planets, comma-separated (default 1).", show_default=False
         ),
     ] = None,
-    ic: Annotated[
-        str,
+    initial_conditions: Annotated[
+        str | None,
         typer.Option(
-            "--ic",
+            "--initial-conditions",
             help=(
                 "Initial conditions: fresh (zero state at every point, the seed's protocol) or "
-                "continuation (each point starts from the previous point's final state)."
+                "continuation (each point starts from the previous point's final state). "
+                "Default: fresh."
             ),
+            show_default=False,
         ),
-    ] = "fresh",
+    ] = None,
+    ic: Annotated[
+        str | None,
+        typer.Option("--ic", hidden=True, help="Deprecated spelling of --initial-conditions."),
+    ] = None,
     direction: Annotated[
         str,
         typer.Option(
@@ -212,13 +238,12 @@ def bifurcation(
             raise ParameterError(
                 f"--vary may be given once or twice (two make a 2-D map): got {len(vary)}"
             )
-        if ic not in ("fresh", "continuation"):
-            raise ParameterError(f"--ic must be fresh or continuation: got {ic!r}")
+        ic = _initial_conditions(initial_conditions, ic)
         if direction not in ("up", "down", "both"):
             raise ParameterError(f"--direction must be up, down or both: got {direction!r}")
         if direction != "up" and ic != "continuation":
             raise ParameterError(
-                f"--direction {direction} needs --ic continuation "
+                f"--direction {direction} needs --initial-conditions continuation "
                 "(fresh starts do not depend on the sweep direction)"
             )
         settings = c.solver_settings(

@@ -90,7 +90,7 @@ def response(
         raise ParameterError(
             f"response needs a model that tracks mesh contact forces (its force_groups and "
             f"n_contact_forces): {target.name} tracks none; its section values' hysteresis "
-            "is drawn by bifurcation with --ic continuation --direction both"
+            "is drawn by bifurcation with --initial-conditions continuation --direction both"
         )
     return bifurcation(
         target,
