@@ -22,6 +22,7 @@ from . import boundary  # noqa: F401
 from ._common import (
     DEFAULT_OMEGA,
     DEFAULT_PRESET,
+    EXIT_BROKEN_PIPE,
     EXIT_FAILURE,
     EXIT_INTERRUPTED,
     EXIT_INVALID,
@@ -34,6 +35,7 @@ from .paper import GALLERY_FIGURES, PAPER_FIGURES
 __all__ = [
     "DEFAULT_OMEGA",
     "DEFAULT_PRESET",
+    "EXIT_BROKEN_PIPE",
     "EXIT_FAILURE",
     "EXIT_INTERRUPTED",
     "EXIT_INVALID",

@@ -5,7 +5,9 @@ Exit codes: 0 success; 2 invalid input (unknown or invalid parameter, conflictin
 missing gear-set file, a sweep store made with other settings or damaged) — the message names
 the parameter, the rule and the value and suggests the closest valid name; 1 the integration
 failed or a file could not be written; 130 a sweep interrupted with Ctrl-C (its store keeps
-every finished chunk). Errors are reported on stderr as one line, never as a traceback.
+every finished chunk); 141, without a word, when the reader of the output went away
+(``gearchaos --help | head``: what a Unix tool ended by SIGPIPE returns). Errors are reported
+on stderr as one line, never as a traceback.
 """
 
 from __future__ import annotations
@@ -13,6 +15,8 @@ from __future__ import annotations
 import contextlib
 import json
 import math
+import os
+import select
 import unicodedata
 import warnings
 from collections.abc import Iterator, Mapping, Sequence
@@ -41,6 +45,8 @@ DEFAULT_PRESET = "sheng2016"
 EXIT_FAILURE = 1
 EXIT_INVALID = 2
 EXIT_INTERRUPTED = 130
+#: The reader of the output went away (``| head``): 128 + SIGPIPE, as a Unix tool ended by it.
+EXIT_BROKEN_PIPE = 141
 
 INTERRUPTED_MESSAGE = (
     "interrupted: the store keeps every finished chunk; run the same command again to resume"
@@ -50,6 +56,18 @@ INTERRUPTED_MESSAGE = (
 class _Commands(typer.core.TyperGroup):
     """The command group: refuses a single-valued option given twice (Click would keep the
     last silently: ``response --vary omega=1:2:3 --vary xi=0.03,0.05`` swept ξ only)."""
+
+    def main(self, *args: Any, **kwargs: Any) -> Any:
+        # Output that meets a closed pipe ends with exit code 1 where Rich or Click catch it
+        # (Rich points stdout at /dev/null, Click silences it): exit as a Unix tool ended by
+        # SIGPIPE instead; a command's own BrokenPipeError ends in end_quietly()
+        before = _stream_identity()
+        try:
+            return super().main(*args, **kwargs)
+        except SystemExit as exc:
+            if exc.code == EXIT_FAILURE and (reader_gone() or _stream_identity() != before):
+                raise SystemExit(EXIT_BROKEN_PIPE) from None
+            raise
 
     def invoke(self, ctx: Any) -> Any:
         # every command's errors, also those outside its own reported_errors() block (an
@@ -141,6 +159,42 @@ def wrote(path: Path | str) -> None:
     stdout().print(Text.assemble(("wrote ", "dim"), (escape_path(path), "bold")), soft_wrap=True)
 
 
+def _stream_identity() -> tuple[int, int] | None:
+    """What stdout's descriptor refers to (it changes only when a broken pipe was silenced)."""
+    try:
+        st = os.fstat(1)
+    except OSError:
+        return None
+    return st.st_dev, st.st_ino
+
+
+def reader_gone() -> bool:
+    """Whether stdout or stderr is a pipe (or socket) whose reading end is closed."""
+    for fd in (1, 2):
+        try:
+            poller = select.poll()
+            poller.register(fd, select.POLLOUT)
+            if any(event & select.POLLERR for _, event in poller.poll(0)):
+                return True
+        except (OSError, ValueError, AttributeError):  # closed, or no poll on this platform
+            continue
+    return False
+
+
+def end_quietly() -> NoReturn:
+    """End without a word when the reader of the output went away (``gearchaos … | head``):
+    the closed streams are pointed at /dev/null, so that nothing fails when Python flushes them
+    at exit, and the exit code is :data:`EXIT_BROKEN_PIPE`."""
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    for fd in (1, 2):
+        poller = select.poll()
+        poller.register(fd, select.POLLOUT)
+        if any(event & select.POLLERR for _, event in poller.poll(0)):
+            os.dup2(devnull, fd)
+    os.close(devnull)
+    raise typer.Exit(EXIT_BROKEN_PIPE)
+
+
 @contextlib.contextmanager
 def reported_errors() -> Iterator[None]:
     """Turn the package's exceptions into one line on stderr and an exit code; say so on
@@ -163,6 +217,8 @@ def reported_errors() -> Iterator[None]:
     except IntegrationError as exc:
         fail(str(exc), EXIT_FAILURE)
     except OSError as exc:
+        if isinstance(exc, BrokenPipeError) and reader_gone():
+            end_quietly()  # `gearchaos … | head`: not an error
         where = f": '{exc.filename}'" if getattr(exc, "filename", None) else ""
         fail(f"{exc.strerror or exc}{where}", EXIT_FAILURE)
 
