@@ -168,17 +168,19 @@ def _stream_identity() -> tuple[int, int] | None:
     return st.st_dev, st.st_ino
 
 
+def _reader_gone(fd: int) -> bool:
+    """Whether ``fd`` is a pipe (or socket) whose reading end is closed."""
+    try:
+        poller = select.poll()
+        poller.register(fd, select.POLLOUT)
+        return any(event & select.POLLERR for _, event in poller.poll(0))
+    except (OSError, ValueError, AttributeError):  # closed, or no poll on this platform
+        return False
+
+
 def reader_gone() -> bool:
     """Whether stdout or stderr is a pipe (or socket) whose reading end is closed."""
-    for fd in (1, 2):
-        try:
-            poller = select.poll()
-            poller.register(fd, select.POLLOUT)
-            if any(event & select.POLLERR for _, event in poller.poll(0)):
-                return True
-        except (OSError, ValueError, AttributeError):  # closed, or no poll on this platform
-            continue
-    return False
+    return _reader_gone(1) or _reader_gone(2)
 
 
 def end_quietly() -> NoReturn:
@@ -187,9 +189,7 @@ def end_quietly() -> NoReturn:
     at exit, and the exit code is :data:`EXIT_BROKEN_PIPE`."""
     devnull = os.open(os.devnull, os.O_WRONLY)
     for fd in (1, 2):
-        poller = select.poll()
-        poller.register(fd, select.POLLOUT)
-        if any(event & select.POLLERR for _, event in poller.poll(0)):
+        if _reader_gone(fd):
             os.dup2(devnull, fd)
     os.close(devnull)
     raise typer.Exit(EXIT_BROKEN_PIPE)
