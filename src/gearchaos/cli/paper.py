@@ -203,36 +203,94 @@ def calibrate(
         typer.Option(
             "--out",
             help=(
-                "JSON-lines file, one line per evaluated candidate; re-used on restart. "
+                "JSON-lines export of the study's finished trials, rewritten after each; "
                 "best.toml is written beside it."
             ),
             dir_okay=False,
         ),
     ] = Path("calibration.jsonl"),
+    storage: Annotated[
+        str | None,
+        typer.Option(
+            "--storage",
+            help=(
+                "Optuna storage URL holding the trials, e.g. sqlite:///calib.db (default: "
+                "sqlite:///OUT.db beside --out). Resumable; several processes may share it."
+            ),
+            show_default=False,
+        ),
+    ] = None,
+    study: Annotated[
+        str | None,
+        typer.Option(
+            "--study",
+            help="Study name in the storage (default gearchaos-calibrate, -quick with --quick).",
+            show_default=False,
+        ),
+    ] = None,
+    trials: Annotated[
+        int | None,
+        typer.Option(
+            "--trials",
+            help="Trials this command runs (each worker with --workers/--dask-local/--scheduler).",
+            show_default=False,
+        ),
+    ] = None,
     budget_minutes: Annotated[
-        float, typer.Option("--budget-minutes", help="Stop evaluating after this many minutes.")
+        float,
+        typer.Option("--budget-minutes", help="Stop starting trials after this many minutes."),
     ] = 110.0,
     max_candidates: Annotated[
         int | None,
         typer.Option(
             "--max-candidates",
-            help="Stop when the candidate sequence (resumed ones included) reaches N.",
+            help="Stop once the study holds N finished trials (resumed ones included).",
             show_default=False,
         ),
     ] = None,
-    seed: Annotated[int, typer.Option("--seed", help="Seed of the candidate sequence.")] = 0,
+    seed: Annotated[
+        int,
+        typer.Option(
+            "--seed", help="Seed of the sampler (give commands sharing a storage different seeds)."
+        ),
+    ] = 0,
     quick: Annotated[
-        bool, typer.Option("--quick", help="3 candidates on tiny sweeps, for CI.")
+        bool, typer.Option("--quick", help="At most 3 trials on tiny sweeps, for CI.")
     ] = False,
+    workers: c.WorkersOpt = None,
+    scheduler: Annotated[
+        str | None,
+        typer.Option(
+            "--scheduler",
+            help=(
+                "Run one optimising worker per worker of the dask.distributed scheduler at this "
+                "address (tcp://HOST:8786, one you trust: Dask exchanges pickles); --storage must "
+                "be reachable from every worker."
+            ),
+            show_default=False,
+        ),
+    ] = None,
+    dask_local: Annotated[
+        int | None,
+        typer.Option(
+            "--dask-local",
+            help="Run the trials on a local Dask cluster with N workers.",
+            show_default=False,
+        ),
+    ] = None,
     quiet: c.QuietOpt = False,
     json_out: c.JsonOpt = False,
 ) -> None:
     """Search the quantities of the seed's lost Table 1 (N and tooth numbers, input torque,
-    transmission-error amplitude, stiffness ratios, mass ratios, b_c, load mode) for the gear set
-    whose coarse sweeps reproduce the most landmarks of the seed's text. Resumable: candidates
-    already in --out are not evaluated again. See docs/reproduction.md.
+    transmission-error amplitude, stiffness ratios, mass ratios, b_c, load mode) with Optuna
+    (multi-objective TPE) for the gear set that reproduces the most landmarks of the seed's text
+    with the report's own evaluation, and whose clearances act (double-sided impact, multipliers
+    that change along the backlashes). Trials live in --storage: rerunning the command resumes
+    it, a trial killed mid-way is run again, and several commands (different --seed) or
+    workers can share it; `optuna-dashboard sqlite:///calibration.db` shows the study. See
+    docs/reproduction.md.
 
-    Example: **gearchaos calibrate --landmarks paper/landmarks.toml --budget-minutes 110**
+    Example: **gearchaos calibrate --storage sqlite:///calib.db --max-candidates 200**
     """
     from ..paper.calibrate import calibrate as run_calibration
 
@@ -241,11 +299,11 @@ def calibrate(
 
     def on_record(rec: Mapping[str, Any], now: bool) -> None:
         if show:
-            what = f"{rec['seconds']:.0f} s" if now else "resumed"
+            what = f"{float(rec['seconds']):.0f} s" if now else "resumed"
             err.print(
                 Text(
-                    f"candidate {rec['index']} ({rec['origin']}): score {rec['score']:.2f} "
-                    f"[{what}]",
+                    f"trial {rec['index']} ({rec['origin']}): landmarks {rec['score']:.2f}, "
+                    f"structure {float(rec.get('structure', 0.0)):.2f} [{what}]",
                     style="dim",
                 )
             )
@@ -253,21 +311,30 @@ def calibrate(
     with c.reported_errors():
         from ..paper.landmarks import load_landmarks
 
-        marks = load_landmarks(landmarks)  # a bad file is refused before anything runs
+        load_landmarks(landmarks)  # a bad file is refused before anything runs
         result = run_calibration(
-            marks,
+            landmarks,
             out,
+            storage=storage,
+            study=study,
+            trials=trials,
             budget_minutes=budget_minutes,
             max_candidates=max_candidates,
             seed=seed,
             quick=quick,
             on_record=on_record,
+            workers=workers,
+            scheduler=scheduler,
+            dask_local=dask_local,
         )
     summary = {
         "out": str(out),
+        "storage": result.storage,
+        "study": result.study,
         "best_toml": str(result.best_toml) if result.best_toml else None,
         "evaluated": result.evaluated,
         "resumed": result.reused,
+        "retried": result.retried,
         "stopped": result.stopped,
         "plausible": result.plausible,
         "problems": result.problems,
@@ -279,10 +346,13 @@ def calibrate(
     elif not quiet:
         table = pairs_table("gearchaos calibrate: best candidate" + (" (quick)" if quick else ""))
         best = result.best or {}
-        table.add_row("score", escape(fmt(best.get("score"))))
+        table.add_row("landmark score", escape(fmt(best.get("score"))))
+        table.add_row("structure", escape(fmt(best.get("structure"))))
+        table.add_row("trial", escape(fmt(best.get("index"))))
         for key, value in (best.get("variables") or {}).items():
             table.add_row(escape(str(key)), escape(fmt(value)))
         table.add_row("evaluated / resumed", f"{result.evaluated} / {result.reused}")
+        table.add_row("study", escape(f"{result.study} in {result.storage}"))
         table.add_row("stopped", escape(result.stopped))
         table.add_row("best.toml", escape(str(result.best_toml)))
         verdict = (
@@ -294,7 +364,7 @@ def calibrate(
         c.stdout().print(table)
     if result.stopped == "interrupted":
         c.fail(
-            f"interrupted: every finished candidate is in {out}; run the same command again "
-            "to resume",
+            f"interrupted: every finished trial is in {result.storage} (study {result.study}); "
+            "run the same command again to resume",
             c.EXIT_INTERRUPTED,
         )

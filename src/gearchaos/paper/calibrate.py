@@ -1,42 +1,46 @@
-"""Calibrate the seed's lost Table 1 against the landmarks of its own text.
+"""Calibrate the seed's lost Table 1 against the landmarks of its own text, with Optuna.
 
 The seed (Sheng et al. 2016) lost the table of its gear set. What survives are its quantitative
 statements — "1T for 0 ≤ Ω ≤ 1.35", "2T at Ω = 1.875", "chaos within b̄_rp ∈ 11.3–11.6" — kept
 as data in ``paper/landmarks.toml`` (:mod:`gearchaos.paper.landmarks`). This module searches
-the quantities Table 1 would have fixed, inside physically plausible ranges, for the gear set
-whose coarse sweeps reproduce the most landmarks.
+the quantities Table 1 would have fixed (:mod:`gearchaos.paper.search_space`, ranges reviewed
+against ISO 1328 and DIN 3967) for the gear set that reproduces the most landmarks with its
+clearances acting.
 
-Objective
-    For a candidate gear set g, the landmarks are grouped by figure; each figure gets one short
-    sweep (:func:`gearchaos.bifurcation`, zero initial state, ``points`` values spread over the
-    landmarks' own ranges, the panels they name, 60 + 60 mesh periods, rtol 1e-7, largest
-    Lyapunov exponent on so that chaos and quasi-periodic motion get told apart). Then
-    ``J(g) = score(evaluate_all(landmarks, stores))`` — the number of landmarks reproduced, each
-    scoring in [0, 1].
+Objective (:mod:`gearchaos.paper.objective`)
+    Two values, both maximised: the landmark score of the report's own evaluation (verdicts,
+    the report's protocol and tolerances, the perturbed start, event landmarks from continued
+    branches) and the structural term of :mod:`gearchaos.paper.structure` (double-sided impact
+    in the chaotic and multi-periodic regions of the backlash sweeps; multipliers that change
+    along b̄_sp and b̄_rp).
 
-Search space (:data:`DEFAULT_SPACE`)
-    N ∈ {3, 4, 5} with standard tooth numbers near the default's (z_r = z_s + 2 z_p,
-    (z_s + z_r)/N an integer, neighbouring planets clear), input torque T_D, transmission-error
-    amplitude A_sp = A_rp, stiffness ratios ε_sp = k_a,sp/k_m,sp and ε_rp, the ratio
-    k_m,rp/k_m,sp, scale factors of the sun, planet and carrier inertia (equivalent masses), the
-    characteristic length b_c and the load mode (constant torque or constant power). The
-    dimensionless clearances b̄ are the seed's, so b_c scales the physical clearances and the
-    ratios A/b_c, and with T_D sets T̄_D = T_D/(r_bs k_m,sp b_c).
+Optimiser
+    An Optuna study (multi-objective TPE, multivariate, constant liar for parallel workers;
+    seeded). A new study starts with the MODEL.md §9 set (``base``) and today's default
+    ``sheng2016`` (``default``) enqueued. The best candidate is the trial of highest landmark
+    score, then highest structure, then the earliest (:func:`ranked`); every trial on the
+    Pareto front is kept in the storage for the confirmation stage.
 
-Method
-    A seeded Latin-hypercube sample (the first candidate is the unchanged base gear set), then a
-    local refinement: each round perturbs one coordinate of each of the best few candidates by
-    ± a step in the unit cube (a neighbouring tooth combination, or the other load mode, for the
-    discrete ones) and halves the step after a round without improvement. The sequence depends
-    only on the seed and on the scores, so it is deterministic and a restart reproduces it.
+Storage, resuming, several processes
+    Trials live in Optuna's storage (default ``sqlite:///OUT.db`` beside ``--out``; any URL
+    Optuna takes, e.g. ``postgresql://…`` for a cluster) under a study name, so a run resumes
+    after an interrupt or a ``kill -9`` with every finished trial kept: a trial that was
+    running in a process that is gone (same host, its pid dead) is marked failed and
+    enqueued again with the same parameters (``retry of #n``); on other hosts Optuna's
+    heartbeat (``heartbeat`` seconds, failed after two missed beats) does the same. Ctrl-C
+    enqueues the interrupted trial again. Several processes may run on one storage at once
+    (``workers`` local processes, a Dask cluster at ``scheduler``, a local one of
+    ``dask_local`` workers, or separate ``gearchaos calibrate`` commands with different
+    ``--seed``); each runs ``study.optimize`` and stops when the study holds
+    ``max_candidates`` finished trials. The study records the objective's configuration
+    and refuses to be resumed with another. ``optuna-dashboard sqlite:///calibration.db``
+    shows it live.
 
-Resumability
-    Every evaluated candidate is appended to a JSON-lines file (one line, flushed and fsynced),
-    keyed by a hash of its variables; a restart reads the file, re-uses the stored scores
-    instead of evaluating again, and continues the same sequence.
-
-Limits: coarse sweeps mis-label points near bifurcations (transients of 60 periods), so scores
-are noisy by about a landmark; the search is a heuristic, not a global optimiser.
+Exports
+    ``--out`` (JSON lines, one finished trial each: ``key``, ``index`` = trial number,
+    ``origin``, ``variables``, ``params``, ``score``, ``structure``, ``landmarks``,
+    ``seconds``, ``study``), rewritten from the storage after every trial, and ``best.toml``
+    beside it.
 """
 
 from __future__ import annotations
@@ -45,18 +49,15 @@ import contextlib
 import json
 import math
 import os
-import time
 from collections.abc import Callable, Iterable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TypeVar
-
-import numpy as np
 
 from .._checks import check_bool, check_int, check_real
 from .._files import MissingFileError, check_path, read_text_file
 from ..errors import ParameterError, StoreError
-from ..integrate.settings import SolverSettings
+from .objective import Evaluation, SweepSettings, landmark_objective, sweep_plan
 from .search_space import (
     BASE_PRESET,
     DEFAULT_SPACE,
@@ -65,21 +66,34 @@ from .search_space import (
     SearchSpace,
     TeethChoice,
     _base,
-    _History,
     base_candidate,
     build_gearset,
     candidate_from_record,
     candidate_key,
+    candidate_of,
+    candidate_params,
     enumerate_teeth,
     gearset_changes,
     plausibility,
-    propose,
     record_gearset,
+)
+from .study import (
+    HEARTBEAT,
+    STUDY,
+    Job,
+    default_storage,
+    enqueue,
+    open_study,
+    optimize,
+    recover,
+    run_worker,
+    study_records,
 )
 
 __all__ = [
     "BASE_PRESET",
     "DEFAULT_SPACE",
+    "STUDY",
     "CalibrationResult",
     "Candidate",
     "Evaluation",
@@ -96,188 +110,17 @@ __all__ = [
     "enumerate_teeth",
     "gearset_changes",
     "landmark_objective",
+    "open_study",
     "plausibility",
-    "propose",
     "ranked",
     "read_results",
     "record_gearset",
+    "study_records",
     "sweep_plan",
 ]
 
 
-# --------------------------------------------------------------------------- objective
-@dataclass(frozen=True)
-class Evaluation:
-    """The outcome of one candidate: total score, per-landmark scores by id, seconds spent."""
-
-    score: float
-    landmarks: Mapping[str, float]
-    seconds: float = 0.0
-
-
-@dataclass(frozen=True)
-class SweepSettings:
-    """Coarseness of the calibration sweeps: points per landmark range and the solver settings
-    (checked on construction, with the same messages as every other entry point)."""
-
-    points: int = 48
-    transient_periods: int = 60
-    periods: int = 60
-    rtol: float = 1e-7
-    atol: float = 1e-9
-    lyapunov: bool = True
-
-    def __post_init__(self) -> None:
-        check_int("points", self.points, lo=1, hi=10**6)
-        check_bool("lyapunov", self.lyapunov)
-        _ = self.solver
-
-    @property
-    def solver(self) -> SolverSettings:
-        """The solver settings of every calibration sweep."""
-        return SolverSettings(
-            transient_periods=self.transient_periods,
-            periods=self.periods,
-            rtol=self.rtol,
-            atol=self.atol,
-        )
-
-    @classmethod
-    def quick(cls) -> SweepSettings:
-        return cls(points=6, transient_periods=20, periods=16)
-
-
-def _landmark_interval(lm: Any) -> tuple[float, float]:
-    lo = getattr(lm, "lo", None)
-    hi = getattr(lm, "hi", None)
-    at = getattr(lm, "at", None)
-    tol = float(getattr(lm, "tolerance", 0.0) or 0.0)
-    if lo is not None and hi is not None:
-        return float(lo) - tol, float(hi) + tol
-    where = at if at is not None else lo if lo is not None else hi
-    if where is None:
-        raise ParameterError(f"landmark {getattr(lm, 'id', lm)!r} has neither lo/hi nor at")
-    x = float(where)
-    return x - tol, x + tol
-
-
-def _grid(intervals: Sequence[tuple[float, float]], points: int, floor: float) -> np.ndarray:
-    """``points`` values over the union of ``intervals`` (≥ 3 per merged interval), every
-    interval's ends included, spread in proportion to length."""
-    iv = sorted((max(a, floor), max(b, floor)) for a, b in intervals)
-    merged: list[list[float]] = []
-    for a, b in iv:
-        if merged and a <= merged[-1][1]:
-            merged[-1][1] = max(merged[-1][1], b)
-        else:
-            merged.append([a, b])
-    total = sum(b - a for a, b in merged) or 1.0
-    vals: list[float] = []
-    for a, b in merged:
-        n = max(3, round(points * (b - a) / total)) if b > a else 1
-        vals.extend(np.linspace(a, b, n).tolist())
-    return np.unique(np.round(np.asarray(vals), 10))
-
-
-def sweep_plan(
-    landmarks: Sequence[Any],
-    settings: SweepSettings,
-    recipe_for: Callable[[Any], str] | None = None,
-) -> dict[str, dict[str, Any]]:
-    """Keyword arguments of :func:`gearchaos.bifurcation` for each figure the landmarks need:
-    the recipe's swept parameter over the union of the landmarks' ranges (± tolerance), the
-    panels they name, the recipe's fixed values updated by the landmarks' own.
-    ``recipe_for`` maps a landmark to its covering recipe (default
-    :func:`gearchaos.paper.landmarks.recipe_for`)."""
-    from .recipes import get_recipe
-
-    if recipe_for is None:
-        from .landmarks import recipe_for as default_recipe_for
-
-        recipe_for = default_recipe_for
-
-    by_fig: dict[str, list[Any]] = {}
-    for lm in landmarks:
-        by_fig.setdefault(recipe_for(lm), []).append(lm)
-    plan: dict[str, dict[str, Any]] = {}
-    for fig, lms in by_fig.items():
-        rec = get_recipe(fig)
-        fam_name = rec.family.name
-        fixed = dict(rec.fixed)
-        families: list[float] = []
-        intervals = []
-        for lm in lms:
-            extra = dict(getattr(lm, "fixed", None) or {})
-            if fam_name in extra:
-                families.append(float(extra.pop(fam_name)))
-            else:
-                families.extend(_panel_values(rec, getattr(lm, "panel", None)))
-            extra.pop(rec.vary.name, None)
-            fixed.update(extra)
-            intervals.append(_landmark_interval(lm))
-        floor = rec.vary.start if rec.vary.name == "omega" else 0.0
-        plan[fig] = {
-            "vary": {rec.vary.name: _grid(intervals, settings.points, floor)},
-            "family": {fam_name: sorted(set(families))},
-            "params": fixed,
-            "observe": rec.observe,
-            "planets": (1,),
-            "initial_conditions": "fresh",
-            "settings": settings.solver,
-            "lyapunov": settings.lyapunov,
-        }
-    return plan
-
-
-def _panel_values(rec: Any, panel: Any) -> list[float]:
-    """Family values of a landmark's panel: a mapping ``{family name: value}``, a letter
-    ``a``–``d`` (index), a number (the value itself) or nothing (every panel)."""
-    vals = list(rec.family.values)
-    if panel is None or panel == "":
-        return vals
-    if isinstance(panel, Mapping):
-        if rec.family.name in panel:
-            return [float(panel[rec.family.name])]
-        return vals
-    if isinstance(panel, str) and len(panel.strip()) == 1 and panel.strip().isalpha():
-        k = ord(panel.strip().lower()) - ord("a")
-        if 0 <= k < len(vals):
-            return [vals[k]]
-    with contextlib.suppress(TypeError, ValueError):
-        return [float(panel)]
-    return vals
-
-
-def _result_id(r: Any) -> str:
-    for attr in ("id", "landmark_id"):
-        if getattr(r, attr, None) is not None:
-            return str(getattr(r, attr))
-    lm = getattr(r, "landmark", None)
-    return str(getattr(lm, "id", lm))
-
-
-def landmark_objective(
-    landmarks: Sequence[Any], settings: SweepSettings | None = None
-) -> Callable[[Any], Evaluation]:
-    """The calibration objective: gear set → :class:`Evaluation` (sum of landmark scores of its
-    coarse sweeps, see the module docstring)."""
-    from ..sweep.run import bifurcation
-    from .landmarks import evaluate_all, score
-
-    settings = settings or SweepSettings()
-    plan = sweep_plan(landmarks, settings)
-
-    def objective(gs: Any) -> Evaluation:
-        t0 = time.perf_counter()
-        stores = {fig: bifurcation(gs, progress=False, **kw) for fig, kw in plan.items()}
-        results = evaluate_all(landmarks, stores)
-        per = {_result_id(r): float(r.score) for r in results}
-        return Evaluation(float(score(results)), per, time.perf_counter() - t0)
-
-    return objective
-
-
-# --------------------------------------------------------------------------- driver
+# --------------------------------------------------------------------------- records
 def read_results(path: str | os.PathLike[str]) -> dict[str, dict[str, Any]]:
     """Finished evaluations of a calibration file by candidate key (a torn last line, left by
     a kill during a write, is ignored)."""
@@ -321,39 +164,28 @@ def _is_record(rec: Any) -> bool:
 _R = TypeVar("_R", bound=Mapping[str, Any])
 
 
-def _rank_key(record: Mapping[str, Any]) -> tuple[float, int]:
-    return -float(record["score"]), int(record["index"])
+def _rank_key(record: Mapping[str, Any]) -> tuple[float, float, int]:
+    structure = record.get("structure")
+    s = float(structure) if isinstance(structure, int | float) else 0.0
+    return -float(record["score"]), -s, int(record["index"])
 
 
 def ranked(records: Iterable[_R]) -> list[_R]:
-    """Calibration records best first: highest score, the earlier candidate on a tie."""
+    """Calibration records best first: highest landmark score, then highest structure, then
+    the earlier trial."""
     return sorted(records, key=_rank_key)
 
 
 def best_record(records: Iterable[_R]) -> _R | None:
-    """The best of ``records`` (highest score, the earliest on a tie), or ``None``."""
+    """The best of ``records`` (:func:`ranked`'s first), or ``None``."""
     return min(records, key=_rank_key, default=None)
 
 
-def _append(path: Path, record: Mapping[str, Any]) -> None:
-    # a torn line from an earlier kill must not glue onto this one
-    needs_newline = path.exists() and path.stat().st_size > 0
-    if needs_newline:
-        with path.open("rb") as fh:
-            fh.seek(-1, os.SEEK_END)
-            needs_newline = fh.read(1) != b"\n"
-    with path.open("a", encoding="utf-8") as fh:
-        if needs_newline:
-            fh.write("\n")
-        fh.write(json.dumps(record, sort_keys=True) + "\n")
-        fh.flush()
-        os.fsync(fh.fileno())
-
-
+# --------------------------------------------------------------------------- driver
 @dataclass
 class CalibrationResult:
-    """What :func:`calibrate` did: every record in sequence order (resumed ones included), how
-    many were evaluated now, whether it stopped on the budget or an interrupt, and the best."""
+    """What :func:`calibrate` did: every finished trial of the study in trial order, how many
+    were evaluated now and how many were there before, why it stopped, and the best."""
 
     records: list[dict[str, Any]]
     evaluated: int
@@ -362,6 +194,9 @@ class CalibrationResult:
     best: dict[str, Any] | None
     best_toml: Path | None
     problems: list[str]
+    storage: str = ""
+    study: str = ""
+    retried: list[int] = field(default_factory=list)
 
     @property
     def plausible(self) -> bool:
@@ -371,135 +206,229 @@ class CalibrationResult:
         return ranked(self.records)[:k]
 
 
+def _export(path: Path, records: Sequence[Mapping[str, Any]]) -> None:
+    """Write the records as JSON lines, atomically (a reader never sees half a file)."""
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    with tmp.open("w", encoding="utf-8") as fh:
+        for rec in records:
+            fh.write(json.dumps(rec, sort_keys=True) + "\n")
+        fh.flush()
+        os.fsync(fh.fileno())
+    os.replace(tmp, path)
+
+
+def _check_out(path: Path, study: str) -> None:
+    """``--out`` may only hold records of this study (never replace another calibration's)."""
+    for rec in read_results(path).values():
+        if rec.get("study") != study:
+            raise StoreError(
+                f"--out {path} holds records of another calibration (not of study {study!r}); "
+                "choose another --out"
+            )
+
+
+def _config(landmarks: Sequence[Any], settings: SweepSettings, space: SearchSpace) -> dict:
+    plan = sweep_plan(landmarks, settings)
+    return {
+        "settings": settings.to_dict(),
+        "landmarks": sorted(str(m.id) for m in landmarks),
+        "panels": {k: len(p.grid) for k, p in plan.items()},
+        "ranges": {r.name: [r.lo, r.hi, r.log] for r in space.ranges},
+        "base": BASE_PRESET,
+    }
+
+
 def calibrate(
     landmarks: Sequence[Any] | str | os.PathLike[str] | None = None,
     out: str | os.PathLike[str] = "calibration.jsonl",
     *,
+    storage: str | None = None,
+    study: str | None = None,
+    trials: int | None = None,
     budget_minutes: float = 110.0,
     max_candidates: int | None = None,
     seed: int = 0,
     quick: bool = False,
-    n_initial: int | None = None,
     space: SearchSpace = DEFAULT_SPACE,
     objective: Callable[[Any], Evaluation] | None = None,
     settings: SweepSettings | None = None,
     on_record: Callable[[dict[str, Any], bool], None] | None = None,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    dask_local: int | None = None,
+    heartbeat: int = HEARTBEAT,
 ) -> CalibrationResult:
-    """Search ``space`` for the gear set that reproduces the most landmarks.
+    """Search ``space`` for the gear set that reproduces the most landmarks with its clearances
+    acting (see the module docstring).
 
     Parameters
     ----------
     landmarks
-        Landmark list or the path of ``landmarks.toml`` (``None``: the packaged default); not
-        needed when ``objective`` is given.
+        Landmark list or the path of ``landmarks.toml`` (``None``: the packaged default).
     out
-        JSON-lines file, one line per evaluated candidate: ``key``, ``index``, ``origin``,
-        ``variables`` (search variables), ``params`` (dotted gear-set changes), ``score``,
-        ``landmarks`` (score per landmark id), ``seconds``. Existing lines are re-used.
+        JSON-lines export of the study's finished trials; ``best.toml`` is written beside it.
+    storage, study
+        Optuna storage URL (default ``sqlite:///OUT.db``) and study name (default
+        :data:`STUDY`, ``-quick`` appended with ``quick``).
+    trials
+        Trials this call runs (each worker with ``workers``/``dask_local``/``scheduler``);
+        default: no limit.
     budget_minutes, max_candidates
-        Stop after this much wall time spent evaluating (this call), or when the sequence
-        (resumed candidates included) reaches ``max_candidates``.
+        Stop starting trials after this much wall time, or once the study holds
+        ``max_candidates`` finished trials (resumed ones included).
     seed
-        Seed of the candidate sequence.
+        Seed of the sampler (workers take ``seed + 1``, ``seed + 2``, …). Give separate
+        commands on one storage different seeds.
     quick
-        3 candidates on tiny sweeps (CI).
-    n_initial
-        Latin-hypercube candidates before refinement (default 48; quick 3).
+        At most 3 finished trials on tiny sweeps (:meth:`SweepSettings.quick`), for CI.
     objective
-        Gear set → :class:`Evaluation`; default :func:`landmark_objective`.
+        Gear set → :class:`Evaluation` (default :func:`landmark_objective`); picklable when run
+        on workers.
     on_record
-        Called with each record and whether it was evaluated now (progress display).
+        Called with each finished record and whether it was evaluated now (progress).
+    workers, scheduler, dask_local
+        Run the trials in that many local processes, on the Dask cluster at ``scheduler``, or
+        on a local Dask cluster of ``dask_local`` workers, all on the same storage (at most
+        one of the three; default: in this process).
+    heartbeat
+        Seconds between heartbeats of a running trial.
 
     Returns
     -------
     CalibrationResult
-        The best candidate's gear set is written to ``best.toml`` next to ``out``. Ctrl-C stops
-        after the last finished candidate (``stopped == "interrupted"``).
+        Ctrl-C stops after enqueuing the running trial again (``stopped == "interrupted"``).
     """
+    from ..sweep.execute import Execution
+
     if max_candidates is not None:
         check_int("max_candidates", max_candidates, lo=1)
+    if trials is not None:
+        check_int("trials", trials, lo=1)
     check_real("budget_minutes", budget_minutes, lo=0.0, lo_open=True)
     check_int("seed", seed, lo=0)
     quick = check_bool("quick", quick)
+    where = Execution(workers=workers, scheduler=scheduler, dask_local=dask_local)
     check_path(out, f"out must be the path of a JSON-lines file: got {out!r}")
     out_path = Path(out)
     if quick:
         max_candidates = 3 if max_candidates is None else min(max_candidates, 3)
-        n_initial = n_initial or 3
         settings = settings or SweepSettings.quick()
-    n_initial = n_initial or 48
+    settings = settings or SweepSettings()
+    name = study or (STUDY + ("-quick" if quick else ""))
+    url = storage or default_storage(out_path)
+    landmarks_path: str | None = None
     if objective is None:
         from .landmarks import load_landmarks
 
-        lms = (
-            load_landmarks(None if landmarks is None else Path(landmarks))
-            if landmarks is None or isinstance(landmarks, (str, os.PathLike))
-            else list(landmarks)
-        )
-        objective = landmark_objective(lms, settings)
-    done = read_results(out_path)
+        if landmarks is None or isinstance(landmarks, str | os.PathLike):
+            landmarks_path = None if landmarks is None else os.fspath(landmarks)
+            lms = load_landmarks(landmarks_path)
+        elif where != Execution():
+            raise ParameterError(
+                "workers, scheduler and dask_local load the landmarks in every worker: give "
+                "landmarks as the path of a landmarks file, not a list"
+            )
+        else:
+            lms = list(landmarks)  # type: ignore[arg-type]
+        config: dict[str, Any] | None = _config(lms, settings, space)
+    else:  # the caller's objective: its configuration is the caller's to keep
+        config = None
+    _check_out(out_path, name)
+    s = open_study(url, name, seed=seed, config=config, heartbeat=heartbeat)
+    before = {r["index"] for r in study_records(s)}
+    if not s.trials:  # a new study starts from the §9 set and today's default
+        from ..gearset import preset
+
+        enqueue(s, candidate_params(base_candidate(_base(), space)), "base")
+        default = candidate_of(preset("sheng2016"), _base(), space)
+        if not plausibility(default, space):
+            enqueue(s, candidate_params(default), "default")
+    retried = recover(s)
     out_path.parent.mkdir(parents=True, exist_ok=True)
-    base = _base()
-    history = _History()
-    records: list[dict[str, Any]] = []
-    stream = propose(space, seed, n_initial, history, base=base_candidate(base, space))
-    evaluated = reused = 0
-    stopped = "max_candidates"
-    t_start = time.monotonic()
+    shown: set[int] = set()
+
+    def show(now: bool) -> None:
+        records = study_records(s)
+        _export(out_path, records)
+        for rec in records:
+            if rec["index"] not in shown:
+                shown.add(rec["index"])
+                if on_record is not None:
+                    on_record(rec, now and rec["index"] not in before)
+
+    show(False)
+    job = Job(
+        url, name, seed, heartbeat, space, landmarks_path, settings,
+        objective, trials, max_candidates, 60.0 * budget_minutes,
+    )  # fmt: skip
+    stopped = "trials"
     try:
-        for cand in stream:
-            if max_candidates is not None and len(history.scores) >= max_candidates:
-                break
-            variables = cand.variables()
-            key = candidate_key(variables)
-            if key in history.seen:  # a duplicate proposal: counts, never re-evaluated
-                history.candidates.append(cand)
-                history.scores.append(-math.inf)
-                continue
-            history.seen.add(key)
-            if key in done:
-                rec = done[key]
-                reused += 1
-                now = False
-            else:
-                if time.monotonic() - t_start > 60.0 * budget_minutes:
-                    stopped = "budget"
-                    break
-                try:
-                    gs = build_gearset(cand, base)
-                except ParameterError:
-                    history.candidates.append(cand)
-                    history.scores.append(-math.inf)
-                    continue
-                ev = objective(gs)
-                rec = {
-                    "key": key,
-                    "index": len(history.scores),
-                    "seed": seed,
-                    "origin": cand.origin,
-                    "variables": variables,
-                    "params": gearset_changes(cand, base),
-                    "score": ev.score,
-                    "landmarks": dict(ev.landmarks),
-                    "seconds": round(ev.seconds, 3),
-                }
-                _append(out_path, rec)
-                evaluated += 1
-                now = True
-            history.candidates.append(cand)
-            history.scores.append(float(rec["score"]))
-            records.append(rec)
-            if on_record is not None:
-                on_record(rec, now)
+        if where == Execution():
+            obj = objective or landmark_objective(lms, settings)
+            stopped = optimize(job, s, obj, [lambda st, tr: show(True)])
+        else:
+            stopped = _parallel(job, where, lambda: show(True))
     except KeyboardInterrupt:
         stopped = "interrupted"
+    show(True)
+    records = study_records(s)
     best = best_record(records)
     best_toml: Path | None = None
     problems: list[str] = []
     if best is not None:
         cand = candidate_from_record(best, space)
         problems = plausibility(cand, space)
-        gs = build_gearset(cand, base)
         best_toml = out_path.with_name("best.toml")
-        best_toml.write_text(gs.to_toml(), encoding="utf-8")
-    return CalibrationResult(records, evaluated, reused, stopped, best, best_toml, problems)
+        best_toml.write_text(build_gearset(cand).to_toml(), encoding="utf-8")
+    evaluated = sum(1 for r in records if r["index"] not in before)
+    return CalibrationResult(
+        records, evaluated, len(before), stopped, best, best_toml, problems, url, name, retried
+    )
+
+
+def _parallel(job: Job, where: Any, progress: Callable[[], None]) -> str:
+    """Run :func:`run_worker` on every worker of ``where`` and wait, showing progress."""
+    import concurrent.futures as cf
+    import multiprocessing
+
+    if where.workers is not None:
+        ctx = multiprocessing.get_context("spawn")
+        with cf.ProcessPoolExecutor(where.workers, mp_context=ctx) as pool:
+            futures = [pool.submit(run_worker, job, i) for i in range(where.workers)]
+            return _wait(futures, progress)
+    from dask.distributed import Client, LocalCluster
+
+    if where.scheduler is not None:
+        with Client(where.scheduler, timeout=30) as client:
+            n = max(1, len(client.scheduler_info().get("workers", {})))
+            futures = [client.submit(run_worker, job, i, pure=False) for i in range(n)]
+            return _wait(futures, progress)
+    with (
+        LocalCluster(
+            n_workers=where.dask_local, threads_per_worker=1, processes=True,
+            dashboard_address=None,
+        ) as cluster,
+        Client(cluster) as client,
+    ):  # fmt: skip
+        futures = [client.submit(run_worker, job, i, pure=False) for i in range(where.dask_local)]
+        return _wait(futures, progress)
+
+
+def _wait(futures: Sequence[Any], progress: Callable[[], None]) -> str:
+    """Wait for the workers' futures (concurrent.futures or dask), showing progress every few
+    seconds; returns why they stopped."""
+    import concurrent.futures as cf
+
+    pending = list(futures)
+    while pending:
+        progress()
+        if isinstance(pending[0], cf.Future):
+            cf.wait(pending, timeout=5.0, return_when=cf.FIRST_COMPLETED)
+        else:
+            from dask.distributed import wait
+
+            with contextlib.suppress(TimeoutError):
+                wait(pending, timeout=5.0, return_when="FIRST_COMPLETED")
+        pending = [f for f in pending if not f.done()]
+    reasons = [f.result() for f in futures]
+    return "max_candidates" if "max_candidates" in reasons else reasons[0]

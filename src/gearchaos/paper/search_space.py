@@ -1,6 +1,44 @@
 """The search space of the calibration (:mod:`gearchaos.paper.calibrate`): the quantities the
-seed's lost Table 1 would have fixed, their plausible ranges, candidates as gear sets, and the
-deterministic proposal sequence (a seeded Latin hypercube, then local refinement).
+seed's lost Table 1 would have fixed, their plausible ranges, candidates as gear sets, and how
+an Optuna trial draws a candidate (:func:`suggest`).
+
+Ranges, and why (module 4 mm, z_s ≈ 33, d_s ≈ 132 mm, centre distance a ≈ 130 mm)
+    ``transmission_error.amplitude`` A = A_sp = A_rp, 1–40 µm (log)
+        The static transmission error of a spur mesh is of the size of its profile and pitch
+        deviations. ISO 1328-1 (grade 5 values, a factor √2 per grade) gives for m = 4 mm,
+        d = 132 mm: single pitch f_pt = 0.3(m + 0.4√d) + 4 ≈ 6.6 µm, total profile
+        F_α = 3.2√m + 0.22√d + 0.7 ≈ 9.6 µm; so f_pt ≈ 3.3 µm at grade 3 (ground), ≈ 19 µm at
+        grade 8 and ≈ 37 µm at grade 10 (hobbed, not finished). 1 µm is a ground mesh with
+        profile modification at its design load. The range was 1–20 µm (grades ≲ 8); the
+        issue-34 optimum sat on its upper edge, so it reaches grade 10 now.
+    ``clearance.characteristic_length`` b_c, 2–50 µm (log)
+        The seed's clearances are b̄ = b/b_c with b̄_sp = 3, b̄_rp = 3.5 in its figures and
+        b̄ = 1–16 along its sweeps, so b_sp = 3 b_c. The minimum normal backlash that ISO/TR
+        10064-2 (and AGMA) recommend, j_bn,min = (2/3)(0.06 + 0.0005 a + 0.03 m) mm ≈ 160 µm
+        at a = 130 mm, is a rated industrial fit (DIN 3967 fits c–d); DIN 3967's fits reach
+        from large allowances (a, ab: several hundred µm) down to h (zero upper tooth
+        thickness allowance), where only the tooth-thickness tolerances leave backlash, of the
+        order of 10–30 µm for precision (low-backlash) planetary gearboxes. b_c = 2 µm makes
+        b_sp = 6 µm (a full backlash of 12 µm: a fit h at tight tolerances), b_c = 50 µm makes
+        it 150 µm (≈ the ISO/TR minimum above, and 800 µm at b̄ = 16). The range was 5–50 µm;
+        the optimum sat on its lower edge, so it reaches the fit-h precision limit now.
+    ``torque.input`` T_D, 200–3000 N·m (log)
+        Light to rated load of a 4 mm-module sun of ≈ 130 mm (tooth root stress ≲ 300 MPa).
+    ``stiffness.epsilon_sp``, ``stiffness.epsilon_rp`` ε = k_a/k_m, 0.05–0.4
+        Spur meshes of contact ratio 1.4–1.9 alternate between one and two tooth pairs; the
+        fundamental of that square wave is 5–40 % of the mean (internal meshes, of higher
+        contact ratio, at the low end).
+    ``stiffness.rp_sp_ratio`` k_m,rp/k_m,sp, 0.8–2
+        Concave–convex internal contact is stiffer (Lin & Parker: 1–1.6).
+    ``inertia.sun_scale``, ``inertia.planet_scale``, ``inertia.carrier_scale``, 0.5–2 (log)
+        Equivalent masses × factor: face width, rim thickness, hollow shafts, single- or
+        double-walled carrier.
+    teeth: N ∈ {3, 4, 5}, 28 ≤ z_s ≤ 40, 25 ≤ z_p ≤ 37
+        Standard 2K-H sets that assemble with equally spaced planets (:func:`enumerate_teeth`).
+    ``torque.mode``: constant torque or constant power.
+
+The dimensionless clearances b̄ are the seed's, so b_c scales the physical clearances, the
+ratio A/b_c and, with T_D, T̄_D = T_D/(r_bs k_m,sp b_c).
 """
 
 from __future__ import annotations
@@ -9,8 +47,8 @@ import hashlib
 import json
 import math
 import warnings
-from collections.abc import Iterator, Mapping, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -26,13 +64,17 @@ __all__ = [
     "TeethChoice",
     "base_candidate",
     "build_gearset",
+    "candidate_from_params",
     "candidate_from_record",
     "candidate_key",
+    "candidate_of",
+    "candidate_params",
     "enumerate_teeth",
     "gearset_changes",
+    "nearest_teeth",
     "plausibility",
-    "propose",
     "record_gearset",
+    "suggest",
 ]
 
 #: The gear set every candidate starts from (MODEL.md §9). Fixed by name so that a calibration
@@ -142,10 +184,11 @@ DEFAULT_SPACE = SearchSpace(
         Range(
             "transmission_error.amplitude",
             1e-6,
-            20e-6,
+            40e-6,
             True,
             "m",
-            "A_sp = A_rp: ISO 1328 grades 3-8 profile/pitch errors of a 4 mm module",
+            "A_sp = A_rp: ISO 1328-1 single pitch / profile deviations of a 4 mm module, "
+            "grades 3 (ground) to 10 (hobbed); was 1-20 µm, the optimum sat on its upper edge",
         ),
         Range(
             "stiffness.epsilon_sp",
@@ -153,7 +196,8 @@ DEFAULT_SPACE = SearchSpace(
             0.4,
             False,
             "1",
-            "k_a/k_m of spur meshes with contact ratio 1.4-1.9 (single/double tooth zones)",
+            "k_a/k_m of spur meshes with contact ratio 1.4-1.9 (one/two tooth pairs: the "
+            "fundamental of that square wave is 5-40 % of the mean)",
         ),
         Range(
             "stiffness.epsilon_rp",
@@ -197,11 +241,12 @@ DEFAULT_SPACE = SearchSpace(
         ),
         Range(
             "clearance.characteristic_length",
-            5e-6,
+            2e-6,
             50e-6,
             True,
             "m",
-            "b_c: with b̄ = 2-16 gives backlash 10-800 µm, the range of DIN 3967 fits",
+            "b_c: b_sp = 3 b_c from 6 µm (DIN 3967 fit h, precision) to 150 µm (ISO/TR 10064-2 "
+            "minimum at a = 130 mm); was 5-50 µm, the optimum sat on its lower edge",
         ),
     ),
     teeth=enumerate_teeth(),
@@ -248,25 +293,8 @@ def _base() -> Any:
 def base_candidate(base: Any = None, space: SearchSpace = DEFAULT_SPACE) -> Candidate:
     """The base gear set (MODEL.md §9) expressed as a candidate of ``space``."""
     gs = base if base is not None else _base()
-    st = gs.stiffness
-    vals = {
-        "torque.input": gs.torque.input,
-        "transmission_error.amplitude": gs.transmission_error.sun_planet,
-        "stiffness.epsilon_sp": st.sun_planet_alternating / st.sun_planet_mean,
-        "stiffness.epsilon_rp": st.planet_ring_alternating / st.planet_ring_mean,
-        "stiffness.rp_sp_ratio": st.planet_ring_mean / st.sun_planet_mean,
-        "inertia.sun_scale": 1.0,
-        "inertia.planet_scale": 1.0,
-        "inertia.carrier_scale": 1.0,
-        "clearance.characteristic_length": gs.clearance.characteristic_length,
-    }
-    t = TeethChoice(gs.n_planets, gs.teeth.sun, gs.teeth.planet, gs.teeth.ring)
-    return Candidate(
-        tuple((r.name, _round(vals[r.name])) for r in space.ranges),
-        t,
-        gs.torque.mode,
-        origin="base",
-    )
+    c = candidate_of(gs, gs, space)
+    return Candidate(c.values, c.teeth, c.mode, origin="base")
 
 
 def gearset_changes(candidate: Candidate, base: Any = None) -> dict[str, Any]:
@@ -366,95 +394,6 @@ def plausibility(candidate: Candidate, space: SearchSpace = DEFAULT_SPACE) -> li
     return problems
 
 
-# --------------------------------------------------------------------------- proposals
-@dataclass
-class _History:
-    """Scores in sequence order, shared between the driver and :func:`propose`."""
-
-    candidates: list[Candidate] = field(default_factory=list)
-    scores: list[float] = field(default_factory=list)
-    seen: set[str] = field(default_factory=set)
-
-
-def _lhs(rng: np.random.Generator, n: int, d: int) -> np.ndarray:
-    u = np.empty((n, d))
-    for j in range(d):
-        u[:, j] = (rng.permutation(n) + rng.random(n)) / n
-    return u
-
-
-def _neighbour_teeth(
-    rng: np.random.Generator, t: TeethChoice, teeth: Sequence[TeethChoice]
-) -> TeethChoice:
-    """A tooth combination close to ``t``: the nearest few by |Δz_s| + |Δz_p| (any N)."""
-    others = [c for c in teeth if c != t]
-    others.sort(key=lambda c: (abs(c.sun - t.sun) + abs(c.planet - t.planet), c.planets, c.sun))
-    pool = others[:6]
-    return pool[int(rng.integers(len(pool)))]
-
-
-def propose(
-    space: SearchSpace,
-    seed: int,
-    n_initial: int,
-    history: _History,
-    *,
-    base: Candidate | None = None,
-    elites: int = 3,
-    step: float = 0.15,
-    min_step: float = 0.02,
-) -> Iterator[Candidate]:
-    """The deterministic candidate sequence for ``seed``.
-
-    First ``n_initial`` Latin-hypercube points (``base`` replaces the first when given), then
-    rounds of coordinate perturbations of the ``elites`` best scored candidates in ``history``
-    (which the caller fills in after each candidate). Perturbations already in
-    ``history.seen`` are redrawn (20 tries). The sequence is infinite; the caller stops it.
-    """
-    rng = np.random.default_rng(seed)
-    d = len(space.ranges)
-    u = _lhs(rng, n_initial, d + 2)
-    for i in range(n_initial):
-        if i == 0 and base is not None:
-            yield base
-            continue
-        values = tuple((r.name, r.from_unit(u[i, j])) for j, r in enumerate(space.ranges))
-        teeth = space.teeth[min(int(u[i, d] * len(space.teeth)), len(space.teeth) - 1)]
-        mode = space.modes[min(int(u[i, d + 1] * len(space.modes)), len(space.modes) - 1)]
-        yield Candidate(values, teeth, mode, origin="lhs")
-    best = max(history.scores, default=-math.inf)
-    round_no = 0
-    while True:
-        round_no += 1
-        order = sorted(range(len(history.scores)), key=lambda k: (-history.scores[k], k))
-        top = [history.candidates[k] for k in order[:elites] if math.isfinite(history.scores[k])]
-        if not top:
-            top = [history.candidates[0]] if history.candidates else []
-        if not top:  # pragma: no cover - nothing to refine
-            return
-        for parent in top:
-            for _ in range(20):
-                which = int(rng.integers(d + 2))
-                sign = 1.0 if rng.random() < 0.5 else -1.0
-                uu = parent.unit(space)
-                teeth, mode = parent.teeth, parent.mode
-                if which < d:
-                    uu[which] = min(max(uu[which] + sign * step, 0.0), 1.0)
-                elif which == d:
-                    teeth = _neighbour_teeth(rng, teeth, space.teeth)
-                else:
-                    mode = space.modes[(space.modes.index(mode) + 1) % len(space.modes)]
-                values = tuple((r.name, r.from_unit(uu[j])) for j, r in enumerate(space.ranges))
-                cand = Candidate(values, teeth, mode, origin=f"refine{round_no}")
-                if candidate_key(cand.variables()) not in history.seen:
-                    break
-            yield cand
-        new_best = max(history.scores, default=-math.inf)
-        if not new_best > best:
-            step = max(step / 2, min_step)
-        best = new_best
-
-
 def candidate_from_record(rec: Mapping[str, Any], space: SearchSpace = DEFAULT_SPACE) -> Candidate:
     """The :class:`Candidate` of one line of a calibration log."""
     v = rec["variables"]
@@ -468,4 +407,104 @@ def candidate_from_record(rec: Mapping[str, Any], space: SearchSpace = DEFAULT_S
         ),
         str(v["torque.mode"]),
         origin=str(rec.get("origin", "")),
+    )
+
+
+# --------------------------------------------------------------------------- Optuna trials
+#: Trial parameters of the tooth combination and the load mode (besides the ranges').
+TEETH_PARAMS = ("geometry.planets", "teeth.sun", "teeth.planet")
+MODE_PARAM = "torque.mode"
+
+
+def _bounds(space: SearchSpace) -> tuple[list[int], tuple[int, int], tuple[int, int]]:
+    planets = sorted({t.planets for t in space.teeth})
+    suns = [t.sun for t in space.teeth]
+    plans = [t.planet for t in space.teeth]
+    return planets, (min(suns), max(suns)), (min(plans), max(plans))
+
+
+def nearest_teeth(planets: int, sun: int, planet: int, space: SearchSpace) -> TeethChoice:
+    """The valid tooth combination of ``space`` closest to (z_s, z_p) = (``sun``, ``planet``):
+    with N = ``planets`` when one exists, smallest |Δz_s| + |Δz_p|, then the smaller z_s and
+    z_p (deterministic)."""
+    same = [t for t in space.teeth if t.planets == planets] or list(space.teeth)
+    if not same:
+        raise ParameterError("the search space has no tooth combination")
+    return min(
+        same,
+        key=lambda t: (abs(t.sun - sun) + abs(t.planet - planet), t.planets != planets, t.sun,
+                       t.planet),
+    )  # fmt: skip
+
+
+def suggest(trial: Any, space: SearchSpace = DEFAULT_SPACE) -> Candidate:
+    """The candidate an Optuna ``trial`` draws from ``space``: a float per range (log-uniform
+    where the range says so), N as a category, z_s and z_p as integers snapped to the nearest
+    valid combination (:func:`nearest_teeth`; the snapped teeth are the candidate's), the load
+    mode as a category. Values keep :data:`DIGITS` significant digits."""
+    values = tuple(
+        (r.name, min(max(_round(trial.suggest_float(r.name, r.lo, r.hi, log=r.log)), r.lo), r.hi))
+        for r in space.ranges
+    )
+    planets, suns, plans = _bounds(space)
+    n = int(trial.suggest_categorical("geometry.planets", planets))
+    zs = int(trial.suggest_int("teeth.sun", suns[0], suns[1]))
+    zp = int(trial.suggest_int("teeth.planet", plans[0], plans[1]))
+    mode = str(trial.suggest_categorical(MODE_PARAM, list(space.modes)))
+    return Candidate(values, nearest_teeth(n, zs, zp, space), mode, origin="trial")
+
+
+def candidate_params(candidate: Candidate) -> dict[str, Any]:
+    """The trial parameters that make :func:`suggest` return ``candidate`` (for
+    ``study.enqueue_trial``)."""
+    out: dict[str, Any] = dict(candidate.values)
+    out["geometry.planets"] = candidate.teeth.planets
+    out["teeth.sun"] = candidate.teeth.sun
+    out["teeth.planet"] = candidate.teeth.planet
+    out[MODE_PARAM] = candidate.mode
+    return out
+
+
+def candidate_from_params(
+    params: Mapping[str, Any], space: SearchSpace = DEFAULT_SPACE, origin: str = "trial"
+) -> Candidate:
+    """The candidate of a finished trial's parameters (the inverse of :func:`candidate_params`,
+    teeth snapped as :func:`suggest` does)."""
+    missing = [k for k in (*space.names[:-2], *TEETH_PARAMS, MODE_PARAM) if k not in params]
+    if missing:
+        raise ParameterError(f"trial parameters lack {', '.join(missing)}")
+    teeth = nearest_teeth(
+        int(params["geometry.planets"]), int(params["teeth.sun"]), int(params["teeth.planet"]),
+        space,
+    )  # fmt: skip
+    values = tuple((r.name, _round(float(params[r.name]))) for r in space.ranges)
+    return Candidate(values, teeth, str(params[MODE_PARAM]), origin=origin)
+
+
+def candidate_of(gearset: Any, base: Any = None, space: SearchSpace = DEFAULT_SPACE) -> Candidate:
+    """A gear set built on ``base`` (default :data:`BASE_PRESET`) as a candidate: its
+    variables read back (the inertia scales as ratios of equivalent masses, of J_c/r_c² for the
+    carrier), so ``build_gearset(candidate_of(gs))`` is ``gs`` to the rounding of the
+    variables. ``candidate_of(preset("sheng2016"))`` starts a study from today's default."""
+    b = base if base is not None else _base()
+    gs = gearset
+    st = gs.stiffness
+    vals = {
+        "torque.input": gs.torque.input,
+        "transmission_error.amplitude": gs.transmission_error.sun_planet,
+        "stiffness.epsilon_sp": st.sun_planet_alternating / st.sun_planet_mean,
+        "stiffness.epsilon_rp": st.planet_ring_alternating / st.planet_ring_mean,
+        "stiffness.rp_sp_ratio": st.planet_ring_mean / st.sun_planet_mean,
+        "inertia.sun_scale": gs.equivalent_mass_sun / b.equivalent_mass_sun,
+        "inertia.planet_scale": gs.equivalent_mass_planet / b.equivalent_mass_planet,
+        "inertia.carrier_scale": (gs.inertia.carrier / gs.radius_carrier**2)
+        / (b.inertia.carrier / b.radius_carrier**2),
+        "clearance.characteristic_length": gs.clearance.characteristic_length,
+    }
+    t = TeethChoice(gs.n_planets, gs.teeth.sun, gs.teeth.planet, gs.teeth.ring)
+    return Candidate(
+        tuple((r.name, _round(vals[r.name])) for r in space.ranges),
+        t,
+        gs.torque.mode,
+        origin=str(gs.name),
     )

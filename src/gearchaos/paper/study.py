@@ -1,0 +1,330 @@
+"""The Optuna study of the calibration (:mod:`gearchaos.paper.calibrate`): its storage, the
+configuration it records, trials lost with their process, the trial function and one worker.
+
+A trial records in its user attributes who runs it (``owner``: host, pid, process start),
+where it comes from (``origin``: ``base``, ``default``, ``tpe`` or ``retry of #n``), the
+candidate (``variables``, ``key``, ``params``: the gear-set changes) and, once finished, the
+landmark scores (``landmarks``), the structural term's parts (``parts``) and ``seconds``; its
+two values are the landmark score and the structure (:data:`OBJECTIVES`).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import socket
+import time
+import warnings
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from .._checks import check_int
+from ..errors import IntegrationError, ParameterError, StoreError
+from .objective import Evaluation, SweepSettings, landmark_objective
+from .search_space import SearchSpace, _base, build_gearset, candidate_key, gearset_changes, suggest
+
+__all__ = [
+    "HEARTBEAT",
+    "OBJECTIVES",
+    "STUDY",
+    "Job",
+    "default_storage",
+    "enqueue",
+    "finished_count",
+    "objective_of",
+    "open_study",
+    "optimize",
+    "recover",
+    "run_worker",
+    "study_records",
+]
+
+#: Default study name (``-quick`` appended for ``quick``).
+STUDY = "gearchaos-calibrate"
+#: The two objectives, both maximised.
+OBJECTIVES = ("landmarks", "structure")
+#: Seconds between heartbeats of a running trial (Optuna fails it after two missed).
+HEARTBEAT = 60
+
+
+def default_storage(out: str | os.PathLike[str]) -> str:
+    """``sqlite:///`` + ``out`` with the suffix ``.db`` (absolute)."""
+    return "sqlite:///" + str(Path(os.path.abspath(out)).with_suffix(".db"))
+
+
+@contextlib.contextmanager
+def _quiet() -> Iterator[None]:
+    """Optuna's notes that a feature is experimental are not the user's concern."""
+    import optuna
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", optuna.exceptions.ExperimentalWarning)
+        yield
+
+
+def _storage(url: str, heartbeat: int) -> Any:
+    import optuna
+    from optuna.storages import RetryHeartbeatStaleTrialCallback
+
+    check_int("heartbeat", heartbeat, lo=1)
+    if not isinstance(url, str) or "://" not in url:
+        raise ParameterError(
+            f"storage must be a database URL such as sqlite:///calib.db: got {url!r}"
+        )
+    kw: dict[str, Any] = {}
+    if url.startswith("sqlite"):
+        # writers of several processes wait for the lock instead of failing
+        kw["engine_kwargs"] = {"connect_args": {"timeout": 120}}
+        path = url.removeprefix("sqlite:///")
+        if path and path != ":memory:":
+            Path(path).parent.mkdir(parents=True, exist_ok=True)
+    try:
+        with _quiet():
+            return optuna.storages.RDBStorage(
+                url,
+                heartbeat_interval=heartbeat,
+                grace_period=2 * heartbeat,
+                heartbeat_stale_trial_callback=RetryHeartbeatStaleTrialCallback(max_retry=2),
+                **kw,
+            )
+    except Exception as exc:  # sqlalchemy raises many types for a bad URL or file
+        raise StoreError(f"storage {url!r} cannot be opened: {type(exc).__name__}: {exc}") from None
+
+
+def open_study(
+    storage: str,
+    study: str = STUDY,
+    *,
+    seed: int = 0,
+    config: Mapping[str, Any] | None = None,
+    heartbeat: int = HEARTBEAT,
+) -> Any:
+    """The Optuna study ``study`` in ``storage`` (created when missing, with two maximised
+    objectives and the seeded sampler). ``config`` (the objective's configuration) is recorded
+    in a new study and must equal the recorded one of an existing study."""
+    import optuna
+
+    check_int("seed", seed, lo=0)
+    if not isinstance(study, str) or not study.strip():
+        raise ParameterError(f"study must be a non-empty name: got {study!r}")
+    sampler = optuna.samplers.TPESampler(seed=seed, multivariate=True, constant_liar=True)
+    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    st = _storage(storage, heartbeat)
+    try:
+        s = optuna.create_study(
+            storage=st,
+            study_name=study,
+            directions=["maximize", "maximize"],
+            sampler=sampler,
+            load_if_exists=True,
+        )
+    except ValueError as exc:
+        raise StoreError(f"study {study!r} in {storage}: {exc}; use another --study") from None
+    if len(s.directions) != len(OBJECTIVES):
+        raise StoreError(
+            f"study {study!r} in {storage} has {len(s.directions)} objective(s), a calibration "
+            f"two ({', '.join(OBJECTIVES)}); use another --study"
+        )
+    if config is not None:
+        want = json.loads(json.dumps(dict(config), sort_keys=True))
+        have = s.user_attrs.get("config")
+        if have is None:
+            s.set_user_attr("config", want)
+            with _quiet():
+                s.set_metric_names(list(OBJECTIVES))
+        elif have != want:
+            diff = sorted(k for k in set(have) | set(want) if have.get(k) != want.get(k))
+            raise StoreError(
+                f"study {study!r} in {storage} was made with another objective "
+                f"({', '.join(diff)} differ); use another --study or the same settings"
+            )
+    return s
+
+
+def _proc_start(pid: int) -> str | None:
+    """The start time of process ``pid`` (Linux: /proc), to tell a reused pid apart."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return None
+    return stat.rsplit(")", 1)[-1].split()[19]
+
+
+def _owner() -> dict[str, Any]:
+    pid = os.getpid()
+    return {"host": socket.gethostname(), "pid": pid, "start": _proc_start(pid)}
+
+
+def _alive(owner: Any) -> bool | None:
+    """Whether the process that runs a trial is alive: None when it cannot be told (another
+    host, no owner)."""
+    if not isinstance(owner, dict) or owner.get("host") != socket.gethostname():
+        return None
+    pid = owner.get("pid")
+    if not isinstance(pid, int):
+        return None
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    start = owner.get("start")
+    return start is None or _proc_start(pid) == start
+
+
+def recover(study: Any) -> list[int]:
+    """Mark failed every running trial whose process on this host is gone (a kill -9, a
+    crash) and enqueue it again with the same parameters; returns their numbers."""
+    from optuna.trial import TrialState
+
+    storage = study._storage
+    study_id = storage.get_study_id_from_name(study.study_name)
+    lost = []
+    for t in study.get_trials(deepcopy=False, states=(TrialState.RUNNING,)):
+        if _alive(t.user_attrs.get("owner")) is not False:
+            continue
+        trial_id = storage.get_trial_id_from_study_id_trial_number(study_id, t.number)
+        with contextlib.suppress(RuntimeError, ValueError):  # another process was first
+            storage.set_trial_state_values(trial_id, TrialState.FAIL)
+            enqueue(study, t.params, f"retry of #{t.number}")
+            lost.append(t.number)
+    return lost
+
+
+def enqueue(study: Any, params: Mapping[str, Any], origin: str) -> None:
+    if params:
+        study.enqueue_trial(dict(params), user_attrs={"origin": origin})
+
+
+def study_records(study: Any) -> list[dict[str, Any]]:
+    """Every finished trial of a calibration study as a record (trial order)."""
+    from optuna.trial import TrialState
+
+    out = []
+    for t in study.get_trials(deepcopy=False, states=(TrialState.COMPLETE,)):
+        ua = t.user_attrs
+        if "variables" not in ua or t.values is None:
+            continue
+        out.append(
+            {
+                "key": ua.get("key", ""),
+                "index": t.number,
+                "origin": ua.get("origin", ""),
+                "variables": ua["variables"],
+                "params": ua.get("params", {}),
+                "score": float(t.values[0]),
+                "structure": float(t.values[1]),
+                "landmarks": ua.get("landmarks", {}),
+                "parts": ua.get("parts", {}),
+                "seconds": ua.get("seconds", 0.0),
+                "study": study.study_name,
+            }
+        )
+    return out
+
+
+# --------------------------------------------------------------------------- one worker
+@dataclass(frozen=True)
+class Job:
+    """What one worker process needs to run trials on the shared study (picklable)."""
+
+    storage: str
+    study: str
+    seed: int
+    heartbeat: int
+    space: SearchSpace
+    landmarks: str | None
+    settings: SweepSettings
+    objective: Callable[[Any], Evaluation] | None
+    trials: int | None
+    max_candidates: int | None
+    timeout: float | None
+
+
+def _trial_function(
+    space: SearchSpace, objective: Callable[[Any], Evaluation], base: Any, study_name: str
+) -> Callable[[Any], tuple[float, float]]:
+    from optuna.storages import RetryHeartbeatStaleTrialCallback
+
+    def run(trial: Any) -> tuple[float, float]:
+        trial.set_user_attr("owner", _owner())
+        cand = suggest(trial, space)
+        origin = trial.user_attrs.get("origin")
+        if origin is None:
+            frozen = trial.study.get_trials(deepcopy=False)[trial.number]
+            with _quiet():
+                retried = RetryHeartbeatStaleTrialCallback.retried_trial_number(frozen)
+            origin = "tpe" if retried is None else f"retry of #{retried}"
+            trial.set_user_attr("origin", origin)
+        variables = cand.variables()
+        trial.set_user_attr("variables", variables)
+        trial.set_user_attr("key", candidate_key(variables))
+        trial.set_user_attr("params", gearset_changes(cand, base))
+        gs = build_gearset(cand, base)
+        try:
+            ev = objective(gs)
+        except KeyboardInterrupt:  # run again on resume: nothing finished is lost
+            enqueue(trial.study, trial.params, f"retry of #{trial.number}")
+            raise
+        trial.set_user_attr("landmarks", dict(ev.landmarks))
+        trial.set_user_attr("seconds", round(float(ev.seconds), 3))
+        trial.set_user_attr("parts", json.loads(json.dumps(dict(ev.parts), default=str)))
+        return float(ev.score), float(ev.structure)
+
+    return run
+
+
+def objective_of(job: Job) -> Callable[[Any], Evaluation]:
+    if job.objective is not None:
+        return job.objective
+    from .landmarks import load_landmarks
+
+    return landmark_objective(load_landmarks(job.landmarks), job.settings)
+
+
+def finished_count(study: Any) -> int:
+    from optuna.trial import TrialState
+
+    return len(study.get_trials(deepcopy=False, states=(TrialState.COMPLETE,)))
+
+
+def optimize(
+    job: Job,
+    study: Any,
+    objective: Callable[[Any], Evaluation],
+    callbacks: Sequence[Callable[[Any, Any], None]] = (),
+) -> str:
+    """Run trials of ``study`` in this process until a limit; returns which one stopped it."""
+    from optuna.study import MaxTrialsCallback
+
+    recover(study)
+    if job.max_candidates is not None and finished_count(study) >= job.max_candidates:
+        return "max_candidates"
+    cbs = list(callbacks)
+    if job.max_candidates is not None:
+        cbs.append(MaxTrialsCallback(job.max_candidates))
+    t0 = time.monotonic()
+    study.optimize(
+        _trial_function(job.space, objective, _base(), study.study_name),
+        n_trials=job.trials,
+        timeout=job.timeout,
+        catch=(ParameterError, IntegrationError),
+        callbacks=cbs,
+        gc_after_trial=True,
+    )
+    if job.max_candidates is not None and finished_count(study) >= job.max_candidates:
+        return "max_candidates"
+    if job.timeout is not None and time.monotonic() - t0 >= job.timeout:
+        return "budget"
+    return "trials"
+
+
+def run_worker(job: Job, index: int = 0) -> str:
+    """One worker of a parallel calibration (a local process or a Dask task): its own
+    sampler seed (``seed + 1 + index``), the shared storage."""
+    study = open_study(job.storage, job.study, seed=job.seed + 1 + index, heartbeat=job.heartbeat)
+    return optimize(job, study, objective_of(job))
