@@ -97,6 +97,15 @@ def main() -> None:
         print(f"  {names[int(code)]:<20s} {100.0 * c / codes.size:6.1f} %")
     unresolved = 100.0 * new.count("unresolved") / len(new)
     print(f"\nunresolved: {unresolved:.1f} % (goal ≤ 1 %)")
+    omegas = np.asarray(verd.omega.values).ravel()  # type: ignore[attr-defined]
+    lle = np.asarray(verd.lle.values).ravel()  # type: ignore[attr-defined]
+    err = np.asarray(verd.lle_error.values).ravel()  # type: ignore[attr-defined]
+    win = np.asarray(verd.window_periods.values).ravel()  # type: ignore[attr-defined]
+    for i in [i for i, lab in enumerate(new) if lab == "unresolved"]:
+        print(
+            f"  unresolved at Ω = {omegas[i]:.4f}: {names[int(codes[i])]}, "
+            f"λ₁ = {lle[i]:.4g} ± {err[i]:.2g} over {int(win[i])} periods"
+        )
     extra = np.asarray(verd.extra_periods.values).ravel()  # type: ignore[attr-defined]
     print(f"periods added per point: mean {extra.mean():.1f}, max {int(extra.max())}")
     if a.baseline is not None:

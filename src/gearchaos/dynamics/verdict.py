@@ -139,7 +139,7 @@ class VerdictSettings:
     extension_periods: int | None = None
     min_extension: int = 100
     max_window: int = 1600
-    budget_periods: int = 3100
+    budget_periods: int = 6300
     settle_budget: int = 6000
     confirm_periods: int = 0
     max_bands: int = 8
