@@ -12,6 +12,7 @@ import dataclasses
 import math
 from fractions import Fraction as Fr
 
+import numpy as np
 import pytest
 
 from gearchaos.integrate import DOPRI5
@@ -133,3 +134,48 @@ def test_check_fails_on_corrupted_tableau(corrupt) -> None:
     bad = corrupt(DOPRI5)
     with pytest.raises(AssertionError):
         bad.check()
+
+
+# ------------------------------------------------------------------------------ dense output
+def test_dense_output_is_hairers_as_scipy_tabulates_it() -> None:
+    """The continuous extension built from the tableau's data (Hairer's d_i on the cubic
+    Hermite form) is, coefficient by coefficient, scipy's ``RK45.P`` (order 4) and, for a pair
+    without d_i, ``RK23.P`` (Bogacki–Shampine's cubic Hermite interpolant)."""
+    from scipy.integrate._ivp.rk import RK23, RK45
+
+    from gearchaos.integrate.tableau import BS32
+
+    for tab, ref in ((DOPRI5, RK45.P), (BS32, RK23.P)):
+        got = np.array([[float(x) for x in row] for row in tab.dense_matrix()])
+        assert got.shape == ref.shape
+        assert np.allclose(got, ref, rtol=1e-15, atol=0.0), tab.name
+
+
+def test_dense_output_order_conditions() -> None:
+    """Σ_i b_i(θ) Φ_i(t) = θ^ρ(t)/γ(t) for the 8 trees up to order 4, evaluated directly at a
+    few θ; at θ = 1 the dense weights are b; the bushy tree of order 5 fails (order 4)."""
+    D = DOPRI5.dense_matrix()
+    c = DOPRI5.c
+
+    def weights(th: Fr) -> list[Fr]:
+        return [sum((x * th ** (m + 1) for m, x in enumerate(row)), Fr(0)) for row in D]
+
+    assert weights(Fr(1)) == list(DOPRI5.b)
+    for th in (Fr(1, 3), Fr(1, 2), Fr(5, 7)):
+        w = weights(th)
+        for k in range(1, 6):
+            got = sum((wi * ci ** (k - 1) for wi, ci in zip(w, c, strict=True)), Fr(0))
+            assert (got == th**k / k) == (k <= 4), (th, k)
+    assert len([k for k in DOPRI5.dense_residuals() if "θ" in k]) == 8 * 4
+
+
+def test_check_fails_on_corrupted_dense_output() -> None:
+    d = DOPRI5.dense
+    assert d is not None
+    with pytest.raises(AssertionError, match="dense output"):
+        dataclasses.replace(DOPRI5, dense=(d[0] + Fr(1, 10**6), *d[1:])).check()
+    with pytest.raises(AssertionError, match="dense output"):
+        dataclasses.replace(DOPRI5, dense_order=5).check()  # it is not of order 5
+    with pytest.raises(AssertionError, match="dense output"):
+        dataclasses.replace(DOPRI5, dense=None, dense_order=4).check()  # Hermite: order 3
+    dataclasses.replace(DOPRI5, dense=None, dense_order=3).check()

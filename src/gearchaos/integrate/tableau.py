@@ -50,6 +50,11 @@ class ButcherTableau:
     order: int
     order_hat: int
     tol: float = 0.0
+    #: Coefficients d_i of the quartic term of the continuous extension (Hairer's dense output,
+    #: :meth:`dense_matrix`); None: the cubic Hermite interpolant of the step's ends.
+    dense: tuple[Fr, ...] | None = None
+    #: The order of the continuous extension (local error O(h^(dense_order + 1))).
+    dense_order: int = 3
 
     @property
     def stages(self) -> int:
@@ -86,15 +91,15 @@ class ButcherTableau:
             and (self.b[-1] == 0)
         )
 
-    def order_residuals(self, weights: tuple[Fr, ...], order: int) -> dict[str, Fr]:
-        """Residuals of the order conditions (exact, as fractions) for rooted trees ≤ ``order``."""
+    def _trees(self) -> dict[str, tuple[list[Fr], Fr, int]]:
+        """The rooted trees up to order 5 by name: their elementary weights Φ_i (a vector over
+        the stages), 1/γ and their order."""
         s = self.stages
         A = [[Fr(0)] * s for _ in range(s)]
         for i, row in enumerate(self.a):
             for j, v in enumerate(row):
                 A[i][j] = v
         c = list(self.c)
-        b = list(weights)
 
         def dot(u: list[Fr], v: list[Fr]) -> Fr:
             return sum((x * y for x, y in zip(u, v, strict=True)), Fr(0))
@@ -135,10 +140,65 @@ class ButcherTableau:
         orders = {"b.1": 1, "b.c": 2, "b.c2": 3, "b.Ac": 3}
         for k in ("b.c3", "b.cAc", "b.Ac2", "b.AAc"):
             orders[k] = 4
-        out = {}
-        for k, (vec, target) in conds.items():
-            if orders.get(k, 5) <= order:
-                out[k] = dot(b, vec) - target
+        return {k: (vec, target, orders.get(k, 5)) for k, (vec, target) in conds.items()}
+
+    def order_residuals(self, weights: tuple[Fr, ...], order: int) -> dict[str, Fr]:
+        """Residuals of the order conditions (exact, as fractions) for rooted trees ≤ ``order``."""
+        return {
+            k: sum((w * x for w, x in zip(weights, vec, strict=True)), Fr(0)) - target
+            for k, (vec, target, r) in self._trees().items()
+            if r <= order
+        }
+
+    def dense_matrix(self) -> tuple[tuple[Fr, ...], ...]:
+        """The continuous extension as polynomial weights: row i holds the coefficients of
+        θ¹ … θ^q of b_i(θ), so that u(τ_n + θh) = y_n + h Σ_i b_i(θ) k_i on θ ∈ [0, 1].
+
+        It is Hairer's form (*Solving ODEs I*, §II.6; the DOPRI5 code's ``CONTD5``) with
+        Δ = y_{n+1} − y_n = h Σ b_i k_i and, for an FSAL pair, k_s = f(τ_n + h, y_{n+1}):
+
+            u(θ) = y_n + θ Δ + θ(1 − θ) (h k_1 − Δ) + θ²(1 − θ) (2Δ − h k_1 − h k_s)
+                   + θ²(1 − θ)² h Σ_i d_i k_i,
+
+        i.e. the cubic Hermite interpolant of y_n, f_n, y_{n+1}, f_{n+1} plus a quartic term
+        with the tableau's coefficients ``dense`` = (d_i), which vanishes with its derivative
+        at both ends. Without them (``dense`` None) it is the cubic Hermite interpolant
+        (order 3); q = 4 with them, 3 without."""
+        s = self.stages
+        d = self.dense if self.dense is not None else (Fr(0),) * s
+        rows = []
+        for i in range(s):
+            b = self.b[i]
+            first = Fr(1 if i == 0 else 0)
+            last = Fr(1 if i == s - 1 else 0)
+            row = (
+                first,
+                3 * b - 2 * first - last + d[i],
+                -2 * b + first + last - 2 * d[i],
+                d[i],
+            )
+            rows.append(row if self.dense is not None else row[:3])
+        return tuple(rows)
+
+    def dense_residuals(self) -> dict[str, Fr]:
+        """Residuals of the order conditions of the continuous extension (exact):
+        Σ_i b_i(θ) Φ_i(t) = θ^ρ(t)/γ(t) for every tree t of order ρ(t) ≤ ``dense_order``, one
+        residual per tree and power of θ (``"b.c2 θ^3"``), and the end conditions that make it
+        a C¹ interpolant of the steps: b_i(1) = b_i, b_i′(0) = δ_i1, b_i′(1) = δ_is."""
+        D = self.dense_matrix()
+        s = self.stages
+        out: dict[str, Fr] = {}
+        for k, (vec, target, r) in self._trees().items():
+            if r > self.dense_order:
+                continue
+            for m in range(1, len(D[0]) + 1):
+                got = sum((D[i][m - 1] * vec[i] for i in range(s)), Fr(0))
+                out[f"{k} θ^{m}"] = got - (target if m == r else Fr(0))
+        for i in range(s):
+            out[f"b_{i + 1}(1)"] = sum(D[i], Fr(0)) - self.b[i]
+            out[f"b_{i + 1}'(0)"] = D[i][0] - (1 if i == 0 else 0)
+            slope = sum(((m + 1) * x for m, x in enumerate(D[i])), Fr(0))
+            out[f"b_{i + 1}'(1)"] = slope - (1 if i == s - 1 else 0)
         return out
 
     def check(self) -> None:
@@ -156,6 +216,12 @@ class ButcherTableau:
         # the embedded pair must differ, otherwise there is no error estimate
         assert any(e != 0 for e in self.error_weights), "b and b_hat coincide"
         assert abs(sum(self.error_weights, Fr(0))) <= tol, "Σ(b − b̂) must vanish"
+        # the continuous extension (needs FSAL: its last stage is f at the step's end)
+        assert self.dense is None or len(self.dense) == s, "dense: one coefficient per stage"
+        assert self.fsal or self.dense is None, "a dense output needs an FSAL pair"
+        if self.fsal:
+            bad = {k: r for k, r in self.dense_residuals().items() if abs(r) > tol}
+            assert not bad, f"{self.name}: conditions of the dense output fail: {bad}"
 
 
 #: The Dormand–Prince 5(4) pair (Dormand & Prince 1980), checked on import.
@@ -183,6 +249,17 @@ DOPRI5 = ButcherTableau(
     ),
     order=5,
     order_hat=4,
+    # Hairer's dense output of order 4 (the DOPRI5 code's D1 … D7; Shampine 1986)
+    dense=(
+        Fr(-12715105075, 11282082432),
+        Fr(0),
+        Fr(87487479700, 32700410799),
+        Fr(-10690763975, 1880347072),
+        Fr(701980252875, 199316789632),
+        Fr(-1453857185, 822651844),
+        Fr(69997945, 29380423),
+    ),
+    dense_order=4,
 )
 DOPRI5.check()
 
