@@ -5,8 +5,9 @@ y₀ (R from the tableau's arrays in numpy); the error estimate is h (b − b̂)
 step of y' = 5τ⁴ is exact (order ≥ 5 quadrature); the controller's new step is its formula; a
 switch is landed on within tolerance of the analytic crossing; the cubic Hermite interpolant
 reproduces a cubic and the tracked extremum is the analytic one; the settling check fires on
-constructed periodic sequences and not on others; samples land exactly on their times and, on
-y' = 5τ⁴, equal the analytic solution. A second tableau (Bogacki–Shampine 3(2)), compiled from
+constructed periodic sequences and not on others; sections land exactly on their times and, on
+y' = 5τ⁴, equal the analytic solution, and the samples between them (the order-4 dense output)
+do so on y' = 4τ³. A second tableau (Bogacki–Shampine 3(2)), compiled from
 the same code with its own constants, converges with order 3 — the tableau is data.
 """
 
@@ -315,16 +316,40 @@ def test_settled_fires_after_enough_repeats_of_a_period() -> None:
 
 
 # ------------------------------------------------------------------------------ sampling
+@numba.njit(cache=True)
+def _cubic_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
+    """y' = 4 τ³: y = τ⁴ + const (a polynomial an order-4 dense output reproduces exactly)."""
+    dydt[0] = 4.0 * t**3
+    obs[0] = y[0]
+    obs[1] = dydt[0]
+
+
+@dataclass(frozen=True)
+class Cubic(Quartic):
+    name = "cubic"
+    rhs = _cubic_rhs
+
+
 def test_samples_land_on_their_times_and_match_a_polynomial_solution() -> None:
-    res = gc.simulate(
-        System(Quartic(), 0.9), transient_periods=1, periods=2, samples_per_period=7,
-        rtol=1e-10, atol=1e-12,
-    )  # fmt: skip
+    """Sections are step ends, the samples between them come from the order-4 continuous
+    extension: on y' = 5τ⁴ the sections are exact (the steps are), on y' = 4τ³ every sample
+    is (the dense output integrates cubics exactly), on y' = 5τ⁴ the samples between are not
+    (order 4, not 5)."""
+    kw = dict(transient_periods=1, periods=2, samples_per_period=7, rtol=1e-10, atol=1e-12)
     T = 2 * math.pi / 0.9
-    tau = np.asarray(res.tau)
-    assert np.array_equal(tau, T + np.arange(14) * (T / 7))  # bitwise: no interpolation
-    y = np.asarray(res.states)[:, 0]
-    assert y - y[0] == pytest.approx(tau**5 - tau[0] ** 5, rel=1e-12)
+    sec = np.arange(14) % 7 == 0
+    for model, power in ((Quartic(), 5), (Cubic(), 4)):
+        res = gc.simulate(System(model, 0.9), **kw)  # type: ignore[arg-type]
+        tau = np.asarray(res.tau)
+        j = np.arange(14)
+        assert np.array_equal(tau, np.where(sec, T + (j // 7) * T, T + j * (T / 7)))
+        y = np.asarray(res.states)[:, 0]
+        exact = tau**power - tau[0] ** power
+        assert y[sec] - y[0] == pytest.approx(exact[sec], rel=1e-12)
+        if power == 4:
+            assert y - y[0] == pytest.approx(exact, rel=1e-12)
+        else:
+            assert np.max(np.abs(y - y[0] - exact)[~sec] / np.abs(exact[~sec])) > 1e-11
 
 
 # ------------------------------------------------------------------ a second tableau: data

@@ -4,13 +4,15 @@ Run from the repository root with ``.venv/bin/python tests/regression/make_refer
 files under ``tests/regression/reference/`` were written by this script *before* the
 refactoring of issue 9 (one path from a parameter to the kernel), so the test proves that the
 refactoring changed no number. Re-run it only when a change of the numerics is intended (a new
-step-size controller, say) and say so in the commit message.
+step-size controller, say) and say so in the commit message. Names of reference files as
+arguments (``make_reference.py simulate.nc``) rewrite only those.
 """
 
 from __future__ import annotations
 
 import os
 import shutil
+import sys
 from pathlib import Path
 
 import gearchaos as gc
@@ -56,15 +58,23 @@ def oscillator() -> gc.System:
     return gc.backlash_oscillator(1.0, zeta=0.05, b=1.0, f_mean=0.1, f_alt=0.2)
 
 
-def main() -> None:
+def main(names: list[str]) -> None:
+    """Write the reference files ``names`` (all of them if empty)."""
+    stores = {
+        "sweep_fresh.zarr": (gearset(), SWEEP_FRESH),
+        "sweep_continuation.zarr": (gearset(), SWEEP_CONTINUATION),
+        "sweep_oscillator.zarr": (oscillator(), SWEEP_OSCILLATOR),
+    }
+    unknown = sorted(set(names) - {"simulate.nc", *stores})
+    if unknown:
+        raise SystemExit(f"no such reference file: {', '.join(unknown)}")
     REF.mkdir(exist_ok=True)
-    res = gc.simulate(gearset(), **SIMULATE)
-    res.save(REF / "simulate.nc")
-    for name, target, kw in (
-        ("sweep_fresh.zarr", gearset(), SWEEP_FRESH),
-        ("sweep_continuation.zarr", gearset(), SWEEP_CONTINUATION),
-        ("sweep_oscillator.zarr", oscillator(), SWEEP_OSCILLATOR),
-    ):
+    if not names or "simulate.nc" in names:
+        res = gc.simulate(gearset(), **SIMULATE)
+        res.save(REF / "simulate.nc")
+    for name, (target, kw) in stores.items():
+        if names and name not in names:
+            continue
         path = REF / name
         if path.exists():
             shutil.rmtree(path)
@@ -74,4 +84,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    main(sys.argv[1:])

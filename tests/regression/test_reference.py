@@ -30,10 +30,9 @@ import gearchaos as gc
 #: Attributes that name the software that wrote a file rather than what it computed.
 VERSION_ATTRS = frozenset({"version", "numba_version", "numpy_version", "scipy_version"})
 
-#: The reference was last regenerated for issue 13 (Newton's method for the predicted switch
-#: time, which moves step ends by less than 1e-9 of a step); it holds the contact forces and
-#: the load factor as issue 12 defined them; issue 24's redefinition of the contact force (its
-#: compressive part) is applied to it by _contact_forces_issue_24.
+#: The stores were last regenerated for issue 13 (Newton's method for the predicted switch
+#: time, which moves step ends by less than 1e-9 of a step); simulate.nc for issue 32 (the
+#: samples between sections interpolated).
 
 
 def _same_attrs(a: dict[str, object], b: dict[str, object], where: str) -> None:
@@ -62,16 +61,12 @@ def _model_repr_issue_12(attrs: dict[str, object]) -> dict[str, object]:
     return out
 
 
-def _settings_record_issue_25(attrs: dict[str, object], store: bool) -> dict[str, object]:
+def _settings_record_issue_25(attrs: dict[str, object]) -> dict[str, object]:
     """Issue 25 writes the solver settings from one record (``SolverSettings.to_record``): a
     store's attributes repeat the whole record — the references' start perturbed by 1e-6, as
-    their ``sweep_toml`` says, is now an attribute too — and a setting equal to what its
-    absence means (a section phase of 0) is left out of every record."""
+    their ``sweep_toml`` says, is now an attribute too."""
     out = dict(attrs)
-    if store:
-        out["perturbation"] = 1e-06
-    elif out.get("section_phase") == 0.0:
-        del out["section_phase"]
+    out["perturbation"] = 1e-06
     return out
 
 
@@ -105,40 +100,10 @@ def _switch_retries_issue_25(new: dict[str, object], ref: dict[str, object]) -> 
     return out
 
 
-def _contact_forces_issue_24(ref: xr.Dataset, widths: dict[str, float]) -> xr.Dataset:
-    """Issue 24 redefined the reported contact force as the compressive part of the mesh
-    force (the damping's pull just before release is no contact force): apply that to the
-    reference — samples F̄ where F̄ δ̄ > 0, else 0; extrema of a window that touched one flank
-    clipped at 0 on that flank's side — and its new descriptions. ``widths``: b̄ per mesh."""
-    out = ref.copy(deep=True)
-    for m, b in widths.items():
-        for tail in ("", "_history"):
-            f = ref[f"contact_force_{m}{tail}"]
-            d = ref[f"delta_{m}{tail}"].values
-            out[f"contact_force_{m}{tail}"].values[...] = np.where(f.values * d > 0, f.values, 0)
-            out[f"contact_force_{m}{tail}"].attrs["long_name"] = f.attrs["long_name"].replace(
-                "in contact, 0 while apart",
-                "where it presses the flanks in contact together, 0 while apart or pulling",
-            )
-        drive = ref[f"delta_{m}_max"].values > b
-        back = ref[f"delta_{m}_min"].values < -b
-        assert np.all(drive & ~back)  # one flank: the clipped extrema are exact
-        for which in ("min", "max"):
-            out[f"contact_force_{m}_{which}"].values[...] = np.maximum(
-                ref[f"contact_force_{m}_{which}"].values, 0.0
-            )
-        out[f"load_factor_{m}"].attrs["note"] = (
-            ref[f"load_factor_{m}"]
-            .attrs["note"]
-            .replace("apart)", "apart or the damping would pull)")
-        )
-    return out
-
-
 def _assert_same_store(new: Path, ref: Path) -> None:
     g_new = zarr.open_group(os.fspath(new), mode="r")
     g_ref = zarr.open_group(os.fspath(ref), mode="r")
-    ref_attrs = _settings_record_issue_25(_model_repr_issue_12(dict(g_ref.attrs)), store=True)
+    ref_attrs = _settings_record_issue_25(_model_repr_issue_12(dict(g_ref.attrs)))
     ref_attrs = _model_reference_issue_25(dict(g_new.attrs), ref_attrs)
     _same_attrs(dict(g_new.attrs), ref_attrs, "store")
     names_new = sorted(k for k, _ in g_new.arrays())
@@ -176,15 +141,14 @@ def test_sweep_store_is_bitwise_equal_to_reference(
 
 
 def test_simulate_result_is_bitwise_equal_to_reference(tmp_path: Path) -> None:
+    """``simulate.nc`` (8 samples per period) was regenerated for issue 32, when the samples
+    between the sections came to be interpolated instead of ending steps; it holds every
+    change of the stores' conversions above already."""
     res = gc.simulate(gearset(), **SIMULATE)  # type: ignore[arg-type]
     res.save(tmp_path / "simulate.nc")
     new = xr.load_dataset(tmp_path / "simulate.nc", engine="h5netcdf")
     ref = xr.load_dataset(REF / "simulate.nc", engine="h5netcdf")
-    bl = gearset().backlash
-    assert bl.units == "dimensionless"
-    ref = _contact_forces_issue_24(ref, {"sp": bl.sun_planet, "rp": bl.planet_ring})
-    ref.attrs = _switch_retries_issue_25(new.attrs, ref.attrs)
-    _same_attrs(new.attrs, _settings_record_issue_25(ref.attrs, store=False), "simulate.nc")
+    _same_attrs(new.attrs, ref.attrs, "simulate.nc")
     assert sorted(new.variables) == sorted(ref.variables)
     for name in ref.variables:
         _same_attrs(new[name].attrs, ref[name].attrs, str(name))

@@ -64,7 +64,7 @@ def extend(
     t0 = (section_fraction(settings) * T)[:, None]
     times = SampleTimes(
         t_rec=t0 + T[:, None],
-        dt=T[:, None].copy(),
+        period=T[:, None].copy(),
         n_samples=int(periods),
         t_end=t0 + periods * T[:, None],
         max_steps=int(100_000 + 50_000 * periods),

@@ -135,7 +135,7 @@ def shoot(
     # Newton iterations): one sample at the start of each period, no transient
     times = SampleTimes(
         t_rec=t0.copy(),
-        dt=np.repeat(T[:, None], period, axis=1),
+        period=np.repeat(T[:, None], period, axis=1),
         n_samples=1,
         t_end=t0 + T[:, None],
         max_steps=_step_budget(settings),

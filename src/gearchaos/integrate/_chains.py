@@ -35,10 +35,12 @@ class ChainRun:
 
     Arrays: ``Y0`` (C, n_full) initial states (system state, then ``n_tangent`` tangent
     vectors); ``P`` (C, L, n_par) packed parameters; ``SW`` (C, L, n_track) dead-zone half
-    widths; ``t0``, ``t_rec``, ``dt``, ``t_end`` (C, L) start, first sample, sample interval
-    and end times; ``settle_spp`` the samples per period when the transient may end early
-    (``settle="auto"``), else 0; ``tangent_tol`` the factor on the error tolerances of the
-    tangent components (1: those of the state).
+    widths; ``t0``, ``t_rec``, ``period``, ``t_end`` (C, L) start, first sample, section
+    interval T (the forcing period) and end times; ``samples_per_period`` the samples per
+    section interval (sample j at τ_rec + jT/s; the steps end on the sections j = ks only,
+    the samples between are interpolated, :func:`~gearchaos.integrate.dopri.dopri_run`);
+    ``settle`` whether the transient may end early (``settle="auto"``); ``tangent_tol`` the
+    factor on the error tolerances of the tangent components (1: those of the state).
     """
 
     kind: int
@@ -47,7 +49,7 @@ class ChainRun:
     SW: np.ndarray
     t0: np.ndarray
     t_rec: np.ndarray
-    dt: np.ndarray
+    period: np.ndarray
     t_end: np.ndarray
     n_samples: int
     n_obs: int
@@ -60,8 +62,14 @@ class ChainRun:
     continuation: bool = False
     h_init: float = -1.0
     max_step: float = np.inf
-    settle_spp: int = 0
+    settle: bool = False
     tangent_tol: float = 1.0
+    samples_per_period: int = 1
+
+    @property
+    def dt(self) -> np.ndarray:
+        """(C, L) sample intervals T/s."""
+        return self.period / self.samples_per_period
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -164,7 +172,7 @@ class ChainRun:
             SW=SW,
             t0=t0,
             t_rec=times.t_rec,
-            dt=times.dt,
+            period=times.period,
             t_end=times.t_end,
             n_samples=times.n_samples,
             n_obs=ref.n_obs,
@@ -177,8 +185,9 @@ class ChainRun:
             continuation=bool(continuation),
             h_init=-1.0 if first_step is None else float(first_step),
             max_step=float(max_step),
-            settle_spp=int(settings.samples_per_period) if settings.settle == "auto" else 0,
+            settle=settings.settle == "auto",
             tangent_tol=float(tangent_tol),
+            samples_per_period=int(times.samples_per_period),
         )
 
     @classmethod
@@ -187,8 +196,7 @@ class ChainRun:
         if len(runs) == 1:
             return runs[0]
         stacked: dict[str, Any] = {
-            name: np.concatenate([getattr(r, name) for r in runs], axis=0)
-            for name in ("Y0", "P", "SW", "t0", "t_rec", "dt", "t_end")
+            name: np.concatenate([getattr(r, name) for r in runs], axis=0) for name in _CHAIN_INPUTS
         }
         return replace(runs[0], **stacked)
 
@@ -322,7 +330,7 @@ def config_record(run: ChainRun) -> np.ndarray:
 
 #: the ChainRun arrays the kernel reads (then the configuration record) and the ChainOutput
 #: arrays it fills, chain axis first, in the kernel's argument order
-_CHAIN_INPUTS = ("Y0", "P", "SW", "t0", "t_rec", "dt", "t_end")
+_CHAIN_INPUTS = ("Y0", "P", "SW", "t0", "t_rec", "period", "t_end")
 _CHAIN_OUTPUTS = (
     "tau", "states", "observables", "obs_min", "obs_max", "final_state", "info", "status",
     "log_sums",

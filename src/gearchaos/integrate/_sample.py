@@ -1,10 +1,14 @@
 """Compiled sampling of the integrator: recording a sample, renormalising the tangent vectors
 there, and starting the running extrema.
 
-The integrator does not interpolate samples: it ends a step exactly on every sample time
-(3–9× more accurate than interpolating), so a sample is the state after such a step, with the
-observables of its last (FSAL) stage. The interpolant inside a step (cubic Hermite, for the
-extrema and the switches) is :func:`~gearchaos.integrate._switch.hermite`.
+The integrator ends a step exactly on every section time (3–9× more accurate than
+interpolating), and on every sample while tangent vectors ride along, so such a sample is the
+state after that step, with the observables of its last (FSAL) stage. A sample between two
+sections is interpolated instead (:func:`~gearchaos.integrate.dopri.record_interpolated`, from
+the continuous extension :func:`~gearchaos.integrate._step.dense_state`), so that the steps do
+not depend on the number of samples per period. The interpolant of the tracked observables
+inside a step (cubic Hermite, for the extrema and the switches) is
+:func:`~gearchaos.integrate._switch.hermite`.
 """
 
 from __future__ import annotations

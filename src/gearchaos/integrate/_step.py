@@ -30,6 +30,7 @@ from .tableau import DOPRI5, ButcherTableau
 __all__ = [
     "MAX_STAGES",
     "TABLEAU",
+    "dense_state",
     "error_norm",
     "fsal_advance",
     "initial_step",
@@ -44,9 +45,11 @@ MAX_STAGES = 12
 
 def tableau_constants(tab: ButcherTableau) -> dict[str, Any]:
     """The module constants the kernels read for the explicit FSAL pair ``tab``: ``STAGES``,
-    ``TAB_A`` (s × s), ``TAB_C``, ``TAB_E`` (b − b̂), ``ALPHA`` (the step controller's
-    exponent, from the embedded order) and ``INIT_EXPONENT`` (1/order, Hairer's starting
-    step)."""
+    ``TAB_A`` (s × s), ``TAB_C``, ``TAB_E`` (b − b̂), ``TAB_D`` (s × q: the coefficients of
+    θ¹ … θ^q of the continuous extension's weights b_i(θ),
+    :meth:`~gearchaos.integrate.tableau.ButcherTableau.dense_matrix`), ``ALPHA`` (the step
+    controller's exponent, from the embedded order) and ``INIT_EXPONENT`` (1/order, Hairer's
+    starting step)."""
     tab.check()
     if not tab.fsal:
         raise ValueError(f"{tab.name}: the integrator needs an FSAL pair (last row of A = b)")
@@ -59,6 +62,7 @@ def tableau_constants(tab: ButcherTableau) -> dict[str, Any]:
         "TAB_A": arr.A,
         "TAB_C": arr.c,
         "TAB_E": arr.e,
+        "TAB_D": np.array([[float(x) for x in row] for row in tab.dense_matrix()]),
         "ALPHA": pi_alpha(tab.order_hat),
         "INIT_EXPONENT": 1.0 / tab.order,
     }
@@ -70,6 +74,7 @@ STAGES: int = _CONSTANTS["STAGES"]
 TAB_A: np.ndarray = _CONSTANTS["TAB_A"]
 TAB_C: np.ndarray = _CONSTANTS["TAB_C"]
 TAB_E: np.ndarray = _CONSTANTS["TAB_E"]
+TAB_D: np.ndarray = _CONSTANTS["TAB_D"]
 ALPHA: float = _CONSTANTS["ALPHA"]
 INIT_EXPONENT: float = _CONSTANTS["INIT_EXPONENT"]
 
@@ -176,6 +181,28 @@ def fsal_advance(y, yt, K, n):  # pragma: no cover - compiled
     for i in range(n):
         y[i] = yt[i]
         K[0, i] = K[STAGES - 1, i]
+
+
+@numba.njit(cache=True, inline="always")
+def dense_state(yi, y, K, hs, theta, w, n):  # pragma: no cover - compiled
+    """The continuous extension of the accepted step of size ``hs`` from ``y`` (= y_n, with its
+    stages ``K``) at the fraction ``theta`` ∈ [0, 1] of the step:
+    yi[:n] = y_n + hs Σ_i b_i(θ) K_i, b_i(θ) = Σ_m TAB_D[i, m] θ^(m+1) (Horner; ``w``: scratch
+    of one weight per stage). For DOPRI5 Hairer's dense output of order 4, for a pair without
+    one the cubic Hermite interpolant of the step's ends
+    (:meth:`~gearchaos.integrate.tableau.ButcherTableau.dense_matrix`)."""
+    q = TAB_D.shape[1]
+    for s in range(STAGES):
+        acc = 0.0
+        for m in range(q - 1, -1, -1):
+            acc = acc * theta + TAB_D[s, m]
+        w[s] = acc * theta
+    for i in range(n):
+        acc = -0.0
+        for s in range(STAGES):
+            if w[s] != 0.0:  # a stage without weight (DOPRI5's second)
+                acc += w[s] * K[s, i]
+        yi[i] = y[i] + hs * acc
 
 
 @njit_noalloc

@@ -1,12 +1,19 @@
-"""Compiled adaptive Dormand–Prince 5(4) integrator that lands exactly on sample times.
+"""Compiled adaptive Dormand–Prince 5(4) integrator that lands exactly on the section times.
 
 The kernel integrates ``y' = f(τ, y)`` of any built-in system (selected by ``kind``) from τ_0,
-discards everything before the record start τ_rec, then stops *exactly* on each sample time
-τ_rec + j Δ (the step is clipped, not interpolated: 3–9× more accurate than interpolation), and
-continues to τ_end. Over [τ_rec, τ_end] it keeps the running minimum and maximum of the first
-``n_track`` observables, refining the extremum inside each accepted step by the cubic Hermite
-interpolant of the observable and its derivative (the observables come for free from the FSAL
-stage).
+discards everything before the record start τ_rec, then stops *exactly* on each section time
+τ_rec + kT (the step is clipped, not interpolated: 3–9× more accurate than interpolation), and
+continues to τ_end. With s > 1 samples per period, the samples between two sections,
+τ_rec + jΔ (Δ = T/s, j not a multiple of s), are taken inside the accepted step that contains
+them from the method's continuous extension (Hairer's dense output of order 4 for DOPRI5,
+:func:`~._step.dense_state`), their observables from the right-hand side at the interpolated
+state: so the steps, and with them the section points, the final state, the step counts and
+the extrema, are the same bit for bit whatever s is (issue 32: on a chaotic transient a
+different step sequence can end on a different attractor). Runs that carry tangent vectors
+still end a step on every sample, where the vectors are renormalised. Over [τ_rec, τ_end] it
+keeps the running minimum and maximum of the first ``n_track`` observables, refining the
+extremum inside each accepted step by the cubic Hermite interpolant of the observable and its
+derivative (the observables come for free from the FSAL stage).
 
 :func:`dopri_run` is the loop; each of its parts is a compiled function of its own that a test
 can call alone:
@@ -25,9 +32,9 @@ can call alone:
   (:func:`~._switch.track`);
 * settling (:mod:`~gearchaos.integrate._settle`): whether the transient's section points repeat;
 * sampling (:mod:`~gearchaos.integrate._sample`): a sample recorded, tangent vectors
-  renormalised there.
+  renormalised there; a sample between sections interpolated (:func:`record_interpolated`).
 
-After a step clipped to land on a sample the pre-clip step size is restored, so sampling does
+After a step clipped to land on a section the pre-clip step size is restored, so sampling does
 not throttle the integration. Another explicit FSAL pair runs this same code with its own
 constants (:func:`~gearchaos.integrate.methods.kernels_for`).
 
@@ -53,7 +60,7 @@ from ..model.kernels import OBS_ALL, OBS_TRACK, rhs
 from ._control import LOG_ERR_OLD_MIN, accepted_step, rejected_step
 from ._sample import copy_into, record_sample, renormalize, start_extrema
 from ._settle import SETTLE_MAX_PERIOD, first_section, settled
-from ._step import ALPHA, STAGES, error_norm, fsal_advance, initial_step, rk_step
+from ._step import ALPHA, STAGES, dense_state, error_norm, fsal_advance, initial_step, rk_step
 from ._switch import aim_step, land_switch, push_point, track
 from .interface import Config, Info
 
@@ -78,35 +85,66 @@ def workspace(n, n_obs, n_track, n_base):  # pragma: no cover - compiled
         np.zeros(3),  # t_hist: their times
         np.empty((SETTLE_MAX_PERIOD + 1, n_base)),  # ring: transient section points
         np.zeros(SETTLE_MAX_PERIOD + 1, dtype=np.int64),  # runs: repeat run lengths
-        np.empty(n),  # f1: scratch of initial_step
-        np.empty(n_obs),  # o1: scratch of initial_step
+        np.empty(n),  # f1: scratch of initial_step and of an interpolated sample
+        np.empty(n_obs),  # o1: scratch of initial_step and of an interpolated sample
+        np.empty(n),  # yi: an interpolated sample's state
+        np.empty(STAGES),  # wd: the dense output's weights b_i(θ)
     )
+
+
+@numba.njit(cache=True, inline="always")
+def sample_time(t_rec, period, dt_sample, spp, j):  # pragma: no cover - compiled
+    """τ_j of sample j: a section (j = k·spp) at τ_rec + k·T, any other at τ_rec + j·Δ (the
+    same numbers for s = 1 and for every power of two s, since T/s is then exact)."""
+    k = j // spp
+    if j == k * spp:
+        return t_rec + k * period
+    return t_rec + j * dt_sample
+
+
+@numba.njit(cache=True, inline="always")
+def record_interpolated(
+    kind, j, tj, theta, y, K, hs, p, yi, wd, f1, o1, out_t, out_y, out_obs, n, n_obs
+):  # pragma: no cover - compiled
+    """Record sample ``j`` at τ_j = ``tj``, the fraction ``theta`` of the accepted step ``hs``
+    from ``y`` (its stages ``K``, before the step is taken over): the state from the continuous
+    extension (:func:`~._step.dense_state`), the observables from the right-hand side there.
+    Inlined into its caller, where ``kind`` must be a compile-time literal."""
+    dense_state(yi, y, K, hs, theta, wd, n)
+    rhs(kind, tj, yi, p, f1, o1, OBS_ALL)
+    out_t[j] = tj
+    copy_into(out_y[j], yi, n)
+    copy_into(out_obs[j], o1, n_obs)
 
 
 @njit_noalloc
 def dopri_run(
-    kind, y0, p, sw, t0, t_rec, dt_sample, t_end, cfg, out, info, lsum, ws
+    kind, y0, p, sw, t0, t_rec, period, t_end, cfg, out, info, lsum, ws
 ):  # pragma: no cover - compiled
     """Integrate one system; fill the output arrays ``out`` = (out_t, out_y, out_obs,
     obs_min, obs_max, y_final); return the status code. ``cfg`` is the configuration record
     (float64, slots :class:`~gearchaos.integrate.interface.Config`): the numbers every point
     of a run shares (n_samples, n_obs, n_track, n_base = n_state, rtol, atol, h_init, max_step,
-    max_steps, settle_spp, tan_tol = tangent_tol). ``tan_tol`` scales the error tolerances of
-    the tangent components.
+    max_steps, settle, tan_tol = tangent_tol, spp = samples_per_period). ``tan_tol`` scales the
+    error tolerances of the tangent components.
 
-    Samples are taken at τ_j = t_rec + j·dt_sample, j = 0 … n_samples−1 (t_rec ≥ t0), then the
-    integration goes on to t_end ≥ τ_last. Extrema of obs[:n_track] are tracked over
-    [t_rec, t_end]. ``sw`` holds the half clearances b_k of the dead zones acting on the tracked
-    observables (``inf``: smooth); a step that crosses a switch obs_k = ±b_k is discarded and
-    retried so that it ends on the switch, so no step straddles a kink of the vector field
-    (DOPRI5's error estimate can miss a kink inside a step: 10–100× larger errors).
+    Samples are taken at τ_j = t_rec + j·Δ, Δ = ``period``/spp, j = 0 … n_samples−1
+    (t_rec ≥ t0; :func:`sample_time`), then the integration goes on to t_end. The steps end
+    exactly on the sections j = k·spp (τ_rec + k·``period``) and on t_end; a sample in between
+    is interpolated inside the accepted step that contains it (:func:`record_interpolated`), so
+    the steps do not depend on spp. With tangent vectors every sample is a step end. Extrema of
+    obs[:n_track] are tracked over [t_rec, t_end]. ``sw`` holds the half clearances b_k of the
+    dead zones acting on the tracked observables (``inf``: smooth); a step that crosses a
+    switch obs_k = ±b_k is discarded and retried so that it ends on the switch, so no step
+    straddles a kink of the vector field (DOPRI5's error estimate can miss a kink inside a
+    step: 10–100× larger errors).
     ``info`` (float64, columns :class:`~gearchaos.integrate.interface.Info`) receives accepted
     steps, steps rejected by the error test, steps discarded to land on a switch, the final time
     reached, the next step size and the transient periods skipped by ``settle``.
 
-    Settling (``settle_spp`` > 0, the samples per period, so T = settle_spp·dt_sample): the
-    steps also land on the transient section points τ_rec − mT, and once their sequence repeats
-    (:func:`~gearchaos.integrate._settle.settled`) at τ_rec − mT, the recording starts there:
+    Settling (``settle``, T = ``period``): the steps also land on the transient section points
+    τ_rec − mT, and once their sequence repeats (:func:`~gearchaos.integrate._settle.settled`)
+    at τ_rec − mT, the recording starts there:
     τ_rec and τ_end move back by mT (whole periods, so the forcing phase of every sample is
     unchanged).
 
@@ -128,10 +166,14 @@ def dopri_run(
     h_init = cfg[Config.H_INIT]
     max_step = cfg[Config.MAX_STEP]
     max_steps = int(cfg[Config.MAX_STEPS])
-    settle_spp = int(cfg[Config.SETTLE_SPP])
+    settle = cfg[Config.SETTLE] != 0.0
     tan_tol = cfg[Config.TANGENT_TOL]
+    spp = int(cfg[Config.SAMPLES_PER_PERIOD])
+    dt_sample = period / spp
+    # the samples the steps end on: the sections (every sample while tangents ride along)
+    land = 1 if lsum.size > 0 else spp
     out_t, out_y, out_obs, obs_min, obs_max, y_final = out
-    y, yt, K, obs, hist, t_hist, ring, runs, f1, o1 = ws
+    y, yt, K, obs, hist, t_hist, ring, runs, f1, o1, yi, wd = ws
     n = y0.size
     copy_into(y, y0, n)
     for s in range(STAGES):
@@ -187,8 +229,7 @@ def dopri_run(
     h_event = -1.0
     log_err_old = LOG_ERR_OLD_MIN  # log err_{n−1}: one log and one exp a step, no pow
     # settling: transient section points, the newest SETTLE_MAX_PERIOD + 1 in a ring
-    settling = settle_spp > 0 and n_samples > 0 and t < t_rec
-    period = dt_sample * settle_spp
+    settling = settle and n_samples > 0 and t < t_rec
     m_next = first_section(t, t_rec, period) if settling else 0
     for r in range(SETTLE_MAX_PERIOD + 1):
         runs[r] = 0
@@ -197,12 +238,18 @@ def dopri_run(
 
     while status == ST_OK:
         sec_step = settling and m_next >= 1
+        on_sample = False  # the target is the next landed sample
         if sec_step:
             target = t_rec - m_next * period
-        elif j < n_samples:
-            target = t_rec + j * dt_sample
         else:
-            target = t_end
+            j_land = ((j + land - 1) // land) * land
+            if j_land < n_samples:
+                target = sample_time(t_rec, period, dt_sample, spp, j_land)
+                on_sample = True
+            else:
+                target = t_end
+                if j < n_samples:  # samples left to interpolate: reach the last one
+                    target = max(t_end, sample_time(t_rec, period, dt_sample, spp, n_samples - 1))
         if j >= n_samples and t >= t_end:
             break
         if n_acc + n_rej + n_sw >= max_steps:
@@ -247,11 +294,21 @@ def dopri_run(
         cut = clipped or shortened
         h, log_err_old = accepted_step(err, hs, h, log_err_old, last_rejected, cut, max_step, ALPHA)
         last_rejected = False
+        # the samples between sections inside this step, from its continuous extension
+        while j < n_samples and j % land != 0:
+            tj = t_rec + j * dt_sample
+            if tj > t_new:
+                break
+            theta = (tj - t) / hs
+            record_interpolated(
+                kind, j, tj, theta, y, K, hs, p, yi, wd, f1, o1, out_t, out_y, out_obs, n, n_obs
+            )
+            j += 1
         t = t_new
         fsal_advance(y, yt, K, n)
         if tracking:
             track(hist, obs, hs, n_track, obs_min, obs_max)
-        record = clipped and j < n_samples and not sec_step
+        record = clipped and on_sample
         if clipped and sec_step:
             m_next -= 1
             if settled(y, ring, runs, n_sec, n_base):
@@ -286,7 +343,7 @@ def dopri_run(
 
 @numba.njit(cache=True, nogil=True)
 def dopri_chains(
-    kind, Y0, P, SW, t0, t_rec, dt_sample, t_end, cfg, out_t, out_y, out_obs, obs_min, obs_max,
+    kind, Y0, P, SW, t0, t_rec, T, t_end, cfg, out_t, out_y, out_obs, obs_min, obs_max,
     y_final, info, status, LSUM
 ):  # pragma: no cover - compiled  # fmt: skip
     """Chains of integrations, one chain after another, points of a chain in order: the one
@@ -297,13 +354,14 @@ def dopri_chains(
     The arguments after ``kind`` are the arrays of a
     :class:`~gearchaos.integrate._chains.ChainRun` (``_CHAIN_INPUTS``), its configuration
     record ``cfg`` (:class:`~gearchaos.integrate.interface.Config`) and the arrays of a
-    :class:`~gearchaos.integrate._chains.ChainOutput` (``_CHAIN_OUTPUTS``), chain axis first.
+    :class:`~gearchaos.integrate._chains.ChainOutput` (``_CHAIN_OUTPUTS``), chain axis first
+    (``T`` the section interval of each point).
     Point j of chain c has parameters ``P[c, j]`` and runs from τ = ``t0[c, j]``; it starts
     from ``Y0[c]`` (fresh) or, with ``continuation``, from the final state of point j−1 of the
     same chain (point 0 from ``Y0[c]``); a failed point restarts its successor from ``Y0[c]``.
     ``LSUM[c, j]`` (k ≥ 0 entries) receives the Lyapunov log sums when the state carries k
-    tangent vectors after its ``n_base`` system components. ``settle_spp`` > 0 (the samples
-    per period) lets every point end its transient early once its section sequence repeats.
+    tangent vectors after its ``n_base`` system components. ``settle`` lets every point end
+    its transient early once its section sequence repeats.
     Every point runs :func:`dopri_run` unchanged, so its result does not depend on the chain
     it runs in, on the other chains or on the number of threads.
     """
@@ -325,7 +383,7 @@ def dopri_chains(
                 SW[c, j],
                 t0[c, j],
                 t_rec[c, j],
-                dt_sample[c, j],
+                T[c, j],
                 t_end[c, j],
                 cfg,
                 out + ext,

@@ -31,8 +31,9 @@ class Config(enum.IntEnum):
     MAX_STEP = 7
     MAX_STEPS = 8  # step attempts allowed per point
     CONTINUATION = 9  # 1: a point starts from its predecessor's final state
-    SETTLE_SPP = 10  # samples per period when the transient may end early, else 0
+    SETTLE = 10  # 1: the transient may end early once its section points repeat
     TANGENT_TOL = 11  # factor on the error tolerances of the tangent components
+    SAMPLES_PER_PERIOD = 12  # samples per section interval (every such sample is a section)
 
 
 class Info(enum.IntEnum):

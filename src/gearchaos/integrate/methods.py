@@ -46,6 +46,7 @@ class Kernels(NamedTuple):
     stage_input: Any
     fsal_advance: Any
     initial_step: Any
+    dense_state: Any
     dopri_run: Any
     dopri_chains: Any
     alpha: float
@@ -79,7 +80,7 @@ def kernels_for(tableau: ButcherTableau) -> Kernels:
     else:
         consts = _step.tableau_constants(tableau)
         step = _rebuild(_step, consts)
-        names = ("rk_step", "error_norm", "fsal_advance", "initial_step")
+        names = ("rk_step", "error_norm", "fsal_advance", "initial_step", "dense_state")
         loop = _rebuild(dopri, {**consts, **{k: step[k] for k in names}})
     return Kernels(
         tableau=tableau,
@@ -88,6 +89,7 @@ def kernels_for(tableau: ButcherTableau) -> Kernels:
         stage_input=step["stage_input"],
         fsal_advance=step["fsal_advance"],
         initial_step=step["initial_step"],
+        dense_state=step["dense_state"],
         dopri_run=loop["dopri_run"],
         dopri_chains=loop["dopri_chains"],
         alpha=float(step["ALPHA"]),

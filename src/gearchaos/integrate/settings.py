@@ -70,15 +70,23 @@ def rest_direction(n: int) -> np.ndarray:
 
 @dataclass(frozen=True)
 class SampleTimes:
-    """Where the kernel samples: τ_j = ``t_rec`` + j ``dt`` for j < ``n_samples``, then on to
-    ``t_end``; at most ``max_steps`` step attempts. ``t_rec``, ``dt`` and ``t_end`` are floats
-    or arrays (one value per point of a sweep)."""
+    """Where the kernel samples: τ_j = ``t_rec`` + j ``dt`` for j < ``n_samples``
+    (``dt`` = ``period``/``samples_per_period``; every ``samples_per_period``-th sample,
+    τ_rec + k·``period``, is a section point, on which the steps end), then on to ``t_end``; at
+    most ``max_steps`` step attempts. ``t_rec``, ``period`` and ``t_end`` are floats or arrays
+    (one value per point of a sweep)."""
 
     t_rec: Any
-    dt: Any
+    period: Any
     n_samples: int
     t_end: Any
     max_steps: int
+    samples_per_period: int = 1
+
+    @property
+    def dt(self) -> Any:
+        """The sample interval T/s."""
+        return self.period / self.samples_per_period
 
 
 @dataclass(frozen=True)
@@ -252,10 +260,11 @@ class SolverSettings:
             t_rec = t_rec + phase * T / (2.0 * math.pi)
         return SampleTimes(
             t_rec=t_rec,
-            dt=T / self.samples_per_period,
+            period=T,
             n_samples=self.n_samples,
             t_end=t_rec + self.periods * T,
             max_steps=self.step_budget,
+            samples_per_period=int(self.samples_per_period),
         )
 
     def check_memory(self, values_per_sample: int, points: int = 1, what: str = "") -> None:
