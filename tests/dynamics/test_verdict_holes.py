@@ -199,3 +199,21 @@ def test_a_long_period_is_seen_before_qp() -> None:
     for a in long:  # the record repeats with its period, independently checked
         x = a.section_states
         assert np.max(np.abs(x[55:] - x[:-55])) < 1e-3 * max(1.0, float(np.max(np.abs(x))))
+
+
+def test_simulate_and_a_sweep_end_in_one_verdict() -> None:
+    # one protocol (100 + 100 periods from rest, perturbed by 1e-6), one point: the single
+    # point door records 64 samples a period, the sweep one; their steps and so their
+    # verdicts must not differ (Ω = 1.2 has a long chaotic transient that amplifies any)
+    from gearchaos import sweep
+    from gearchaos.dynamics.point import analyse_point
+    from gearchaos.integrate.settings import SIMULATION
+
+    cfg = SIMULATION.replace(periods=100)
+    ds = sweep.bifurcation(SHENG, "omega=1.2,1.1426", progress=False)
+    for i, omega in enumerate((1.2, 1.1426)):
+        pa = analyse_point(SHENG, {"omega": omega}, cfg)
+        assert pa.verdict is not None
+        assert pa.verdict.label == str(ds.motion.values[i]), omega
+        lam = float(ds.lle.values[i])
+        assert pa.verdict.lle == lam or (math.isnan(lam) and math.isnan(pa.verdict.lle))
