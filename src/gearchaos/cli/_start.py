@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from .._checks import check_int, check_real
 from .._text import escape_path, escape_text
 from ..errors import ParameterError, StoreError
 
@@ -108,16 +109,19 @@ def _load(path: str, where: dict[str, str]) -> Start:
     from ..dynamics.branch import open_branch
 
     try:
-        return _from_branch(path, open_branch(path), where)
-    except StoreError:
-        pass
+        branch = open_branch(path)
+    except StoreError as exc:
+        branch, reason = None, str(exc)
+    if branch is not None:  # a branch file: what is wrong with it is said, not tried as another
+        return _from_branch(path, branch, where)
     from ..dynamics.orbit_file import open_orbit
 
     try:
         ds = open_orbit(path)
     except StoreError:
         raise StoreError(
-            f"--from {escape_path(path)} is no sweep store, branch file or orbit file of gearchaos"
+            f"--from {escape_path(path)} is no sweep store, branch file or orbit file of "
+            f"gearchaos (as a branch: {escape_text(reason)})"
         ) from None
     return _from_orbit(path, ds, where)
 
@@ -140,7 +144,130 @@ def _gearset(attrs: Any, path: str) -> Any:
                 "(periodic_orbit(system, guess=state))"
             )
         return System(model, 1.0)
-    return GearSet.from_toml_string(text)
+    try:
+        return GearSet.from_toml_string(text)
+    except ParameterError as exc:
+        raise StoreError(
+            f"--from {escape_path(path)}: its attribute gearset_toml is no valid gear set "
+            f"({escape_text(exc)}); the file is damaged"
+        ) from None
+
+
+# ------------------------------------------------------------------ a file's attributes
+#: Longest period of an orbit a file may record (the shooting's own bound).
+MAX_PERIOD = 10_000
+_MISSING = object()
+
+
+def _damaged(path: str, key: str, rule: str, value: Any = _MISSING) -> StoreError:
+    """The refusal of a file's attribute ``key`` that is missing or breaks ``rule``: one line
+    naming the file, the attribute and the rule."""
+    where = f"--from {escape_path(path)}"
+    if value is _MISSING:
+        return StoreError(
+            f"{where}: the attribute {key} is missing ({rule}); the file is damaged or was not "
+            "written by gearchaos"
+        )
+    plain = value.item() if isinstance(value, np.generic) else value
+    shown = escape_text(repr(plain))
+    shown = shown if len(shown) <= 60 else shown[:57] + "..."
+    return StoreError(
+        f"{where}: the attribute {key} must be {rule}: got {shown}; the file is damaged"
+    )
+
+
+def _int_attr(attrs: Any, key: str, path: str, lo: int, hi: int) -> int:
+    """The integer attribute ``key`` in [lo, hi]."""
+    value = attrs.get(key, _MISSING)
+    rule = f"an integer in [{lo}, {hi}]"
+    if value is _MISSING:
+        raise _damaged(path, key, rule)
+    try:
+        return check_int(key, value, lo=lo, hi=hi)
+    except ParameterError:
+        raise _damaged(path, key, rule, value) from None
+
+
+def _real_attr(
+    attrs: Any, key: str, path: str, *, lo: float | None = None, lo_open: bool = False
+) -> float:
+    """The finite number attribute ``key`` (>= ``lo``, or > with ``lo_open``)."""
+    value = attrs.get(key, _MISSING)
+    rule = "a finite number" + ("" if lo is None else f" {'>' if lo_open else '>='} {lo:g}")
+    if value is _MISSING:
+        raise _damaged(path, key, rule)
+    try:
+        return check_real(key, value, lo=lo, lo_open=lo_open)
+    except ParameterError:
+        raise _damaged(path, key, rule, value) from None
+
+
+def _text_attr(attrs: Any, key: str, path: str) -> str:
+    value = attrs.get(key, _MISSING)
+    if value is _MISSING:
+        raise _damaged(path, key, "text")
+    if not isinstance(value, str) or not value:
+        raise _damaged(path, key, "text", value)
+    return value
+
+
+def _parameters(attrs: Any, path: str) -> dict[str, Any]:
+    """The ``parameter:NAME`` attributes: numbers as float, text (``torque.mode``) as it is."""
+    values: dict[str, Any] = {}
+    for key, v in attrs.items():
+        if not key.startswith("parameter:"):
+            continue
+        if isinstance(v, str):
+            values[key.partition(":")[2]] = v
+        else:
+            values[key.partition(":")[2]] = _real_attr(attrs, key, path)
+    return values
+
+
+def _fixed(attrs: Any, path: str) -> dict[str, Any]:
+    """A branch file's ``fixed`` attribute: a JSON object of parameter values."""
+    text = attrs.get("fixed", _MISSING)
+    if text is _MISSING:
+        raise _damaged(path, "fixed", "a JSON object of parameter values")
+    try:
+        raw = json.loads(str(text))
+    except ValueError:
+        raw = None
+    if not isinstance(raw, dict):
+        raise _damaged(path, "fixed", "a JSON object of parameter values", text)
+    values: dict[str, Any] = {}
+    for key, v in raw.items():
+        if isinstance(v, str):
+            values[str(key)] = v
+        elif isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v):
+            values[str(key)] = float(v)
+        else:
+            raise _damaged(path, "fixed", f"a JSON object of parameter values ({key})", text)
+    return values
+
+
+def _state(values: Any, path: str, target: Any, omega: float, what: str) -> np.ndarray:
+    """The state ``values`` (the file's ``what``) as a vector of the model's states: its
+    length and finiteness are the file's, checked before any shooting starts from it."""
+    from ..model.target import resolve
+
+    try:
+        state = np.asarray(values, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise _damaged(path, what, "a vector of numbers", values) from None
+    n = resolve(target, {OMEGA: omega}).n_state
+    if state.shape != (n,):
+        raise StoreError(
+            f"--from {escape_path(path)}: its {what} has shape {state.shape}, but the model it "
+            f"records has {n} states; the file is damaged"
+        )
+    bad = int(np.sum(~np.isfinite(state)))
+    if bad:
+        raise StoreError(
+            f"--from {escape_path(path)}: its {what} has {bad} entries that are NaN or "
+            "infinite; the file is damaged"
+        )
+    return state
 
 
 def _from_store(path: str, where: dict[str, str]) -> Start:
@@ -184,12 +311,13 @@ def _from_store(path: str, where: dict[str, str]) -> Start:
                 f"{coord.min():g} … {coord.max():g}), e.g. --at {dim}={coord[coord.size // 2]:g}"
             )
         value = _number(dim, where[dim])
-        span = float(np.ptp(coord)) or 1.0
-        k = int(np.argmin(np.abs(coord - value)))
-        if abs(float(coord[k]) - value) > 1e-6 * span:
-            near = ", ".join(f"{c:g}" for c in coord[max(0, k - 1) : k + 2])
+        k = _stored_index(np.asarray(coord, dtype=float), value)
+        if k is None:
+            j = int(np.argmin(np.abs(coord - value)))
+            near = _distinct(np.asarray(coord[max(0, j - 1) : j + 2], dtype=float))
             raise ParameterError(
-                f"--at {dim}={value:g} is no point of {path}; the nearest stored values are {near}"
+                f"--at {dim}={where[dim]} is no point of {escape_path(path)}; the nearest stored "
+                f"values are {near}: give one of them"
             )
         index[dim] = coord[k]
         chosen[dim] = float(coord[k])
@@ -219,13 +347,42 @@ def _from_store(path: str, where: dict[str, str]) -> Start:
     )
 
 
-def _section(attrs: Any) -> dict[str, float]:
-    return {k: float(attrs[k]) for k in ("section_phase", "transient_periods") if k in attrs}
+def _stored_index(coord: np.ndarray, value: float) -> int | None:
+    """The index of the stored coordinate ``--at`` names: the only one within 1e-6 of the
+    axis's span or equal to ``value`` at the 6 significant digits the refusal prints (so
+    1.33333 names 4/3); None for none or more than one."""
+    gap = np.abs(coord - value)
+    digit = 10.0 ** (math.floor(math.log10(abs(value))) - 5) if value != 0 else 0.0
+    tol = max(1e-6 * (float(np.ptp(coord)) or 1.0), 0.5 * digit * (1 + 1e-9))
+    near = np.flatnonzero(gap <= tol)
+    return int(near[np.argmin(gap[near])]) if near.size == 1 else None
+
+
+def _distinct(values: np.ndarray) -> str:
+    """``values`` with the fewest significant digits (6 or more) that tell them apart, as the
+    user can type them back."""
+    for digits in range(6, 18):
+        shown = [f"{v:.{digits}g}" for v in values]
+        if len(set(shown)) == len(shown):
+            return ", ".join(shown)
+    return ", ".join(repr(float(v)) for v in values)
+
+
+def _section(attrs: Any, path: str) -> dict[str, float]:
+    """The section the recorded state lies on: ``section_phase`` and ``transient_periods``."""
+    out = {}
+    if "section_phase" in attrs:
+        out["section_phase"] = _real_attr(attrs, "section_phase", path)
+    if "transient_periods" in attrs:
+        out["transient_periods"] = _real_attr(attrs, "transient_periods", path, lo=0.0)
+    return out
 
 
 def _from_branch(path: str, ds: Any, where: dict[str, str]) -> Start:
     target = _gearset(ds.attrs, path)  # a model the user has not named: refused first
-    name = str(ds.attrs["parameter"])
+    name = _text_attr(ds.attrs, "parameter", path)
+    if name not in ds:
+        raise _damaged(path, "parameter", "the name of the branch's parameter", name)
     if set(where) != {name}:
         raise ParameterError(
             f"--at must name the branch's parameter alone for --from {path}: --at "
@@ -239,40 +396,33 @@ def _from_branch(path: str, ds: Any, where: dict[str, str]) -> Start:
             f"--at {name}={value:g} is off the branch of {path}, which covers {lo:g} … {hi:g}"
         )
     k = int(np.argmin(np.abs(lam - value)))
-    values = {str(key): _value(v) for key, v in json.loads(str(ds.attrs["fixed"])).items()}
+    values = _fixed(ds.attrs, path)
     values[name] = value
+    omega = float(values.get(OMEGA, 1.0))
     return Start(
         gearset=target,
         values=values,
-        state=np.asarray(ds["orbit_state"].values[k], dtype=np.float64),
-        period=int(ds.attrs["period"]),
+        state=_state(ds["orbit_state"].values[k], path, target, omega, f"orbit_state[{k}]"),
+        period=_int_attr(ds.attrs, "period", path, 1, MAX_PERIOD),
         source=f"{escape_path(os.path.basename(path))} at {escape_text(name)}={value:g} "
         f"(branch point {k})",
-        section=_section(ds.attrs),
+        section=_section(ds.attrs, path),
     )
-
-
-def _value(v: Any) -> Any:
-    """A stored parameter value: numbers as float, text (``torque.mode``) as it is."""
-    return v if isinstance(v, str) else float(v)
 
 
 def _from_orbit(path: str, ds: Any, where: dict[str, str]) -> Start:
     target = _gearset(ds.attrs, path)  # a model the user has not named: refused first
     if where:
         raise ParameterError(f"--at does not apply to an orbit file ({path}): drop it")
-    values = {
-        key.partition(":")[2]: _value(v)
-        for key, v in ds.attrs.items()
-        if key.startswith("parameter:")
-    }
-    values[OMEGA] = float(ds.attrs["omega"])
+    values = _parameters(ds.attrs, path)
+    values[OMEGA] = _real_attr(ds.attrs, OMEGA, path, lo=0.0, lo_open=True)
+    period = _int_attr(ds.attrs, "period", path, 1, MAX_PERIOD)
     return Start(
         gearset=target,
         values=values,
-        state=np.asarray(ds["orbit_state"].values, dtype=np.float64),
-        period=int(ds.attrs["period"]),
-        source=f"{escape_path(os.path.basename(path))} (period-{int(ds.attrs['period'])} orbit "
+        state=_state(ds["orbit_state"].values, path, target, values[OMEGA], "orbit_state"),
+        period=period,
+        source=f"{escape_path(os.path.basename(path))} (period-{period} orbit "
         f"at Ω = {values[OMEGA]:g})",
-        section=_section(ds.attrs),
+        section=_section(ds.attrs, path),
     )

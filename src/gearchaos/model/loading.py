@@ -100,7 +100,7 @@ def load_model_class(spec: str) -> type:
                 f"--model {shown}: no model of that name is installed (entry points of "
                 f"{ENTRY_POINT_GROUP}: {', '.join(known) or 'none'}); or give FILE.py:CLASS"
             )
-        cls = found[0].load()
+        cls = _imported(found[0].load, shown)
     else:
         if where.endswith(".py"):
             path = os.path.abspath(where)
@@ -120,14 +120,9 @@ def load_model_class(spec: str) -> type:
                 )
             if folder not in sys.path:
                 sys.path.insert(0, folder)
-            module = importlib.import_module(stem)
+            module = _imported(lambda: importlib.import_module(stem), shown, path)
         else:
-            try:
-                module = importlib.import_module(where)
-            except ImportError as exc:
-                raise ParameterError(
-                    f"--model {shown}: cannot import '{escape_text(where)}' ({exc})"
-                ) from None
+            module = _imported(lambda: importlib.import_module(where), shown)
         cls = getattr(module, attr, None)
         if cls is None:
             raise ParameterError(
@@ -137,6 +132,50 @@ def load_model_class(spec: str) -> type:
         raise ParameterError(f"--model {shown} must name a model class: got {type(cls).__name__}")
     _NAMED[spec] = cls
     return cls
+
+
+def _imported(load: Any, shown: str, path: str | None = None) -> Any:
+    """``load()``, the import of the user's model (``--model``, shown as ``shown``): whatever
+    its code raises while imported — an exception, a syntax error, ``sys.exit`` — is refused
+    in one line naming the file, the line and the exception; what it prints goes to stderr,
+    so that ``--json`` output stays JSON. Ctrl-C is not caught."""
+    import contextlib
+
+    try:
+        with contextlib.redirect_stdout(sys.stderr):
+            return load()
+    except (Exception, SystemExit) as exc:
+        where = _raised_at(exc, path)
+        kind = type(exc).__name__
+        text = exc.msg if isinstance(exc, SyntaxError) else str(exc)
+        what = f"{kind}: {text}" if text else kind
+        if isinstance(exc, SystemExit):
+            what = f"it calls sys.exit({text}) when imported"
+        raise ParameterError(
+            f"--model {shown}: importing it failed{where}: {escape_text(what)}"
+        ) from None
+
+
+def _raised_at(exc: BaseException, path: str | None) -> str:
+    """`` at FILE, line N``: where ``exc`` was raised — a syntax error's own place, else the
+    deepest frame of the model's file ``path`` (else of any file that is not importlib's)."""
+    import traceback
+
+    if isinstance(exc, SyntaxError) and exc.filename:
+        return f" at {escape_text(exc.filename)}, line {exc.lineno}"
+    import importlib
+
+    skip = (os.path.dirname(importlib.__file__ or ""), os.path.abspath(__file__))
+    frames = [
+        f
+        for f in traceback.extract_tb(exc.__traceback__)
+        if not f.filename.startswith("<") and not os.path.abspath(f.filename).startswith(skip)
+    ]
+    own = [f for f in frames if path is not None and os.path.abspath(f.filename) == path]
+    chosen = own or frames
+    if not chosen:
+        return ""
+    return f" at {escape_text(chosen[-1].filename)}, line {chosen[-1].lineno}"
 
 
 def named_models() -> tuple[str, ...]:
