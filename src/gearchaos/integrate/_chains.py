@@ -24,7 +24,7 @@ from ..errors import ParameterError, Status
 from ..model.system import System
 from .interface import Config, Info
 from .settings import SampleTimes, SolverSettings
-from .threads import pool, wait_all
+from .threads import announce_ready, pool, wait_all
 
 __all__ = ["ChainOutput", "ChainRun", "SampleArrays", "config_record", "run_chains"]
 
@@ -348,7 +348,8 @@ def run_threaded(call: Any, n: int, threads: int) -> None:
 
     threads = max(1, min(int(threads), n))
     if threads == 1 and threading.current_thread() is not threading.main_thread():
-        call(0, n)  # a sweep driver's single block runs where it is
+        announce_ready()
+        call(0, n)  # a sweep driver's (or Dask worker's) single block runs where it is
         return
     workers = pool(threads)
     size = max(1, n // (8 * threads))

@@ -15,11 +15,12 @@ thread runs it.
 
 **Readiness.** With the environment variable :data:`READY_ENV` (``GEARCHAOS_READY_LINE``) set
 to anything but ``""`` or ``0``, a process writes :data:`READY_LINE` to stderr once, when it
-first waits for compiled blocks: its kernels are compiled (or loaded from the cache) and the
-computation runs, so a signal is handled at once from there on. A script or a test that must
-interrupt a computation rather than its start-up waits for this line, not for a time (a fresh
-clone compiles for a minute or more on a loaded machine). Worker processes inherit the variable
-and write the line too.
+first waits for compiled blocks or runs one on its own thread (:func:`announce_ready`): its
+kernels are compiled (or loaded from the cache) and the computation runs, so a signal is
+handled at once from there on. A script or a test that must interrupt a computation rather
+than its start-up waits for this line, not for a time (a fresh clone compiles for a minute or
+more on a loaded machine). Worker processes (local or Dask) inherit the variable and write the
+line too.
 """
 
 from __future__ import annotations
@@ -36,6 +37,7 @@ __all__ = [
     "DaemonPool",
     "abandon",
     "abandoned",
+    "announce_ready",
     "pool",
     "resume",
     "wait_all",
@@ -55,8 +57,9 @@ _READY_PID: list[int] = []
 _READY_LOCK = threading.Lock()
 
 
-def _announce_ready() -> None:
-    """Write :data:`READY_LINE` once per process when :data:`READY_ENV` asks for it."""
+def announce_ready() -> None:
+    """Write :data:`READY_LINE` once per process when :data:`READY_ENV` asks for it; called
+    where compiled blocks start (:func:`wait_all`, a driver's or Dask worker's own block)."""
     if os.environ.get(READY_ENV, "") in ("", "0"):
         return
     pid = os.getpid()
@@ -128,7 +131,7 @@ def wait_all(futures: list[cf.Future[Any]]) -> None:
     main thread's wait at once, :func:`abandon` any other thread's within a slice; then the
     blocks not yet started are cancelled and ``KeyboardInterrupt`` is raised."""
     main = threading.current_thread() is threading.main_thread()
-    _announce_ready()
+    announce_ready()
     try:
         pending = set(futures)
         while pending:
