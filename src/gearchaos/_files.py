@@ -31,7 +31,9 @@ __all__ = [
     "check_output_file",
     "check_path",
     "check_regular_file",
+    "irregular_entry",
     "open_regular_nofollow",
+    "read_nofollow",
     "read_text_file",
 ]
 
@@ -133,6 +135,53 @@ def open_regular_nofollow(path: str) -> int:
         os.close(fd)
         raise OSError(errno.EINVAL, f"{_kind(mode)}, not a regular file")
     return fd
+
+
+def read_nofollow(path: str, max_bytes: int) -> bytes:
+    """The bytes of the regular file at ``path`` itself (a file gearchaos wrote: store
+    metadata, a manifest, a lock, a task marker), opened by :func:`open_regular_nofollow` —
+    so a symbolic link, a FIFO, a device or a directory raises ``OSError`` before anything is
+    read and the open never blocks — and at most ``max_bytes`` of them: a larger file raises
+    ``OSError`` ``EFBIG`` after ``max_bytes`` + 1 bytes, whatever size it claims."""
+    fd = open_regular_nofollow(path)
+    try:
+        chunks: list[bytes] = []
+        total = 0
+        while total <= max_bytes:
+            chunk = os.read(fd, min(1 << 20, max_bytes + 1 - total))
+            if not chunk:
+                break
+            chunks.append(chunk)
+            total += len(chunk)
+        if total > max_bytes:
+            raise OSError(errno.EFBIG, f"larger than the {_size(max_bytes)} allowed")
+        return b"".join(chunks)
+    finally:
+        os.close(fd)
+
+
+def irregular_entry(root: str) -> tuple[str, str] | None:
+    """(path relative to ``root`` with ``/``, what it is) of the first entry under the
+    directory ``root`` that is neither a regular file nor a directory — a FIFO, a device, a
+    socket or a symbolic link, which gearchaos never writes in a store it makes — or ``None``.
+    Checked before a library that opens files plainly (Zarr) reads the directory: it would
+    block on a FIFO or read a device without end. Symbolic links are not followed."""
+    for dirpath, dirnames, files in os.walk(root):
+        dirnames.sort()
+        for name in sorted([*dirnames, *files]):
+            full = os.path.join(dirpath, name)
+            rel = os.path.relpath(full, root).replace(os.sep, "/")
+            try:
+                mode = os.lstat(full).st_mode
+            except FileNotFoundError:
+                continue  # removed meanwhile (a writer's temporary)
+            except OSError as exc:
+                return rel, f"not readable ({exc.strerror or exc})"
+            if stat.S_ISLNK(mode):
+                return rel, "a symbolic link"
+            if not (stat.S_ISREG(mode) or stat.S_ISDIR(mode)):
+                return rel, _kind(mode)
+    return None
 
 
 def check_regular_file(path: object, *, what: str) -> str:

@@ -10,7 +10,10 @@ symbolic link — is refused with :class:`~gearchaos.errors.StoreError` naming t
 **The one way to write.** :func:`staged_file` and :func:`staged_dir` give the writer a
 temporary path beside the target with a unique name, created exclusively (``O_EXCL``: a
 symbolic link planted under any name is never followed), and on success flush it to disk and
-rename it over the target in one step; on every error path the temporary is removed. An
+rename it over the target in one step; on every error path the temporary is removed. Its name
+says whose it is (``.NAME.HOST-PID-random.partial``: a digest of this host's name and the
+writer's pid), so a later write of the same output removes what a killed writer (even by
+SIGKILL) left (:func:`remove_stale_staging`), and nothing a live writer still fills. An
 ``ENOSPC`` becomes "no space left on device … N bytes free" instead of a crash or a truncated
 file; writers whose libraries crash on a full disk (HDF5) serialise to memory first and write
 the bytes with :func:`write_file`.
@@ -27,11 +30,13 @@ import json
 import os
 import re
 import shutil
+import socket
 import stat
 import tempfile
+import zlib
 from collections.abc import Callable, Iterator
 
-from ._files import open_regular_nofollow
+from ._files import open_regular_nofollow, read_nofollow
 from .errors import StoreError
 
 __all__ = [
@@ -39,8 +44,10 @@ __all__ = [
     "check_replaceable",
     "file_has_mark",
     "is_own_zarr",
+    "remove_stale_staging",
     "staged_dir",
     "staged_file",
+    "staging_prefix",
     "write_error",
     "write_file",
 ]
@@ -103,14 +110,67 @@ def _parent(path: str) -> tuple[str, str]:
     return os.path.dirname(full), os.path.basename(full.rstrip(os.sep)) or "output"
 
 
+def _host_tag() -> str:
+    """Eight hex digits naming this host (CRC-32 of its name) in staging names."""
+    return f"{zlib.crc32(socket.gethostname().encode('utf-8', 'replace')):08x}"
+
+
+def staging_prefix(path: str) -> str:
+    """The name prefix of this process's temporaries for the output ``path``:
+    ``.NAME.HOST-PID-`` (followed by a random part and ``.partial``)."""
+    return f".{_parent(path)[1]}.{_host_tag()}-{os.getpid()}-"
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError):
+        return True
+    return True
+
+
+def remove_stale_staging(path: str) -> list[str]:
+    """Remove the temporaries of the output ``path`` (files or directories named by
+    :func:`staging_prefix`) whose writer on this host no longer runs — what a writer killed
+    before it could clean up (``kill -9``) left beside the output; returns their paths.
+    Temporaries of a live process, of another host (a shared file system) or of an older
+    version (no pid in the name) are left alone."""
+    parent, name = _parent(path)
+    own = re.compile(re.escape(f".{name}.{_host_tag()}-") + r"([0-9]+)-[^/]*\.partial")
+    try:
+        entries = list(os.scandir(parent))
+    except OSError:
+        return []
+    removed = []
+    for e in entries:
+        m = own.fullmatch(e.name)
+        if m is None or _alive(int(m.group(1))):
+            continue
+        with contextlib.suppress(OSError):
+            if e.is_dir(follow_symlinks=False):
+                shutil.rmtree(e.path)
+            else:
+                os.unlink(e.path)
+            removed.append(e.path)
+    return removed
+
+
 @contextlib.contextmanager
-def staged_file(path: str, *, what: str, needed: int | None = None) -> Iterator[str]:
+def staged_file(
+    path: str, *, what: str, needed: int | None = None, clean: bool = True
+) -> Iterator[str]:
     """A temporary file path beside ``path`` for a writer to fill; renamed over ``path`` when
     the block ends without error, removed otherwise. ``needed`` (bytes), when known, goes
-    into the message of a full disk."""
-    parent, name = _parent(path)
+    into the message of a full disk. With ``clean`` the temporaries of ``path`` that killed
+    writers left are removed first (:func:`remove_stale_staging`; records written often in
+    one directory, such as task markers, skip that scan)."""
+    parent, _ = _parent(path)
+    if clean:
+        remove_stale_staging(path)
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=".partial", dir=parent)
+        fd, tmp = tempfile.mkstemp(prefix=staging_prefix(path), suffix=".partial", dir=parent)
     except OSError as exc:
         raise write_error(exc, what, path, needed) from None
     done = False
@@ -138,10 +198,10 @@ def staged_file(path: str, *, what: str, needed: int | None = None) -> Iterator[
             _remove(tmp)
 
 
-def write_file(path: str, data: bytes | memoryview, *, what: str) -> str:
+def write_file(path: str, data: bytes | memoryview, *, what: str, clean: bool = True) -> str:
     """Write ``data`` to ``path`` through :func:`staged_file`; returns ``path``."""
     view = memoryview(data).cast("B")
-    with staged_file(path, what=what, needed=view.nbytes) as tmp:
+    with staged_file(path, what=what, needed=view.nbytes, clean=clean) as tmp:
         flags = os.O_WRONLY | os.O_TRUNC | getattr(os, "O_NOFOLLOW", 0)
         fd = os.open(tmp, flags)
         try:
@@ -158,11 +218,13 @@ def staged_dir(path: str, *, what: str) -> Iterator[str]:
     """A temporary directory beside ``path`` for a writer to fill; put in place of ``path``
     when the block ends without error (an existing ``path`` — which the caller has checked
     with :func:`check_replaceable` — is moved aside first and removed after), removed
-    otherwise."""
+    otherwise. The temporaries of ``path`` that killed writers left are removed first
+    (:func:`remove_stale_staging`)."""
     parent, name = _parent(path)
     try:
         os.makedirs(parent, exist_ok=True)
-        tmp = tempfile.mkdtemp(prefix=f".{name}.", suffix=".partial", dir=parent)
+        remove_stale_staging(path)
+        tmp = tempfile.mkdtemp(prefix=staging_prefix(path), suffix=".partial", dir=parent)
     except OSError as exc:
         raise write_error(exc, what, path) from None
     done = False
@@ -259,9 +321,8 @@ def is_own_zarr(
     # its attributes, or their consolidated copy when a damaged store lost the first
     found = False
     for name, pick in ((".zattrs", lambda d: d), (".zmetadata", _consolidated_root)):
-        try:
-            with open(os.path.join(path, name), encoding="utf-8") as f:
-                attrs = pick(json.loads(f.read(1 << 24)))
+        try:  # never through a link, never blocking on a FIFO, never without end
+            attrs = pick(json.loads(read_nofollow(os.path.join(path, name), 1 << 26)))
         except (OSError, ValueError, AttributeError, TypeError):
             continue
         if isinstance(attrs, dict) and all(k in attrs for k in keys):

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 from typing import Annotated, Any
@@ -328,9 +327,10 @@ def _is_branch(path: Path) -> bool:
 def _is_basin_store(path: Path) -> bool:
     """Whether ``path`` is a store of `gearchaos basins` or `basin-fractions`."""
     from ..sweep._basin_store import KINDS
+    from ..sweep.integrity import read_json
 
-    try:
-        attrs = json.loads((path / ".zattrs").read_text(encoding="utf-8"))
+    try:  # never blocking on a FIFO, never reading a device without end
+        attrs = read_json(str(path / ".zattrs"))
     except (OSError, ValueError):
         return False
     return isinstance(attrs, dict) and attrs.get("kind") in KINDS

@@ -49,7 +49,7 @@ from typing import Any
 import numpy as np
 
 from .._checks import check_bool
-from .._files import check_path, check_regular_file
+from .._files import check_path, check_regular_file, irregular_entry, read_nofollow
 from .._output import check_replaceable, file_has_mark, is_own_zarr, staged_dir, write_file
 from .._version import provenance
 from ..errors import ParameterError, StoreError
@@ -372,7 +372,8 @@ def save_branch(ds: Any, path: str | os.PathLike[str], *, overwrite: bool = Fals
         with staged_dir(path, what="branch store") as tmp:
             # every chunk written (none skipped as all fill values) and its digest kept
             ds.to_zarr(tmp, mode="w", consolidated=True, zarr_format=2, write_empty_chunks=True)
-            digests = {key: _digest(os.path.join(tmp, key)) for key in _chunk_files(tmp)}
+            keys = _chunk_files(tmp) + _metadata_files(tmp)
+            digests = {key: _digest(os.path.join(tmp, key)) for key in keys}
             with open(os.path.join(tmp, MANIFEST), "w", encoding="utf-8") as f:
                 json.dump(digests, f)
     else:  # HDF5 Fletcher-32 checksums: a damaged chunk is an error when read, never data
@@ -446,20 +447,40 @@ def _chunk_files(root: str) -> list[str]:
     return sorted(found)
 
 
+def _metadata_files(root: str) -> list[str]:
+    """The Zarr metadata files of a branch store (``.zmetadata``, which readers use, and every
+    ``.zgroup``, ``.zattrs`` and ``.zarray``), sorted."""
+    found = []
+    for d, dirs, files in os.walk(root):
+        dirs[:] = sorted(x for x in dirs if not x.startswith("."))
+        found += [
+            os.path.relpath(os.path.join(d, f), root).replace(os.sep, "/")
+            for f in files
+            if f in (".zmetadata", ".zgroup", ".zattrs", ".zarray")
+        ]
+    return sorted(found)
+
+
 def _digest(path: str) -> str:
+    """SHA-256 of a chunk file itself (never through a link, never blocking on a FIFO, at
+    most 4 GiB: a chunk of a branch is far smaller)."""
     import hashlib
 
-    with open(path, "rb") as f:
-        return hashlib.sha256(f.read()).hexdigest()
+    return hashlib.sha256(read_nofollow(path, 1 << 32)).hexdigest()
 
 
 def _check_chunks(path: str) -> None:
     """Every chunk of a Zarr branch is the one :func:`save_branch` wrote (its manifest of
     SHA-256 digests): a deleted, emptied or overwritten chunk, or one added, is reported by
     name instead of being read as data (fill values, junk)."""
+    found = irregular_entry(path)
+    if found is not None:  # Zarr opens its files plainly: it would block on a FIFO
+        raise StoreError(
+            f"branch {path} is damaged: {found[0]} is {found[1]}, not a regular file "
+            "(gearchaos writes only files and directories in a branch store)"
+        )
     try:
-        with open(os.path.join(path, MANIFEST), encoding="utf-8") as f:
-            manifest = json.load(f)
+        manifest = json.loads(read_nofollow(os.path.join(path, MANIFEST), 1 << 30))
         if not isinstance(manifest, dict) or not all(
             isinstance(k, str) and isinstance(v, str) for k, v in manifest.items()
         ):
@@ -469,8 +490,17 @@ def _check_chunks(path: str) -> None:
             f"branch {path} is damaged: its chunk manifest is missing or unreadable"
         ) from None
     on_disk = set(_chunk_files(path))
+    # branches written since the manifest holds the metadata's digests have them checked too
+    # (an array re-typed in .zarray and .zmetadata would be read as other numbers)
+    metadata = {k for k in manifest if k.rsplit("/", 1)[-1].startswith(".")}
+    on_disk |= set(_metadata_files(path)) if metadata else set()
     for key in sorted(set(manifest) | on_disk):
+        what = "metadata file" if key.rsplit("/", 1)[-1].startswith(".") else "chunk"
         if key not in manifest:
-            raise StoreError(f"branch {path} is damaged: chunk {key} is not in its manifest")
-        if key not in on_disk or _digest(os.path.join(path, key)) != manifest[key]:
-            raise StoreError(f"branch {path} is damaged: chunk {key} is missing or altered")
+            raise StoreError(f"branch {path} is damaged: {what} {key} is not in its manifest")
+        try:
+            same = key in on_disk and _digest(os.path.join(path, key)) == manifest[key]
+        except OSError:
+            same = False
+        if not same:
+            raise StoreError(f"branch {path} is damaged: {what} {key} is missing or altered")

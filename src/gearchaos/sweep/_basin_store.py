@@ -15,7 +15,6 @@ continues with the same attractor codes); when every task is done it moves into 
 from __future__ import annotations
 
 import contextlib
-import json
 import os
 import shutil
 import warnings
@@ -26,7 +25,13 @@ import numpy as np
 from .._files import check_path
 from .._output import check_replaceable, is_own_zarr
 from ..errors import StoreError
-from .integrity import MANIFEST, verify_manifest, write_json_atomic
+from .integrity import (
+    MANIFEST,
+    check_store_tree,
+    read_json,
+    verify_manifest,
+    write_json_atomic,
+)
 from .store import PROGRESS, SweepStore, consolidate, set_attributes
 from .storecheck import verify_metadata, verify_progress
 
@@ -60,9 +65,10 @@ def open_basins(path: str | os.PathLike[str], *, verify: bool = True) -> Any:
         raise StoreError(
             f"no basin store at {root!r} (not a Zarr directory written by gearchaos basins)"
         )
+    check_store_tree(root, "the basin computation")  # nothing for Zarr to block on
     if verify:
-        verify_manifest(root)
         verify_metadata(root)
+        verify_manifest(root)
     try:
         ds = xr.open_zarr(root, chunks=None, consolidated=True)
     except Exception as exc:  # zarr and xarray raise many types for damaged metadata
@@ -106,8 +112,7 @@ class BasinStore(SweepStore):
         if self.path is None:
             return {}
         try:
-            with open(os.path.join(self.path, CATALOGUE), encoding="utf-8") as f:
-                data = json.load(f)
+            data = read_json(os.path.join(self.path, CATALOGUE))
         except FileNotFoundError:
             return {}
         except (OSError, ValueError):

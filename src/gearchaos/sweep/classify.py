@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from .._checks import check_int, check_real
-from .._output import write_error
+from .._output import remove_stale_staging, staging_prefix, write_error
 from ..errors import ParameterError, Status, StoreError
 from .result import SweepResult
 from .store import SweepStore, consolidate, foreign_files_ignored, open_sweep, set_attributes
@@ -198,8 +198,8 @@ def _staging(zstore: Any) -> str | None:
     if not isinstance(zstore, str):
         return None
     parent = os.path.dirname(os.path.abspath(zstore))
-    name = os.path.basename(os.path.abspath(zstore))
-    return tempfile.mkdtemp(prefix=f".{name}.classify.", suffix=".partial", dir=parent)
+    remove_stale_staging(zstore)  # what a killed classification left beside the store
+    return tempfile.mkdtemp(prefix=staging_prefix(zstore), suffix=".partial", dir=parent)
 
 
 def _swap_in(staging: str, zstore: str, attrs: dict[str, Any]) -> None:

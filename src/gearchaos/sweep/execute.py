@@ -2,7 +2,8 @@
 
 * in-process (default): tasks run here, :func:`~gearchaos.integrate.run_chains` spreads
   chains over all cores on its threads; small tasks are grouped so every call has enough chains;
-* ``workers=N``: a pool of N local processes (spawn start method), one numba thread each;
+* ``workers=N``: a pool of N local processes (spawn start method), one numba thread each,
+  each ending as soon as its parent is gone, even killed with SIGKILL (:func:`watch_parent`);
 * ``scheduler="tcp://host:port"``: an existing ``dask.distributed`` cluster;
 * ``dask_local=N``: a ``dask.distributed.LocalCluster`` with N single-threaded workers.
 
@@ -17,6 +18,11 @@ import concurrent.futures as cf
 import contextlib
 import functools
 import multiprocessing
+import os
+import signal
+import sys
+import threading
+import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
@@ -25,12 +31,45 @@ from .._checks import check_int
 from ..errors import ParameterError
 from ..integrate._chains import run_chains
 
-__all__ = ["EXECUTION_OPTIONS", "Execution", "InProcess", "executor"]
+__all__ = ["EXECUTION_OPTIONS", "Execution", "InProcess", "executor", "watch_parent"]
 
 
-def _init_worker() -> None:  # pragma: no cover - runs in worker processes
+#: Seconds between two looks of a worker at its parent (the portable fallback of the death
+#: signal).
+PARENT_POLL_SECONDS = 0.5
+
+
+def watch_parent(parent: int, death_signal: bool = True) -> None:  # pragma: no cover - workers
+    """End this worker process as soon as its parent ``parent`` (a pid) is gone, also when
+    the parent was killed with SIGKILL and could not end it: no worker outlives its command.
+
+    On Linux the kernel kills it (``prctl(PR_SET_PDEATHSIG, SIGKILL)``, set through ctypes)
+    when ``death_signal``: the signal follows the *thread* that started the worker, so it is
+    asked for only where that thread lives as long as the pool. Everywhere, a daemon thread
+    looks at ``os.getppid()`` every :data:`PARENT_POLL_SECONDS` and ends the process when it
+    changed (the orphan was adopted by init or a subreaper); it also covers a parent that died
+    before the signal was set. Called first by the initializer of every worker pool."""
+    if death_signal and sys.platform.startswith("linux"):
+        with contextlib.suppress(OSError, AttributeError):
+            import ctypes
+
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(1, int(signal.SIGKILL), 0, 0, 0)  # 1 = PR_SET_PDEATHSIG
+    if os.getppid() != parent:
+        os._exit(1)
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(PARENT_POLL_SECONDS)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="gearchaos-parent-watch", daemon=True).start()
+
+
+def _init_worker(parent: int) -> None:  # pragma: no cover - runs in worker processes
     import numba
 
+    watch_parent(parent)
     numba.set_num_threads(1)
 
 
@@ -86,7 +125,11 @@ def executor(execution: Execution | None = None) -> Iterator[tuple[Any, Any, str
     if ex_.workers is not None:
         n = int(ex_.workers)
         ctx = multiprocessing.get_context("spawn")
-        ex = cf.ProcessPoolExecutor(max_workers=n, mp_context=ctx, initializer=_init_worker)
+        # started by this thread's submits, which last as long as the pool: the death signal
+        # of watch_parent may follow this thread
+        ex = cf.ProcessPoolExecutor(
+            max_workers=n, mp_context=ctx, initializer=_init_worker, initargs=(os.getpid(),)
+        )
         try:
             yield ex, run_chains, f"{n} local processes"
         except BaseException:

@@ -5,10 +5,22 @@
   write the same store (resume, ``--overwrite`` or an identical sweep started at the same time)
   is refused with a message naming the owner; a lock left by a process that no longer runs on
   this host is stale and taken over.
+  A lock that is no regular file (a FIFO, a device, a symbolic link, a directory) is refused
+  with its path: it is neither read nor removed.
 * Chunk checksums — every chunk file a task writes is recorded (size and CRC-32) in the task's
-  marker; a complete store carries ``_manifest.json`` with every chunk of every array.
-  :func:`verify_manifest` finds a deleted, truncated or overwritten chunk and names it, so no
-  reader mistakes a damaged chunk for data (Zarr reads a missing chunk as its fill value).
+  marker; a complete store carries ``_manifest.json`` with every chunk of every array and a
+  digest of every array's metadata (``.zarray`` and ``.zattrs``: element type, shape, fill
+  value, compressor, dimensions). :func:`verify_manifest` finds a deleted, truncated or
+  overwritten chunk, or an array whose metadata changed (re-typed ``<f8`` → ``<i8`` would read
+  every float's bits as an integer), and names it, so no reader mistakes damage for data
+  (Zarr reads a missing chunk as its fill value). A manifest of an older version has no
+  metadata digests: its stores still open, and the element types the sweep's layout fixes are
+  checked instead (:func:`~gearchaos.sweep.storecheck.verify_attributes`).
+* Safe reads — every file of a store that gearchaos reads itself (metadata, the manifest, task
+  markers, the lock) goes through :func:`read_json`: the file itself, never a symbolic link,
+  a FIFO or a device, opened without blocking and read up to a size cap.
+  :func:`check_store_tree` refuses a store that holds anything but regular files and
+  directories before Zarr, which opens files plainly, reads it.
 """
 
 from __future__ import annotations
@@ -25,25 +37,63 @@ import zlib
 from collections.abc import Iterable, Iterator, Mapping
 from typing import Any
 
-from .._files import open_regular_nofollow
-from .._output import write_file
+from .._files import irregular_entry, open_regular_nofollow, read_nofollow
+from .._output import remove_stale_staging, staging_prefix, write_file
 from ..errors import StoreError
 
 __all__ = [
     "MANIFEST",
     "StoreLock",
     "all_chunks",
+    "check_store_tree",
     "chunk_keys",
     "digest_chunks",
     "file_digest",
+    "manifest_record",
+    "read_json",
     "read_manifest",
+    "verify_array_metadata",
     "verify_chunks",
     "verify_manifest",
     "write_json_atomic",
 ]
 
-#: File of a complete store listing every chunk: {relative path: [size, crc32]}.
+#: File of a complete store listing every chunk, {"chunks": {relative path: [size, crc32]},
+#: "metadata": {array/.zarray or array/.zattrs: SHA-256 of its JSON}}.
 MANIFEST = "_manifest.json"
+
+#: The largest metadata file, task marker or attractor catalogue read (bytes).
+METADATA_MAX_BYTES = 64 << 20
+#: The largest chunk manifest read (bytes): about 40 bytes a chunk.
+MANIFEST_MAX_BYTES = 1 << 30
+#: The largest lock file read (bytes): gearchaos writes about 80.
+LOCK_MAX_BYTES = 64 << 10
+
+
+def read_json(path: str, max_bytes: int = METADATA_MAX_BYTES) -> Any:
+    """The JSON value of the regular file ``path`` itself, read by
+    :func:`~gearchaos._files.read_nofollow` (never through a symbolic link, never blocking on a
+    FIFO, at most ``max_bytes``): ``OSError`` when it cannot be read so (``strerror`` says
+    why: ``a FIFO (named pipe), not a regular file``), ``ValueError`` when it is not JSON."""
+    return json.loads(read_nofollow(path, max_bytes))
+
+
+def check_store_tree(root: str, what: str = "the sweep") -> None:
+    """Raise :class:`StoreError` naming the first entry of the store ``root`` that is neither
+    a regular file nor a directory (:func:`~gearchaos._files.irregular_entry`: a FIFO, a
+    device, a socket, a symbolic link): gearchaos never writes one, and Zarr, which opens its
+    files plainly, would block on a FIFO or read a device without end. Run before any Zarr
+    read of the store."""
+    found = irregular_entry(root)
+    if found is not None:
+        rel, kind = found
+        name = rel.rsplit("/", 1)[-1]
+        chunk = "/" in rel and not name.startswith(".") and not name.endswith(".done")
+        raise StoreError(
+            f"{root} is damaged: {'chunk' if chunk else 'the file'} {rel} cannot be read "
+            f"({kind}, not a regular file: gearchaos writes only files and directories in a "
+            f"store). It is not read; run {what} again with --overwrite (overwrite=True)"
+        )
 
 
 # ------------------------------------------------------------------------------------ lock
@@ -69,14 +119,26 @@ class StoreLock:
         self._held = False
 
     def _owner(self) -> dict[str, Any] | None:
+        """The owner recorded in the lock, ``None`` when there is no lock, ``{}`` when it
+        names none (torn). A lock that is no regular file gearchaos could have written (a
+        FIFO, a device, a symbolic link, a directory, a huge file) is refused by name: it is
+        neither read (a FIFO would block, ``/dev/zero`` never ends) nor removed."""
         try:
-            with open(self.path, encoding="utf-8") as f:
-                data = json.load(f)
-            return data if isinstance(data, dict) else {}
+            data = read_json(self.path, LOCK_MAX_BYTES)
         except FileNotFoundError:
             return None
-        except (OSError, ValueError):
+        except OSError as exc:
+            if exc.errno in (errno.ELOOP, errno.EINVAL, errno.EFBIG, errno.EISDIR):
+                raise StoreError(
+                    f"the lock file {self.path} of {self.store_path} is "
+                    f"{exc.strerror or exc}: gearchaos writes its locks as small regular "
+                    "files, so it is neither read nor replaced; remove it if no gearchaos "
+                    "process writes that store"
+                ) from None
             return {}
+        except ValueError:
+            return {}
+        return data if isinstance(data, dict) else {}
 
     def _stale(self, owner: Mapping[str, Any]) -> bool:
         pid, host = owner.get("pid"), owner.get("host")
@@ -122,7 +184,10 @@ class StoreLock:
         parent = os.path.dirname(self.path)
         try:
             os.makedirs(parent, exist_ok=True)
-            fd, tmp = tempfile.mkstemp(prefix=".lock.", suffix=".partial", dir=parent)
+            remove_stale_staging(self.path)  # what a killed taker of this lock left
+            fd, tmp = tempfile.mkstemp(
+                prefix=staging_prefix(self.path), suffix=".partial", dir=parent
+            )
         except OSError as exc:
             raise StoreError(f"cannot create the lock {self.path}: {exc.strerror or exc}") from None
         try:
@@ -149,10 +214,11 @@ class StoreLock:
 
     def release(self) -> None:
         if self._held:
-            owner = self._owner()
-            if owner is not None and owner.get("pid") == os.getpid():
-                with contextlib.suppress(FileNotFoundError):
-                    os.remove(self.path)
+            with contextlib.suppress(StoreError):
+                owner = self._owner()
+                if owner is not None and owner.get("pid") == os.getpid():
+                    with contextlib.suppress(FileNotFoundError):
+                        os.remove(self.path)
             self._held = False
 
     def __enter__(self) -> StoreLock:
@@ -267,18 +333,24 @@ def verify_chunks(root: str, chunks: Mapping[str, Any]) -> list[str]:
 def write_json_atomic(path: str, data: Any) -> None:
     """Write JSON through the package's one staged write (unique temporary name, flushed to
     disk, renamed into place; a full disk is a clear error)."""
-    write_file(path, json.dumps(data, separators=(",", ":")).encode("utf-8"), what="record")
+    text = json.dumps(data, separators=(",", ":")).encode("utf-8")
+    # task markers are written often into one directory: no scan for stale temporaries (the
+    # store's own rerun or --overwrite takes care of them)
+    write_file(path, text, what="record", clean=False)
 
 
 def read_manifest(root: str) -> dict[str, Any] | None:
     """The manifest of a complete store, or ``None`` for a store without one (older stores)."""
     path = os.path.join(root, MANIFEST)
     try:
-        with open(path, encoding="utf-8") as f:
-            data = json.load(f)
+        data = read_json(path, MANIFEST_MAX_BYTES)
     except FileNotFoundError:
         return None
-    except (OSError, ValueError):
+    except OSError as exc:
+        raise StoreError(
+            f"{root}: the chunk manifest {MANIFEST} is not readable ({exc.strerror or exc})"
+        ) from None
+    except ValueError:
         raise StoreError(f"{root}: the chunk manifest {MANIFEST} is not readable") from None
     if not isinstance(data, dict) or not isinstance(data.get("chunks"), dict):
         raise StoreError(f"{root}: the chunk manifest {MANIFEST} is not a manifest")
@@ -292,8 +364,7 @@ def verify_manifest(root: str, arrays: Iterable[str] | None = None) -> None:
         # a store is complete only with its manifest (written first): without it no chunk
         # could be checked, so a complete store that lost it is damage, not an older store
         try:
-            with open(os.path.join(root, ".zattrs"), encoding="utf-8") as f:
-                complete = json.loads(f.read(1 << 24)).get("complete") is True
+            complete = read_json(os.path.join(root, ".zattrs")).get("complete") is True
         except (OSError, ValueError, AttributeError):
             complete = False
         if complete:
@@ -312,6 +383,8 @@ def verify_manifest(root: str, arrays: Iterable[str] | None = None) -> None:
         unknown = sorted(set(all_chunks(root)) - set(listed))
         problems += [f"chunk {key} is not in the manifest" for key in unknown]
     problems += verify_chunks(root, listed)
+    if "metadata" in manifest:  # older versions recorded only the chunks
+        problems += verify_array_metadata(root, manifest["metadata"], arrays)
     if problems:
         shown = "; ".join(problems[:5]) + (
             f"; and {len(problems) - 5} more" if len(problems) > 5 else ""
@@ -320,3 +393,73 @@ def verify_manifest(root: str, arrays: Iterable[str] | None = None) -> None:
             f"{root} is damaged: {shown}. Its data cannot be trusted; run the sweep again "
             "with --overwrite (overwrite=True)"
         )
+
+
+# ------------------------------------------------------------------------ metadata digests
+def _metadata_digest(path: str) -> str:
+    """SHA-256 of a metadata file's JSON value, written canonically (sorted keys), so that
+    the same metadata written again with another layout of its text has the same digest."""
+    import hashlib
+
+    text = json.dumps(read_json(path), sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()
+
+
+def _array_metadata_files(root: str) -> list[str]:
+    """``<array>/.zarray`` and ``<array>/.zattrs`` of every array of the store, sorted."""
+    keys = []
+    for dirpath, _, files in os.walk(root):
+        if ".zarray" not in files:
+            continue
+        rel = os.path.relpath(dirpath, root).replace(os.sep, "/")
+        keys += [f"{rel}/{name}" for name in (".zarray", ".zattrs") if name in files]
+    return sorted(keys)
+
+
+def manifest_record(root: str) -> dict[str, Any]:
+    """The manifest of a complete store: the size and CRC-32 of every chunk, and the digest of
+    every array's metadata."""
+    return {
+        "chunks": digest_chunks(root, all_chunks(root)),
+        "metadata": {
+            key: _metadata_digest(os.path.join(root, *key.split("/")))
+            for key in _array_metadata_files(root)
+        },
+    }
+
+
+def verify_array_metadata(
+    root: str, recorded: Any, arrays: Iterable[str] | None = None
+) -> list[str]:
+    """The problems of the arrays' metadata against the digests of the manifest: a metadata
+    file changed, missing or not recorded."""
+    if not isinstance(recorded, Mapping) or not all(
+        isinstance(k, str) and isinstance(v, str) for k, v in recorded.items()
+    ):
+        return ["the manifest's record of the array metadata is not readable"]
+    on_disk = set(_array_metadata_files(root))
+    keys = set(recorded) | on_disk
+    if arrays is not None:
+        wanted = set(arrays)
+        keys = {k for k in keys if k.split("/", 1)[0] in wanted}
+    problems = []
+    for key in sorted(keys):
+        array = key.rsplit("/", 1)[0]
+        if key not in recorded:
+            problems.append(f"the metadata {key} of the array {array} is not in the manifest")
+            continue
+        try:
+            digest = _metadata_digest(os.path.join(root, *key.split("/")))
+        except FileNotFoundError:
+            problems.append(f"the metadata {key} of the array {array} is missing")
+            continue
+        except (OSError, ValueError) as exc:
+            why = exc.strerror if isinstance(exc, OSError) and exc.strerror else "not JSON"
+            problems.append(f"the metadata {key} of the array {array} cannot be read ({why})")
+            continue
+        if digest != recorded[key]:
+            problems.append(
+                f"the metadata {key} of the array {array} changed since it was written "
+                "(element type, shape, fill value, compressor or dimensions)"
+            )
+    return problems

@@ -24,15 +24,18 @@ from typing import Any
 
 import numpy as np
 
-from .._files import check_path
+from .._files import check_path, read_nofollow
 from .._output import check_replaceable, is_own_zarr, write_error, write_file
 from ..errors import Status, StoreError
 from ..gearset.mapping import flatten
 from .integrity import (
     MANIFEST,
-    all_chunks,
+    METADATA_MAX_BYTES,
+    check_store_tree,
     chunk_keys,
     digest_chunks,
+    manifest_record,
+    read_json,
     verify_chunks,
     verify_manifest,
     write_json_atomic,
@@ -67,8 +70,7 @@ def set_attributes(root: str, updates: dict[str, Any]) -> None:
     """Update the root attributes (``.zattrs``) of an on-disk store in one atomic write (Zarr
     rewrites the file in place: a kill or a full disk would leave it torn)."""
     path = os.path.join(root, ".zattrs")
-    with open(path, encoding="utf-8") as f:
-        attrs = json.load(f)
+    attrs = read_json(path)
     attrs.update(updates)
     write_file(path, json.dumps(attrs, indent=4).encode("utf-8"), what="store attributes")
 
@@ -89,8 +91,9 @@ def consolidate(store: Any) -> None:
         rel = os.path.relpath(dirpath, store).replace(os.sep, "/")
         for name in (".zgroup", ".zattrs", ".zarray"):
             if name in files:
-                with open(os.path.join(dirpath, name), encoding="utf-8") as f:
-                    meta[name if rel == "." else f"{rel}/{name}"] = json.load(f)
+                meta[name if rel == "." else f"{rel}/{name}"] = read_json(
+                    os.path.join(dirpath, name)
+                )
     text = json.dumps({"metadata": meta, "zarr_consolidated_format": 1}, indent=4)
     write_file(os.path.join(store, ".zmetadata"), text.encode("utf-8"), what="store metadata")
 
@@ -115,11 +118,12 @@ def open_sweep(path: str | os.PathLike[str], *, verify: bool = True) -> Any:
             f"{root!r} is not a readable sweep store: it is a file, not a directory such as "
             "run.zarr"
         )
-    if not os.path.exists(os.path.join(root, ".zgroup")):
+    if not os.path.lexists(os.path.join(root, ".zgroup")):
         raise StoreError(f"{root!r} is not a readable sweep store (no Zarr group metadata .zgroup)")
-    if verify:
-        verify_manifest(root)
+    check_store_tree(root)  # no FIFO or device for Zarr to block on, even unverified
+    if verify:  # the metadata first, as before a resume: then its digests and the chunks
         verify_metadata(root)
+        verify_manifest(root)
     consolidated = os.path.exists(os.path.join(root, ".zmetadata"))
     try:
         ds = xr.open_zarr(root, chunks=None, consolidated=consolidated)
@@ -178,6 +182,7 @@ class SweepStore:
         file equal to its consolidated copy, every array of the schema gearchaos writes)
         and, when complete, every chunk against the manifest."""
         if self.path is not None:
+            check_store_tree(self.path)
             verify_metadata(self.path)
             verify_manifest(self.path)
 
@@ -288,8 +293,7 @@ class SweepStore:
                 continue
             try:
                 index = int(name[:-5])
-                with open(os.path.join(d, name), encoding="utf-8") as f:
-                    text = f.read()
+                text = read_nofollow(os.path.join(d, name), METADATA_MAX_BYTES)
                 chunks = json.loads(text)["chunks"] if text.strip() else {}
             except (ValueError, KeyError, TypeError, OSError):
                 continue  # a marker torn by a kill: the task is computed again
@@ -336,10 +340,7 @@ class SweepStore:
         """Rewrite the chunk manifest of a complete store after a legitimate change (the
         classifier relabelling its points)."""
         if self.path is not None and os.path.exists(os.path.join(self.path, MANIFEST)):
-            write_json_atomic(
-                os.path.join(self.path, MANIFEST),
-                {"chunks": digest_chunks(self.path, all_chunks(self.path))},
-            )
+            write_json_atomic(os.path.join(self.path, MANIFEST), manifest_record(self.path))
 
     def finish(self) -> None:
         """Mark the store complete: write the chunk manifest, set ``complete``, consolidate the
@@ -348,10 +349,7 @@ class SweepStore:
         import zarr
 
         if self.path is not None:
-            write_json_atomic(
-                os.path.join(self.path, MANIFEST),
-                {"chunks": digest_chunks(self.path, all_chunks(self.path))},
-            )
+            write_json_atomic(os.path.join(self.path, MANIFEST), manifest_record(self.path))
         if self.path is not None:
             set_attributes(self.path, {"complete": True})
         else:

@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError, StoreError
-from .integrity import verify_chunks
+from .integrity import read_json, verify_chunks
 
 __all__ = ["verify_attributes", "verify_metadata", "verify_progress"]
 
@@ -56,8 +56,7 @@ def _damaged(root: str, what: str) -> StoreError:
 
 
 def _load_json(path: str) -> Any:
-    with open(path, encoding="utf-8") as f:
-        return json.load(f)
+    return read_json(path)
 
 
 def verify_metadata(root: str) -> None:
@@ -83,7 +82,11 @@ def verify_metadata(root: str) -> None:
             actual = _load_json(path)
         except FileNotFoundError:
             raise _damaged(root, f"the metadata file {key} is missing") from None
-        except (OSError, ValueError):
+        except OSError as exc:
+            raise _damaged(
+                root, f"the metadata file {key} cannot be read ({exc.strerror or exc})"
+            ) from None
+        except ValueError:
             raise _damaged(root, f"the metadata file {key} is not readable JSON") from None
         if actual != consolidated and not _classification_left(key, actual, consolidated):
             raise _damaged(root, f"the metadata file {key} differs from .zmetadata")
@@ -209,6 +212,7 @@ def verify_attributes(root: str, ds: Any) -> Any:
         got = _short(attrs.get("complete"))
         raise _damaged(root, f"the attribute complete must be true or false: got {got}")
     _verify_target(root, attrs)
+    _verify_element_types(root, ds, spec)
     swept = OMEGA in [a.name for a in spec.axes]
     raw = attrs.get("omega_fixed")
     if swept and "omega_fixed" in attrs:
@@ -240,6 +244,36 @@ def verify_attributes(root: str, ds: Any) -> Any:
     return spec
 
 
+def _verify_element_types(root: str, ds: Any, spec: Any) -> None:
+    """The arrays whose element type the sweep's layout fixes have it: floats for its
+    coordinates, the section values of the observed variables and the final states; the
+    status, step counts, verdict and orbit evidence as their tables say. An array re-typed
+    (edited consistently in ``.zarray`` and ``.zmetadata``: ``<f8`` to ``<i8`` with no fill
+    value) would read every stored float's bits as a huge integer. Stores written since the
+    manifest records a digest of every array's metadata are checked whole by
+    :func:`~gearchaos.sweep.integrity.verify_manifest`; this check also covers older ones."""
+    from .orbits import ORBIT_VARIABLES
+    from .run import SKIPPED, STEP_COUNTS
+    from .verdicts import VERDICT_VARIABLES
+
+    expected: dict[str, Any] = {name: np.float64 for name in spec.observe}
+    expected.update({a.name: np.float64 for a in spec.axes})
+    expected.update(final_state=np.float64, status=np.int8, section=np.int64)
+    expected.update({name: np.int64 for name in (*STEP_COUNTS, SKIPPED)})
+    for table in (VERDICT_VARIABLES, ORBIT_VARIABLES):
+        for name, (_, dtype, _) in table.items():
+            if np.dtype(dtype).kind != "U":  # a label's width is no damage
+                expected[name] = np.dtype(dtype)
+    for name in sorted(set(expected) & set(ds.variables)):
+        dtype = ds.variables[name].dtype
+        if dtype != expected[name]:
+            raise _damaged(
+                root,
+                f"the array {name} has the element type {dtype}, but a sweep writes it as "
+                f"{np.dtype(expected[name])} (the array was re-typed)",
+            )
+
+
 def _verify_target(root: str, attrs: Any) -> None:
     """``model`` names the model; a planetary store's ``gearset_toml`` is a valid gear set."""
     model, gtext = attrs.get("model"), attrs.get("gearset_toml")
@@ -269,9 +303,7 @@ def verify_progress(root: str, progress_dir: str) -> None:
         if not name.endswith(".done"):
             continue
         try:
-            with open(os.path.join(d, name), encoding="utf-8") as f:
-                text = f.read()
-            chunks = json.loads(text)["chunks"] if text.strip() else {}
+            chunks = read_json(os.path.join(d, name))["chunks"]
             if not isinstance(chunks, dict):
                 raise TypeError(type(chunks).__name__)
         except (OSError, ValueError, KeyError, TypeError):
