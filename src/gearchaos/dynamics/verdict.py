@@ -22,7 +22,8 @@ asks them, for K points at once (a sweep task, or one point):
    left along its unstable eigenvector.
 3. **Windows with a Lyapunov exponent** (:mod:`~gearchaos.dynamics.verdict_rules`): every point
    not decided is integrated further, one window at a time (the first as long as the record,
-   at least ``min_extension``; each next one twice as long, at most ``max_window``), with one
+   at least ``min_extension``, the second as long, each next one twice as long, at most
+   ``max_window``), with one
    tangent vector: λ₁ ± σ per window, θ = c_θ/t its bias bound. Chaos needs the interval above
    the bound (or positive with the 0–1 test chaotic on every band) in two consecutive windows;
    QP needs the interval within the bound and a torus on the section (the rotation test on
@@ -187,10 +188,13 @@ class VerdictSettings:
             return int(self.extension_periods)
         return min(max(int(record_periods), self.min_extension), self.max_window)
 
-    def next_window(self, previous: int) -> int:
-        """Periods of the window after one of ``previous`` periods (at least
-        ``confirm_periods`` once a window has run)."""
-        return max(min(2 * int(previous), self.max_window), self.confirm_periods)
+    def next_window(self, previous: int, count: int) -> int:
+        """Periods of the window after ``count`` windows, the last of ``previous`` periods:
+        the second as long as the first (a later window to confirm what the first says),
+        each one after it twice as long (θ and σ shrink for a weak exponent), at most
+        ``max_window``, and at least ``confirm_periods`` once a window has run."""
+        grow = 1 if count == 1 else 2
+        return max(min(grow * int(previous), self.max_window), self.confirm_periods)
 
 
 def confirmed_settings(confirm_periods: int = CONFIRM_PERIODS) -> VerdictSettings:
@@ -453,7 +457,8 @@ def decide_motion(
         # 2. the windows decide the rest, or they are extended
         spent = {k: pts[k].extra - pts[k].settled_extra for k in live}
         for k in [k for k in live if k not in done and pts[k].settle is None]:
-            last = spent[k] + vs.next_window(length[k]) > vs.budget_periods
+            nxt = vs.next_window(length[k], len(pts[k].windows))
+            last = spent[k] + nxt > vs.budget_periods
             v = decide_by_exponent(pts[k], vs, last)
             if v is not None:
                 done[k] = v
@@ -504,7 +509,7 @@ def _extend(
             groups.setdefault((p.settle.periods, False), []).append(k)
         else:
             if p.windows:
-                length[k] = vs.next_window(length[k])
+                length[k] = vs.next_window(length[k], len(p.windows))
             groups.setdefault((length[k], True), []).append(k)
     n_state = systems[0].n_state
     for (periods, tangents), ks in sorted(groups.items()):

@@ -16,7 +16,8 @@ Each extension of the run is a *window* with its own λ₁ ± σ (block means) a
   and the section shows a torus: for some n ≤ ``max_bands`` every
   subsequence x_{j::n} keeps its cyclic order (the rotation test,
   :func:`~gearchaos.analysis.bands.circle_order`), or the 0–1 test is regular for every n;
-* otherwise the run is extended (the next window twice as long, so θ and σ shrink), and when
+* otherwise the run is extended (the second window as long as the first, each later one twice
+  as long, so θ and σ shrink), and when
   the budget is spent the point is ``unresolved`` with the reason.
 """
 
