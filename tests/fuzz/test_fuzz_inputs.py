@@ -11,6 +11,8 @@ name the option.
   text is refused naming ``pack``.
 * **A failed integration** names options the command line has (``--rtol``), not only the
   Python keyword ``max_steps``.
+* **Grids of starts** (``basins``, ``basin-fractions``) whose starts would not fit in memory
+  are refused before anything is allocated, naming ``--x`` or ``--starts``.
 
 Every case is a test with its expected class (see :mod:`fuzz_helpers`): a refusal (exit 2, one
 ``error:`` line naming the culprit) or a failure (exit 1); never a traceback, never accepted.
@@ -193,3 +195,48 @@ def test_a_pack_that_gives_no_vector_of_numbers_is_refused(pack: str, tmp_path: 
     with inside(tmp_path / "run"):
         text = cli_refused("CLI simulate", ["simulate", "--model", spec, "--json"], "pack")
     assert "Oscillator.pack(omega) must return a vector of numbers" in text
+
+
+# ----------------------------------------------------------------------------- grids of starts
+#: A basin image and basin fractions of 10¹² starts or more: no machine holds their starts
+#: (36 bytes a start of the Duffing oscillator), so each is refused before anything is made.
+HUGE_GRIDS = {
+    "basins": (
+        lambda: gc.basins(gc.duffing(1.2), "x=-2:2:1000000", "x_dot=-2:2:1000000", progress=False),
+        "x",
+    ),
+    "basin_fractions": (
+        lambda: gc.basin_fractions(
+            gc.duffing(1.2), "gamma=0.1:0.2:1000000", starts=10_000_000, progress=False
+        ),
+        "starts",
+    ),
+}
+
+
+@pytest.mark.parametrize("door", sorted(HUGE_GRIDS))
+def test_a_grid_of_starts_beyond_memory_is_refused_before_allocating(
+    door: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``basins --x x=…:…:1000000 --y …:10000`` tried to allocate 7.28 TiB."""
+    monkeypatch.chdir(tmp_path)
+    call, keyword = HUGE_GRIDS[door]
+    exc = refused(door, call, "memory")
+    assert getattr(exc, "name", None) == keyword and "TiB" in str(exc)
+
+
+@pytest.mark.parametrize(
+    ("args", "option"),
+    [
+        (["basins", "--x", "x=-2:2:1000000", "--y", "x_dot=-2:2:1000000"], "--x"),
+        (["basin-fractions", "--vary", "gamma=0.1:0.2:1000000", "--starts", "10000000"],
+         "--starts"),
+    ],
+)  # fmt: skip
+def test_cli_refuses_a_grid_of_starts_beyond_memory(
+    args: list[str], option: str, tmp_path: Path
+) -> None:
+    full = [*args, "--model", DUFFING, "--set", "omega=1.2", "-o", "b.zarr", "-q"]
+    with inside(tmp_path):
+        text = cli_refused(f"CLI {args[0]}", full, option)
+    assert text.startswith(f"error: {option}") and "memory" in text

@@ -1,16 +1,14 @@
 """Every refusal names the option and the way forward (issue 33): ``boundary`` ranges and
-landing values, the ``--at`` of a start from a sweep store, and basin images that would be
-stored as damaged.
+landing values, and basin images that would be stored as damaged.
 
 * ``boundary --vary xi=nan:0.04`` said "vary start must be a finite number" and
   ``--within omega=nan:3.5`` was blamed on "vary start": each refusal now starts with its own
   option; a reversed ``--vary`` and ``--at`` values outside its range were silently accepted.
-* ``--at omega=1.33333`` on a store whose Ω axis holds 4/3 was refused, although the refusal
-  listed 1.33333 as the nearest stored value.
 * ``basins`` with an axis of equal or falling values (``--x x=2:2:4``) or with ``--base``
   setting a varied coordinate exited 0 and wrote a store: refused before anything runs.
 
-Every case is a test with its expected class (see :mod:`fuzz_helpers`).
+(``--at`` on a store: :mod:`test_fuzz_loading`.) Every case is a test with its expected class
+(see :mod:`fuzz_helpers`).
 """
 
 from __future__ import annotations
@@ -100,3 +98,55 @@ def test_boundary_command_refuses_ranges_by_their_option(
     with inside(tmp_path):
         line = cli_refused("CLI boundary", cmd, option)
     assert line.startswith(f"error: {option}") and text in line
+
+
+# ----------------------------------------------------------------------------- basin images
+DUFFING = "gearchaos.model.library:Duffing"
+BASIN_CLI = ["basins", "--model", DUFFING, "--set", "alpha=-1", "--set", "omega=1.2",
+             "--transient", "1", "--periods", "2", "--sample", "2", "-q",
+             "-o", "b.zarr"]  # fmt: skip
+#: (x, y, base_state, the keyword named, text of the way forward)
+BASIN_CASES = [
+    ("x=2:2:4", "x_dot=-1:1:2", None, "x", "x=1:3:4"),
+    ("x=2:-2:3", "x_dot=-1:1:2", None, "x", "x=-2:2:3"),
+    ("x=1,0,2", "x_dot=-1:1:2", None, "x", "increasing order"),
+    ("x=-2:2:3", "x_dot=1:1:2", None, "y", "x_dot=0:2:2"),
+    ("x=-2:2:3", "x_dot=1,1", None, "y", "distinct"),
+    ("x=-2:2:3", "x_dot=-1:1:2", {"x": 1.0}, "base_state", "leave x out"),
+    ("x=-2:2:3", "x_dot=-1:1:2", {"x_dot": 0.0}, "base_state", "leave x_dot out"),
+]
+
+
+@pytest.mark.parametrize(("x", "y", "base", "keyword", "way"), BASIN_CASES)
+def test_basins_refuses_an_image_it_would_store_as_damaged(
+    x: str, y: str, base: Any, keyword: str, way: str, tmp_path: Path
+) -> None:
+    """An axis of equal or falling values, or a base state that sets a varied coordinate,
+    ran and wrote a store; refused before anything is written, naming the keyword or option
+    and how to give it."""
+    system = gc.duffing(1.2, alpha=-1.0)
+    store = tmp_path / "b.zarr"
+    exc = refused(
+        "basins",
+        lambda: gc.basins(
+            system,
+            x,
+            y,
+            base_state=base,
+            store=store,
+            progress=False,
+            transient_periods=1,
+            periods=2,
+            sample=2,
+        ),
+        keyword,
+    )
+    assert way in str(exc) and getattr(exc, "name", None) == keyword
+    assert not store.exists()
+    option = {"x": "--x", "y": "--y", "base_state": "--base"}[keyword]
+    args = [*BASIN_CLI, "--x", x, "--y", y]
+    if base is not None:
+        args += [f"--base={k}={v}" for k, v in base.items()]
+    with inside(tmp_path / "cli"):
+        line = cli_refused("CLI basins", args, option)
+    assert line.startswith(f"error: {option}") and way in line

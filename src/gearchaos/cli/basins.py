@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import time
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -89,6 +91,26 @@ def _box(items: list[str] | None) -> dict[str, tuple[float, float]] | None:
     return out or None
 
 
+#: The options of the keywords of basins() and basin_fractions() that refusals name.
+_OPTIONS = {"x": "--x", "y": "--y", "base_state": "--base", "starts": "--starts", "box": "--box"}
+
+
+@contextlib.contextmanager
+def _options() -> Iterator[None]:
+    """A refusal of a keyword of the basin doors (its ``name``) names the option it was given
+    as: ``--x: …`` for ``x``."""
+    try:
+        yield
+    except ParameterError as exc:
+        option = _OPTIONS.get(exc.name or "")
+        if option is None:
+            raise
+        text = str(exc)
+        if option == f"--{exc.name}" and text.startswith(f"{exc.name} "):
+            raise ParameterError(f"--{text}", name=exc.name) from None
+        raise ParameterError(f"{option}: {text}", name=exc.name) from None
+
+
 def _target(preset: Any, gearset: Any, model: Any, sets: list[str] | None, quiet: bool) -> Any:
     omega, changes = c.parse_sets(sets or [])
     target = c.load_target(preset, gearset, model, changes)
@@ -169,7 +191,7 @@ def basins(
         target, omega = _target(preset, gearset, model, set_, quiet or json_out)
         settings = c.solver_settings(transient, periods, rtol, atol)
         t0 = time.perf_counter()
-        with c.warnings_to_stderr():
+        with c.warnings_to_stderr(), _options():
             ds = run(
                 target,
                 x,
@@ -268,7 +290,7 @@ def basin_fractions(
         values = c.sweep_fixed({name}, omega, {}, quiet or json_out, "varied", "swept or set")
         settings = c.solver_settings(transient, periods, rtol, atol)
         t0 = time.perf_counter()
-        with c.warnings_to_stderr():
+        with c.warnings_to_stderr(), _options():
             ds = run(
                 target,
                 vary,

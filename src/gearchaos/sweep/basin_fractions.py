@@ -24,7 +24,15 @@ from ..dynamics.basins import FAILED
 from ..errors import ParameterError
 from ..integrate.settings import SolverSettings
 from ..model.target import resolve
-from .basins import _base_state, _Job, _jsonable, _match_options, _run, _split
+from .basins import (
+    _base_state,
+    _Job,
+    _jsonable,
+    _match_options,
+    _run,
+    _split,
+    check_starts_memory,
+)
 from .spec import parse_axis
 
 __all__ = ["basin_fractions", "fractions"]
@@ -128,6 +136,10 @@ def basin_fractions(
     check_real("confidence", confidence, lo=0.0, hi=1.0, lo_open=True, hi_open=True)
     match = _match_options(tol, spread_fraction)
     row_values = [{**values, ax.name: v} for v in ax.values]
+    n_state = resolve(target, row_values[0]).n_state
+    check_starts_memory(
+        "the basin fractions vary × starts", len(ax.values), n_starts, n_state, "starts"
+    )
     pts = _box_starts(target, row_values, box, base_state, n_starts, seed, cfg)
     spec = {
         "vary": [ax.name, list(ax.values)],

@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from .._checks import check_bool, check_int, check_real
+from .._checks import check_bool, check_int, check_memory, check_real
 from .._version import provenance
 from ..dynamics.basins import FAILED, Catalogue, catalogue_from_sample, identify, link_tracks
 from ..errors import ParameterError, Status, StoreError
@@ -359,17 +359,71 @@ def _base_state(system: Any, base_state: Any) -> np.ndarray:
 
 
 def _state_axis(system: Any, item: Any, which: str) -> Axis:
-    ax = parse_axis(item)
+    try:
+        ax = parse_axis(item)
+    except ParameterError as exc:
+        raise ParameterError(str(exc), name=which) from None
     names = list(system.state_names)
     if ax.name not in names:
         raise ParameterError(
-            f"{which} must name a state of the model ({', '.join(names)}): got {ax.name!r}"
+            f"{which} must name a state of the model ({', '.join(names)}): got {ax.name!r}",
+            name=which,
         )
     if ax.name in _RESERVED:
-        raise ParameterError(f"{which}: the state name {ax.name!r} is reserved in basin stores")
+        raise ParameterError(
+            f"{which}: the state name {ax.name!r} is reserved in basin stores", name=which
+        )
     if len(ax.values) < 2:
-        raise ParameterError(f"{which} needs at least 2 values: got {len(ax.values)}")
+        raise ParameterError(f"{which} needs at least 2 values: got {len(ax.values)}", name=which)
+    steps = np.diff(np.asarray(ax.values))
+    if not np.all(steps > 0):  # an image's axis: equal or falling values make no image
+        lo, hi, n = min(ax.values), max(ax.values), len(ax.values)
+        way = (
+            f"give {ax.name}={lo:g}:{hi:g}:{n}"
+            if lo < hi and np.all(steps < 0)
+            else f"give distinct values, e.g. {ax.name}={lo - 1:g}:{hi + 1:g}:{n}"
+            if lo == hi
+            else "give them in increasing order"
+        )
+        raise ParameterError(
+            f"{which} must give increasing values of {ax.name} (the axis of an image): got "
+            f"{_shown_values(ax.values)}; {way}",
+            name=which,
+        )
     return ax
+
+
+def _shown_values(values: tuple[float, ...]) -> str:
+    shown = ", ".join(f"{v:g}" for v in values[:4])
+    return shown + (f", … ({len(values)} values)" if len(values) > 4 else "")
+
+
+def check_starts_memory(what: str, rows: int, columns: int, n: int, name: str) -> None:
+    """Refuse, before the starts are made, ``rows`` × ``columns`` starts of ``n`` states that
+    would not fit in memory: the starts themselves (n float64), the image's coordinates of each
+    (2 float64) and the attractor code the result is read back as (int32), per start. The
+    refusal's name is ``name``, the keyword to change."""
+    try:
+        check_memory(
+            f"{what} ({rows} × {columns} starts of {n} states)",
+            float(rows) * float(columns) * (8.0 * (n + 2) + 4.0),
+        )
+    except ParameterError as exc:
+        raise ParameterError(str(exc), name=name) from None
+
+
+def _varied_base(base_state: Any, axes: tuple[Axis, Axis]) -> None:
+    """Refuse a ``base_state`` mapping that sets a coordinate the image varies: its value
+    would be replaced at every start (the mapping's point is the coordinates not varied)."""
+    if not isinstance(base_state, Mapping):
+        return
+    for ax, which in zip(axes, ("x", "y"), strict=True):
+        if ax.name in base_state:
+            raise ParameterError(
+                f"base_state sets {ax.name}, which the image varies along {which}; leave "
+                f"{ax.name} out of base_state",
+                name="base_state",
+            )
 
 
 def _split(
@@ -454,8 +508,12 @@ def basins(
     system = resolve(target, values)
     ax, ay = _state_axis(system, x, "x"), _state_axis(system, y, "y")
     if ax.name == ay.name:
-        raise ParameterError(f"x and y must be two different states: got {ax.name!r} twice")
+        raise ParameterError(
+            f"x and y must be two different states: got {ax.name!r} twice", name="y"
+        )
+    _varied_base(base_state, (ax, ay))
     base = _base_state(system, base_state)
+    check_starts_memory("the basin image y × x", len(ay.values), len(ax.values), base.size, "x")
     names = list(system.state_names)
     X, Y = np.meshgrid(np.array(ax.values), np.array(ay.values))
     starts = np.broadcast_to(base, (*X.shape, base.size)).copy()
