@@ -3,6 +3,9 @@ and exit code 2, before anything listens."""
 
 from __future__ import annotations
 
+import signal
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -36,3 +39,31 @@ def test_a_port_out_of_range_is_refused(port: str, gear_store: Path) -> None:
     result = CliRunner().invoke(app, ["explore", str(gear_store), "--port", port, "--no-browser"])
     assert result.exit_code == EXIT_INVALID
     assert f"--port must be an integer in 0..65535: got {port}" in result.stderr
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+def test_a_signal_stops_the_server_without_a_warning(gear_store: Path, sig: int) -> None:
+    """Issue 35: Ctrl-C stopped the explorer with "warning: add_callback_from_signal is
+    deprecated" (Tornado's call, made from the package's own signal handler)."""
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "gearchaos", "explore", str(gear_store), "--port", "0",
+         "--no-browser"],
+        stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    try:
+        assert proc.stdout is not None
+        for line in proc.stdout:  # the URL line: the server listens (no time is waited)
+            if "http://" in line:
+                break
+        else:
+            pytest.fail(f"the explorer ended ({proc.wait()}) without its URL")
+        proc.send_signal(sig)
+        out, err = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert proc.returncode == 0, err
+    assert "explorer stopped" in out
+    assert err == "", err

@@ -98,10 +98,12 @@ def serve(
     url = f"http://localhost:{server.port}/"
     loop = server.io_loop
 
-    def stop(*_: Any) -> None:
-        loop.add_callback_from_signal(loop.stop)
-
-    old = {s: signal.signal(s, stop) for s in (signal.SIGINT, signal.SIGTERM)}
+    # Ctrl-C and SIGTERM stop the loop through asyncio's own signal handling (Tornado's
+    # add_callback_from_signal is deprecated); the handlers before are put back after
+    signals = (signal.SIGINT, signal.SIGTERM)
+    old = {s: signal.getsignal(s) for s in signals}
+    for s in signals:
+        loop.asyncio_loop.add_signal_handler(s, loop.stop)
     try:
         server.start()
         if ready is not None:
@@ -111,6 +113,7 @@ def serve(
         loop.start()
     finally:
         for s, h in old.items():
+            loop.asyncio_loop.remove_signal_handler(s)
             signal.signal(s, h)
         server.stop()
         workers.shutdown()
