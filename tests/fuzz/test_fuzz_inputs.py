@@ -166,6 +166,26 @@ def test_a_run_out_of_steps_names_options_the_cli_has(tmp_path: Path) -> None:
     assert "MAX_STEPS" in text and "--atol" in text
 
 
+def test_samples_do_not_exhaust_the_step_budget(tmp_path: Path) -> None:
+    """``simulate --samples-per-period 100000`` stopped after 47 s with "MAX_STEPS … raise
+    max_steps": every sample ended a step, and 100 000 samples a period outran the budget of
+    50 000 steps a period. 200 000 samples of one period (budget 150 000 steps) complete, on
+    the same steps as one sample a period."""
+    from typer.testing import CliRunner
+
+    from gearchaos.cli import app
+
+    one = gc.simulate(gc.duffing(1.2), transient_periods=0, periods=1, samples_per_period=1)
+    many = gc.simulate(gc.duffing(1.2), transient_periods=0, periods=1, samples_per_period=200_000)
+    assert many.status is gc.Status.OK and many.steps_accepted == one.steps_accepted
+    args = ["simulate", "--model", DUFFING, "--set", "omega=1.2", "--transient", "0",
+            "--periods", "1", "--samples-per-period", "200000", "--no-verdict",
+            "--json"]  # fmt: skip
+    with inside(tmp_path):
+        result = CliRunner().invoke(app, args)
+    assert result.exit_code == 0, result.output
+
+
 # ----------------------------------------------------------------------------- model parameters
 @pytest.mark.parametrize("value", ["nan", "inf", "-inf"])
 def test_a_model_parameter_that_is_not_finite_is_named(value: str, tmp_path: Path) -> None:
