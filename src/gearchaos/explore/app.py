@@ -34,6 +34,7 @@ from ..errors import ParameterError
 from ..model.loading import named_models
 from ..plot.regimes import REGIME_COLOURS
 from ..plot.stability import boundary_label
+from ..sweep.execute import watch_parent
 from ..sweep.result import open_result
 from .compute import compute_point, run_zoom
 from .model import ExploreModel, Point, parameter_axis_label, parameter_label
@@ -47,7 +48,8 @@ POLL_MS = 250
 class Workers:
     """The worker processes of an explorer: one for points, one for finer sweeps (so that a
     long sweep never delays a click), and the cache of computed points, shared by every
-    session of a server. Processes start on first use (``spawn``: no forked server state)."""
+    session of a server. Processes start on first use (``spawn``: no forked server state) and
+    end with the server, even when it is killed (:func:`~gearchaos.sweep.execute.watch_parent`)."""
 
     def __init__(self) -> None:
         self._pools: dict[str, cf.ProcessPoolExecutor] = {}
@@ -63,8 +65,14 @@ class Workers:
             fut = self.running.get(key)
             if fut is None:
                 if pool not in self._pools:
+                    # the worker starts now, from this thread: the kernel's death signal may
+                    # follow it only when it is the main thread (a server's loop)
+                    main = threading.current_thread() is threading.main_thread()
                     self._pools[pool] = cf.ProcessPoolExecutor(
-                        max_workers=1, mp_context=multiprocessing.get_context("spawn")
+                        max_workers=1,
+                        mp_context=multiprocessing.get_context("spawn"),
+                        initializer=watch_parent,
+                        initargs=(os.getpid(), main),
                     )
                 fut = self._pools[pool].submit(fn, *args)
                 self.running[key] = fut
