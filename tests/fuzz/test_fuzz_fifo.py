@@ -90,12 +90,14 @@ def _copy(base: Path, where: Path) -> Path:
 
 
 def fifo(path: Path) -> None:
-    path.unlink()
+    path.parent.mkdir(exist_ok=True)  # a task marker: its directory is gone once complete
+    path.unlink(missing_ok=True)
     os.mkfifo(path)
 
 
 def dev_zero(path: Path) -> None:
-    path.unlink()
+    path.parent.mkdir(exist_ok=True)
+    path.unlink(missing_ok=True)
     path.symlink_to("/dev/zero")
 
 
@@ -122,6 +124,8 @@ CASES = [
     *[("plot", "fifo", f) for f in FILES],
     *[("export", "fifo", f) for f in (".zattrs", "_manifest.json", "delta_sp/.zarray")],
     *[("bifurcation", "fifo", f) for f in (".zattrs", "_manifest.json", "omega/.zarray")],
+    ("bifurcation", "fifo", "_progress/0.done"),
+    ("bifurcation", "dev_zero", "_progress/1.done"),
     ("plot", "dev_zero", ".zattrs"),
     ("export", "dev_zero", "_manifest.json"),
     ("plot", "link", "delta_sp/.zarray"),
