@@ -34,7 +34,7 @@ LAYERS = (
     "cli",
     "facade",
 )
-BASE_MODULES = {"errors", "_checks", "_version", "_numba", "_files", "_output", "_text"}
+BASE_MODULES = {"errors", "_checks", "_version", "_numba", "_files", "_output", "_text", "_marks"}
 MAX_LINES = 600
 
 

@@ -224,18 +224,19 @@ def test_a_full_disk_is_a_clear_error_that_loses_nothing(tmp_path: Path) -> None
         with pytest.raises(StoreError, match="no space left on device"):
             save_branch(gc.continuation(OSC, ("omega", 1.5, 1.9), max_points=40), disk / "b.nc")
         assert not [p for p in disk.rglob("*") if "partial" in p.name]
-        # init-gearset --force keeps the user's file whole
+        # init-gearset --force keeps its old file whole
         (disk / "ballast").unlink()
         gs_file = disk / "g.toml"
-        gs_file.write_text("# my gear set\n")
-        _fill(disk, 1024)
         from typer.testing import CliRunner
 
         from gearchaos.cli import app
 
+        assert CliRunner().invoke(app, ["init-gearset", str(gs_file)]).exit_code == 0
+        before = gs_file.read_bytes()
+        _fill(disk, 1024)
         r = CliRunner().invoke(app, ["init-gearset", str(gs_file), "--force"])
         assert r.exit_code != 0 and "no space left on device" in r.output
-        assert gs_file.read_text() == "# my gear set\n"
+        assert gs_file.read_bytes() == before
 
 
 def test_a_sweep_on_a_full_disk_leaves_no_lock_and_no_half_store(tmp_path: Path) -> None:

@@ -2,10 +2,12 @@
 
 **The overwrite rule.** A path that already exists is replaced only when it is gearchaos's own
 output of the same kind, recognised by its own metadata (:func:`check_replaceable`, with the
-writer's test ``ours``): a sweep store whose attributes name its sweep and which holds nothing
-else, a branch file with its ``parameter`` attribute, a figure or export carrying the
-``gearchaos`` mark. Anything else — a user's directory, a thesis, a file of another program, a
-symbolic link — is refused with :class:`~gearchaos.errors.StoreError` naming the path.
+writer's test ``ours``): every writer puts a structured mark, ``gearchaos_output``, holding the
+digest of the output's own header or content (:mod:`gearchaos._marks`), and only a mark whose
+digest matches counts — a sweep store that holds nothing else, a branch file, a figure, page or
+export nobody edited since. A file that merely mentions gearchaos, a user's directory, a
+thesis, a file of another program, a symbolic link — anything else is refused with
+:class:`~gearchaos.errors.StoreError` naming the path.
 
 **The one way to write.** :func:`staged_file` and :func:`staged_dir` give the writer a
 temporary path beside the target with a unique name, created exclusively (``O_EXCL``: a
@@ -18,8 +20,8 @@ SIGKILL) left (:func:`remove_stale_staging`), and nothing a live writer still fi
 file; writers whose libraries crash on a full disk (HDF5) serialise to memory first and write
 the bytes with :func:`write_file`.
 
-A leaf module: it imports nothing from the package but :mod:`gearchaos.errors` and
-:mod:`gearchaos._files`.
+A leaf module: it imports nothing from the package but :mod:`gearchaos.errors`,
+:mod:`gearchaos._files` and :mod:`gearchaos._marks`.
 """
 
 from __future__ import annotations
@@ -36,11 +38,11 @@ import tempfile
 import zlib
 from collections.abc import Callable, Iterator
 
-from ._files import open_regular_nofollow, read_nofollow
+from ._files import read_nofollow
+from ._marks import file_is_marked, zarr_is_marked
 from .errors import StoreError
 
 __all__ = [
-    "MARK",
     "check_replaceable",
     "file_has_mark",
     "is_own_zarr",
@@ -51,12 +53,6 @@ __all__ = [
     "write_error",
     "write_file",
 ]
-
-#: The bytes that identify a file gearchaos wrote (figure metadata, CSV and TOML headers).
-MARK = b"gearchaos"
-
-#: How much of a file :func:`file_has_mark` reads at most (figures and exports are small).
-_MARK_SCAN = 64 * 1024 * 1024
 
 
 def _umask() -> int:
@@ -248,28 +244,11 @@ def staged_dir(path: str, *, what: str) -> Iterator[str]:
 
 
 def file_has_mark(path: str) -> bool:
-    """Whether the regular file ``path`` holds :data:`MARK` within its first 64 MiB (a figure's
-    metadata, an export's header); never follows a symbolic link or opens a FIFO."""
-    try:
-        fd = open_regular_nofollow(path)
-    except OSError:
-        return False
-    try:
-        tail = b""
-        left = _MARK_SCAN
-        while left > 0:
-            block = os.read(fd, min(1 << 20, left))
-            if not block:
-                return False
-            if MARK in tail + block:
-                return True
-            tail = block[-len(MARK) :]
-            left -= len(block)
-        return False
-    except OSError:
-        return False
-    finally:
-        os.close(fd)
+    """Whether the regular file ``path`` carries gearchaos's mark with the digest of what it
+    holds now (:func:`gearchaos._marks.file_is_marked`: a figure, page, gear-set file or
+    export gearchaos wrote and nobody edited since); a file that merely mentions gearchaos
+    does not. Never follows a symbolic link or opens a FIFO."""
+    return file_is_marked(path)
 
 
 def check_replaceable(path: str, *, what: str, ours: Callable[[str], bool]) -> None:
@@ -285,8 +264,8 @@ def check_replaceable(path: str, *, what: str, ours: Callable[[str], bool]) -> N
     if not ours(path):
         kind = "directory" if os.path.isdir(path) else "file"
         raise StoreError(
-            f"{path!r} exists and is not a {what} gearchaos wrote (a {kind} of something "
-            "else): it is not replaced; move it away or choose another path"
+            f"{path!r} exists and is not a {what} gearchaos wrote (a {kind} without gearchaos's "
+            "mark, or edited since): it is not replaced; move it away or choose another path"
         )
 
 
@@ -308,7 +287,8 @@ def is_own_zarr(
     markers: str | None = None,
 ) -> bool:
     """Whether ``path`` is a Zarr (format 2) directory gearchaos wrote and nothing else: its
-    ``.zattrs`` holds every attribute in ``keys``; its top level holds only Zarr metadata,
+    ``.zattrs`` holds every attribute in ``keys`` and gearchaos's mark of its header
+    (:func:`gearchaos._marks.zarr_is_marked`); its top level holds only Zarr metadata,
     the named ``files``, the ``markers`` directory of ``*.done`` files, temporaries of an
     interrupted write, and arrays (directories of ``.zarray``, ``.zattrs`` and chunk files).
     A file or directory a user put inside makes it no longer only gearchaos's."""
@@ -318,15 +298,16 @@ def is_own_zarr(
         entries = list(os.scandir(path))
     except OSError:
         return False
-    # its attributes, or their consolidated copy when a damaged store lost the first
+    # its attributes, or their consolidated copy when a damaged store lost the first (not
+    # when they were edited: then the store is no longer as gearchaos wrote it)
     found = False
     for name, pick in ((".zattrs", lambda d: d), (".zmetadata", _consolidated_root)):
         try:  # never through a link, never blocking on a FIFO, never without end
             attrs = pick(json.loads(read_nofollow(os.path.join(path, name), 1 << 26)))
         except (OSError, ValueError, AttributeError, TypeError):
             continue
-        if isinstance(attrs, dict) and all(k in attrs for k in keys):
-            found = True
+        if isinstance(attrs, dict):
+            found = all(k in attrs for k in keys) and zarr_is_marked(attrs)
             break
     if not found:
         return False

@@ -54,14 +54,20 @@ def test_init_gearset_round_trip(runner: CliRunner, tmp_path) -> None:
     assert gs.evolve({"name": ref.name, "description": ref.description}) == ref
 
     # refuses to overwrite without --force, and leaves the file alone
-    f.write_text("# edited\n" + f.read_text(encoding="utf-8"), encoding="utf-8")
     result = runner.invoke(app, ["init-gearset", str(f)])
     assert result.exit_code == 1
     assert "--force" in result.stderr
-    assert f.read_text(encoding="utf-8").startswith("# edited")
+    # --force replaces the file it wrote, as it wrote it
+    written = f.read_bytes()
     result = runner.invoke(app, ["init-gearset", str(f), "--force"])
-    assert result.exit_code == 0
-    assert not f.read_text(encoding="utf-8").startswith("# edited")
+    assert result.exit_code == 0, result.output
+    assert f.read_bytes() == written
+    # an edited file is the user's (issue 33): --force refuses it and leaves it whole
+    f.write_text("# edited\n" + f.read_text(encoding="utf-8"), encoding="utf-8")
+    result = runner.invoke(app, ["init-gearset", str(f), "--force"])
+    assert result.exit_code == 2
+    assert "not a gear-set file gearchaos wrote" in result.stderr
+    assert f.read_text(encoding="utf-8").startswith("# edited")
 
     # the written file drives a simulation
     result = runner.invoke(

@@ -18,7 +18,8 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from fuzz_helpers import cli_refused, refused
+from fuzz_helpers import cli_refused, hsettings, refused
+from hypothesis import strategies as st
 
 import gearchaos as gc
 from gearchaos.dynamics.orbit_file import save_orbit
@@ -316,3 +317,289 @@ def test_a_users_model_runs_with_the_users_consent_only(
     ref = gc.periodic_orbit(DUFFING, period=out["period"], **TINY)
     assert out["converged"] and ref.converged
     assert out["x_sp1"] == pytest.approx(list(ref.section("x")), abs=1e-8)
+
+
+# ------------------------------------------------------------------ 2. ours by a mark only
+#: Foreign text that mentions the package: the word anywhere, a made-up mark, the titles and
+#: attribute names gearchaos writes.
+MENTIONS = st.one_of(
+    st.builds(lambda a, b: f"{a}gearchaos{b}", st.text(max_size=30), st.text(max_size=30)),
+    st.builds(
+        lambda a, h: f"{a} gearchaos_output:sha256:{h}",
+        st.text(max_size=20),
+        st.text("0123456789abcdef", min_size=64, max_size=64),
+    ),
+    st.sampled_from([
+        "notes on my gearchaos runs",
+        "gearchaos periodic orbit",
+        "gearchaos simulation",
+        "Creator: gearchaos 0.1.0",
+        "# gearchaos export\nomega,motion\n1.0,1T\n",
+        "gearchaos_output",
+    ]),
+)  # fmt: skip
+
+
+def _foreign_netcdf(path: Path, text: str, forged_mark: str) -> None:
+    """A netCDF-4 file of another program that looks like gearchaos's: its title and
+    attributes mention gearchaos, it has the variables of an orbit and a branch, and a made-up
+    ``gearchaos_output`` attribute."""
+    import warnings
+
+    import numpy as np
+    import xarray as xr
+
+    text = text.replace("\0", "")  # HDF5 strings hold no NUL
+    ds = xr.Dataset(
+        {"orbit_state": ("k", np.zeros(2)), "multiplier_re": ("k", np.zeros(2))},
+        attrs={"title": f"gearchaos periodic orbit {text}", "parameter": "omega",
+               "gearchaos_output": forged_mark},
+    )  # fmt: skip
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ds.to_netcdf(path, engine="h5netcdf", invalid_netcdf=True)
+
+
+def _foreign_png(path: Path, text: str, forged_mark: str) -> None:
+    """A PNG of another program with text chunks that mention gearchaos and a made-up mark."""
+    from PIL import Image, PngImagePlugin
+
+    info = PngImagePlugin.PngInfo()
+    info.add_text("Software", f"gearchaos {text}"[:200])
+    info.add_text("gearchaos_output", forged_mark)
+    Image.new("RGB", (4, 4)).save(path, pnginfo=info)
+
+
+def _foreign_store(path: Path, text: str, forged_mark: str) -> None:
+    """A Zarr directory of another program whose attributes hold the names gearchaos's stores
+    are recognised by, mentioning gearchaos, and a made-up mark."""
+    path.mkdir()
+    (path / ".zgroup").write_text('{"zarr_format": 2}')
+    attrs = {
+        "title": f"gearchaos sweep {text}",
+        "sweep_toml": "gearchaos",
+        "version": "0.1.0",
+        "basin_spec": "gearchaos",
+        "parameter": "omega",
+        "gearchaos_output": forged_mark,
+    }
+    (path / ".zattrs").write_text(json.dumps(attrs))  # fmt: skip
+
+
+def _tree(path: Path) -> dict[str, bytes]:
+    if path.is_file():
+        return {"": path.read_bytes()}
+    return {str(p.relative_to(path)): p.read_bytes() for p in path.rglob("*") if p.is_file()}
+
+
+@pytest.fixture(scope="module")
+def results(files: dict[str, Path]) -> dict[str, Any]:
+    """What each writer writes, computed once."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots()
+    ax.plot([0, 1], [1, 0])
+    branch = gc.open_branch(files["branch"])
+    cascade = branch.copy()
+    cascade.attrs.update(cascade="[]", cascade_skipped="[]", cascade_requested=0)
+    return {
+        "figure": fig,
+        "simulation": gc.simulate(DUFFING, transient_periods=2, periods=2),
+        "orbit": gc.periodic_orbit(DUFFING, period=1, **TINY),
+        "branch": branch,
+        "cascade": cascade,
+    }
+
+
+def _writers(results: dict[str, Any], files: dict[str, Path]) -> dict[str, Any]:
+    """Every writer, as (suffix, kind of foreign file, write(path))."""
+    from typer.testing import CliRunner
+
+    from gearchaos.cli import app
+    from gearchaos.dynamics.cascade import save_cascade
+    from gearchaos.plot import savefig
+    from gearchaos.sweep.exports import export
+
+    def init_gearset(path: Path) -> None:
+        result = CliRunner().invoke(app, ["init-gearset", str(path), "--force"])
+        if result.exit_code:
+            raise gc.errors.StoreError(result.output.strip())
+
+    def sweep(path: Path) -> None:
+        gc.bifurcation(gc.duffing(1.0), "omega=1.0:1.1:2", store=path, overwrite=True,
+                       progress=False, transient_periods=2, periods=2)  # fmt: skip
+
+    def basins(path: Path) -> None:
+        gc.basins(DUFFING, "x=-1:1:2", "x_dot=-1:1:2", store=path, overwrite=True,
+                  progress=False, transient_periods=2, periods=2)  # fmt: skip
+
+    return {
+        "figure.png": (".png", "png", lambda p: savefig(results["figure"], p)),
+        "figure.pdf": (".pdf", "text", lambda p: savefig(results["figure"], p)),
+        "figure.svg": (".svg", "text", lambda p: savefig(results["figure"], p)),
+        "simulation.nc": (".nc", "netcdf", lambda p: results["simulation"].save(p)),
+        "orbit.nc": (".nc", "netcdf", lambda p: save_orbit(results["orbit"], p)),
+        "branch.nc": (".nc", "netcdf", lambda p: gc.save_branch(results["branch"], p,
+                                                                 overwrite=True)),
+        "cascade.nc": (".nc", "netcdf", lambda p: save_cascade([results["cascade"]], p,
+                                                               overwrite=True)),
+        "branch.zarr": (".zarr", "store", lambda p: gc.save_branch(results["branch"], p,
+                                                                    overwrite=True)),
+        "sweep.zarr": (".zarr", "store", sweep),
+        "basins.zarr": (".zarr", "store", basins),
+        "export.csv": (".csv", "text", lambda p: export(files["store"], p)),
+        "export.mat": (".mat", "text", lambda p: export(files["store"], p)),
+        "gearset.toml": (".toml", "text", init_gearset),
+    }  # fmt: skip
+
+
+WRITERS = ["figure.png", "figure.pdf", "figure.svg", "simulation.nc", "orbit.nc", "branch.nc",
+           "cascade.nc", "branch.zarr", "sweep.zarr", "basins.zarr", "export.csv",
+           "export.mat", "gearset.toml"]  # fmt: skip
+
+
+@pytest.mark.parametrize("writer", WRITERS)
+def test_kept_no_writer_replaces_a_foreign_file_that_mentions_gearchaos(
+    results: dict[str, Any], files: dict[str, Path], writer: str
+) -> None:
+    """`echo 'notes on my gearchaos runs' > notes.nc; orbit -o notes.nc` replaced the notes,
+    and `export -o mynotes.csv` a CSV whose header mentions gearchaos: a mention, a made-up
+    mark, or a file of the right format with gearchaos's titles is the user's."""
+    import tempfile
+
+    from hypothesis import given
+
+    suffix, kind, write = _writers(results, files)[writer]
+
+    @hsettings(12)
+    @given(text=MENTIONS, structured=st.booleans(),
+           digest=st.text("0123456789abcdef", min_size=64, max_size=64))  # fmt: skip
+    def check(text: str, structured: bool, digest: str) -> None:
+        forged = f"sha256:{digest}"
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / f"mine{suffix}"
+            if structured and kind == "netcdf":
+                _foreign_netcdf(path, text, forged)
+            elif structured and kind == "png":
+                _foreign_png(path, text, forged)
+            elif kind == "store":
+                _foreign_store(path, text, forged)
+            else:
+                path.write_bytes(text.encode("utf-8", "surrogatepass"))
+            before = _tree(path)
+            refused(f"{writer} over a foreign file", lambda: write(path), "gearchaos wrote",
+                    errors=(gc.errors.StoreError,))  # fmt: skip
+            assert _tree(path) == before
+
+    check()
+
+
+@pytest.mark.parametrize("writer", WRITERS)
+def test_every_writer_replaces_what_it_wrote_and_not_once_edited(
+    results: dict[str, Any], files: dict[str, Path], tmp_path: Path, writer: str
+) -> None:
+    """The mark holds the digest of the output: the writer replaces its own output, and a
+    file (or a store's header) edited since is the user's."""
+    suffix, kind, write = _writers(results, files)[writer]
+    path = tmp_path / f"out{suffix}"
+    write(path)
+    write(path)  # its own output: replaced
+    if kind == "store":  # the header (here its title) edited
+        zattrs = json.loads((path / ".zattrs").read_text())
+        zattrs["title"] = zattrs.get("title", "") + " (mine now)"
+        (path / ".zattrs").write_text(json.dumps(zattrs))
+    elif kind == "netcdf":  # an attribute edited
+        _forge_nc(path, tmp_path / "edited.nc", title="mine now")
+        (tmp_path / "edited.nc").replace(path)
+    else:  # one byte in the middle changed
+        raw = bytearray(path.read_bytes())
+        raw[len(raw) // 2] ^= 0x01
+        path.write_bytes(bytes(raw))
+    before = _tree(path)
+    refused(f"{writer} over its edited output", lambda: write(path), "gearchaos wrote",
+            errors=(gc.errors.StoreError,))  # fmt: skip
+    assert _tree(path) == before
+
+
+# ------------------------------------------------------------------ 3. text from files escaped
+#: A gear-set name that retitles the terminal window and clears the screen.
+HOSTILE_NAME = "\x1b]0;owned\x07\x1b[2J"
+
+
+def _acting(text: str) -> list[str]:
+    """The characters of ``text`` that would act on a terminal (controls but the newline)."""
+    import unicodedata
+
+    return [c for c in text if c != "\n" and unicodedata.category(c) in ("Cc", "Cf")]
+
+
+@pytest.fixture(scope="module")
+def gearset_orbit(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """An orbit file of the sheng2016 gear set."""
+    path = tmp_path_factory.mktemp("gearset_orbit") / "orb.nc"
+    save_orbit(gc.periodic_orbit(gc.preset("sheng2016"), omega=0.5, period=1, **TINY), path)
+    return path
+
+
+def test_escaped_a_gear_set_name_from_a_file_never_reaches_the_terminal_raw(
+    gearset_orbit: Path, tmp_path: Path
+) -> None:
+    """`orbit --from orb.nc` whose gear set is named "\\x1b]0;owned\\x07\\x1b[2J" wrote the
+    escape sequences to the terminal (window title, cleared screen)."""
+    import re
+
+    from typer.testing import CliRunner
+
+    from gearchaos.cli import app
+
+    toml = str(open_orbit_attrs(gearset_orbit)["gearset_toml"])
+    hostile = json.dumps(HOSTILE_NAME)  # a TOML basic string with \\u escapes
+    forged_toml = re.sub(r'(?m)^name = ".*"$', lambda m: f"name = {hostile}", toml, count=1)
+    assert forged_toml != toml
+    path = _forge_nc(gearset_orbit, tmp_path / "named.nc", gearset_toml=forged_toml)
+    result = CliRunner().invoke(app, ["orbit", "--from", str(path)])
+    assert "Traceback" not in result.output
+    assert not _acting(result.stdout) and not _acting(result.stderr), result.output
+    assert "\\x1b]0;owned\\x07" in result.output  # shown, as escapes
+
+
+def open_orbit_attrs(path: Path) -> dict[str, Any]:
+    from gearchaos.dynamics.orbit_file import open_orbit
+
+    return dict(open_orbit(path).attrs)
+
+
+@pytest.mark.parametrize(
+    ("case", "args", "code"),
+    [
+        ("plot -o", ["plot", "STORE", "-o", "f\x1b[2J.png"], 0),
+        ("init-gearset", ["init-gearset", "g\x1b[2J.toml"], 0),
+        ("missing --from", ["orbit", "--from", "/x\x1b[2J"], 2),
+        ("bad --output", ["plot", "STORE", "-o", "f\x1b[2J.jpg\x07"], 2),
+        ("missing store", ["plot", "/nowhere/\x1b]0;owned\x07.zarr", "-o", "f.png"], 2),
+    ],
+)
+def test_escaped_paths_the_command_line_echoes(
+    files: dict[str, Path],
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    case: str,
+    args: list[str],
+    code: int,
+) -> None:
+    """`plot -o $'f\\e[2J.png'`, `init-gearset $'g\\e[2J.toml'` and a missing
+    `--from $'/x\\e[2J'` echoed the path raw."""
+    from typer.testing import CliRunner
+
+    from gearchaos.cli import app
+
+    monkeypatch.chdir(tmp_path)
+    argv = [str(files["store"]) if a == "STORE" else a for a in args]
+    result = CliRunner().invoke(app, argv)
+    assert result.exit_code == code, result.output
+    assert "Traceback" not in result.output
+    assert not _acting(result.stdout) and not _acting(result.stderr), (case, result.output)
+    assert "\\x1b" in result.output  # the path is named, its escape shown

@@ -27,8 +27,11 @@ from make_reference import (
 
 import gearchaos as gc
 
-#: Attributes that name the software that wrote a file rather than what it computed.
-VERSION_ATTRS = frozenset({"version", "numba_version", "numpy_version", "scipy_version"})
+#: Attributes that name the software that wrote a file rather than what it computed (issue
+#: 33: ``gearchaos_output``, the mark only gearchaos writes, a digest of the others).
+VERSION_ATTRS = frozenset(
+    {"version", "numba_version", "numpy_version", "scipy_version", "gearchaos_output"}
+)
 
 #: The stores were last regenerated for issue 13 (Newton's method for the predicted switch
 #: time, which moves step ends by less than 1e-9 of a step); simulate.nc for issue 32 (the

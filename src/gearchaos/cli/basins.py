@@ -14,6 +14,7 @@ from rich.markup import escape
 from rich.table import Table
 from rich.text import Text
 
+from .._text import escape_path
 from ..errors import ParameterError
 from ..sweep.basins import BASIN_SETTINGS
 from . import _common as c
@@ -235,7 +236,11 @@ def basins(
     title = f"{codes.size} starts at Ω = {omega:g}"
     out.print(_legend_table(title, entries, codes, xname, column))
     out.print(
-        Text(f"{seconds:.3g} s; next: gearchaos plot {output} -o {output.stem}.png", style="dim")
+        Text(
+            f"{seconds:.3g} s; next: gearchaos plot {escape_path(output)} -o "
+            f"{escape_path(output.stem)}.png",
+            style="dim",
+        )
     )
 
 
@@ -352,5 +357,9 @@ def basin_fractions(
     out = c.stdout()
     out.print(table)
     out.print(
-        Text(f"{seconds:.3g} s; next: gearchaos plot {output} -o {output.stem}.png", style="dim")
+        Text(
+            f"{seconds:.3g} s; next: gearchaos plot {escape_path(output)} -o "
+            f"{escape_path(output.stem)}.png",
+            style="dim",
+        )
     )

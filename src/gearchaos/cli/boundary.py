@@ -10,6 +10,7 @@ from typing import Annotated, Any
 import typer
 from rich.text import Text
 
+from .._text import escape_path
 from ..errors import ParameterError
 from . import _common as c
 
@@ -207,7 +208,8 @@ def boundary(
                     f"  {e['kind']} at {summary['parameter']}={e['value']:.8g}, "
                     f"{summary['parameter2']}={e['value2']:.8g}"
                 )
-            out.print(Text(f"next: gearchaos plot MAP.zarr --boundaries {path} -o chart.png",
+            shown = escape_path(path)
+            out.print(Text(f"next: gearchaos plot MAP.zarr --boundaries {shown} -o chart.png",
                            style="dim"))  # fmt: skip
     c.wrote(path)
 

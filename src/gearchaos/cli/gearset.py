@@ -70,26 +70,40 @@ def init_gearset(
         Path, typer.Argument(help="TOML file to write.", dir_okay=False, show_default=False)
     ],
     force: Annotated[
-        bool, typer.Option("--force", "-f", help="Overwrite an existing file.")
+        bool,
+        typer.Option(
+            "--force",
+            "-f",
+            help="Overwrite an existing gear-set file that init-gearset wrote and nobody has "
+            "edited since (never another file).",
+        ),
     ] = False,
 ) -> None:
     """Write a commented gear-set file to start from (the sheng2016 values, every line
     explained); edit it, then run **gearchaos simulate --gearset FILE**."""
-    from .._output import write_file
+    from .._marks import fill_mark, placeholder
+    from .._output import check_replaceable, file_has_mark, write_file
+    from .._text import escape_path
     from ..gearset import template_toml
 
+    shown = escape_path(file)
     if file.is_symlink() or (file.exists() and not file.is_file()):  # a FIFO would block
         c.fail(
-            f"{file} exists and is not a regular file (a link, directory, FIFO or device); "
+            f"{shown} exists and is not a regular file (a link, directory, FIFO or device); "
             "choose another path",
             c.EXIT_INVALID,
         )
     if file.exists() and not force:
-        c.fail(f"{file} already exists; pass --force to overwrite it", c.EXIT_FAILURE)
+        c.fail(f"{shown} already exists; pass --force to overwrite it", c.EXIT_FAILURE)
     with c.reported_errors():
+        # --force replaces only a file init-gearset wrote, as it wrote it (its mark holds)
+        check_replaceable(str(file), what="gear-set file", ours=file_has_mark)
+        # gearchaos's mark: the digest of the file (an edited file is the user's)
+        head = f"# {placeholder()} (written by gearchaos init-gearset)\n"
+        text = fill_mark((head + template_toml()).encode("utf-8"))
         # complete or not at all: a full disk leaves the old file (or none), never a part
-        write_file(str(file), template_toml().encode("utf-8"), what="gear-set file")
+        write_file(str(file), text, what="gear-set file")
     c.wrote(file)
     c.stdout().print(
-        Text(f"next: gearchaos simulate --gearset {file} --set omega=1.5 -o out/", style="dim")
+        Text(f"next: gearchaos simulate --gearset {shown} --set omega=1.5 -o out/", style="dim")
     )

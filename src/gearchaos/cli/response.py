@@ -9,6 +9,7 @@ import typer
 from rich.markup import escape
 from rich.text import Text
 
+from .._text import escape_path
 from ..errors import ParameterError
 from ..sweep.spec import RESPONSE_SOLVER
 from . import _common as c
@@ -119,4 +120,5 @@ def response(
     table.add_row("store", escape(str(output)))
     out = c.stdout()
     out.print(table)
-    out.print(Text(f"next: gearchaos plot {output} -o {output.stem}.png", style="dim"))
+    shown, stem = escape_path(output), escape_path(output.stem)
+    out.print(Text(f"next: gearchaos plot {shown} -o {stem}.png", style="dim"))

@@ -9,6 +9,7 @@ from typing import Annotated, Any
 import typer
 from rich.text import Text
 
+from .._text import escape_path
 from ..errors import ParameterError
 from ..integrate.settings import SIMULATION
 from . import _common as c
@@ -133,7 +134,7 @@ def simulate(
     if json_out:
         c.print_json(summary)
         for path in written:
-            c.stderr().print(f"wrote {path}", soft_wrap=True)
+            c.stderr().print(Text(f"wrote {escape_path(path)}"), soft_wrap=True)
         return
     from ._render import format_summary
 

@@ -10,6 +10,7 @@ import typer
 from rich.markup import escape
 from rich.text import Text
 
+from .._text import escape_path
 from ..errors import ParameterError
 from ..gearset.parsing import parse_int
 from ..sweep.spec import SWEEP_SOLVER
@@ -311,7 +312,8 @@ def bifurcation(
     regimes = res.regime_table()
     if regimes:
         out.print(regime_table(regimes, title="motion regimes (fraction of the swept points)"))
-    out.print(Text(f"next: gearchaos plot {output} -o {output.stem}.png", style="dim"))
+    shown, stem = escape_path(output), escape_path(output.stem)
+    out.print(Text(f"next: gearchaos plot {shown} -o {stem}.png", style="dim"))
 
 
 def _is_branch(path: Path) -> bool:

@@ -50,7 +50,8 @@ import numpy as np
 
 from .._checks import check_bool
 from .._files import check_path, check_regular_file, irregular_entry, read_nofollow
-from .._output import check_replaceable, file_has_mark, is_own_zarr, staged_dir, write_file
+from .._marks import MARK_KEY, hdf5_is_marked, mark_hdf5, zarr_mark
+from .._output import check_replaceable, is_own_zarr, staged_dir, write_file
 from .._version import provenance
 from ..errors import ParameterError, StoreError
 from ..model.response import mesh_groups, peak_contact_forces
@@ -369,6 +370,8 @@ def save_branch(ds: Any, path: str | os.PathLike[str], *, overwrite: bool = Fals
     path = os.fspath(path)
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     if kind == "zarr":
+        ds = ds.copy()  # the caller's dataset keeps its attributes
+        ds.attrs[MARK_KEY] = zarr_mark(ds.attrs)
         with staged_dir(path, what="branch store") as tmp:
             # every chunk written (none skipped as all fill values) and its digest kept
             ds.to_zarr(tmp, mode="w", consolidated=True, zarr_format=2, write_empty_chunks=True)
@@ -383,22 +386,18 @@ def save_branch(ds: Any, path: str | os.PathLike[str], *, overwrite: bool = Fals
             if var.ndim and var.size and var.dtype.kind in "biuf"
         }
         # serialised in memory first: HDF5 crashes on a full disk, a plain write fails cleanly
-        data = ds.to_netcdf(engine="h5netcdf", encoding=encoding)
+        data = mark_hdf5(ds.to_netcdf(engine="h5netcdf", encoding=encoding))
         write_file(path, data, what="branch file")
     return path
 
 
 def is_branch_file(path: str) -> bool:
     """Whether ``path`` is a branch gearchaos wrote (what ``overwrite`` may replace): a Zarr
-    branch holding only its arrays and manifest, or a netCDF file whose attributes name the
-    continued ``parameter`` (a damaged one still carries the gearchaos mark)."""
+    branch holding only its arrays and manifest, or a netCDF file, each with gearchaos's mark
+    of its attributes (:mod:`gearchaos._marks`); a file that mentions gearchaos is not."""
     if os.path.isdir(path):
         return is_own_zarr(path, keys=("parameter",), files=frozenset({MANIFEST}))
-    try:
-        open_branch(path)
-        return True
-    except (StoreError, ParameterError):
-        return file_has_mark(path)
+    return hdf5_is_marked(path)
 
 
 def open_branch(path: str | os.PathLike[str]) -> Any:

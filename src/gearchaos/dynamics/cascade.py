@@ -35,6 +35,7 @@ import numpy as np
 
 from .._checks import check_int, check_real
 from .._files import check_path
+from .._marks import mark_hdf5_file
 from .._output import staged_file
 from ..errors import IntegrationError, ParameterError, StoreError
 
@@ -225,6 +226,7 @@ def save_cascade(
                 engine="h5netcdf",
                 encoding=encoding,
             )
+        mark_hdf5_file(tmp)  # the mark of its root attributes: what overwrite may replace
     return path
 
 

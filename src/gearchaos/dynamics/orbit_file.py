@@ -13,7 +13,8 @@ import os
 from typing import Any
 
 from .._files import check_output_file, load_netcdf
-from .._output import check_replaceable, file_has_mark, write_file
+from .._marks import hdf5_is_marked, mark_hdf5
+from .._output import check_replaceable, write_file
 from ..errors import ParameterError, StoreError
 
 __all__ = ["ORBIT_TITLE", "is_orbit_file", "open_orbit", "save_orbit"]
@@ -30,7 +31,7 @@ def save_orbit(orbit: Any, path: str | os.PathLike[str]) -> str:
         raise ParameterError(f"orbit must be a PeriodicOrbit: got {type(orbit).__name__}")
     text = check_output_file(path, what="orbit file")
     check_replaceable(text, what="orbit file", ours=is_orbit_file)
-    data = orbit.to_dataset().to_netcdf(engine="h5netcdf", invalid_netcdf=True)
+    data = mark_hdf5(orbit.to_dataset().to_netcdf(engine="h5netcdf", invalid_netcdf=True))
     return write_file(text, data, what="orbit file")
 
 
@@ -47,10 +48,7 @@ def open_orbit(path: str | os.PathLike[str]) -> Any:
 
 
 def is_orbit_file(path: str) -> bool:
-    """Whether ``path`` is an orbit file gearchaos wrote (a damaged one still carries the
-    gearchaos mark)."""
-    try:
-        open_orbit(path)
-        return True
-    except (StoreError, ParameterError):
-        return file_has_mark(path)
+    """Whether ``path`` is a netCDF file gearchaos wrote (what a new orbit file may replace):
+    its mark ``gearchaos_output`` holds the digest of its attributes
+    (:func:`gearchaos._marks.hdf5_is_marked`); a file that mentions gearchaos is not."""
+    return hdf5_is_marked(path)

@@ -24,7 +24,8 @@ from typing import Any
 import numpy as np
 
 from .._files import check_output_file, load_netcdf
-from .._output import check_replaceable, file_has_mark, write_file
+from .._marks import hdf5_is_marked, mark_hdf5
+from .._output import check_replaceable, write_file
 from .._version import provenance
 from ..errors import ParameterError, StoreError
 from ..model.loading import model_reference
@@ -152,7 +153,7 @@ class SimulationResult(Trajectory):
         check_replaceable(text, what="simulation file", ours=is_simulation_file)
         # serialised in memory first (HDF5 crashes on a full disk), then written under a
         # unique temporary name and renamed: never a half-written file under the final name
-        data = self.to_dataset().to_netcdf(engine="h5netcdf", invalid_netcdf=True)
+        data = mark_hdf5(self.to_dataset().to_netcdf(engine="h5netcdf", invalid_netcdf=True))
         return write_file(text, data, what="simulation file")
 
 
@@ -175,10 +176,7 @@ def open_simulation(path: str | os.PathLike[str]) -> Any:
 
 
 def is_simulation_file(path: str) -> bool:
-    """Whether ``path`` is a simulation file gearchaos wrote (what a new one may replace); a
-    damaged one still carries the gearchaos mark."""
-    try:
-        open_simulation(path)
-        return True
-    except (StoreError, ParameterError):
-        return file_has_mark(path)
+    """Whether ``path`` is a netCDF file gearchaos wrote (what a new simulation file may
+    replace): its mark ``gearchaos_output`` holds the digest of its attributes
+    (:func:`gearchaos._marks.hdf5_is_marked`); a file that mentions gearchaos is not."""
+    return hdf5_is_marked(path)

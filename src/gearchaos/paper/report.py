@@ -31,6 +31,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from .._marks import fill_mark, placeholder
 from .._output import check_replaceable, file_has_mark, write_file
 from ..sweep.result import SweepResult
 
@@ -476,7 +477,9 @@ def build_report(
     )
     index = out / "index.html"
     check_replaceable(str(index), what="report page", ours=file_has_mark)
-    write_file(str(index), page.encode("utf-8"), what="report page")
+    # gearchaos's mark, the digest of the page, in a comment: what a new report may replace
+    marked = fill_mark(f"{page.rstrip()}\n<!-- {placeholder()} -->\n".encode())
+    write_file(str(index), marked, what="report page")
     summary = {
         "quick": quick,
         "gearset": label,

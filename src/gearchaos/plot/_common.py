@@ -58,7 +58,7 @@ def axis_symbol(name: str, symbols: Mapping[str, str] | None = None) -> str:
     ``symbols``: a model's own parameter symbols (:func:`parameter_symbols`), which come
     first."""
     sym = _tex(name, symbols)
-    return f"${sym}$" if sym is not None else name
+    return f"${sym}$" if sym is not None else figure_text(name)
 
 
 def axis_label(name: str, symbols: Mapping[str, str] | None = None) -> str:
@@ -70,7 +70,7 @@ def axis_label(name: str, symbols: Mapping[str, str] | None = None) -> str:
         return f"${symbols[name]}$"
     sym = _tex(name)
     if sym is None:
-        return name
+        return figure_text(name)  # a name read from a file: printable, no mathtext
     if name in _DEFINITIONS:
         return f"${sym} = {_DEFINITIONS[name]}$"
     field = describe(name)
@@ -83,7 +83,7 @@ def given(name: str, value: Any, symbols: Mapping[str, str] | None = None) -> st
     ``$\\delta$ = 0.25``; an unknown name as it is, a value that is no number as written.
     ``symbols`` as for :func:`axis_symbol`."""
     number = isinstance(value, int | float | np.number) and not isinstance(value, bool)
-    return f"{axis_symbol(name, symbols)} = {fmt(value) if number else value}"
+    return f"{axis_symbol(name, symbols)} = {fmt(value) if number else figure_text(value)}"
 
 
 def subject(attrs: Any, gearset: Any = None) -> str:

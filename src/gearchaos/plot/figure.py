@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from .._files import check_output_file
+from .._marks import mark_file, placeholder
 from .._output import check_replaceable, file_has_mark, staged_file
 from .._version import __version__
 from ..analysis.summary import motion_text
@@ -210,7 +211,9 @@ def savefig(fig: Any, path: str | os.PathLike[str], *, dpi: float = 150) -> str:
     """Write ``fig`` as PNG, PDF or SVG, chosen by the suffix of ``path``; returns the path.
 
     Raises :class:`~gearchaos.errors.ParameterError` for any other suffix. The file carries
-    the gearchaos mark in its metadata; an existing file without it is never replaced
+    gearchaos's mark (:mod:`gearchaos._marks`: a PNG text chunk, or the PDF's and SVG's
+    creator, holding the digest of the file); an existing file without a valid one — another
+    program's, or one that merely mentions gearchaos — is never replaced
     (:class:`~gearchaos.errors.StoreError`), and the figure is written under a unique
     temporary name and renamed, so a failed write never leaves a partial file at ``path``.
     """
@@ -222,7 +225,12 @@ def savefig(fig: Any, path: str | os.PathLike[str], *, dpi: float = 150) -> str:
         )
     # an existing file is replaced only if gearchaos drew it (the mark in its metadata)
     check_replaceable(str(p), what="figure", ours=file_has_mark)
-    key = "Software" if suffix == ".png" else "Creator"
+    creator = f"gearchaos {__version__}"
+    if suffix == ".png":  # the mark is a chunk of its own (mark_file)
+        metadata = {"Software": creator}
+    else:
+        metadata = {"Creator": f"{creator} {placeholder()}"}
     with staged_file(str(p), what="figure") as tmp:
-        fig.savefig(tmp, format=suffix[1:], dpi=dpi, metadata={key: f"gearchaos {__version__}"})
+        fig.savefig(tmp, format=suffix[1:], dpi=dpi, metadata=metadata)
+        mark_file(tmp)
     return str(p)

@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from .._files import check_output_file, check_path, load_netcdf, read_text_file
+from .._marks import mark_file, placeholder
 from .._output import check_replaceable, file_has_mark, staged_file
 from .._text import escape_path
 from ..errors import ParameterError, StoreError
@@ -243,6 +244,12 @@ def _write_mat(ds: Any, path: str) -> None:
             attrs[_mat_name(str(k))] = str(v)
     data["attrs"] = attrs
     savemat(path, data, do_compression=True, oned_as="column", appendmat=False)
+    # the 116 bytes of descriptive text of a MAT 5 file hold gearchaos's mark: the digest of
+    # the file (what a new export may replace)
+    text = f"MATLAB 5.0 MAT-file, {placeholder()}".encode("ascii").ljust(116)
+    with open(path, "r+b") as f:
+        f.write(text)
+    mark_file(path)
 
 
 def export(source: Any, path: str | os.PathLike[str], *, to: str | None = None) -> Path:

@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from .._files import check_path, read_nofollow
+from .._marks import MARK_KEY, zarr_mark
 from .._output import check_replaceable, is_own_zarr, write_error, write_file
 from ..errors import Status, StoreError
 from ..gearset.mapping import flatten
@@ -249,6 +250,7 @@ class SweepStore:
             ds = xr.Dataset(coords={k: (d, v) for k, (d, v) in coords.items()})
             ds.attrs.update(attrs)
             ds.attrs["complete"] = False
+            ds.attrs[MARK_KEY] = zarr_mark(ds.attrs)  # gearchaos's mark: what overwrite replaces
             # Zarr format 2: consolidated metadata and string coordinates are part of its
             # specification (format 3 still flags both as unstable)
             ds.to_zarr(target, mode="w", consolidated=False, zarr_format=2)
