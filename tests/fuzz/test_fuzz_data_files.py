@@ -603,3 +603,29 @@ def test_escaped_paths_the_command_line_echoes(
     assert "Traceback" not in result.output
     assert not _acting(result.stdout) and not _acting(result.stderr), (case, result.output)
     assert "\\x1b" in result.output  # the path is named, its escape shown
+
+
+def test_read_a_store_of_an_older_version_without_the_mark_is_still_read(
+    files: dict[str, Path], tmp_path: Path
+) -> None:
+    """The mark decides what may be replaced, not what may be read: a store written before
+    the mark existed starts an orbit as before (and is never replaced)."""
+    from typer.testing import CliRunner
+
+    from gearchaos.cli import app
+    from gearchaos.sweep.store import is_sweep_store
+
+    old = tmp_path / "old.zarr"
+    import shutil
+
+    shutil.copytree(files["store"], old)
+    zattrs = json.loads((old / ".zattrs").read_text())
+    del zattrs["gearchaos_output"]
+    (old / ".zattrs").write_text(json.dumps(zattrs, indent=4))
+    meta = json.loads((old / ".zmetadata").read_text())
+    del meta["metadata"][".zattrs"]["gearchaos_output"]
+    (old / ".zmetadata").write_text(json.dumps(meta, indent=4))
+    assert not is_sweep_store(str(old))
+    result = CliRunner().invoke(app, ["orbit", "--from", str(old), "--at", "omega=1.0", "--json"])
+    assert result.exit_code == 0, result.output
+    assert json.loads(result.stdout)["converged"]

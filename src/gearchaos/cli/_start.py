@@ -101,10 +101,21 @@ def load_start(path: str, at: str | None, model: str | None = None) -> Start:
     return start
 
 
-def _load(path: str, where: dict[str, str]) -> Start:
-    from ..sweep.store import is_sweep_store
+def _names_a_sweep(path: str) -> bool:
+    """Whether the directory ``path`` says it is a sweep store (its attributes hold
+    ``sweep_toml``): read, not whether gearchaos may replace it (a store of an older version
+    has no mark, and is read all the same)."""
+    from ..sweep.integrity import read_json
 
-    if os.path.isdir(path) and is_sweep_store(path):
+    try:  # never through a link, never blocking on a FIFO
+        attrs = read_json(os.path.join(path, ".zattrs"))
+    except (OSError, ValueError):
+        return False
+    return isinstance(attrs, dict) and "sweep_toml" in attrs
+
+
+def _load(path: str, where: dict[str, str]) -> Start:
+    if os.path.isdir(path) and _names_a_sweep(path):
         return _from_store(path, where)
     from ..dynamics.branch import open_branch
 
