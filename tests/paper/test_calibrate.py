@@ -390,6 +390,21 @@ def test_a_study_resumes_after_kill_9_without_losing_a_finished_trial(tmp_path: 
     assert len(done) == 6 and min(set(done) - set(before)) > 2  # the count continues
 
 
+def test_two_worker_processes_share_one_storage(tmp_path: Path) -> None:
+    out, url = tmp_path / "c.jsonl", f"sqlite:///{tmp_path / 'c.db'}"
+    res = calibrate(out=out, storage=url, objective=Stub(), max_candidates=8, workers=2)
+    trials = _trials(url, cal.STUDY)
+    done = [t for t in trials if t.state.name == "COMPLETE"]
+    # each worker stops once the study holds 8: one may finish the trial it had started
+    assert res.stopped == "max_candidates" and 8 <= len(done) <= 9
+    owners = {t.user_attrs["owner"]["pid"] for t in done}
+    assert 1 <= len(owners) <= 2 and os.getpid() not in owners  # run by the workers
+    assert len({t.params["torque.input"] for t in done}) == len(done)  # no trial run twice
+    assert [json.loads(x)["index"] for x in out.read_text().splitlines()] == [
+        t.number for t in done
+    ]
+
+
 def test_a_study_refuses_another_objective_and_out_refuses_another_log(tmp_path: Path) -> None:
     from gearchaos.errors import StoreError
     from gearchaos.paper.study import open_study
