@@ -36,7 +36,6 @@ continuation finds.
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass, field
@@ -335,8 +334,3 @@ def landmark_objective(
         )
 
     return objective
-
-
-def finite(value: float) -> float:
-    """``value``, or 0 when it is NaN (a term that could not be measured scores nothing)."""
-    return float(value) if math.isfinite(value) else 0.0

@@ -104,7 +104,8 @@ def open_study(
 ) -> Any:
     """The Optuna study ``study`` in ``storage`` (created when missing, with two maximised
     objectives and the seeded sampler). ``config`` (the objective's configuration) is recorded
-    in a new study and must equal the recorded one of an existing study."""
+    in a new study and must equal the recorded one of an existing study. Optuna's line per
+    trial is silenced (its warnings stay): the calibration shows its own progress."""
     import optuna
 
     check_int("seed", seed, lo=0)
@@ -246,7 +247,7 @@ class Job:
 
 
 def _trial_function(
-    space: SearchSpace, objective: Callable[[Any], Evaluation], base: Any, study_name: str
+    space: SearchSpace, objective: Callable[[Any], Evaluation], base: Any
 ) -> Callable[[Any], tuple[float, float]]:
     from optuna.storages import RetryHeartbeatStaleTrialCallback
 
@@ -309,7 +310,7 @@ def optimize(
         cbs.append(MaxTrialsCallback(job.max_candidates))
     t0 = time.monotonic()
     study.optimize(
-        _trial_function(job.space, objective, _base(), study.study_name),
+        _trial_function(job.space, objective, _base()),
         n_trials=job.trials,
         timeout=job.timeout,
         catch=(ParameterError, IntegrationError),
