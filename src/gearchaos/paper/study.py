@@ -129,13 +129,14 @@ def open_study(
             f"study {study!r} in {storage} has {len(s.directions)} objective(s), a calibration "
             f"two ({', '.join(OBJECTIVES)}); use another --study"
         )
+    if not s.metric_names:  # named for optuna-dashboard
+        with _quiet():
+            s.set_metric_names(list(OBJECTIVES))
     if config is not None:
         want = json.loads(json.dumps(dict(config), sort_keys=True))
         have = s.user_attrs.get("config")
         if have is None:
             s.set_user_attr("config", want)
-            with _quiet():
-                s.set_metric_names(list(OBJECTIVES))
         elif have != want:
             diff = sorted(k for k in set(have) | set(want) if have.get(k) != want.get(k))
             raise StoreError(
