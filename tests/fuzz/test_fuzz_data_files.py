@@ -629,3 +629,18 @@ def test_read_a_store_of_an_older_version_without_the_mark_is_still_read(
     result = CliRunner().invoke(app, ["orbit", "--from", str(old), "--at", "omega=1.0", "--json"])
     assert result.exit_code == 0, result.output
     assert json.loads(result.stdout)["converged"]
+
+
+def test_kept_notes_that_mention_gearchaos_are_not_an_orbit_file(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`echo 'notes on my gearchaos runs' > notes.nc; gearchaos orbit … -o notes.nc` replaced
+    the notes."""
+    monkeypatch.chdir(tmp_path)
+    notes = tmp_path / "notes.nc"
+    notes.write_text("notes on my gearchaos runs\n")
+    args = ["orbit", "--model", "gearchaos.model.library:Duffing", "--set", "omega=1.2",
+            "-o", str(notes)]  # fmt: skip
+    text = cli_refused("orbit -o notes.nc", args, "notes.nc", watch=tmp_path)
+    assert "not a orbit file gearchaos wrote" in text
+    assert notes.read_text() == "notes on my gearchaos runs\n"
