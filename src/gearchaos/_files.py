@@ -165,22 +165,32 @@ def irregular_entry(root: str) -> tuple[str, str] | None:
     directory ``root`` that is neither a regular file nor a directory — a FIFO, a device, a
     socket or a symbolic link, which gearchaos never writes in a store it makes — or ``None``.
     Checked before a library that opens files plainly (Zarr) reads the directory: it would
-    block on a FIFO or read a device without end. Symbolic links are not followed."""
-    for dirpath, dirnames, files in os.walk(root):
-        dirnames.sort()
-        for name in sorted([*dirnames, *files]):
-            full = os.path.join(dirpath, name)
-            rel = os.path.relpath(full, root).replace(os.sep, "/")
+    block on a FIFO or read a device without end. Symbolic links are not followed; the types
+    come from the directory listings (no call per file where the file system gives them)."""
+    pending = [""]
+    while pending:
+        rel_dir = pending.pop()
+        try:
+            with os.scandir(os.path.join(root, rel_dir) if rel_dir else root) as it:
+                entries = sorted(it, key=lambda e: e.name)
+        except OSError as exc:
+            return rel_dir or ".", f"not readable ({exc.strerror or exc})"
+        for e in entries:
+            rel = f"{rel_dir}/{e.name}" if rel_dir else e.name
             try:
-                mode = os.lstat(full).st_mode
+                if e.is_symlink():
+                    return rel, "a symbolic link"
+                if e.is_dir(follow_symlinks=False):
+                    pending.append(rel)
+                    continue
+                if e.is_file(follow_symlinks=False):
+                    continue
+                mode = e.stat(follow_symlinks=False).st_mode
             except FileNotFoundError:
                 continue  # removed meanwhile (a writer's temporary)
             except OSError as exc:
                 return rel, f"not readable ({exc.strerror or exc})"
-            if stat.S_ISLNK(mode):
-                return rel, "a symbolic link"
-            if not (stat.S_ISREG(mode) or stat.S_ISDIR(mode)):
-                return rel, _kind(mode)
+            return rel, _kind(mode)
     return None
 
 
