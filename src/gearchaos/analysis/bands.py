@@ -17,6 +17,11 @@ on each of which Pⁿ acts as an orientation-preserving circle homeomorphism.
   about the band's centroid in its two principal directions; a curve that is not star-shaped
   about its centroid fails the test (a false negative: the torus is then not confirmed by this
   test, never a false positive).
+* :func:`uniform_return` — the recurrence test, whatever the shape: on an invariant circle
+  (conjugate to a rotation by ρ) some shift q brings *every* point back close to itself,
+  ‖x_{k+q} − x_k‖ ≤ |h′|·‖qρ‖ for all k, and the best such distance falls like 1/q as the record
+  grows; on a chaotic set no shift brings all points back at once (mixing), so the best
+  uniform return stays of the order of the set's size.
 * :func:`band_tests` — both per band, with the 0–1 test K of every band's subsequence.
 """
 
@@ -30,21 +35,23 @@ import numpy as np
 from .chaos01 import MIN_LENGTH as MIN_LENGTH_01
 from .chaos01 import chaos01
 
-__all__ = ["BandTests", "band_count", "band_tests", "circle_order"]
+__all__ = ["BandTests", "band_count", "band_tests", "circle_order", "uniform_return"]
 
 #: Fewest points of a band for the rotation test.
 MIN_BAND_POINTS = 32
 
 
 def _standardised(x: np.ndarray) -> np.ndarray:
-    """Columns scaled to unit range (constant columns dropped): one metric for states whose
-    components have different sizes."""
+    """The sequence shifted to its minimum and divided by its largest coordinate range (one
+    scale for every column: a component that barely moves, such as a sun centre held by
+    symmetry, must not be blown up to the size of the motion)."""
     x = np.asarray(x, dtype=np.float64)
-    span = np.ptp(x, axis=0)
-    keep = span > 1e-12 * max(1.0, float(np.max(np.abs(x))) if x.size else 1.0)
-    if not np.any(keep):
+    if x.size == 0:
         return np.zeros((x.shape[0], 1))
-    return (x[:, keep] - x[:, keep].min(axis=0)) / span[keep]
+    span = float(np.max(np.ptp(x, axis=0)))
+    if span <= 1e-12 * max(1.0, float(np.max(np.abs(x)))):
+        return np.zeros((x.shape[0], 1))
+    return (x - x.min(axis=0)) / span
 
 
 def _nearest_in_own(z: np.ndarray, n: int) -> float:
@@ -58,8 +65,8 @@ def _nearest_in_own(z: np.ndarray, n: int) -> float:
 
 
 def _principal(x: np.ndarray, k: int = 2) -> np.ndarray:
-    """The sequence's coordinates along its k principal directions (standardised columns): the
-    observables that carry its motion, whichever state components they are."""
+    """The sequence's coordinates along its k principal directions (one scale for all
+    columns): the observables that carry its motion, whichever state components they are."""
     z = _standardised(x)
     c = z - z.mean(axis=0)
     if c.shape[1] <= 1:
@@ -111,6 +118,25 @@ def circle_order(x: np.ndarray) -> float:
     ext = np.concatenate([counts[-w:], counts, counts[:w]])
     win = np.convolve(ext, np.ones(2 * w + 1), mode="valid")
     return float(np.max(win) / shift.size)
+
+
+def uniform_return(x: np.ndarray, max_shift: int | None = None) -> tuple[float, int]:
+    """(r, q): the smallest over shifts q ≤ ``max_shift`` (default m/3) of
+    max_k ‖x_{k+q} − x_k‖_∞ relative to the set's largest coordinate range, and the shift
+    that gives it (see the module docstring: small on an invariant circle, of order one on a
+    chaotic set).
+    (inf, 0) for fewer than :data:`MIN_BAND_POINTS` points."""
+    z = _standardised(x)
+    m = z.shape[0]
+    if m < MIN_BAND_POINTS:
+        return math.inf, 0
+    top = max(1, min(m - 1, m // 3 if max_shift is None else int(max_shift)))
+    best, arg = math.inf, 0
+    for q in range(1, top + 1):
+        r = float(np.max(np.abs(z[q:] - z[:-q])))
+        if r < best:
+            best, arg = r, q
+    return best, arg
 
 
 @dataclass(frozen=True)

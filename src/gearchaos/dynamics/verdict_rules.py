@@ -13,9 +13,10 @@ Each extension of the run is a *window* with its own λ₁ ± σ (block means) a
   of the longest periods looked for long (a long period is seen first), no unstable orbit
   holds the motion, no stable orbit found by shooting may still be approached (a record too
   short to measure the approach runs on: a spiral onto an orbit keeps its cyclic order too),
-  and the section shows a torus: for some n ≤ ``max_bands`` every
-  subsequence x_{j::n} keeps its cyclic order (the rotation test,
-  :func:`~gearchaos.analysis.bands.circle_order`), or the 0–1 test is regular for every n;
+  and the section shows a torus: for some n ≤ ``max_bands`` every subsequence x_{j::n}
+  keeps its cyclic order (the rotation test, :func:`~gearchaos.analysis.bands.circle_order`),
+  or some shift brings every point back close to itself (uniform recurrence,
+  :func:`~gearchaos.analysis.bands.uniform_return`), or the 0–1 test is regular for every n;
 * otherwise the run is extended (the second window as long as the first, each later one twice
   as long, so θ and σ shrink), and when
   the budget is spent the point is ``unresolved`` with the reason.
@@ -29,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from ..analysis.bands import circle_order
+from ..analysis.bands import circle_order, uniform_return
 from ..analysis.chaos01 import MIN_LENGTH as MIN_LENGTH_01
 from ..analysis.chaos01 import chaos01
 from ..analysis.classify import K_CHAOS, K_REGULAR
@@ -41,6 +42,14 @@ __all__ = ["SectionTests", "Window", "decide_by_exponent", "section_tests"]
 K01_STRIDES = (1, 2, 3, 4)
 #: Fraction of rank shifts in one window for the rotation test to pass.
 MIN_ORDER = 0.9
+#: Largest uniform return (relative to the set's largest extent) of a torus: measured
+#: 0.004–0.033 on tori of ``sheng2016`` (Ω = 3.3325, 1.0408, 2.5732 over 1600 periods; up to
+#: 0.10 over 400), 0.18–0.69 on chaotic sets (``sheng2016`` Ω = 3.2338, 2.5, 2.45 and
+#: ``hindawi2021``'s two-band weak chaos at Ω = 2.5, over 400 or 1600 periods).
+MAX_RETURN = 0.1
+#: A uniform return this small (the recurrence tolerance of a period, relative to the set's
+#: size) is a repeating record, not a torus.
+MIN_RETURN = 1e-3
 #: Points of a subsequence the 0–1 test uses (its last ones): the test's cost grows with the
 #: square of the length, and a few hundred points decide it.
 K01_POINTS = 400
@@ -68,6 +77,7 @@ class SectionTests:
     def __init__(self, x: np.ndarray, max_bands: int) -> None:
         self.x = np.asarray(x, dtype=np.float64)
         self._k01: dict[int, tuple[float, ...]] = {}
+        self._returns: tuple[float, int] | None = None
         self.torus_stride = 0
         for n in range(1, max_bands + 1):
             orders = [circle_order(self.x[j::n]) for j in range(n)]
@@ -95,6 +105,33 @@ class SectionTests:
                 return n
         return 0
 
+    def returns(self) -> tuple[float, int]:
+        """The uniform return (r, q) of the window's sequence
+        (:func:`~gearchaos.analysis.bands.uniform_return`)."""
+        if self._returns is None:
+            self._returns = uniform_return(self.x)
+        return self._returns
+
+    def torus(self) -> str | None:
+        """Why the section is a torus, or None: its cyclic order on each of its closed
+        curves, a uniform return within :data:`MAX_RETURN` of the set's size, or a regular
+        0–1 test on every band — never for a record whose every point returns within
+        :data:`MIN_RETURN` (a periodic record, or one drifting along a family of orbits: the
+        period candidates decide it)."""
+        r, q = self.returns()
+        if r <= MIN_RETURN:  # every point back on itself: a (nearly) periodic record
+            return None
+        if self.torus_stride:
+            return f"the section keeps its cyclic order in {self.torus_stride} curve(s)"
+        if r <= MAX_RETURN:
+            return (
+                f"every section point returns within {r:.3f} of the set's size after {q} "
+                f"periods (uniform recurrence)"
+            )
+        if self.regular():
+            return "the 0–1 test is regular on every band"
+        return None
+
     def regular(self) -> bool:
         """K < K_REGULAR for every subsequence of every stride of :data:`K01_STRIDES` (all
         of them tested: bands visited in turn hide chaos from the shorter strides)."""
@@ -110,11 +147,13 @@ class SectionTests:
             vals = ", ".join(f"{k:.2f}" for k in ks)
             parts.append(f"K = {vals}" if n == 1 else f"every {_ordinal(n)} point: {vals}")
         k = "0–1 test " + "; ".join(parts) if parts else "no 0–1 test needed"
-        t = (
-            f"the section keeps its cyclic order in {self.torus_stride} curve(s)"
-            if self.torus_stride
-            else "no closed curve found"
-        )
+        if self.torus_stride:
+            t = f"the section keeps its cyclic order in {self.torus_stride} curve(s)"
+        elif self._returns is not None and math.isfinite(self._returns[0]):
+            r, q = self._returns
+            t = f"no closed curve found (best uniform return {r:.3f} after {q} periods)"
+        else:
+            t = "no closed curve found"
         return f"{k}; {t}"
 
 
@@ -204,16 +243,15 @@ def decide_by_exponent(p: Any, vs: Any, last: bool) -> Verdict | None:
             )
     elif 0 <= hi <= w.theta and p.unstable is None and not p.approaching:
         long_record = p.history.shape[0] >= 2 * vs.longest_period
-        torus = tests.torus_stride > 0 or tests.regular()
-        if torus and long_record and w.periods >= vs.confirm_periods:
+        torus = tests.torus() if long_record and w.periods >= vs.confirm_periods else None
+        if torus is not None:
             return Verdict(
                 label="QP",
                 period=0,
                 evidence="lyapunov",
                 reason=(
                     f"no period ≤ {vs.longest_period} and no converging orbit; {text}: the "
-                    f"interval lies within the bound of a regular attractor; "
-                    f"{tests.text()}{coexist}"
+                    f"interval lies within the bound of a regular attractor; {torus}{coexist}"
                 ),
                 **common,
             )
