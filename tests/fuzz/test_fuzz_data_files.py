@@ -580,6 +580,7 @@ def open_orbit_attrs(path: Path) -> dict[str, Any]:
         ("missing --from", ["orbit", "--from", "/x\x1b[2J"], 2),
         ("bad --output", ["plot", "STORE", "-o", "f\x1b[2J.jpg\x07"], 2),
         ("missing store", ["plot", "/nowhere/\x1b]0;owned\x07.zarr", "-o", "f.png"], 2),
+        ("a forged error line", ["orbit", "--from", "/x\nerror: \x1b[2J"], 2),
     ],
 )
 def test_escaped_paths_the_command_line_echoes(
@@ -603,6 +604,8 @@ def test_escaped_paths_the_command_line_echoes(
     assert "Traceback" not in result.output
     assert not _acting(result.stdout) and not _acting(result.stderr), (case, result.output)
     assert "\\x1b" in result.output  # the path is named, its escape shown
+    errors = [line for line in result.output.splitlines() if line.startswith("error:")]
+    assert len(errors) == (code != 0)  # a refusal is one line, a path cannot forge another
 
 
 def test_read_a_store_of_an_older_version_without_the_mark_is_still_read(

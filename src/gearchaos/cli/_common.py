@@ -141,15 +141,16 @@ def stderr() -> Console:
 
 
 def fail(message: str, code: int) -> NoReturn:
-    """``error: MESSAGE`` on stderr (control characters of paths and names in it shown as
-    escapes, :func:`~gearchaos._text.escape_text`), then exit with ``code``."""
-    text = escape_text(message, keep="\n")
+    """``error: MESSAGE`` on stderr, one line (control characters of paths and names in it,
+    a newline included, shown as escapes: :func:`~gearchaos._text.escape_text`), then exit
+    with ``code``."""
+    text = escape_text(message)
     stderr().print(Text("error: ", style="bold red") + Text(text), soft_wrap=True)
     raise typer.Exit(code)
 
 
 def warn(message: str) -> None:
-    text = escape_text(message, keep="\n")
+    text = escape_text(message)
     stderr().print(Text("warning: ", style="bold yellow") + Text(text), soft_wrap=True)
 
 
