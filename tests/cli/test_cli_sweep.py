@@ -282,3 +282,33 @@ def test_reproduce_calls_the_recipe_and_prints_json(
     result = runner.invoke(app, ["reproduce", "fig4", "-o", str(tmp_path)])
     assert result.exit_code == 130
     assert INTERRUPTED_MESSAGE in result.stderr
+
+
+def test_a_dask_local_sweep_says_nothing_but_its_result(tmp_path: Path) -> None:
+    """Issue 35: a --dask-local sweep ended with Dask's log lines ("Worker process still alive
+    after 4.0 seconds, killing", heartbeat tracebacks) and, when port 8787 was taken, with
+    "Port 8787 is already in use" (the scheduler's HTTP server on every interface)."""
+    import socket
+    import subprocess
+    import sys
+
+    pytest.importorskip("dask.distributed")
+    held = socket.socket()
+    try:
+        held.bind(("0.0.0.0", 8787))  # taken, as by another cluster or notebook
+        held.listen()
+    except OSError:
+        pass  # taken already
+    try:
+        proc = subprocess.run(
+            [sys.executable, "-m", "gearchaos", "bifurcation", "--vary", "omega=1,1.5", *SHORT,
+             "--dask-local", "2", "-q", "-o", str(tmp_path / "d.zarr")],
+            capture_output=True, text=True, timeout=600,
+        )  # fmt: skip
+    finally:
+        held.close()
+    assert proc.returncode == 0, proc.stderr
+    notice = ("compiling numerical kernels", "analysis:", "load them from the cache")
+    said = [ln for ln in proc.stderr.splitlines() if ln.strip()]
+    assert not [ln for ln in said if not ln.startswith(notice)], proc.stderr
+    assert gc.open_sweep(tmp_path / "d.zarr").attrs["complete"] is True

@@ -87,6 +87,81 @@ class InProcess:
         return fut
 
 
+@contextlib.contextmanager
+def _signals_deferred() -> Iterator[None]:
+    """Hold Ctrl-C and SIGTERM until the block ends, then raise ``KeyboardInterrupt`` if one
+    came: a Dask cluster interrupted while it starts can be neither used nor closed (Dask
+    tries again at exit and fails with a traceback). A second signal is not held: whoever
+    insists is not kept waiting by a start that hangs."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    came: list[int] = []
+
+    def hold(signum: int, frame: Any) -> None:
+        came.append(signum)
+        if len(came) > 1:
+            raise KeyboardInterrupt(f"signal {signum}")
+
+    old = {s: signal.signal(s, hold) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for s, handler in old.items():
+            signal.signal(s, handler)
+    if came:
+        raise KeyboardInterrupt(f"signal {came[0]}")
+
+
+@contextlib.contextmanager
+def _local_cluster(n: int) -> Iterator[Any]:
+    """A client of a local Dask cluster of ``n`` single-threaded worker processes.
+
+    Ctrl-C or SIGTERM while the cluster starts takes effect once it has started (interrupted
+    there, Dask can neither use nor close it, and fails again at exit with a traceback). At
+    the end, interrupted or not, the workers are ended at once (:func:`_end_cluster`): their
+    results are read already, or nobody will read them."""
+    from dask.distributed import Client, LocalCluster
+
+    with _signals_deferred():
+        cluster = LocalCluster(
+            n_workers=n,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=None,
+            # no dashboard; the scheduler's own HTTP server on a free loopback port (by
+            # default it takes :8787 on every interface, and warns when that is taken)
+            scheduler_kwargs={"dashboard": False, "dashboard_address": "127.0.0.1:0"},
+        )
+        try:
+            client = Client(cluster)
+        except BaseException:
+            _end_cluster(None, cluster)
+            raise
+    try:
+        yield client
+    finally:
+        with _signals_deferred():
+            _end_cluster(client, cluster)
+
+
+def _end_cluster(client: Any, cluster: Any) -> None:
+    """End a local Dask cluster without waiting for its workers: each nanny is told not to
+    restart its worker, the worker process is killed, then the client and the cluster close.
+    A graceful close would wait for a worker still in a compiled block (Dask then logs
+    "Worker process still alive after 4.0 seconds, killing", the cancelled tasks, and — cut
+    short by a second signal — pending asyncio tasks at exit)."""
+    for nanny in list(cluster.workers.values()):
+        nanny.close_gracefully(reason="gearchaos sweep ended")
+        pid = nanny.pid
+        if pid:
+            with contextlib.suppress(OSError):
+                os.kill(pid, signal.SIGKILL)
+    if client is not None:
+        client.close()
+    cluster.close()
+
+
 #: The keyword names of :class:`Execution`.
 EXECUTION_OPTIONS = ("workers", "scheduler", "dask_local")
 
@@ -143,7 +218,7 @@ def executor(execution: Execution | None = None) -> Iterator[tuple[Any, Any, str
         return
     if ex_.scheduler is not None or ex_.dask_local is not None:
         try:
-            from dask.distributed import Client, LocalCluster
+            from dask.distributed import Client
         except ImportError as exc:  # pragma: no cover - dask is in [dev] and [dask]
             raise ParameterError(
                 "scheduler/dask_local need dask.distributed: pip install 'gearchaos[dask]'"
@@ -159,12 +234,7 @@ def executor(execution: Execution | None = None) -> Iterator[tuple[Any, Any, str
                 yield client.get_executor(), single, f"dask cluster {ex_.scheduler}"
             return
         n = int(ex_.dask_local)  # type: ignore[arg-type]
-        with (
-            LocalCluster(
-                n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None
-            ) as cluster,
-            Client(cluster) as client,
-        ):
+        with _local_cluster(n) as client:
             yield client.get_executor(), single, f"dask LocalCluster ({n})"
         return
     yield InProcess(), run_chains, "in-process (all cores)"
