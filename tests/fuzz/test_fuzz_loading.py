@@ -171,6 +171,7 @@ DAMAGE: list[tuple[str, str, Any, str]] = [
     ("orbit", "section_phase = 'abc'", {"section_phase": "abc"}, "section_phase"),
     ("orbit", "transient_periods = -1", {"transient_periods": -1.0}, "transient_periods"),
     ("orbit", "parameter:omega = [1, 2]", {"parameter:omega": np.array([1.0, 2.0])}, "omega"),
+    ("orbit", "parameter:gamma = 'abc'", {"parameter:gamma": "abc"}, "gamma"),
     ("orbit", "short state", lambda ds: ds.isel(state=slice(0, 1)), "orbit_state"),
     ("orbit", "state NaN", _nan_state, "orbit_state"),
     ("branch", "no fixed", {"fixed": None}, "fixed"),

@@ -257,16 +257,23 @@ def _fixed(attrs: Any, path: str) -> dict[str, Any]:
     return values
 
 
-def _state(values: Any, path: str, target: Any, omega: float, what: str) -> np.ndarray:
-    """The state ``values`` (the file's ``what``) as a vector of the model's states: its
-    length and finiteness are the file's, checked before any shooting starts from it."""
+def _state(values: Any, path: str, target: Any, params: dict[str, Any], what: str) -> np.ndarray:
+    """The state ``values`` (the file's ``what``) as a vector of the states of the model at the
+    recorded parameter values ``params``: the values, the state's length and its finiteness
+    are the file's, checked before any shooting starts from it."""
     from ..model.target import resolve
 
     try:
         state = np.asarray(values, dtype=np.float64)
     except (TypeError, ValueError):
         raise _damaged(path, what, "a vector of numbers", values) from None
-    n = resolve(target, {OMEGA: omega}).n_state
+    try:
+        n = resolve(target, params).n_state
+    except ParameterError as exc:
+        raise StoreError(
+            f"--from {escape_path(path)}: its recorded parameter values do not fit its model "
+            f"({escape_text(exc)}); the file is damaged"
+        ) from None
     if state.shape != (n,):
         raise StoreError(
             f"--from {escape_path(path)}: its {what} has shape {state.shape}, but the model it "
@@ -409,11 +416,10 @@ def _from_branch(path: str, ds: Any, where: dict[str, str]) -> Start:
     k = int(np.argmin(np.abs(lam - value)))
     values = _fixed(ds.attrs, path)
     values[name] = value
-    omega = float(values.get(OMEGA, 1.0))
     return Start(
         gearset=target,
         values=values,
-        state=_state(ds["orbit_state"].values[k], path, target, omega, f"orbit_state[{k}]"),
+        state=_state(ds["orbit_state"].values[k], path, target, values, f"orbit_state[{k}]"),
         period=_int_attr(ds.attrs, "period", path, 1, MAX_PERIOD),
         source=f"{escape_path(os.path.basename(path))} at {escape_text(name)}={value:g} "
         f"(branch point {k})",
@@ -431,7 +437,7 @@ def _from_orbit(path: str, ds: Any, where: dict[str, str]) -> Start:
     return Start(
         gearset=target,
         values=values,
-        state=_state(ds["orbit_state"].values, path, target, values[OMEGA], "orbit_state"),
+        state=_state(ds["orbit_state"].values, path, target, values, "orbit_state"),
         period=period,
         source=f"{escape_path(os.path.basename(path))} (period-{period} orbit "
         f"at Ω = {values[OMEGA]:g})",
