@@ -15,9 +15,10 @@ Every field of both tables is written by the :mod:`csv` module (quoted where it 
 comma or a quote): a name or a label can never start a row of its own, and text from the
 result has passed :func:`~gearchaos._text.escape_text` before it gets here.
 
-**Ownership.** The sidecar records the SHA-256 digest of each table it describes and a digest
-of its own content (:data:`MARK`). A file at an export's path is replaced only when it is
-gearchaos's: a sidecar whose own digest holds, and a table whose digest the sidecar beside it
+**Ownership.** The sidecar carries gearchaos's mark (:mod:`gearchaos._marks`:
+``gearchaos_output:sha256:…``, the digest of the sidecar itself) and records the SHA-256 digest
+of each table it describes (:data:`MARK`). A file at an export's path is replaced only when it
+is gearchaos's: a sidecar whose mark holds, and a table whose digest the sidecar beside it
 records. A file that merely mentions gearchaos, or a table edited since (saved from a
 spreadsheet), is the user's and is refused. The sidecar is written first and also records the
 digests of the tables it is about to replace, so an export interrupted between its files
@@ -37,18 +38,16 @@ from typing import Any
 
 import numpy as np
 
-from .._files import open_regular_nofollow
+from .._files import open_regular_nofollow, read_nofollow
+from .._marks import MARK_KEY, MAX_MARKED_BYTES, file_is_marked, fill_mark, placeholder
 from .._output import check_replaceable, write_file
 from .._version import __version__
 from .export_table import Column, ExportTables
 
 __all__ = ["MARK", "sections_path", "sidecar_path", "write_csv_export"]
 
-#: The key of the sidecar's mark: the digests of the tables and of the sidecar itself.
+#: The key of the sidecar's record of the export: the kind and the digests of its tables.
 MARK = "gearchaos_export"
-
-#: The largest sidecar read back when an export is replaced (it holds a gear set and a spec).
-_SIDECAR_MAX = 64 * 1024 * 1024
 
 #: Attributes grouped in the sidecar (the rest go under ``attributes``).
 _SETTINGS = ("rtol", "atol", "perturbation")
@@ -127,37 +126,6 @@ def _sha256(data: bytes) -> str:
     return hashlib.sha256(data).hexdigest()
 
 
-def _self_digest(record: dict[str, Any]) -> str:
-    """The digest of a sidecar's content without its own digest."""
-    body = dict(record)
-    mark = dict(body.get(MARK, {}))
-    mark.pop("digest", None)
-    body[MARK] = mark
-    return _sha256(json.dumps(body, sort_keys=True, ensure_ascii=True).encode("ascii"))
-
-
-def _read_limited(path: str, limit: int) -> bytes | None:
-    """At most ``limit`` bytes of the regular file ``path`` itself (never a link or a FIFO);
-    ``None`` when it is none or larger."""
-    try:
-        fd = open_regular_nofollow(path)
-    except OSError:
-        return None
-    try:
-        chunks, total = [], 0
-        while total <= limit:
-            block = os.read(fd, min(1 << 20, limit + 1 - total))
-            if not block:
-                break
-            chunks.append(block)
-            total += len(block)
-        return None if total > limit else b"".join(chunks)
-    except OSError:
-        return None
-    finally:
-        os.close(fd)
-
-
 def file_digest(path: str) -> str | None:
     """The SHA-256 digest of the regular file ``path`` (``None``: none there, a link, a FIFO)."""
     try:
@@ -176,17 +144,16 @@ def file_digest(path: str) -> str | None:
 
 
 def read_sidecar(path: str) -> dict[str, Any] | None:
-    """The sidecar at ``path`` if gearchaos wrote it (its own digest holds), else ``None``."""
-    data = _read_limited(path, _SIDECAR_MAX)
-    if data is None:
+    """The sidecar at ``path`` if gearchaos wrote it and nobody edited it since (it carries
+    :data:`~gearchaos._marks.MARK_KEY` with the digest of what it holds,
+    :func:`~gearchaos._marks.file_is_marked`), else ``None``."""
+    if not file_is_marked(path):
         return None
     try:
-        record = json.loads(data.decode("utf-8"))
-    except (UnicodeDecodeError, ValueError):
+        record = json.loads(read_nofollow(path, MAX_MARKED_BYTES).decode("utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError):
         return None
     if not isinstance(record, dict) or not isinstance(record.get(MARK), dict):
-        return None
-    if record[MARK].get("digest") != _self_digest(record):
         return None
     return record
 
@@ -287,6 +254,7 @@ def write_csv_export(
     previous = sorted(d for p in (path, sections) if (d := file_digest(p)) is not None and d in own)
     data = {p: render(cols) for p, cols in tables_out}
     record: dict[str, Any] = {
+        MARK_KEY: placeholder(),  # filled in with the digest of the sidecar (fill_mark)
         MARK: {
             "version": __version__,
             "kind": tables.kind,
@@ -303,9 +271,8 @@ def write_csv_export(
             ),
         },
     }
-    record[MARK]["digest"] = _self_digest(record)
     text = json.dumps(record, indent=2, ensure_ascii=True) + "\n"
-    write_file(side, text.encode("ascii"), what="export")
+    write_file(side, fill_mark(text.encode("ascii")), what="export")
     for p, b in data.items():
         write_file(p, b, what="export")
     if not tables.sections and file_digest(sections) in own:  # a stale table of ours

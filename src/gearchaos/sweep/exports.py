@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from .._files import check_output_file, check_path, load_netcdf, read_text_file
+from .._files import check_output_file, check_path, load_netcdf
 from .._marks import mark_file, placeholder
 from .._output import check_replaceable, file_has_mark, staged_file
 from .._text import escape_path
@@ -103,12 +103,11 @@ _ORBIT_HINT = (
 def _store_kind(path: str) -> str | None:
     """The ``kind`` attribute of a Zarr directory's root (``None`` when unreadable or absent;
     the store's own reader then reports what is wrong)."""
+    from .integrity import read_json
+
     try:
-        text = read_text_file(
-            os.path.join(path, ".zattrs"), what="store attributes", max_bytes=1 << 26
-        )
-        attrs = json.loads(text)
-    except (StoreError, ParameterError, ValueError):
+        attrs = read_json(os.path.join(path, ".zattrs"))
+    except (OSError, ValueError):
         return None
     if not isinstance(attrs, dict):
         return None
