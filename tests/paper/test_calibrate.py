@@ -179,7 +179,7 @@ def test_the_grid_has_a_point_inside_every_landmark_interval(cfg: SweepSettings)
 
     plan = sweep_plan(load_landmarks(), cfg)
     typed = _typed_intervals()
-    assert len(typed) == 49
+    assert len(typed) == 50
     for lid, key, lo, hi, _ in typed:
         grid = np.asarray(plan[key].grid)
         inside = grid[(grid > lo) & (grid < hi)]

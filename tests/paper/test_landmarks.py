@@ -104,6 +104,29 @@ def test_validation_names_the_landmark_and_the_rule(tmp_path):
         load_landmarks(bad)
 
 
+@pytest.mark.parametrize(
+    ("kind", "extra", "message"),
+    [
+        ("window", 'expected = ["chaos"]\ncontrast = "below"', "contrast is only for label"),
+        ("label", 'expected = ["chaos"]\ncontrast = "left"', "contrast must be one of below"),
+        ("label", 'expected = ["1T"]\nmax_change = 0.1', "max_change is only for negligible"),
+        ("negligible", 'expected = ["1T"]', "expected is not for a negligible landmark"),
+        ("negligible", "max_change = 2.0", r"max_change must be in \(0, 1\]"),
+        ("label", "", "expected is required"),
+    ],
+)
+def test_the_new_keys_are_checked_for_their_kind(tmp_path, kind, extra, message):
+    bad = tmp_path / "bad.toml"
+    bad.write_text(
+        f'[[landmark]]\nid = "x"\nfigure = "fig12"\npanel = {{ omega = 1.5 }}\nquote = "q"\n'
+        f'axis = "clearance.sun_bearing"\nkind = "{kind}"\nlo = 1.0\nhi = 10.0\n{extra}\n'
+        'fixed = { omega = 1.5, xi = 0.05, "backlash.sun_planet" = 3.0, '
+        '"backlash.planet_ring" = 3.5 }\n'
+    )
+    with pytest.raises(ParameterError, match=rf"landmark #1 \(x\): {message}"):
+        load_landmarks(bad)
+
+
 def test_all_1T_sweep_holds_the_1T_landmark(marks):
     omega = np.linspace(0.01, 4.0, 400)
     res = evaluate(marks["fig4a-1T-low"], _sweep(omega, ["1T"] * omega.size))
@@ -117,12 +140,47 @@ def test_all_1T_sweep_holds_the_1T_landmark(marks):
 
 
 def test_label_fraction_decides_partly(marks):
-    omega = np.linspace(0.0, 1.35, 11)
-    labels = ["1T"] * 6 + ["QP"] * 5  # 6/11 = 55 %: partly (>= 0.4, < 0.8)
-    res = evaluate(marks["fig4a-1T-low"], _sweep(omega, labels))
+    mark = marks["fig5-QP-3T-switching"]  # QP/3T over 1.35–1.69, the default 0.8
+    omega = np.linspace(1.35, 1.69, 11)
+    labels = ["QP"] * 6 + ["1T"] * 5  # 6/11 = 55 %: partly (>= 0.4, < 0.8)
+    res = evaluate(mark, _sweep(omega, labels))
     assert res.verdict == "partly"
     assert res.score == pytest.approx((6 / 11) / 0.8)
     assert "55% of 11 points" in res.evidence
+
+
+def test_fig4a_dominant_is_the_files_own_rule_for_dominant(marks):
+    # the seed: "1T-periodic motion is in a dominant position within 0 ≤ Ω ≤ 1.35"; the file
+    # reads "dominant" as at least half of the points (fig6a, fig9a), so 6 of 11 points hold
+    omega = np.linspace(0.0, 1.35, 11)
+    mark = marks["fig4a-1T-low"]
+    assert mark.min_fraction == 0.5
+    assert marks["fig6a-chaos-dominant"].min_fraction == mark.min_fraction
+    res = evaluate(mark, _sweep(omega, ["1T"] * 6 + ["QP"] * 5))
+    assert res.verdict == "holds" and res.score == 1.0
+    less = evaluate(mark, _sweep(omega, ["1T"] * 5 + ["QP"] * 6))  # 5/11 = 45 %
+    assert less.verdict == "partly"
+    assert less.score == pytest.approx((5 / 11) / 0.5)
+
+
+def test_becoming_dominant_needs_a_trend(marks):
+    mark = marks["fig9a-chaos-dominant"]  # "chaos becomes dominant when b̄_rp is larger than 8"
+    assert mark.contrast == "below"
+    b = np.linspace(1.0, 16.0, 31)  # step 0.5: 14 points below 8, 17 from 8 on
+    ds = xr.Dataset(
+        {"motion": (("xi", "backlash.planet_ring"), np.empty((1, b.size), dtype="<U10"))},
+        coords={"xi": [0.03], "backlash.planet_ring": b},
+    )
+    ds["motion"][0] = np.where(b >= 8.0, "chaos", "1T")
+    trend = evaluate(mark, ds)
+    assert trend.verdict == "holds" and trend.measured["trend"]
+    assert trend.measured["fraction_outside"] == 0.0
+    # chaotic on both sides, as issue 34 found (73 % below and above 8): dominant, no trend
+    ds["motion"][0] = np.where(np.arange(b.size) % 4 == 0, "1T", "chaos")
+    flat = evaluate(mark, ds)
+    assert flat.measured["fraction"] >= 0.5 and flat.measured["fraction_outside"] >= 0.5
+    assert flat.verdict == "partly" and flat.score == 0.5
+    assert "no trend" in flat.evidence
 
 
 def test_transition_scored_by_distance(marks):
@@ -199,6 +257,39 @@ def test_evaluate_all_routes_galleries_to_their_sweep_and_sums(marks):
     assert [r.verdict for r in results] == ["holds", "holds", "not evaluated"]
     assert "no sweep of fig6" in results[2].evidence
     assert score(results) == pytest.approx(2.0)
+
+
+def _bs_sweep(sections: np.ndarray) -> xr.Dataset:
+    b = np.linspace(1.0, 10.0, sections.shape[0])
+    return xr.Dataset(
+        {
+            "motion": (("omega", "clearance.sun_bearing"), np.full((1, b.size), "1T", "<U10")),
+            "delta_sp": (
+                ("omega", "clearance.sun_bearing", "section", "planet"),
+                sections[None, ..., None],
+            ),
+        },
+        coords={"omega": [1.5], "clearance.sun_bearing": b, "planet": [1]},
+    )
+
+
+def test_affected_negligibly_reads_the_section_values(marks):
+    mark = marks["fig12-negligible"]
+    assert mark.kind == "negligible" and mark.expected == () and mark.max_change == 0.05
+    assert "affected negligibly" in mark.quote and "affected" not in marks["fig12-periodic"].quote
+    n, k = 10, 8
+    cloud = 3.0 + 0.2 * np.sin(np.arange(k))  # the same attractor at every point
+    same = evaluate(mark, _bs_sweep(np.tile(cloud, (n, 1))))
+    assert same.verdict == "holds" and same.measured["relative_change"] == 0.0
+    # the attractor's centre moves by 0.3 along b̄_s: 0.3 / 3.5 = 8.6 % of the largest |X̄_sp1|
+    moved = np.tile(cloud, (n, 1)) + np.linspace(0.0, 0.3, n)[:, None]
+    res = evaluate(mark, _bs_sweep(moved))
+    assert res.measured["centre_change"] == pytest.approx(0.3)
+    assert res.measured["relative_change"] == pytest.approx(0.3 / (3.2 + 0.3), rel=0.01)
+    assert res.verdict == "partly"
+    # its size grows from 0.4 to 2.4: not negligible
+    grown = 3.0 + np.linspace(1.0, 6.0, n)[:, None] * 0.2 * np.sin(np.arange(k))[None, :]
+    assert evaluate(mark, _bs_sweep(grown)).verdict == "does not hold"
 
 
 def test_nT_wildcard_accepts_multi_periodic_only(marks):

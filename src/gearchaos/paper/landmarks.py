@@ -20,44 +20,73 @@ about Figs. 4–12: the swept axis, the panel and fixed parameters, and one of t
     with ``f`` the fraction of points inside carrying an expected label and ``s_lo``, ``s_hi``
     the distance scores (as for transitions) of the window's measured edges (the nearest entry
     into / exit from the expected labels). *holds* ≥ 0.8, *partly* ≥ 0.4.
+``negligible``
+    the swept parameter affects the motion negligibly over ``[lo, hi]``: per point the centre
+    (mean) and the size (max − min) of its X̄_sp1 section values; ``c`` the larger of their
+    ranges along the axis over the points inside (``failed`` left out), relative to the largest
+    |X̄_sp1| there. Score 1 (*holds*) for ``c ≤ max_change`` (0.05 unless the landmark says
+    otherwise), then as a transition's distance score with ``max_change`` for the tolerance.
+
+A label landmark with ``contrast = "below"`` (or ``"above"``) says its labels *become*
+dominant at the range: the fraction ``f_out`` of expected labels over the rest of the sweep on
+that side must stay below ``min_fraction``; when they are dominant there too the verdict is at
+most *partly* (score ≤ 0.5: dominant, but no trend).
 
 The label ``nT`` in a landmark stands for any n-periodic label with n ≥ 2.
+
+A hold is only as good as the swept parameter's effect: :mod:`gearchaos.paper.action` tests,
+per panel, whether the parameter acts at all, and :func:`gearchaos.paper.action.apply_actions`
+turns a hold on a panel where it does not into ``holds (constant)``, counted apart.
 
 >>> from gearchaos.paper.landmarks import load_landmarks, evaluate_all, score
 >>> marks = load_landmarks()
 >>> results = evaluate_all(marks, {"fig4": ds4})   # doctest: +SKIP
 >>> score(results)                                  # doctest: +SKIP
 
-Limits: a landmark is checked on the motion labels of one planet-independent sweep store; the
-seed's own reading of its figures was by eye, so the verdicts measure agreement with the
-labels, not with the seed's pictures. Amplitude statements are not landmarks.
+Limits: a landmark is checked on the motion labels (a negligible one on the section values) of
+one planet-independent sweep store; the seed's own reading of its figures was by eye, so the
+verdicts measure agreement with the labels, not with the seed's pictures. Amplitude statements
+are not landmarks, except "affected negligibly" (Fig. 12).
 """
 
 from __future__ import annotations
 
 import math
 import re
-import tomllib
 from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
-from importlib import resources
-from pathlib import Path
-from types import MappingProxyType
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 
-from .._files import read_text_file
-from ..errors import ParameterError
-from ..gearset.mapping import flatten
 from ..sweep.result import SweepResult
+from .landmark_data import (
+    AXES,
+    CONTRASTS,
+    EVENTS,
+    KINDS,
+    MAX_LANDMARKS_BYTES,
+    VERDICTS,
+    AxisAction,
+    Landmark,
+    LandmarkResult,
+    Verdict,
+    _close,
+    load_landmarks,
+    recipe_for,
+)
 
 __all__ = [
     "AXES",
+    "CONTRASTS",
+    "EVENTS",
     "KINDS",
+    "MAX_LANDMARKS_BYTES",
+    "VERDICTS",
+    "AxisAction",
     "Landmark",
     "LandmarkResult",
+    "Verdict",
     "evaluate",
     "evaluate_all",
     "load_landmarks",
@@ -65,298 +94,12 @@ __all__ = [
     "score",
 ]
 
-#: Swept axes a landmark may name.
-AXES = ("omega", "xi", "backlash.sun_planet", "backlash.planet_ring", "clearance.sun_bearing")
-#: Landmark kinds.
-KINDS = ("label", "transition", "window")
-#: Gallery → the bifurcation recipe whose sweep covers its statements.
-_GALLERY_RECIPE = {"fig5": "fig4", "fig7": "fig6", "fig10": "fig9"}
 #: Labels that say nothing about the motion: skipped when locating changes.
 _NO_LABEL = ("failed", "unresolved")
-_LABEL_RE = re.compile(r"^(?:[1-9][0-9]*T|nT|QP|chaos)$")
 _PERIOD_RE = re.compile(r"^([1-9][0-9]*)T$")
-_REL = 1e-9
-
-Verdict = Literal["holds", "partly", "does not hold", "not evaluated"]
-
-
-def _freeze(d: Mapping[str, float]) -> Mapping[str, float]:
-    return MappingProxyType(dict(d))
-
-
-@dataclass(frozen=True)
-class Landmark:
-    """One quantitative statement of the seed's Section 3.
-
-    Attributes
-    ----------
-    id, figure, quote, note
-        Name, seed figure (``fig4`` … ``fig12``), the seed's words, readings/contradictions.
-    panel
-        Family value(s) of the covering sweep, e.g. ``{"xi": 0.03}`` (also in ``fixed``).
-    axis
-        Swept parameter (dotted name).
-    kind
-        ``label``, ``transition`` or ``window``.
-    lo, hi, at
-        Range or value in axis units (``at`` xor ``lo``/``hi``; a window needs ``lo``/``hi``).
-    expected
-        Accepted labels (after the change for a transition); ``nT`` = any n ≥ 2 period.
-    from_labels
-        Accepted labels before the change (transitions; TOML key ``from``).
-    fixed
-        Every other parameter by dotted name.
-    tolerance
-        In axis units.
-    min_fraction
-        Fraction of points with an expected label needed for *holds* (label, window).
-    event
-        The bifurcation the statement names (``period_doubling``, ``neimark_sacker`` — the
-        seed's "Hopf" — or ``period_3``, a 3T channel), or "".
-    """
-
-    id: str
-    figure: str
-    panel: Mapping[str, float] = field(hash=False)
-    quote: str
-    axis: str
-    kind: str
-    expected: tuple[str, ...]
-    fixed: Mapping[str, float] = field(hash=False)
-    tolerance: float
-    lo: float | None = None
-    hi: float | None = None
-    at: float | None = None
-    from_labels: tuple[str, ...] = ()
-    min_fraction: float = 0.8
-    note: str = ""
-    event: str = ""
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "panel", _freeze(self.panel))
-        object.__setattr__(self, "fixed", _freeze(self.fixed))
-
-    @property
-    def span(self) -> tuple[float, float]:
-        """``(lo, hi)``, or ``(at, at)``."""
-        if self.at is not None:
-            return (self.at, self.at)
-        assert self.lo is not None and self.hi is not None
-        return (self.lo, self.hi)
-
-    def where(self) -> str:
-        """``"omega = 1.926"`` or ``"omega ∈ [2.45, 3.03]"``."""
-        if self.at is not None:
-            return f"{self.axis} = {self.at:g}"
-        return f"{self.axis} ∈ [{self.lo:g}, {self.hi:g}]"
-
-
-@dataclass(frozen=True)
-class LandmarkResult:
-    """Verdict of one landmark on one sweep: ``score`` in [0, 1], ``evidence`` in words with
-    the numbers, ``measured`` the numbers themselves."""
-
-    landmark: Landmark
-    verdict: Verdict
-    score: float
-    evidence: str
-    measured: Mapping[str, Any] = field(default_factory=dict, hash=False)
-
-
-# ------------------------------------------------------------------------------ loading
-def _number(where: str, key: str, v: Any) -> float:
-    if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
-        raise ParameterError(f"{where}: {key} must be a finite number: got {v!r}")
-    return float(v)
-
-
-def _labels(where: str, key: str, v: Any) -> tuple[str, ...]:
-    if not isinstance(v, list) or not v or not all(isinstance(x, str) for x in v):
-        raise ParameterError(f"{where}: {key} must be a non-empty list of labels: got {v!r}")
-    bad = [x for x in v if not _LABEL_RE.match(x)]
-    if bad:
-        raise ParameterError(
-            f"{where}: {key} labels must be 1T, 2T, …, nT, QP or chaos: got {', '.join(bad)}"
-        )
-    return tuple(v)
-
-
-def _params(where: str, key: str, v: Any) -> dict[str, float]:
-    if not isinstance(v, Mapping):
-        raise ParameterError(f"{where}: {key} must be a table of parameters: got {v!r}")
-    flat = flatten(v)
-    for name in flat:
-        if name not in AXES:
-            raise ParameterError(f"{where}: {key}.{name} is not one of {', '.join(AXES)}")
-    return {k: _number(where, f"{key}.{k}", x) for k, x in flat.items()}
-
-
-_KEYS = {
-    "id", "figure", "panel", "quote", "axis", "kind", "lo", "hi", "at", "expected", "from",
-    "fixed", "tolerance", "min_fraction", "note", "event",
-}  # fmt: skip
-#: Bifurcations a landmark may name (``event``): checked on continued branches when the
-#: report has them (:func:`gearchaos.paper.routes.landmarks_from_events`).
-EVENTS = ("period_doubling", "neimark_sacker", "period_3")
-
-
-def _landmark(i: int, d: Mapping[str, Any]) -> Landmark:
-    where = f"landmark #{i + 1}" + (f" ({d['id']})" if isinstance(d.get("id"), str) else "")
-    unknown = sorted(set(d) - _KEYS)
-    if unknown:
-        raise ParameterError(f"{where}: unknown keys {', '.join(unknown)}")
-    for key in ("id", "figure", "panel", "quote", "axis", "kind", "expected", "fixed"):
-        if key not in d:
-            raise ParameterError(f"{where}: {key} is required")
-    for key in ("id", "figure", "quote", "axis", "kind"):
-        if not isinstance(d[key], str) or not d[key]:
-            raise ParameterError(f"{where}: {key} must be a non-empty string: got {d[key]!r}")
-    if not re.match(r"^fig[0-9]+$", d["figure"]):
-        raise ParameterError(f"{where}: figure must look like 'fig4': got {d['figure']!r}")
-    if d["axis"] not in AXES:
-        raise ParameterError(f"{where}: axis must be one of {', '.join(AXES)}: got {d['axis']!r}")
-    if d["kind"] not in KINDS:
-        raise ParameterError(f"{where}: kind must be one of {', '.join(KINDS)}: got {d['kind']!r}")
-    panel = _params(where, "panel", d["panel"])
-    fixed = _params(where, "fixed", d["fixed"])
-    if d["axis"] in fixed:
-        raise ParameterError(f"{where}: the swept axis {d['axis']} must not be in fixed")
-    for k, v in panel.items():
-        if k not in fixed or not math.isclose(fixed[k], v, rel_tol=_REL, abs_tol=0.0):
-            raise ParameterError(f"{where}: panel {k} = {v:g} must equal fixed.{k}")
-    lo = _number(where, "lo", d["lo"]) if "lo" in d else None
-    hi = _number(where, "hi", d["hi"]) if "hi" in d else None
-    at = _number(where, "at", d["at"]) if "at" in d else None
-    if at is not None and (lo is not None or hi is not None):
-        raise ParameterError(f"{where}: give either at or lo/hi, not both")
-    if at is None and (lo is None or hi is None):
-        raise ParameterError(f"{where}: give at, or both lo and hi")
-    if lo is not None and hi is not None and not lo < hi:
-        raise ParameterError(f"{where}: lo must be below hi: got {lo:g}, {hi:g}")
-    if d["kind"] == "window" and at is not None:
-        raise ParameterError(f"{where}: a window needs lo and hi, not at")
-    expected = _labels(where, "expected", d["expected"])
-    if d["kind"] == "transition":
-        if "from" not in d:
-            raise ParameterError(f"{where}: a transition needs from")
-        from_labels = _labels(where, "from", d["from"])
-    elif "from" in d:
-        raise ParameterError(f"{where}: from is only for transitions")
-    else:
-        from_labels = ()
-    min_fraction = _number(where, "min_fraction", d.get("min_fraction", 0.8))
-    if not 0.0 < min_fraction <= 1.0:
-        raise ParameterError(f"{where}: min_fraction must be in (0, 1]: got {min_fraction:g}")
-    note = d.get("note", "")
-    if not isinstance(note, str):
-        raise ParameterError(f"{where}: note must be a string: got {note!r}")
-    event = d.get("event", "")
-    if event not in ("", *EVENTS):
-        raise ParameterError(f"{where}: event must be one of {', '.join(EVENTS)}: got {event!r}")
-    mark = Landmark(
-        id=d["id"],
-        figure=d["figure"],
-        panel=panel,
-        quote=d["quote"],
-        axis=d["axis"],
-        kind=d["kind"],
-        expected=expected,
-        fixed=fixed,
-        tolerance=1.0,
-        lo=lo,
-        hi=hi,
-        at=at,
-        from_labels=from_labels,
-        min_fraction=min_fraction,
-        note=note,
-        event=event,
-    )
-    if "tolerance" in d:
-        tol = _number(where, "tolerance", d["tolerance"])
-    else:
-        from .recipes import RECIPES
-
-        vary = RECIPES[recipe_for(mark)].vary
-        tol = 0.02 * (vary.stop - vary.start)
-    if not tol > 0.0:
-        raise ParameterError(f"{where}: tolerance must be > 0: got {tol:g}")
-    object.__setattr__(mark, "tolerance", tol)
-    return mark
-
-
-#: Largest landmarks file read (the packaged one has about 30 kB).
-MAX_LANDMARKS_BYTES = 4 * 2**20
-
-
-def load_landmarks(path: str | Path | None = None) -> list[Landmark]:
-    """Read and validate the landmarks (default: the packaged ``landmarks.toml``).
-
-    Raises
-    ------
-    ParameterError
-        A landmark breaks a rule (the message names it, the key, the rule and the value), or
-        two landmarks share an id.
-    """
-    if path is None:
-        text = resources.files(__package__).joinpath("landmarks.toml").read_text("utf-8")
-        source = "landmarks.toml (packaged)"
-    else:
-        text = read_text_file(path, what="landmarks file", max_bytes=MAX_LANDMARKS_BYTES)
-        source = str(path)
-    try:
-        data = tomllib.loads(text)
-    except (tomllib.TOMLDecodeError, RecursionError, ValueError) as exc:
-        raise ParameterError(f"{source}: not valid TOML: {exc}") from None
-    rows = data.get("landmark")
-    if not isinstance(rows, list) or not rows:
-        raise ParameterError(f"{source}: needs at least one [[landmark]] table")
-    marks = [_landmark(i, d) for i, d in enumerate(rows)]
-    dup = [k for k, n in Counter(m.id for m in marks).items() if n > 1]
-    if dup:
-        raise ParameterError(f"{source}: landmark ids must be unique: repeated {', '.join(dup)}")
-    return marks
-
-
-def recipe_for(landmark: Landmark) -> str:
-    """Name of the :data:`~gearchaos.paper.recipes.RECIPES` entry whose sweep covers
-    ``landmark``: same swept axis, the panel among its family values, its fixed values equal
-    to the landmark's and the landmark's range inside the swept range (± tolerance).
-
-    Raises
-    ------
-    ParameterError
-        No recipe covers it.
-    """
-    from .recipes import RECIPES
-
-    preferred = _GALLERY_RECIPE.get(landmark.figure, landmark.figure)
-    names = sorted(RECIPES, key=lambda n: n != preferred)
-    lo, hi = landmark.span
-    for name in names:
-        r = RECIPES[name]
-        if r.vary.name != landmark.axis:
-            continue
-        fam = landmark.fixed.get(r.family.name)
-        if fam is None or not any(_close(fam, v) for v in r.family.values):
-            continue
-        if any(
-            k not in landmark.fixed or not _close(landmark.fixed[k], v) for k, v in r.fixed.items()
-        ):
-            continue
-        slack = 0.02 * (r.vary.stop - r.vary.start)
-        if lo < r.vary.start - slack or hi > r.vary.stop + slack:
-            continue
-        return name
-    raise ParameterError(
-        f"{landmark.id}: no recipe sweeps {landmark.where()} at {dict(landmark.fixed)}"
-    )
 
 
 # ---------------------------------------------------------------------------- evaluation
-def _close(a: float, b: float) -> bool:
-    return abs(a - b) <= _REL * max(abs(a), abs(b), 1e-300) or a == b
-
-
 def _matches(label: str, accepted: Sequence[str]) -> bool:
     if label in accepted:
         return True
@@ -378,8 +121,9 @@ def _not_evaluated(mark: Landmark, why: str) -> LandmarkResult:
     return LandmarkResult(mark, "not evaluated", 0.0, why, {})
 
 
-def _panel(mark: Landmark, ds: Any, planet: int) -> tuple[np.ndarray, np.ndarray] | str:
-    """(axis values, labels) of the landmark's panel, sorted by axis; or why not."""
+def _select(mark: Landmark, ds: Any, planet: int) -> dict[str, Any] | str:
+    """Positions (``planet`` by value) of the landmark's panel in every dimension of ``motion``
+    but the swept one; or why there is none."""
     if "motion" not in getattr(ds, "data_vars", {}):
         return "the dataset has no motion labels (classify the sweep store first)"
     motion = ds["motion"]
@@ -407,9 +151,34 @@ def _panel(mark: Landmark, ds: Any, planet: int) -> tuple[np.ndarray, np.ndarray
     for k, v in stored.items():
         if k in mark.fixed and k not in motion.dims and not _close(float(v), mark.fixed[k]):
             return f"the dataset fixes {k} = {float(v):g}, the landmark {mark.fixed[k]:g}"
-    named = {k: v for k, v in sel.items() if k == "planet"}
-    idx = {k: v for k, v in sel.items() if k != "planet"}
-    panel = motion.sel(named).isel(idx) if named else motion.isel(idx)
+    return sel
+
+
+def _take(var: Any, sel: Mapping[str, Any], planet: int) -> Any:
+    """``var`` at the panel ``sel`` (planet by value when ``var`` has planets)."""
+    idx = {k: v for k, v in sel.items() if k != "planet" and k in var.dims}
+    if "planet" in var.dims:
+        var = var.sel(planet=planet) if "planet" in var.coords else var.isel(planet=planet - 1)
+    return var.isel(idx) if idx else var
+
+
+def _panel(mark: Landmark, ds: Any, planet: int) -> tuple[np.ndarray, np.ndarray] | str:
+    """(axis values, labels) of the landmark's panel, sorted by axis; or why not."""
+    got = _panel_order(mark, ds, planet)
+    if isinstance(got, str):
+        return got
+    x, labels, _, _ = got
+    return x, labels
+
+
+def _panel_order(
+    mark: Landmark, ds: Any, planet: int
+) -> tuple[np.ndarray, np.ndarray, dict[str, Any], np.ndarray] | str:
+    """(sorted axis values, labels, the panel's positions, the sorting order); or why not."""
+    sel = _select(mark, ds, planet)
+    if isinstance(sel, str):
+        return sel
+    panel = _take(ds["motion"], sel, planet)
     x = np.asarray(ds[mark.axis].values, dtype=float)
     labels = np.asarray(panel.transpose(mark.axis).values).astype(str)
     order = np.argsort(x, kind="stable")
@@ -418,7 +187,7 @@ def _panel(mark: Landmark, ds: Any, planet: int) -> tuple[np.ndarray, np.ndarray
     lo, hi = mark.span
     if lo < x[0] - tol or hi > x[-1] + tol:
         return f"the dataset sweeps {mark.axis} over [{x[0]:g}, {x[-1]:g}], not {mark.where()}"
-    return x, labels
+    return x, labels, sel, order
 
 
 def _stored_fixed(ds: Any) -> dict[str, Any]:
@@ -473,7 +242,86 @@ def _label(mark: Landmark, x: np.ndarray, labels: np.ndarray) -> LandmarkResult:
     )
     exp = "/".join(mark.expected)
     evidence = f"{exp} at {frac:.0%} of {n} points {where} (found: {_counts(sub)})"
-    measured = {"fraction": frac, "points": n, "counts": dict(Counter(sub.tolist()))}
+    measured: dict[str, Any] = {
+        "fraction": frac,
+        "points": n,
+        "counts": dict(Counter(sub.tolist())),
+    }
+    if mark.contrast:
+        return _contrast(mark, x, labels, LandmarkResult(mark, verdict, sc, evidence, measured))
+    return LandmarkResult(mark, verdict, sc, evidence, measured)
+
+
+def _contrast(
+    mark: Landmark, x: np.ndarray, labels: np.ndarray, inside: LandmarkResult
+) -> LandmarkResult:
+    """A label landmark whose labels *become* dominant at its range (``contrast``): at most
+    *partly* (score ≤ 0.5) unless they are not dominant over the sweep on the other side."""
+    lo, hi = mark.span
+    if mark.contrast == "below":
+        out = x < lo - 1e-12 * max(1.0, abs(lo))
+        side = f"below {lo:g}"
+    else:
+        out = x > hi + 1e-12 * max(1.0, abs(hi))
+        side = f"above {hi:g}"
+    sub = labels[out]
+    n = int(sub.size)
+    frac = float(np.mean([_matches(s, mark.expected) for s in sub.tolist()])) if n else math.nan
+    trend = n > 0 and frac < mark.min_fraction
+    measured = {**inside.measured, "fraction_outside": frac, "points_outside": n, "trend": trend}
+    if n == 0:
+        tail = f"; no point {side} to show that they become dominant: no trend shown"
+    elif trend:
+        tail = f"; {side}: {frac:.0%} of {n} points (found: {_counts(sub)}): a trend"
+    else:
+        tail = (
+            f"; {side}: {frac:.0%} of {n} points (found: {_counts(sub)}): dominant on both "
+            "sides, no trend"
+        )
+    verdict, sc = inside.verdict, inside.score
+    if not trend and verdict == "holds":
+        verdict, sc = "partly", min(sc, 0.5)
+    elif not trend:
+        sc = min(sc, 0.5)
+    return LandmarkResult(mark, verdict, sc, inside.evidence + tail, measured)
+
+
+def _negligible(
+    mark: Landmark, x: np.ndarray, labels: np.ndarray, sections: np.ndarray | None
+) -> LandmarkResult:
+    """Per-point attractor (centre, size of the section values) unchanged along the axis."""
+    lo, hi = mark.span
+    if sections is None:
+        return _not_evaluated(mark, "the dataset has no delta_sp section values")
+    inside = (x >= lo - 1e-12 * max(1.0, abs(lo))) & (x <= hi + 1e-12 * max(1.0, abs(hi)))
+    inside &= labels != "failed"
+    sec = np.asarray(sections, dtype=float)[inside]
+    finite = np.isfinite(sec).any(axis=1)
+    sec = sec[finite]
+    n = int(sec.shape[0])
+    if n < 2:
+        return _not_evaluated(mark, f"fewer than 2 computed points in [{lo:g}, {hi:g}]")
+    with np.errstate(all="ignore"):
+        centre = np.nanmean(sec, axis=1)
+        size = np.nanmax(sec, axis=1) - np.nanmin(sec, axis=1)
+        scale = float(np.nanmax(np.abs(sec)))
+    d_centre, d_size = float(np.ptp(centre)), float(np.ptp(size))
+    change = max(d_centre, d_size) / scale if scale > 0 else 0.0
+    m = mark.max_change
+    sc = _dist_score(change, m)
+    verdict: Verdict = "holds" if change <= m else "partly" if change <= 3 * m else "does not hold"
+    evidence = (
+        f"over {n} points in [{lo:g}, {hi:g}] the centre of the X̄_sp1 section values moves by "
+        f"{d_centre:.3g} and their spread changes by {d_size:.3g}: {change:.2%} of the largest "
+        f"|X̄_sp1| {scale:.3g} (negligible up to {m:.0%})"
+    )
+    measured = {
+        "points": n,
+        "centre_change": d_centre,
+        "size_change": d_size,
+        "scale": scale,
+        "relative_change": change,
+    }
     return LandmarkResult(mark, verdict, sc, evidence, measured)
 
 
@@ -558,16 +406,24 @@ def evaluate(landmark: Landmark, ds: Any, *, planet: int = 1) -> LandmarkResult:
     must agree too. When the dataset does not cover the landmark (no ``motion``, another axis,
     a missing panel, a range outside the sweep, no grid point in the range) the verdict is
     ``not evaluated`` with the reason as evidence. ``planet`` selects the planet when the
-    labels carry a ``planet`` dimension.
+    labels (or, for a negligible landmark, the ``delta_sp`` section values) carry a
+    ``planet`` dimension.
     """
-    got = _panel(landmark, ds, planet)
+    got = _panel_order(landmark, ds, planet)
     if isinstance(got, str):
         return _not_evaluated(landmark, got)
-    x, labels = got
+    x, labels, sel, order = got
     if landmark.kind == "label":
         return _label(landmark, x, labels)
     if landmark.kind == "transition":
         return _transition(landmark, x, labels)
+    if landmark.kind == "negligible":
+        sections = None
+        if "delta_sp" in ds.data_vars:
+            var = _take(ds["delta_sp"], sel, planet)
+            sections = np.asarray(var.transpose(landmark.axis, "section").values, dtype=float)
+            sections = sections[order]
+        return _negligible(landmark, x, labels, sections)
     return _window(landmark, x, labels)
 
 
