@@ -12,6 +12,7 @@ import xarray as xr
 
 from gearchaos.paper.conclusions import (
     CONCLUSIONS,
+    WEAK_COUPLING_RATIO,
     Verdict,
     attractor_size,
     chaos_onsets,
@@ -26,6 +27,7 @@ from gearchaos.paper.conclusions import (
     conclusion_8,
     evaluate_conclusions,
     qp_near_3t,
+    section_spread,
 )
 
 NSEC = 16
@@ -261,6 +263,40 @@ def test_bs_spread_like_brp_is_not_weak() -> None:
         sections=sec,
     )
     assert conclusion_7({"fig12": chaotic, "fig9": _wild_brp(10.0)}).verdict == "does not hold"
+
+
+def _bs(sections: np.ndarray, label: str = "1T") -> xr.Dataset:
+    n = sections.shape[0]
+    return sweep(
+        [[label] * n],
+        family="omega",
+        fvalues=[1.5],
+        vary="clearance.sun_bearing",
+        sections=sections[None],
+    )
+
+
+def test_c7_measures_the_change_of_each_points_attractor_not_the_pooled_spread() -> None:
+    n = 10
+    brp = _wild_brp(1.0)  # along b̄_rp the attractor's centre moves by 1.0
+    # every point along b̄_s keeps the same wide record (a transient left in it, QP-like): its
+    # pooled spread is large, but nothing changes from one b̄_s to the next
+    record = 5.0 + np.random.default_rng(3).uniform(-2.0, 2.0, NSEC)
+    wide = _bs(np.tile(record, (n, 1)))
+    v = conclusion_7({"fig12": wide, "fig9": brp})
+    assert v.measured["change_bs"]["change"] == 0.0
+    assert v.measured["ratio"] == 0.0 and v.verdict == "holds"
+    assert section_spread(wide) / section_spread(brp, 0.05) > WEAK_COUPLING_RATIO  # old: strong
+    # only the transient changes: a narrower record at every point moves nothing either
+    narrow = _bs(np.tile(5.0 + 0.1 * (record - 5.0), (n, 1)))
+    assert conclusion_7({"fig12": narrow, "fig9": brp}).measured["ratio"] == 0.0
+    # the attractors themselves change along b̄_s: their size grows from 0.4 to 4
+    grow = 5.0 + np.linspace(0.1, 1.0, n)[:, None] * (record - 5.0)[None, :]
+    moved = conclusion_7({"fig12": _bs(grow), "fig9": brp})
+    change = moved.measured["change_bs"]
+    assert change["size"] == pytest.approx(0.9 * float(np.ptp(record)))
+    assert moved.measured["ratio"] > WEAK_COUPLING_RATIO
+    assert moved.verdict == "partly"  # periodic, no bifurcation, but not weakly coupled
 
 
 # --------------------------------------------------------------------------- conclusion 8

@@ -52,11 +52,14 @@ from .evidence import (
     _labels,
     _nonperiodic,
     _resolved,
+    attractor_change,
     attractor_size,
     chaos_onsets,
     chaotic_fraction,
+    clearance_reach,
     label_fraction,
     panels,
+    point_statistics,
     qp_near_3t,
     section_spread,
 )
@@ -78,7 +81,8 @@ __all__ = [
 ]
 
 VERDICTS = ("holds", "partly", "does not hold", "not evaluated")
-#: Ratio of the b̄_s spread to the b̄_rp spread below which b̄_s "couples weakly".
+#: Ratio of the change of the per-point attractors along b̄_s to that along b̄_rp below which
+#: b̄_s "couples weakly" (:func:`conclusion_7`).
 WEAK_COUPLING_RATIO = 0.2
 
 Stores = Mapping[str, Any]
@@ -417,7 +421,16 @@ def conclusion_6(
 def conclusion_7(
     stores: Stores, weak: str = "fig12", strong: str = "fig9", strong_panel: float = 0.05
 ) -> Verdict:
-    """b̄_s sweep: no bifurcation, no chaos, and X̄_sp1 spread ≪ that of the b̄_rp sweep."""
+    """b̄_s sweep: no bifurcation, no chaos, and its attractors change along b̄_s much less than
+    along b̄_rp.
+
+    The coupling of an axis is the change of the per-point attractor along it
+    (:func:`~gearchaos.paper.evidence.attractor_change`): per labelled point the centre and
+    the size of its X̄_sp1 section values, their ranges over the points, the larger of the two.
+    Pooled section spreads are not used: they grow with every point's own attractor (or a
+    transient left in its record) even when nothing changes from point to point. b̄_s couples
+    weakly when its change is below :data:`WEAK_COUPLING_RATIO` of b̄_rp's (Fig. 9's ξ =
+    ``strong_panel`` panel); distinct section points and λ₁ along both axes are evidence."""
     if weak not in stores:
         return _missing(7, [weak])
     ds = stores[weak]
@@ -426,29 +439,54 @@ def conclusion_7(
     kinds = sorted(set(res.tolist()))
     no_chaos = "chaos" not in kinds and "QP" not in kinds
     no_bif = len(kinds) <= 1
-    s_weak = section_spread(ds)
-    s_strong = math.nan
+    w_stats = point_statistics(ds)
+    w = attractor_change(w_stats) if w_stats is not None and w_stats["x"].size else None
+    s: dict[str, Any] | None = None
     if strong in stores:
         sds = stores[strong]
-        s_strong = section_spread(sds, strong_panel if _family_name(sds) else None)
-        if not math.isfinite(s_strong):
-            s_strong = section_spread(sds)
-    ratio = s_weak / s_strong if s_strong and math.isfinite(s_strong) else math.nan
+        st = point_statistics(sds, strong_panel if _family_name(sds) else None)
+        if st is None:  # no such panel: the first one
+            st = point_statistics(sds)
+        s = attractor_change(st) if st is not None and st["x"].size else None
+    c_weak = w["change"] if w else math.nan
+    c_strong = s["change"] if s else math.nan
+    ratio = c_weak / c_strong if c_strong and math.isfinite(c_strong) else math.nan
     weakly = math.isfinite(ratio) and ratio < WEAK_COUPLING_RATIO
+    reach = clearance_reach(ds, "clearance.sun_bearing", panels(ds)[0][0])
     measured = {
         "labels_bs": kinds,
-        "spread_bs": s_weak,
-        "spread_brp": s_strong,
+        "change_bs": w,
+        "change_brp": s,
         "ratio": ratio,
         "no_chaos": no_chaos,
         "no_bifurcation": no_bif,
+        "bearing_reach": reach,
     }
+
+    def side(c: dict[str, Any] | None) -> str:
+        if c is None:
+            return "no labelled points"
+        lle = c["lle"]
+        lle_text = (
+            f"λ₁ {_fmt(lle[0])} to {_fmt(lle[1])} (error ≤ {_fmt(c['lle_error'])})"
+            if lle is not None
+            else "no λ₁"
+        )
+        return (
+            f"per-point centre moves by {_fmt(c['centre'])}, size by {_fmt(c['size'])} over "
+            f"{c['points']} points; distinct section points {c['distinct'][:6]}; {lle_text}"
+        )
+
     evidence = (
-        f"{weak} (b̄_s sweep) motion types {kinds or ['none labelled']}; std of X̄_sp1 section "
-        f"values across the b̄_s sweep {_fmt(s_weak)} vs across the b̄_rp sweep ({strong}, "
-        f"ξ={strong_panel:g}) {_fmt(s_strong)}: ratio {_fmt(ratio)} "
+        f"{weak} (b̄_s sweep) motion types {kinds or ['none labelled']}; along b̄_s: {side(w)}; "
+        f"along b̄_rp ({strong}, ξ={strong_panel:g}): {side(s)}; change ratio {_fmt(ratio)} "
         f"(weak if < {WEAK_COUPLING_RATIO:g})"
     )
+    if reach is not None and reach["reached"] == 0:
+        evidence += (
+            f"; the sun never reaches its bearing clearance (largest |x̄_s|, |ȳ_s| "
+            f"{_fmt(reach['depth'])} of b̄_s): b̄_s does not act at all"
+        )
     if res.size < MIN_RESOLVED * max(lab.size, 1) or not math.isfinite(ratio):
         verdict = "not evaluated"
     elif no_chaos and no_bif and weakly:
