@@ -151,3 +151,34 @@ def test_quick_reproduce_resumes_a_finished_store(tmp_path):
     assert _chunk_mtimes(again["store"]) == chunks
     xr.testing.assert_identical(before, xr.open_zarr(again["store"]).load())
     assert again["figure"] == first["figure"]
+
+
+def test_paper_protocol_is_the_seeds_zero_start_and_record_labels(tmp_path):
+    from gearchaos.paper.recipes import PAPER_PROTOCOL
+    from gearchaos.sweep import classify_dataset
+    from gearchaos.sweep.result import SweepResult
+
+    kw = RECIPES["fig12"].sweep_kwargs(quick=True, paper_protocol=True)
+    assert kw["verdicts"] is False and kw["lyapunov"] is False and kw["perturbation"] == 0.0
+    assert dict(PAPER_PROTOCOL) == {"verdicts": False, "lyapunov": False, "perturbation": 0.0}
+    assert RECIPES["fig12"].sweep_kwargs(quick=True).get("perturbation") is None  # default start
+
+    res = reproduce("fig12", tmp_path, quick=True, progress=False, paper_protocol=True)
+    assert res["store"] == str(tmp_path / "fig12-quick-paper.zarr")  # beside, never replacing
+    assert res["figure"] == str(tmp_path / "fig12-quick-paper.png")
+    ds = xr.open_zarr(res["store"]).load()
+    spec = SweepResult.of(ds).spec
+    assert spec.solver.perturbation == 0.0 and spec.verdicts is False and spec.lyapunov is False
+    assert "verdict" not in ds.data_vars and "lle" not in ds.data_vars
+    ok = ds["status"].values == 0
+    assert ok.all()
+    # from the exact zero state the identical in-phase planets never leave their symmetric
+    # subspace (every mesh deflects alike) and the sun stays centred: the start was exact
+    dmin = ds["delta_sp_min"].values
+    np.testing.assert_allclose(dmin, np.broadcast_to(dmin[..., :1], dmin.shape), rtol=0, atol=1e-9)
+    for v in ("x_s_max", "x_s_min", "y_s_max", "y_s_min"):
+        assert np.abs(ds[v].values).max() < 1e-9, v
+    # the labels are the record's own: re-deriving them from the stored sections agrees
+    np.testing.assert_array_equal(
+        ds["motion"].values.astype(str), classify_dataset(ds)["motion"].astype(str)
+    )

@@ -15,9 +15,11 @@ Fig. 11 b̄_rp ∈ [1, 11]                  Ω = 1, 1.5, 2, 2.5           ξ = 0
 Fig. 12 b̄_s ∈ [1, 10]                   Ω = 1.5 (one panel)          ξ = 0.05, b̄_sp = 3, b̄_rp = 3.5
 ======  ==============================  ===========================  ==============================
 
-Every sweep starts each point from the zero state (the seed's protocol), integrates 100
-transient mesh periods and records 100 section points, on the default gear set
-(``gearchaos.preset("sheng2016")``). Dotted parameter names: ``omega``, ``xi`` (all three
+Every sweep starts each point from rest perturbed by 10⁻⁶ along a fixed seeded direction,
+integrates 100 transient mesh periods and records 100 section points, on the default gear set
+(``gearchaos.preset("sheng2016")``), and decides every label by the motion verdict;
+``paper_protocol`` runs the seed's own protocol instead (the exact zero start, labels from the
+record alone). Dotted parameter names: ``omega``, ``xi`` (all three
 damping ratios), ``backlash.sun_planet``, ``backlash.planet_ring``, ``clearance.sun_bearing``.
 
 :func:`reproduce` runs one recipe into a resumable Zarr store and draws it as a PNG; ``quick``
@@ -46,7 +48,16 @@ import numpy as np
 from ..errors import ParameterError
 from ..gearset.schema import tex
 
-__all__ = ["PRESET", "QUICK_PERIODS", "RECIPES", "FamilyAxis", "Recipe", "VaryAxis", "reproduce"]
+__all__ = [
+    "PAPER_PROTOCOL",
+    "PRESET",
+    "QUICK_PERIODS",
+    "RECIPES",
+    "FamilyAxis",
+    "Recipe",
+    "VaryAxis",
+    "reproduce",
+]
 
 #: Gear set every recipe runs on.
 PRESET = "sheng2016"
@@ -56,6 +67,12 @@ FULL_PERIODS = (100, 100)
 QUICK_PERIODS = (20, 16)
 #: Points per panel of the ``quick`` sweeps.
 QUICK_POINTS = 12
+#: The seed's own protocol, beside the report's verdicts (``paper_protocol``): every point
+#: from the exact zero state (no perturbation: the planets stay in their symmetric subspace),
+#: labelled from its 100 + 100-period record alone (no verdict, no λ₁), as the seed did.
+PAPER_PROTOCOL: Mapping[str, Any] = MappingProxyType(
+    {"verdicts": False, "lyapunov": False, "perturbation": 0.0}
+)
 
 _CLEARANCES = ("backlash.sun_planet", "backlash.planet_ring", "clearance.sun_bearing")
 
@@ -139,9 +156,11 @@ class Recipe:
         """Whether the swept parameter is Ω (mark resonances)."""
         return self.vary.name == "omega"
 
-    def sweep_kwargs(self, quick: bool = False) -> dict[str, Any]:
-        """Keyword arguments of :func:`gearchaos.bifurcation` (all but target and store)."""
+    def sweep_kwargs(self, quick: bool = False, paper_protocol: bool = False) -> dict[str, Any]:
+        """Keyword arguments of :func:`gearchaos.bifurcation` (all but target and store); with
+        ``paper_protocol`` the seed's own protocol (:data:`PAPER_PROTOCOL`)."""
         tr, rec = QUICK_PERIODS if quick else (self.transient_periods, self.periods)
+        own = dict(PAPER_PROTOCOL) if paper_protocol else {}
         return {
             "vary": {self.vary.name: self.vary.values(quick)},
             "family": {self.family.name: list(self.family.values)},
@@ -154,9 +173,10 @@ class Recipe:
             # the largest Lyapunov exponent decides QP vs chaos in the motion labels that the
             # regime bands, landmarks and conclusions read (about 1.3x the cost)
             "lyapunov": True,
+            **own,
         }
 
-    def title(self, quick: bool = False) -> str:
+    def title(self, quick: bool = False, paper_protocol: bool = False) -> str:
         """Figure title in matplotlib mathtext, built from the recipe's own numbers."""
         number = self.name.removeprefix("fig")
         given = ", ".join(f"${tex(k)} = {_num(v)}$" for k, v in self.fixed.items())
@@ -172,6 +192,8 @@ class Recipe:
                 f"\n(quick: {self.vary.quick_count} points per panel, "
                 f"{QUICK_PERIODS[0]} + {QUICK_PERIODS[1]} periods)"
             )
+        if paper_protocol:
+            text += "\n(the seed's protocol: exact zero start, labels from the record alone)"
         return text
 
 
@@ -238,6 +260,7 @@ def reproduce(
     workers: int | None = None,
     overwrite: bool = False,
     gearset: Any = None,
+    paper_protocol: bool = False,
 ) -> dict[str, Any]:
     """Run the sweep of the seed's figure ``name`` and draw it in the seed's layout.
 
@@ -266,6 +289,11 @@ def reproduce(
     gearset
         The gear set (default: the :data:`PRESET` preset). Its fixed parameters are replaced by
         the recipe's (Ω or ξ and the clearances as the figure sets them).
+    paper_protocol
+        Run the seed's own protocol instead (:data:`PAPER_PROTOCOL`: exact zero start,
+        labels from the record alone, no verdict and no λ₁) into ``<name>-paper.zarr`` and
+        ``<name>-paper.png`` (``-quick-paper`` with ``quick``): what the seed's method says,
+        beside the verdicts.
 
     Returns
     -------
@@ -287,12 +315,12 @@ def reproduce(
     t0 = time.perf_counter()
     out = Path(os.fspath(outdir))
     out.mkdir(parents=True, exist_ok=True)
-    stem = recipe.name + ("-quick" if quick else "")
+    stem = recipe.name + ("-quick" if quick else "") + ("-paper" if paper_protocol else "")
     store = out / f"{stem}.zarr"
     png = out / f"{stem}.png"
     ds = bifurcation(
         preset(PRESET) if gearset is None else gearset,
-        **recipe.sweep_kwargs(quick),
+        **recipe.sweep_kwargs(quick, paper_protocol),
         store=str(store),
         overwrite=overwrite,
         workers=workers,
@@ -305,7 +333,7 @@ def reproduce(
         clearance_lines=recipe.clearance_sweep,
         resonances=recipe.frequency_sweep,
     )
-    fig.suptitle(recipe.title(quick), fontsize="medium")
+    fig.suptitle(recipe.title(quick, paper_protocol), fontsize="medium")
     try:
         savefig(fig, png)
     finally:
