@@ -47,6 +47,27 @@ def test_reproduce_all_quick_writes_every_figure_and_the_report(tmp_path: Path) 
     verdicts = {"holds", "partly", "does not hold", "not evaluated"}
     assert {c["verdict"] for c in summary["conclusions"]} <= verdicts
     assert all(not f.get("error") for f in summary["figures"].values())
+    # every landmark row says whether its swept parameter acts and what the seed's protocol says
+    from gearchaos.paper.landmarks import VERDICTS, load_landmarks
+
+    rows = summary["landmarks"]
+    assert [r["id"] for r in rows] == [m.id for m in load_landmarks()]
+    assert {r["acts"] for r in rows} <= {"acts", "constant", "undecided"}
+    assert all(r["action"] for r in rows)
+    assert {r["verdict"] for r in rows} | {r["paper_verdict"] for r in rows} <= set(VERDICTS)
+    for r in rows:  # a constant panel never holds as a hold
+        assert not (r["acts"] == "constant" and r["verdict"] == "holds"), r["id"]
+    counts = summary["counts"]
+    assert list(counts["landmarks"]) == list(VERDICTS)
+    assert sum(counts["landmarks"].values()) == sum(counts["landmarks_paper"].values()) == len(rows)
+    assert counts["landmarks"]["holds (constant)"] == sum(
+        r["verdict"] == "holds (constant)" for r in rows
+    )
+    assert "id='landmarks'" in page and "paper protocol" in page and "acts?" in page
+    for fig in ("fig4", "fig6", "fig8", "fig9", "fig11", "fig12"):  # the seed's protocol ran
+        assert (out / f"{fig}-quick-paper.zarr").is_dir(), fig
+    printed = res.output.replace("\n", " ")
+    assert "holds (constant)" in printed
 
 
 def test_reproduce_needs_a_figure_or_all(tmp_path: Path) -> None:

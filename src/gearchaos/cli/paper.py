@@ -57,6 +57,18 @@ def reproduce(
     quick: Annotated[
         bool, typer.Option("--quick", help="A coarse version (fewer points and periods), for CI.")
     ] = False,
+    paper_protocol: Annotated[
+        bool | None,
+        typer.Option(
+            "--paper-protocol/--no-paper-protocol",
+            help=(
+                "The seed's own protocol: every point from the exact zero start, labels from "
+                "the 100 + 100-period record alone (no verdicts, no λ₁), into FIG-paper.zarr. "
+                "With --all (on by default) it fills the report's paper-protocol column."
+            ),
+            show_default=False,
+        ),
+    ] = None,
     workers: c.WorkersOpt = None,
     overwrite: c.OverwriteOpt = False,
     preset: c.PresetOpt = None,
@@ -78,7 +90,10 @@ def reproduce(
 
     --all runs every figure into OUTPUT, checks the conclusions of the seed's Section 4 and its
     landmarks against the runs and writes the report OUTPUT/index.html (resumable, with
-    progress; the report records its own run time; --quick is a coarse version for CI).
+    progress; the report records its own run time; --quick is a coarse version for CI), then
+    prints the counts: a landmark that holds only because its swept parameter does not act
+    is "holds (constant)", counted apart; the paper-protocol column (--no-paper-protocol
+    leaves it out) says what the seed's own method gives.
 
     Example: **gearchaos reproduce fig4 -o paper/ --quick**;
     **gearchaos reproduce --all -o report/**
@@ -111,11 +126,14 @@ def reproduce(
                 workers=workers,
                 gearset=gs,
                 gearset_label=label,
+                paper_protocol=paper_protocol is not False,
             )
+        counts = _report_counts(index)
         if json_out:
-            c.print_json({"report": str(index)})
+            c.print_json({"report": str(index), "counts": counts})
         elif not quiet:
             c.stdout().print(escape(str(index)), soft_wrap=True)
+            c.stdout().print(_counts_table(counts))
         return
     if figure is None:
         c.fail("give a figure (FIG) or --all", c.EXIT_INVALID)
@@ -129,6 +147,11 @@ def reproduce(
                 f"FIG must be one of {', '.join(PAPER_FIGURES)}: got {figure!r}{hint}"
             )
         if name in GALLERY_FIGURES:
+            if paper_protocol:
+                raise ParameterError(
+                    f"--paper-protocol is for the bifurcation figures, not the gallery {name} "
+                    "(its values are single runs from the zero state already)"
+                )
             if workers is not None and not (quiet or json_out):
                 c.stderr().print(
                     Text(
@@ -161,6 +184,7 @@ def reproduce(
                     workers=workers,
                     overwrite=overwrite,
                     gearset=gs,
+                    paper_protocol=bool(paper_protocol),
                 )
             )
     if json_out:
@@ -185,6 +209,35 @@ def reproduce(
         if key not in ("figure", "store", "points", "failed", "seconds"):
             table.add_row(escape(str(key)), escape(fmt(value)))
     c.stdout().print(table)
+
+
+def _report_counts(index: Path) -> dict[str, dict[str, int]]:
+    """The counts the report wrote beside its page (``report.json``)."""
+    import json
+
+    summary = json.loads((index.parent / "report.json").read_text(encoding="utf-8"))
+    counts: dict[str, dict[str, int]] = summary["counts"]
+    return counts
+
+
+def _counts_table(counts: Mapping[str, Mapping[str, int]]) -> Any:
+    """One row per verdict, one column per kind of count (zeros written out)."""
+    from rich.table import Table
+
+    titles = {
+        "conclusions": "conclusions",
+        "landmarks": "landmarks",
+        "landmarks_paper": "landmarks (paper protocol)",
+    }
+    table = Table(title="reproduction report: verdicts")
+    table.add_column("verdict")
+    for key in counts:
+        table.add_column(titles.get(key, key), justify="right")
+    verdicts = list(dict.fromkeys(v for col in counts.values() for v in col))
+    for v in verdicts:
+        table.add_row(v, *(str(col.get(v, 0)) if v in col else "—" for col in counts.values()))
+    table.add_row("total", *(str(sum(col.values())) for col in counts.values()))
+    return table
 
 
 @c.app.command()

@@ -10,12 +10,19 @@ escaped text) with how it was made, each figure beside the paper's caption with 
 table, one row per conclusion and per landmark with the measured evidence and the verdict, and
 an Honesty section saying what differs from the paper and why.
 
+Every landmark row also says whether the swept parameter acts on its panel
+(:mod:`.action`; a hold where it does not is ``holds (constant)``, counted apart) and what the
+seed's own protocol says (:mod:`.accounting`: the same sweep from the exact zero start with
+labels from the record alone, ``paper_protocol``).
+
 Motion labels are the motion verdict of every point (:mod:`gearchaos.dynamics.verdict`):
 periodic labels confirmed by shooting with their Floquet multipliers, chaos and QP from λ₁ with
 its standard error over an extension of the run, transients finished.
 
 Cost: the full run is 6 700 sweep points of 200 mesh periods plus 38 gallery values of 600
-periods; the report records its own wall time (``seconds`` in ``report.json``), and
+periods, the same 6 700 points again without verdicts for the paper-protocol column, and two
+short continued branches per landmark panel; the report records its own wall time
+(``seconds`` in ``report.json``), and
 ``benchmarks/bench_verdicts.py`` measures the verdicts' share against plain sweeps.
 """
 
@@ -34,8 +41,10 @@ from typing import Any
 from .._marks import fill_mark, placeholder
 from .._output import check_replaceable, file_has_mark, write_file
 from ..sweep.result import SweepResult
+from .accounting import count_text, verdict_counts
+from .accounting import landmark_rows as accounting_rows
 
-__all__ = ["FIGURES", "HONESTY", "build_report", "render_html"]
+__all__ = ["FIGURES", "HONESTY", "build_report", "render_html", "report_counts"]
 
 #: Every figure of the seed, in the paper's order.
 FIGURES = ("fig4", "fig5", "fig6", "fig7", "fig8", "fig9", "fig10", "fig11", "fig12")
@@ -96,10 +105,28 @@ HONESTY: tuple[tuple[str, str], ...] = (
         "their symmetric subspace and the sun stays centred. Fig. 4 starts at Ω = 0.01 since the "
         "mesh period is unbounded at Ω = 0.",
     ),
+    (
+        "Holds where nothing changes",
+        "A landmark can hold along an axis on which the swept parameter does nothing: a "
+        "backlash whose back flank is never reached only shifts the mesh coordinate, a bearing "
+        "clearance the sun never reaches does not enter the motion at all. Every landmark row "
+        "says whether the parameter acts on its panel (a continued period-1 branch along the "
+        "axis from the seed's value whose largest multiplier changes by more than 10⁻³ or "
+        "that has events, or the clearance reached on the sweep); a hold where it does not "
+        "is 'holds (constant)' and is counted apart from the holds.",
+    ),
+    (
+        "The paper-protocol column",
+        "Beside each verdict, the same landmark checked on the seed's own protocol: every "
+        "point from the exact zero state and labelled from its 100 + 100-period record alone "
+        "(no verdict, no λ₁, no continued branches), so a reader sees what the seed's method "
+        "would have said here.",
+    ),
 )
 
 _COLOURS = {
     "holds": "#1a7f37",
+    "holds (constant)": "#57606a",
     "partly": "#b08800",
     "does not hold": "#cf222e",
     "not evaluated": "#6e7781",
@@ -108,6 +135,32 @@ _COLOURS = {
 
 def _e(text: Any) -> str:
     return html.escape(str(text), quote=True)
+
+
+def _run_paper_protocol(
+    outdir: Path, quick: bool, progress: bool, workers: int | None, gearset: Any = None
+) -> dict[str, dict[str, Any]]:
+    """Every recipe's sweep on the seed's own protocol (``paper_protocol``): figure name →
+    what :func:`~gearchaos.paper.recipes.reproduce` returned, or ``{"error": …}``."""
+    from .recipes import RECIPES, reproduce
+
+    out: dict[str, dict[str, Any]] = {}
+    for name in RECIPES:
+        try:
+            out[name] = dict(
+                reproduce(
+                    name,
+                    outdir,
+                    quick=quick,
+                    progress=progress,
+                    workers=workers,
+                    gearset=gearset,
+                    paper_protocol=True,
+                )
+            )
+        except Exception as exc:
+            out[name] = {"error": f"{type(exc).__name__}: {exc}"}
+    return out
 
 
 def _run_figures(
@@ -153,37 +206,6 @@ def _open_stores(results: Mapping[str, Mapping[str, Any]]) -> dict[str, Any]:
             except Exception:
                 continue
     return stores
-
-
-def _landmark_rows(
-    stores: Mapping[str, Any], branches: Mapping[str, Any] | None = None
-) -> tuple[list[dict[str, Any]], str]:
-    try:
-        from . import landmarks as lm_mod  # written alongside; optional
-    except ImportError as exc:
-        return [], f"landmarks not available: {exc}"
-    try:
-        lms = lm_mod.load_landmarks()
-        results = lm_mod.evaluate_all(lms, dict(stores))
-        if branches:
-            from .routes import landmarks_from_events
-
-            results = landmarks_from_events(results, branches)
-    except Exception as exc:
-        return [], f"landmark evaluation failed: {type(exc).__name__}: {exc}"
-    rows = []
-    for r in results:
-        lm = r.landmark
-        rows.append(
-            {
-                "id": str(getattr(lm, "id", "")),
-                "figure": f"{getattr(lm, 'figure', '')} {getattr(lm, 'panel', '') or ''}".strip(),
-                "statement": str(getattr(lm, "quote", "")),
-                "evidence": str(getattr(r, "evidence", "")),
-                "verdict": str(getattr(r, "verdict", "not evaluated")),
-            }
-        )
-    return rows, ""
 
 
 def _branches_note(followed: Mapping[str, Any]) -> str:
@@ -259,9 +281,26 @@ def _gallery_table(rows: Sequence[Mapping[str, Any]], param: str) -> str:
     )
 
 
-def _verdict_cell(verdict: str) -> str:
+def _verdict_cell(verdict: str, title: str | None = None) -> str:
     colour = _COLOURS.get(verdict, "#6e7781")
-    return f"<td class='verdict' style='background:{colour}'>{_e(verdict)}</td>"
+    tip = f" title='{_e(title)}'" if title else ""
+    return f"<td class='verdict' style='background:{colour}'{tip}>{_e(verdict)}</td>"
+
+
+def report_counts(
+    verdicts: Sequence[Any], landmark_rows: Sequence[Mapping[str, Any]]
+) -> dict[str, dict[str, int]]:
+    """The counts every summary prints: ``conclusions``, ``landmarks`` (``holds (constant)``
+    apart from ``holds``) and ``landmarks_paper`` (the paper-protocol column)."""
+    from .conclusions import VERDICTS as CONCLUSION_VERDICTS
+
+    return {
+        "conclusions": verdict_counts((v.verdict for v in verdicts), CONCLUSION_VERDICTS),
+        "landmarks": verdict_counts(r["verdict"] for r in landmark_rows),
+        "landmarks_paper": verdict_counts(
+            r.get("paper_verdict", "not evaluated") for r in landmark_rows
+        ),
+    }
 
 
 _CSS = """
@@ -330,9 +369,11 @@ def render_html(
         "<li>Versions: " + ", ".join(f"{_e(k)} {_e(v)}" for k, v in versions.items() if v) + "</li>"
     )
     if attrs:
+        spec = SweepResult.of(first).spec if attrs.get("sweep_toml") else None
+        eps = spec.solver.perturbation if spec is not None else attrs.get("perturbation", 0.0)
         p.append(
             "<li>Protocol: start at rest, perturbed by "
-            f"{_e(attrs.get('perturbation', 0.0))} along a fixed seeded direction (breaking "
+            f"{_e(f'{eps:g}')} along a fixed seeded direction (breaking "
             "the planets' symmetry as in any real gearbox), at every point; "
             f"{_e(attrs.get('transient_periods'))} "
             f"transient mesh periods discarded, {_e(attrs.get('periods'))} section points "
@@ -399,20 +440,39 @@ def render_html(
             f"<tr><td>C{_e(v.conclusion_id)}</td><td>{_e(v.statement)}</td>"
             f"<td>{_e(v.evidence)}</td>{_verdict_cell(v.verdict)}</tr>"
         )
+    p.append("</table>")
+    p.append(
+        "<p class='note'><em>acts?</em>: whether the swept parameter acts on the landmark's "
+        "panel (gearchaos.paper.action): a continued period-1 branch along the axis whose "
+        "largest multiplier changes by more than 10⁻³ or that has events, or the clearance "
+        "reached on the sweep; a hold where it does not is <em>holds (constant)</em>, counted "
+        "apart. <em>paper protocol</em>: the same landmark on the seed's own protocol (exact "
+        "zero start, labels from the 100 + 100-period record alone; hover for its evidence)."
+        "</p>"
+    )
+    p.append(
+        "<table id='landmarks'><tr><th>landmark</th><th>statement</th><th>measured evidence</th>"
+        "<th>acts?</th><th>verdict</th><th>paper protocol</th></tr>"
+    )
     for r in landmark_rows:
         p.append(
             f"<tr><td>{_e(r['id'])}<br><span class='note'>{_e(r['figure'])}</span></td>"
             f"<td>{_e(r['statement'])}</td><td>{_e(r['evidence'])}</td>"
-            f"{_verdict_cell(r['verdict'])}</tr>"
+            f"<td><strong>{_e(r.get('acts', ''))}</strong><br>"
+            f"<span class='note'>{_e(r.get('action', ''))}</span></td>"
+            f"{_verdict_cell(r['verdict'])}"
+            f"{_verdict_cell(r.get('paper_verdict', 'not evaluated'), r.get('paper_evidence'))}"
+            "</tr>"
         )
     p.append("</table>")
     if landmark_note:
         p.append(f"<p class='note'>{_e(landmark_note)}</p>")
-    counts: dict[str, int] = {}
-    for v in [*(x.verdict for x in verdicts), *(r["verdict"] for r in landmark_rows)]:
-        counts[v] = counts.get(v, 0) + 1
+    counts = report_counts(verdicts, landmark_rows)
     p.append(
-        "<p>Summary: " + ", ".join(f"{_e(k)}: {n}" for k, n in sorted(counts.items())) + "</p>"
+        "<p id='summary'>Summary — conclusions: "
+        f"{_e(count_text(counts['conclusions']))}; landmarks: "
+        f"{_e(count_text(counts['landmarks']))}; landmarks on the paper protocol: "
+        f"{_e(count_text(counts['landmarks_paper']))}.</p>"
     )
     # -- honesty
     p.append("<h2 id='honesty'>Honesty: what differs from the paper, and why</h2><dl>")
@@ -430,6 +490,7 @@ def build_report(
     workers: int | None = None,
     gearset: Any = None,
     gearset_label: str | None = None,
+    paper_protocol: bool = True,
 ) -> Path:
     """Run every figure of the seed into ``outdir`` and write ``outdir/index.html``.
 
@@ -437,7 +498,9 @@ def build_report(
     re-checks. A figure that fails is reported in the page (the others still run).
     ``gearset`` replaces the default preset (e.g. a calibration candidate); ``gearset_label``
     names it in the page and in ``report.json`` (default: ``"gear set NAME"``, or
-    ``"preset sheng2016"`` without ``gearset``).
+    ``"preset sheng2016"`` without ``gearset``). ``paper_protocol`` also runs every recipe on
+    the seed's own protocol (``FIG-paper.zarr``) for the paper-protocol column; the test of
+    whether each landmark's swept parameter acts (:mod:`.action`) always runs.
 
     Returns
     -------
@@ -458,11 +521,26 @@ def build_report(
     t0 = time.perf_counter()
     results = _run_figures(out, quick, progress, workers, gearset)
     stores = _open_stores(results)
+    paper = _run_paper_protocol(out, quick, progress, workers, gearset) if paper_protocol else {}
+    paper_stores = _open_stores(paper)
+    for name, res in paper.items():
+        results.setdefault(name, {})["paper_protocol"] = res
+    from ..gearset import preset
+    from .action import landmark_actions
+    from .landmarks import load_landmarks
+    from .recipes import PRESET
     from .routes import report_branches
 
     branches, followed = report_branches(stores, out, quick=quick, gearset=gearset)
     verdicts = evaluate_conclusions(stores, branches=branches)
-    lm_rows, lm_note = _landmark_rows(stores, branches)
+    marks = load_landmarks()
+    target = preset(PRESET) if gearset is None else gearset
+    t_act = time.perf_counter()
+    actions = landmark_actions(target, marks, stores, branches=branches, quick=quick)
+    acted = {"seconds": time.perf_counter() - t_act}
+    lm_rows, lm_note = accounting_rows(
+        stores, branches, paper_stores=paper_stores, actions=actions, landmarks=marks
+    )
     page = render_html(
         quick=quick,
         results=results,
@@ -489,7 +567,9 @@ def build_report(
             {"id": v.conclusion_id, "verdict": v.verdict, "evidence": v.evidence} for v in verdicts
         ],
         "landmarks": lm_rows,
+        "counts": report_counts(verdicts, lm_rows),
         "branches": followed,
+        "actions": acted,
     }
     (out / "report.json").write_text(
         json.dumps(summary, indent=2, ensure_ascii=False, default=str) + "\n", encoding="utf-8"
