@@ -2,8 +2,8 @@
 
 Run from the repository root with the project's environment:
 ``.venv/bin/python docs/make_doc_numbers.py [--check] [--fast]``. Every number of README.md,
-the tutorial and the reproduce how-to that a command printed (or that the committed report
-holds) sits between markers, and this script rewrites what is between them::
+the tutorial, the reproduce how-to and docs/reproduction.md that a command printed (or that the
+committed report holds) sits between markers, and this script rewrites what is between them::
 
     |μ| ≈ <!-- gen:gallery.mu-3.5 -->0.97<!-- /gen --> per two periods
 
@@ -48,7 +48,12 @@ sys.path.insert(0, str(ROOT / "tests" / "docs"))
 
 from tutorial_blocks import TUTORIAL, runnable  # noqa: E402
 
-PAGES = (ROOT / "README.md", TUTORIAL, ROOT / "docs" / "howto" / "reproduce.md")
+PAGES = (
+    ROOT / "README.md",
+    TUTORIAL,
+    ROOT / "docs" / "howto" / "reproduce.md",
+    ROOT / "docs" / "reproduction.md",
+)
 REPORT = ROOT / "docs" / "report" / "report.json"
 MARK = re.compile(r"<!-- gen:(?P<name>[^ ]+) -->(?P<body>.*?)<!-- /gen -->", re.S)
 COLUMNS = 100
@@ -262,17 +267,36 @@ def _fig4a(work: Path) -> dict[str, str]:
     return values
 
 
+def _slug(verdict: str) -> str:
+    """``holds (constant)`` → ``holds-constant``, ``does not hold`` → ``does-not-hold``."""
+    return re.sub(r"[^a-z]+", "-", verdict.lower()).strip("-")
+
+
 def _report(_: Path) -> dict[str, str]:
-    """Counts and run time of the committed report (``docs/report/report.json``)."""
+    """Counts and run time of the committed report (``docs/report/report.json``), counted by
+    the report's own code (:func:`gearchaos.paper.accounting.verdict_counts`): keys
+    ``PART.VERDICT`` (``landmarks.holds``, ``landmarks.holds-constant`` — a hold where the
+    swept parameter does not act, counted apart —, ``conclusions.does-not-hold`` …),
+    ``PART.total``, ``PART.not-ids`` and the paper-protocol column as
+    ``landmarks-paper.VERDICT``."""
+    from gearchaos.paper.accounting import verdict_counts
+    from gearchaos.paper.conclusions import VERDICTS as CONCLUSION_VERDICTS
+
     report = json.loads(REPORT.read_text(encoding="utf-8"))
     values: dict[str, str] = {"seconds": f"{report['seconds']:.0f}"}
-    for part in ("landmarks", "conclusions"):
-        verdicts = [item["verdict"] for item in report[part]]
+    columns = {
+        "landmarks": ("landmarks", "verdict", None),
+        "landmarks-paper": ("landmarks", "paper_verdict", None),
+        "conclusions": ("conclusions", "verdict", CONCLUSION_VERDICTS),
+    }
+    for part, (rows, key, order) in columns.items():
+        verdicts = [str(item.get(key, "not evaluated")) for item in report[rows]]
+        counts = verdict_counts(verdicts) if order is None else verdict_counts(verdicts, order)
         values[f"{part}.total"] = str(len(verdicts))
-        for verdict in ("holds", "partly", "does not hold"):
-            values[f"{part}.{verdict.replace(' ', '-')}"] = str(verdicts.count(verdict))
+        for verdict, n in counts.items():
+            values[f"{part}.{_slug(verdict)}"] = str(n)
         values[f"{part}.not-ids"] = ", ".join(
-            str(item["id"]) for item in report[part] if item["verdict"] == "does not hold"
+            str(item["id"]) for item in report[rows] if item.get(key) == "does not hold"
         )
     return values
 
