@@ -34,6 +34,7 @@ from .._version import __version__
 from ..errors import IntegrationError, ParameterError, StoreError
 from ..gearset.parsing import parse_text
 from ..model.target import DEFAULT_OMEGA, OMEGA, check_omega
+from ._speeds import one_point, point_omega, without_speeds
 
 if TYPE_CHECKING:
     from ..gearset import GearSet
@@ -271,7 +272,9 @@ def parse_sets(items: Sequence[str]) -> tuple[float | None, dict[str, object]]:
     Parameters
     ----------
     items : sequence of str
-        The option values, e.g. ``["omega=1.5", "xi=0.05", "backlash.sun_planet=3"]``.
+        The option values, e.g. ``["omega=1.5", "xi=0.05", "backlash.sun_planet=3"]``. A
+        speed (``sun_rpm=7500``, ``mesh_hz=3000``) stays among the changes: it sets Ω through
+        the gear set the changes build (:func:`point_omega`, :func:`sweep_fixed`).
         Values are parsed by the kind of the field: integers for tooth and planet numbers,
         numbers for physical values, comma-separated numbers (optionally in brackets) for the
         stiffness harmonics, text for ``torque.mode``, ``*.units``, ``mesh_phasing.model``,
@@ -288,8 +291,9 @@ def parse_sets(items: Sequence[str]) -> tuple[float | None, dict[str, object]]:
     Raises
     ------
     ParameterError
-        For an item without ``=``, a value that does not parse as its field's kind, or
-        ``omega`` not a finite number > 0.
+        For an item without ``=``, a value that does not parse as its field's kind,
+        ``omega`` not a finite number > 0 in its plausible range, or Ω set twice (``omega``
+        and a speed, or two speeds).
     """
     omega: float | None = None
     changes: dict[str, object] = {}
@@ -302,6 +306,7 @@ def parse_sets(items: Sequence[str]) -> tuple[float | None, dict[str, object]]:
             omega = check_omega(parse_text(OMEGA, raw))
         else:
             changes[key] = parse_text(key, raw)
+    one_point(set(), changes, omega, "set")
     return omega, changes
 
 
@@ -321,6 +326,7 @@ def load_gearset(
         gs = GearSet.from_toml(gearset_file)
     else:
         gs = load_preset(preset if preset is not None else DEFAULT_PRESET)
+    changes = without_speeds(changes or {})  # a speed is the operating point (point_omega)
     if changes:
         # a changed gear set is no longer the named one: its name says so (and which
         # parameters), so titles and result files never call it plain "sheng2016"
@@ -348,7 +354,8 @@ def load_target(
 ) -> Any:
     """The gear set of ``--preset``/``--gearset`` with ``changes`` (:func:`load_gearset`), or,
     with ``--model``, a :class:`~gearchaos.model.System` of that model class with ``changes``
-    as its parameters (at Ω = DEFAULT_OMEGA until a command sets Ω)."""
+    as its parameters (at Ω = DEFAULT_OMEGA until a command sets Ω). A speed among
+    ``changes`` is no gear-set field (:func:`point_omega` reads it); a model refuses it."""
     if model is None:
         return load_gearset(preset, gearset_file, changes)
     if preset is not None or gearset_file is not None:
@@ -356,7 +363,10 @@ def load_target(
     from ..model import System
     from ..model.loading import build_model, load_model_class
 
-    return System(build_model(load_model_class(model), dict(changes or {})), DEFAULT_OMEGA)
+    own = without_speeds(changes or {})
+    system = System(build_model(load_model_class(model), own), DEFAULT_OMEGA)
+    point_omega(system, None, changes or {})  # a speed: refused, naming it (no gear set)
+    return system
 
 
 def sweep_target(
@@ -400,18 +410,16 @@ def sweep_fixed(
 ) -> dict[str, Any]:
     """The fixed values of a command over the parameters ``swept`` from ``--set``: refuse a
     name both swept and set, and fix Ω (the default, with a note, when it is neither swept nor
-    set). ``verb`` names what the command does to them in the messages (swept, varied,
-    continued), ``note`` in the default-Ω note (default ``verb``)."""
+    set; a speed, swept or set, gives Ω and stays among the values for the library). ``verb``
+    names what the command does to them in the messages, ``note`` in the default-Ω note."""
     fixed: dict[str, Any] = dict(changes)
     for name in sorted(swept & set(fixed)):
         raise ParameterError(f"{name} is both {verb} and set with --set; choose one")
-    if OMEGA not in swept:
+    if not one_point(swept, fixed, omega, verb):
         if omega is None:
             omega = DEFAULT_OMEGA
             default_omega_note(quiet, verb if note is None else note)
         fixed[OMEGA] = omega
-    elif omega is not None:
-        raise ParameterError(f"omega is both {verb} and set with --set; choose one")
     return fixed
 
 

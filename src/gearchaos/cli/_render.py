@@ -93,6 +93,10 @@ _LABELS: dict[str, str] = {
     "omega_at_resonances.kind": "mode class",
     "omega_at_resonances.harmonic": "harmonic h",
     "omega_at_resonances.omega": "Ω = (ω/ω_n)/h",
+    "omega_at_resonances.sun_speed_rpm": "sun speed [rpm]",
+    "clearances_um.sun_planet": "b_sp = b̄_sp b_c (sun–planet backlash)",
+    "clearances_um.planet_ring": "b_rp = b̄_rp b_c (planet–ring backlash)",
+    "clearances_um.sun_bearing": "b_s = b̄_s b_c (sun bearing)",
     "operating_point.omega": "Ω = ω/ω_n",
     "operating_point.mesh_frequency_rad_s": "mesh frequency ω [rad/s]",
     "operating_point.mesh_frequency_hz": "mesh frequency [Hz]",
@@ -107,6 +111,7 @@ _TITLES: dict[str, str] = {
     "natural_frequencies": "Natural frequencies (mean stiffness, no clearance)",
     "omega_at_resonances": "Resonances: mesh harmonic h·Ω meets a mode",
     "operating_point": "Operating point",
+    "clearances_um": "Half clearances [µm]",
 }
 #: Groups shown as rows of the overview table rather than as tables of their own.
 _OVERVIEW_GROUPS = ("teeth", "mesh_phasing")
@@ -300,9 +305,19 @@ def sweep_summary(res: Any, output: Any, seconds: float) -> dict[str, Any]:
 
 
 def sweep_table(title: str, res: Any, summary: Mapping[str, Any]) -> Table:
-    """The summary table of a sweep command, headed by its grid, points and failed points."""
+    """The summary table of a sweep command, headed by its grid (Ω with the sun speed the
+    store records beside it), points and failed points."""
     table = pairs_table(title)
     table.add_row("grid", escape(" × ".join(f"{d} ({res.ds.sizes[d]})" for d in res.lead_dims)))
+    from ..plot.units import PhysicalScales
+
+    rpm = PhysicalScales.of_sweep(res).rpm_per_omega  # None: no gear set, or ω_n swept
+    om = res.ds["omega"].values if "omega" in res.lead_dims else res.fixed_value("omega")
+    if rpm is not None and om is not None:
+        lo, hi = float(np.min(om)), float(np.max(om))
+        span = f"{lo:.6g}" if lo == hi else f"{lo:.6g} … {hi:.6g}"
+        speeds = f"{lo * rpm:.5g}" if lo == hi else f"{lo * rpm:.5g} … {hi * rpm:.5g}"
+        table.add_row("Ω (sun speed)", f"{span} ({speeds} rpm)")
     table.add_row("points", str(summary["points"]))
     failed = summary["failed"]
     table.add_row("failed", Text(str(failed), style="bold red" if failed else ""))

@@ -115,6 +115,7 @@ def _options() -> Iterator[None]:
 def _target(preset: Any, gearset: Any, model: Any, sets: list[str] | None, quiet: bool) -> Any:
     omega, changes = c.parse_sets(sets or [])
     target = c.load_target(preset, gearset, model, changes)
+    omega = c.point_omega(target, omega, changes)  # --set sun_rpm / mesh_hz: through it
     if omega is None:
         omega = c.DEFAULT_OMEGA
         c.default_omega_note(quiet, "set")
@@ -291,6 +292,7 @@ def basin_fractions(
     with c.reported_errors(), c.interruptible():
         omega, changes = c.parse_sets(set_ or [])
         target = c.load_target(preset, gearset, model, changes)
+        omega = c.point_omega(target, omega, changes)  # --set sun_rpm / mesh_hz: through it
         name = vary.partition("=")[0].strip()
         values = c.sweep_fixed({name}, omega, {}, quiet or json_out, "varied", "swept or set")
         settings = c.solver_settings(transient, periods, rtol, atol)

@@ -29,6 +29,7 @@ def info(
     with c.reported_errors():
         omega, changes = c.parse_sets(set_ or [])
         gs = c.load_gearset(preset, gearset, changes)
+        omega = c.point_omega(gs, omega, changes)  # --set sun_rpm / mesh_hz: through gs
         from ..model.derived import gearset_info
 
         data = dict(gearset_info(gs))

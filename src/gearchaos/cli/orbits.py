@@ -18,8 +18,10 @@ from ..dynamics.coexistence import ATTRACTOR_SETTINGS
 from ..dynamics.orbits import ORBIT_SETTINGS
 from ..dynamics.verdict import CONFIRM_PERIODS
 from ..errors import IntegrationError, ParameterError
+from ..gearset.schema import OMEGA, SPEEDS
 from . import _common as c
 from ._render import pairs_table
+from ._speeds import speed_note, speed_range, speeds_per_omega
 
 PeriodOpt = Annotated[
     int | None,
@@ -81,21 +83,24 @@ def _start_values(
     """(gear set, parameter values, start or None) of ``orbit`` and ``continue``: from
     ``--from``/``--at`` when given (its gear set and values, ``--set`` on top), else the gear
     set of ``--preset``/``--gearset`` changed by ``--set`` and Ω alone as a value."""
-    from ._start import OMEGA, load_start
+    from ._start import load_start
 
     omega, changes = c.parse_sets(sets)
     if from_ is None:
         if at is not None:
             raise ParameterError(f"--at picks a point of --from, which is missing: got --at {at}")
+        target = c.load_target(preset, gearset, model, changes)
+        omega = c.point_omega(target, omega, changes)  # --set sun_rpm / mesh_hz: through it
         values: dict[str, Any] = {} if omega is None else {OMEGA: omega}
-        return c.load_target(preset, gearset, model, changes), values, None
+        return target, values, None
     if preset is not None or gearset is not None:
         raise ParameterError(
             "--from brings the gear set it was computed for: drop --preset/--gearset (change "
             "values with --set)"
         )
     start = load_start(from_, at, model)
-    values = {**start.values, **changes}
+    values = {**start.values, **c.without_speeds(changes)}
+    omega = c.point_omega(start.gearset, omega, changes, values)
     if omega is not None:
         values[OMEGA] = omega
     return start.gearset, values, start
@@ -174,7 +179,7 @@ def orbit(
         c.print_json(summary)  # exactly the keys of PeriodicOrbit.summary()
         return
     out = c.stdout()
-    title = f"period-{period} orbit of {gs.name} at Ω = {omega:g}"
+    title = f"period-{period} orbit of {gs.name} at Ω = {omega:g}{speed_note(gs, omega, values)}"
     table = pairs_table(title + ("" if start is None else f", from {start.source}"))
     table.add_row(
         "converged",
@@ -305,6 +310,8 @@ def continue_(
             start = None
         else:
             gs, values, start = _start_values(from_, at, preset, gearset, set_ or [], model)
+        if name in SPEEDS:  # a branch in Ω: the speed's range converted through the gear set
+            vary, name = speed_range(gs, vary, values), OMEGA
         settings = c.solver_settings(transient, 1, rtol, atol)
         period = _period(period, start)
         first = None
@@ -353,13 +360,14 @@ def continue_(
     if quiet:
         return
     out = c.stdout()
-    _print_branch(out, summary, f"period-{period} branch of {gs.name} in {name}", name)
+    rpm = speeds_per_omega(gs, values).get("sun_rpm") if name == OMEGA else None
+    _print_branch(out, summary, f"period-{period} branch of {gs.name} in {name}", name, rpm)
     for entry in summary.get("cascade", []):
         title = (
             f"{entry['branch']}: period-{entry['period']} branch from the period doubling at "
             f"{name}={entry['parent_value']:.6g} of {entry['parent']}"
         )
-        _print_branch(out, entry, title, name)
+        _print_branch(out, entry, title, name, rpm)
     for skip in summary.get("cascade_skipped", []):
         out.print(
             Text(
@@ -394,8 +402,11 @@ def _cascade_entry(branch: Any) -> dict[str, Any]:
     }
 
 
-def _print_branch(out: Any, summary: dict[str, Any], title: str, name: str) -> None:
-    """The points, stop reason, segments and events table of one branch."""
+def _print_branch(
+    out: Any, summary: dict[str, Any], title: str, name: str, rpm: float | None = None
+) -> None:
+    """The points, stop reason, segments and events table of one branch; with ``rpm`` (the
+    sun speed per unit Ω of a branch in Ω) the segments and events also in rpm."""
     table = pairs_table(title)
     table.add_row("points", str(summary["points"]))
     table.add_row("stopped", escape(str(summary["stop_reason"])))
@@ -403,12 +414,15 @@ def _print_branch(out: Any, summary: dict[str, Any], title: str, name: str) -> N
         table.add_row("seconds", f"{summary['seconds']:.3g}")
     for seg in summary["segments"]:
         what = "stable" if seg["stable"] else "unstable"
+        speed = "" if rpm is None else f" ({seg['from'] * rpm:.5g} … {seg['to'] * rpm:.5g} rpm)"
         table.add_row(
-            escape(f"{what} {seg['from']:.6g} … {seg['to']:.6g}"), f"{seg['points']} points"
+            escape(f"{what} {seg['from']:.6g} … {seg['to']:.6g}{speed}"),
+            f"{seg['points']} points",
         )
     out.print(table)
     events = Table(title="events along the branch", title_justify="left")
-    for col in ("kind", f"{name} ± uncertainty", "multiplier", "detail"):
+    speed_cols = () if rpm is None else ("sun speed [rpm]",)
+    for col in ("kind", f"{name} ± uncertainty", *speed_cols, "multiplier", "detail"):
         events.add_column(escape(col))
     for e in summary["events"]:
         mu = e.get("multiplier")
@@ -416,6 +430,7 @@ def _print_branch(out: Any, summary: dict[str, Any], title: str, name: str) -> N
         events.add_row(
             escape(e["kind"]),
             _with_uncertainty(e["value"], e.get("uncertainty")),
+            *(() if rpm is None else (f"{e['value'] * rpm:.5g}",)),
             escape(mu_text),
             escape(str(e.get("detail", ""))),
         )
@@ -479,6 +494,7 @@ def attractors(
     with c.reported_errors():
         omega, changes = c.parse_sets(set_ or [])
         gs = c.load_target(preset, gearset, model, changes)
+        omega = c.point_omega(gs, omega, changes)  # --set sun_rpm / mesh_hz: through gs
         if omega is None:
             omega = c.DEFAULT_OMEGA
             c.default_omega_note(json_out, "set")
@@ -499,7 +515,8 @@ def attractors(
         return
     out = c.stdout()
     table = Table(
-        title=f"{len(found)} attractor(s) of {gs.name} at Ω = {omega:g} from {starts} starts",
+        title=f"{len(found)} attractor(s) of {gs.name} at Ω = {omega:g}"
+        f"{speed_note(gs, omega)} from {starts} starts",
         title_justify="left",
     )
     for col in ("motion", "λ₁", "starts (0: at rest)", "X̄_sp1 at the section", "orbit"):

@@ -14,6 +14,7 @@ from ..errors import ParameterError
 from ..integrate.settings import SIMULATION
 from . import _common as c
 from ._render import add_motion_rows
+from ._speeds import speed_note
 
 
 @c.app.command()
@@ -95,6 +96,7 @@ def simulate(
             raise ParameterError(f"--output must be a directory: {str(output)!r} is a file")
         omega, changes = c.parse_sets(set_ or [])
         gs = c.load_target(preset, gearset, model, changes)
+        omega = c.point_omega(gs, omega, changes)  # --set sun_rpm / mesh_hz: through gs
         omega = c.DEFAULT_OMEGA if omega is None else omega
         settings = c.solver_settings(
             transient, periods, rtol, atol, samples_per_period, settle, perturbation
@@ -139,7 +141,8 @@ def simulate(
     from ._render import format_summary
 
     out = c.stdout()
-    table = format_summary(summary, title=f"gearchaos simulation of {gs.name} at Ω = {omega:g}")
+    title = f"gearchaos simulation of {gs.name} at Ω = {omega:g}{speed_note(gs, omega)}"
+    table = format_summary(summary, title=title)
     add_motion_rows(table, summary)
     out.print(table)
     out.print(

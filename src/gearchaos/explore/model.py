@@ -19,8 +19,9 @@ import numpy as np
 from .._checks import check_int
 from ..errors import ParameterError, Status
 from ..gearset.schema import describe
-from ..plot._common import edges
+from ..plot._common import clearances_in_metres, edges
 from ..plot.regimes import REGIME_COLOURS, regime_category
+from ..plot.units import PhysicalScales
 from ..sweep.result import SweepResult
 
 __all__ = [
@@ -93,15 +94,28 @@ class Point:
         Its swept values by dotted name (family value included; no ``direction``).
     direction
         ``up`` or ``down`` for a store with both continuation branches, else ``None``.
+    sun_rpm
+        The sun speed n_s [rpm] at the point's Ω where the gear set defines it (swept or
+        fixed Ω), else ``None``.
+    metres
+        The names among ``values`` of clearances the gear set gives in metres (shown in µm).
     """
 
     index: tuple[int, ...]
     values: Mapping[str, float]
     direction: str | None = None
+    sun_rpm: float | None = None
+    metres: frozenset[str] = frozenset()
 
     def title(self) -> str:
-        """``Ω = 1.43`` style text naming the point."""
-        parts = [f"{_symbol(k)} = {v:.6g}" for k, v in self.values.items()]
+        """``Ω = 1.43, n_s = 7234 rpm`` style text naming the point (a clearance in metres
+        in µm: ``b_sp = 100 µm``)."""
+        parts = [
+            f"{_symbol(k)} = {v * 1e6:.4g} µm" if k in self.metres else f"{_symbol(k)} = {v:.6g}"
+            for k, v in self.values.items()
+        ]
+        if self.sun_rpm is not None:
+            parts.append(f"n_s = {self.sun_rpm:.5g} rpm")
         if self.direction:
             parts.append(f"{self.direction} branch")
         return ", ".join(parts)
@@ -180,6 +194,9 @@ class ExploreModel:
         self.res = self.full.select(chosen)
         self._lead = self.full.lead_dims
         self._fixed_index = {d: self._index_of(d, v) for d, v in chosen.items() if d in self._lead}
+        # the sun speed per unit Ω, where the gear set defines one over the whole sweep
+        self._rpm_per_omega = PhysicalScales.of_sweep(self.full).rpm_per_omega
+        self._metres = frozenset(clearances_in_metres(self.full.gearset))
 
     # ------------------------------------------------------------------ axes
     @property
@@ -232,7 +249,9 @@ class ExploreModel:
         for name in self.vary:
             values[name] = float(self.axis(name)[full[name]])
         direction = str(self.selection["direction"]) if self.directions else None
-        return Point(tuple(full[d] for d in self._lead), values, direction)
+        omega = values.get("omega", self.full.fixed_value("omega"))
+        rpm = None if omega is None or self._rpm_per_omega is None else omega * self._rpm_per_omega
+        return Point(tuple(full[d] for d in self._lead), values, direction, rpm, self._metres)
 
     def _at(self, name: str, point: Point) -> np.ndarray:
         da = self.full.ds[name].isel(dict(zip(self._lead, point.index, strict=True)))

@@ -14,7 +14,7 @@ import difflib
 import math
 
 from ..errors import ParameterError
-from .schema import ALIASES, EXTRA, FIELDS, META, OMEGA
+from .schema import ALIASES, EXTRA, FIELDS, META, OMEGA, SPEEDS
 from .tables import RECORD_CLASSES
 
 __all__ = ["parse_float", "parse_floats", "parse_int", "parse_text", "unquote"]
@@ -109,7 +109,7 @@ def parse_text(name: str, raw: str) -> object:
         raise ParameterError(
             f"{name} is a table, not a parameter; set one of its fields: {', '.join(names)}"
         )
-    close = difflib.get_close_matches(name.lower(), [*FIELDS, *ALIASES, OMEGA], n=1)
-    if close == [OMEGA]:
-        raise ParameterError(f"unknown parameter {name!r}; did you mean 'omega'?")
+    close = difflib.get_close_matches(name.lower(), [*FIELDS, *ALIASES, OMEGA, *SPEEDS], n=1)
+    if close and close[0] in (OMEGA, *SPEEDS):  # the operating point, not a gear-set field
+        raise ParameterError(f"unknown parameter {name!r}; did you mean {close[0]!r}?")
     return raw  # GearSet.evolve reports the unknown name with its own suggestion

@@ -47,7 +47,7 @@ from .tables import (
     TransmissionError,
 )
 from .tomltext import MAX_FILE_BYTES, parse, to_toml
-from .validation import validate
+from .validation import validate, warn_if_clearance_in_metres
 
 __all__ = ["MAX_FILE_BYTES", "UNITS", "GearSet"]
 
@@ -84,6 +84,7 @@ class GearSet:
 
     def __post_init__(self) -> None:
         validate(self)
+        warn_if_clearance_in_metres(self)  # a value in metres for one in units of b_c?
 
     # ------------------------------------------------------------------ geometry
     @property
@@ -215,6 +216,26 @@ class GearSet:
         w = omega * self.omega_n
         ws = w * (z.sun + z.ring) / (z.sun * z.ring)
         return ws * 60.0 / (2.0 * math.pi)
+
+    def speed(self, name: str, omega: float) -> float:
+        """The operating speed ``name`` at Ω: ``sun_rpm``, the sun speed n_s [rpm]
+        (:meth:`sun_speed_rpm`), or ``mesh_hz``, the mesh frequency f_m = Ω ω_n/2π [Hz]. The
+        one conversion between Ω and the speeds (its inverse is :meth:`omega_at`)."""
+        if name == "sun_rpm":
+            return self.sun_speed_rpm(omega)
+        if name == "mesh_hz":
+            return omega * self.omega_n / (2.0 * math.pi)
+        raise ParameterError(f"a speed is sun_rpm or mesh_hz: got {name!r}")
+
+    def omega_at(self, name: str, value: float) -> float:
+        """Ω = ω/ω_n at the operating speed ``name`` = ``value`` (the inverse of
+        :meth:`speed`): ω = 2π n_s z_s z_r / (60 (z_s + z_r)) for ``sun_rpm`` (MODEL.md §2,
+        :meth:`mesh_frequency`), ω = 2π f_m for ``mesh_hz``."""
+        if name == "sun_rpm":
+            return self.mesh_frequency(value) / self.omega_n
+        if name == "mesh_hz":
+            return 2.0 * math.pi * value / self.omega_n
+        raise ParameterError(f"a speed is sun_rpm or mesh_hz: got {name!r}")
 
     # ------------------------------------------------------------------ clearances
     def _bar(self, value: float, units: str) -> float:

@@ -4,7 +4,8 @@ For each gear-set field (``teeth.sun`` … ``mesh_phasing.ring_sun``) :data:`FIE
 :class:`Field`: its kind (``int``, ``float``, ``str`` or ``floats``), unit, plain and TeX
 symbol, meaning, allowed choices, its rule (the sign or interval the model needs) and its
 plausible range (``limits``: where a value stops describing a gear set; docs/gearset-rules.md).
-The operating point ``omega`` (Ω = ω/ω_n) and the alias ``xi`` (the three damping ratios) are
+The operating point ``omega`` (Ω = ω/ω_n), the speeds that set it through a gear set
+(``sun_rpm``, ``mesh_hz``: :data:`SPEEDS`) and the alias ``xi`` (the three damping ratios) are
 described in :data:`EXTRA`. :data:`CLEARANCES` says which clearance belongs to which
 observable, :data:`MODULE_BOUNDED` which lengths may not exceed one module. Validation, TOML
 I/O, the command line's ``--set`` parsing, plot labels and the paper's tables all read this
@@ -26,9 +27,12 @@ __all__ = [
     "EXTRA",
     "FIELDS",
     "MAX_HARMONICS",
+    "MESH_HZ",
     "META",
     "MODULE_BOUNDED",
     "OMEGA",
+    "SPEEDS",
+    "SUN_RPM",
     "TABLES",
     "UNITS",
     "XI",
@@ -54,6 +58,9 @@ _HARMONIC: Final = Rule(-1e13, 1e13)
 _DAMPING: Final = Rule(0.0, 10.0)
 _TORQUE: Final = Rule(-1e9, 1e9)
 _OMEGA: Final = Rule(1e-6, 1e6)
+# Ω of an operating point: a mesh frequency 50 times the first mesh mode's is no gearbox's
+# (an rpm typed as Ω, 7000, is 34 million rpm for sheng2016: refused, with a hint at sun_rpm)
+_OMEGA_POINT: Final = Rule(1e-6, 50.0)
 _LENGTH_SCALE: Final = Rule(1e-9, 1.0)
 _PHASE: Final = Rule(-1e6, 1e6)
 
@@ -479,8 +486,15 @@ ALIASES: Final = MappingProxyType(
 #: by name like one (``--set omega=1.5``, ``--vary omega=0.1:4:800``).
 OMEGA: Final = "omega"
 XI: Final = "xi"
+#: The sun (input) speed n_s [rpm] and the mesh frequency f_m [Hz]: the operating point in a
+#: drivetrain engineer's units, each setting Ω through the gear set's ω_n (and tooth numbers)
+#: (:meth:`~gearchaos.gearset.GearSet.omega_at`). Addressed like Ω (``--set sun_rpm=7500``,
+#: ``--vary sun_rpm=1000:20000:200``); at most one of Ω and these per point.
+SUN_RPM: Final = "sun_rpm"
+MESH_HZ: Final = "mesh_hz"
+SPEEDS: Final = (SUN_RPM, MESH_HZ)
 
-#: Names that are not gear-set fields: Ω and the alias ξ.
+#: Names that are not gear-set fields: Ω, the speeds that set it and the alias ξ.
 EXTRA: Final = MappingProxyType(
     {
         OMEGA: Field(
@@ -491,7 +505,25 @@ EXTRA: Final = MappingProxyType(
             r"\Omega",
             "dimensionless mesh frequency Ω = ω/ω_n",
             POSITIVE,
-            limits=_OMEGA,
+            limits=_OMEGA_POINT,
+        ),
+        SUN_RPM: Field(
+            SUN_RPM,
+            "float",
+            "rpm",
+            "n_s",
+            "n_s",
+            "sun (input) speed; sets Ω = 2π n_s z_s z_r / (60 (z_s + z_r) ω_n)",
+            POSITIVE,
+        ),
+        MESH_HZ: Field(
+            MESH_HZ,
+            "float",
+            "Hz",
+            "f_m",
+            "f_m",
+            "mesh frequency; sets Ω = 2π f_m / ω_n",
+            POSITIVE,
         ),
         XI: Field(
             XI,
@@ -539,7 +571,8 @@ CLEARANCES: Final = MappingProxyType(
 
 
 def describe(name: str) -> Field | None:
-    """The :class:`Field` of a gear-set field, ``omega`` or ``xi``; ``None`` for other names."""
+    """The :class:`Field` of a gear-set field, ``omega``, a speed or ``xi``; ``None`` for other
+    names."""
     return FIELDS.get(name) or EXTRA.get(name)
 
 

@@ -16,7 +16,9 @@ calls it: a gear set is anything with the twelve table attributes, ``name`` and
 The edges of a valid gear set are explained in ``docs/gearset-rules.md``.
 
 :func:`warn_if_eccentric` is a separate, non-fatal check for analyses that sample the response at
-the mesh-period Poincaré section.
+the mesh-period Poincaré section; :func:`warn_if_clearance_in_metres`, run with
+:func:`validate`, warns of a clearance in units of b_c so small that it is most likely a value
+in metres.
 """
 
 from __future__ import annotations
@@ -39,10 +41,16 @@ __all__ = [
     "FIELD_KINDS",
     "POINCARE_ANALYSES",
     "RECORD_CLASSES",
+    "SMALL_CLEARANCE_BAR",
     "show",
     "validate",
+    "warn_if_clearance_in_metres",
     "warn_if_eccentric",
 ]
+
+#: A clearance in units of b_c below this (and above 0) is most likely a value in metres: b_c
+#: is some µm, so 1e-3 b_c is some nm, far below any manufactured backlash.
+SMALL_CLEARANCE_BAR: Final = 1e-3
 
 #: Kind of every dotted field: ``"int"``, ``"float"``, ``"str"`` or ``"floats"`` (tuple of floats).
 FIELD_KINDS: Final = MappingProxyType({name: f.kind for name, f in FIELDS.items()})
@@ -390,6 +398,32 @@ def _check_planets_fit(gs: Any) -> None:
 POINCARE_ANALYSES: Final = frozenset(
     {"poincare", "poincare_map", "bifurcation", "periodicity", "period", "classify", "map"}
 )
+
+
+def warn_if_clearance_in_metres(gs: Any) -> list[str]:
+    """Warn for every clearance given in units of b_c (its ``units`` field ``dimensionless``)
+    whose value lies in (0, :data:`SMALL_CLEARANCE_BAR`): a value in metres given for a
+    parameter in units of b_c (``--set backlash.sun_planet=60e-6`` on a gear set in b_c means
+    6×10⁻⁵ b_c, about a nanometre) is the likely mistake, and the warning says so, with the
+    value in units of b_c that the metres would be. Returns the names warned about."""
+    bc = gs.clearance.characteristic_length
+    warned = []
+    for name, units_field in MODULE_BOUNDED.items():
+        if units_field is None or _value(gs, units_field) != "dimensionless":
+            continue
+        v = float(_value(gs, name))
+        if not 0.0 < v < SMALL_CLEARANCE_BAR:
+            continue
+        warned.append(name)
+        warnings.warn(
+            f"{name} = {v:g} is in units of b_c ({units_field} = 'dimensionless'), so it is "
+            f"{v * bc * 1e9:.3g} nm (b_c = {bc * 1e6:.4g} µm): is it a value in metres given "
+            f"for a parameter in units of b_c? {v:g} m is {v / bc:.4g} b_c (give {name} = "
+            f"{v / bc:.4g}), or set {units_field} = 'm' to give clearances in metres",
+            UserWarning,
+            stacklevel=4,  # the code that built the gear set (through GearSet.__init__)
+        )
+    return warned
 
 
 def _normalise_analysis(analysis: str) -> str:

@@ -54,10 +54,13 @@ def gearset_info(gs: GearSet) -> dict[str, Any]:
           equilibrium (MODEL.md §10.1);
         - ``static_deflection``: F/k_m of each mesh in metres and in units of b_c
           (``*_m`` and ``*_bar``), the elastic part of δ = b + F/k_m;
+        - ``clearances_um``: the half clearances b_sp, b_rp, b_s in µm (b̄ b_c, whatever units
+          the gear set gives them in), beside their b̄ among ``dimensionless``;
         - ``natural_frequencies``: :func:`gearchaos.model.modal.modes_table` rows;
         - ``omega_at_resonances``: for every non-zero mode and h in
-          :data:`RESONANCE_HARMONICS`, ``{"mode_ratio", "kind", "harmonic", "omega"}`` with
-          Ω = ratio/h, the dimensionless mesh frequency at which h Ω meets the mode; sorted by Ω.
+          :data:`RESONANCE_HARMONICS`, ``{"mode_ratio", "kind", "harmonic", "omega",
+          "sun_speed_rpm"}`` with Ω = ratio/h, the dimensionless mesh frequency at which h Ω
+          meets the mode, and the sun speed there; sorted by Ω.
     """
     par, scales = nondimensionalise(gs)
     n = gs.n_planets
@@ -76,6 +79,7 @@ def gearset_info(gs: GearSet) -> dict[str, Any]:
             "kind": m.kind,
             "harmonic": h,
             "omega": float(m.ratio / h),
+            "sun_speed_rpm": gs.sun_speed_rpm(float(m.ratio / h)),
         }
         for m in modes
         if m.ratio > 0.0
@@ -150,6 +154,11 @@ def gearset_info(gs: GearSet) -> dict[str, Any]:
             "sun_planet_bar": float(defl_sp / bc),
             "planet_ring_m": float(defl_rp),
             "planet_ring_bar": float(defl_rp / bc),
+        },
+        "clearances_um": {
+            "sun_planet": float(par.b_sp * bc * 1e6),
+            "planet_ring": float(par.b_rp * bc * 1e6),
+            "sun_bearing": float(par.b_s * bc * 1e6),
         },
         "natural_frequencies": table,
         "omega_at_resonances": resonances,

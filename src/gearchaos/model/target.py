@@ -4,9 +4,12 @@ A *target* is what a user simulates, sweeps or continues: a
 :class:`~gearchaos.gearset.GearSet` (parameters: the dotted gear-set names of
 :mod:`gearchaos.gearset.schema`, the alias ``xi``) or a :class:`System` (a reference system or a
 model built by hand; parameters: the fields of its model, ``zeta``, ``f_alt`` …). Both take
-``omega``, the dimensionless forcing frequency Ω. This module is the one place that applies
-such names: it splits Ω from the rest, applies the rest to the target, and refuses unknown
-names with the closest valid one.
+``omega``, the dimensionless forcing frequency Ω, or instead one of the speeds that set it
+through a gear set (``sun_rpm``, the sun speed in rpm, and ``mesh_hz``, the mesh frequency in
+Hz: :data:`~gearchaos.gearset.schema.SPEEDS`). This module is the one place that applies such
+names: it splits Ω (or the speed, converted by the gear set's
+:meth:`~gearchaos.gearset.GearSet.omega_at`) from the rest, applies the rest to the target, and
+refuses unknown names with the closest valid one.
 """
 
 from __future__ import annotations
@@ -20,18 +23,24 @@ from typing import Any
 from .._checks import check_real
 from ..errors import ParameterError
 from ..gearset import GearSet
-from ..gearset.schema import ALIASES, EXTRA, FIELDS
+from ..gearset.schema import ALIASES, EXTRA, FIELDS, SPEEDS
 from .planetary import PlanetaryModel
 from .system import System
 
 __all__ = [
     "DEFAULT_OMEGA",
     "OMEGA",
+    "SPEEDS",
     "check_names",
+    "check_one_operating_point",
     "model_for",
+    "operating_omega",
     "parameter_names",
     "resolve",
     "scale_attrs",
+    "speed_gearset",
+    "speed_names",
+    "speeds_at",
     "split_omega",
 ]
 
@@ -52,17 +61,16 @@ def _check_target(target: Any) -> None:
 
 
 def parameter_names(target: Any) -> list[str]:
-    """The names :func:`resolve` accepts for ``target`` (Ω included)."""
+    """The names :func:`resolve` accepts for ``target`` (Ω and the speeds included: a target
+    without a gear set refuses a speed when it is used, with the reason)."""
     _check_target(target)
     if isinstance(target, GearSet):
-        return [*FIELDS, *ALIASES, OMEGA]
+        return [*FIELDS, *ALIASES, OMEGA, *SPEEDS]
     model = target.model
     if not dataclasses.is_dataclass(model):
-        return [OMEGA]
-    return [
-        *(f.name for f in dataclasses.fields(model) if f.name not in _LAYOUT_FIELDS),
-        OMEGA,
-    ]
+        return [OMEGA, *SPEEDS]
+    own = [f.name for f in dataclasses.fields(model) if f.name not in _LAYOUT_FIELDS]
+    return [*own, OMEGA, *(s for s in SPEEDS if s not in own)]
 
 
 def check_names(target: Any, names: Any) -> None:
@@ -78,22 +86,98 @@ def check_names(target: Any, names: Any) -> None:
 
 
 def check_omega(value: Any) -> float:
-    """Ω as a float: a finite number > 0 inside its plausible range (the registry's)."""
+    """Ω as a float: a finite number > 0 inside its plausible range (the registry's); a value
+    outside is refused with a hint at the speeds (an rpm typed as Ω is the likely mistake)."""
     omega = check_real(OMEGA, value, lo=0.0, lo_open=True)
     limits = EXTRA[OMEGA].limits
     if limits is not None and not limits.holds(omega):
         raise ParameterError(
-            f"omega must lie in the plausible range {limits.text()[3:]}: got {value!r}"
+            f"omega must lie in the plausible range {limits.text()[3:]}: got {omega:g}; Ω = "
+            f"ω/ω_n is dimensionless (a gear set's sun speed in rpm is sun_rpm={omega:g}, "
+            f"its mesh frequency in Hz mesh_hz={omega:g}: --set sun_rpm=...)",
+            name=OMEGA,
         )
     return omega
 
 
 def split_omega(values: Mapping[str, Any]) -> tuple[float | None, dict[str, Any]]:
-    """(Ω or None, the other values); Ω is checked by :func:`check_omega`."""
+    """(Ω or None, the other values); Ω is checked by :func:`check_omega`. Speeds are left
+    among the other values (:func:`operating_omega` converts them)."""
     rest = dict(values)
     if OMEGA not in rest:
         return None, rest
     return check_omega(rest.pop(OMEGA)), rest
+
+
+def speed_names(target: Any, names: Any) -> list[str]:
+    """The speeds among the parameter ``names`` of ``target`` (a model's own field of the same
+    name is no speed)."""
+    if isinstance(target, System) and dataclasses.is_dataclass(target.model):
+        own = {f.name for f in dataclasses.fields(target.model)}
+        return [n for n in names if n in SPEEDS and n not in own]
+    return [n for n in names if n in SPEEDS]
+
+
+def check_one_operating_point(target: Any, names: Any) -> None:
+    """Refuse Ω and a speed, or two speeds, given together (each sets Ω)."""
+    given = [n for n in names if n == OMEGA] + speed_names(target, names)
+    if len(given) > 1:
+        raise ParameterError(
+            f"{' and '.join(given)} each set Ω (the operating point): give one of them",
+            name=given[1],
+        )
+
+
+def speed_gearset(target: Any, name: str, changes: Mapping[str, Any] | None = None) -> GearSet:
+    """The gear set through which the speed ``name`` sets Ω on ``target`` with ``changes``
+    (no Ω): the target itself, evolved, or the gear set a planetary model was built from. A
+    model without one (a reference system, your own model) has no physical scales: refused,
+    naming the speed."""
+    model = model_for(target, changes or {})
+    if isinstance(model, PlanetaryModel) and model.gearset is not None:
+        return model.gearset
+    raise ParameterError(
+        f"{name} sets Ω through a gear set's ω_n and tooth numbers, but {model.name} is not "
+        "built from a gear set (it has no physical scales): give omega (Ω = ω/ω_n) instead",
+        name=name,
+    )
+
+
+def _speed_omega(target: Any, name: str, value: Any, changes: Mapping[str, Any]) -> float:
+    """Ω of the speed ``name`` = ``value`` on ``target`` with ``changes``, checked."""
+    unit = EXTRA[name].unit
+    v = check_real(name, value, lo=0.0, lo_open=True)
+    omega = speed_gearset(target, name, changes).omega_at(name, v)
+    limits = EXTRA[OMEGA].limits
+    if limits is not None and not limits.holds(omega):
+        raise ParameterError(
+            f"{name} = {v:g} {unit} is Ω = {omega:.4g} for this gear set, outside Ω's "
+            f"plausible range {limits.text()[3:]}",
+            name=name,
+        )
+    return omega
+
+
+def operating_omega(target: Any, values: Mapping[str, Any]) -> tuple[float | None, dict[str, Any]]:
+    """(Ω or None, the other values) of ``values`` on ``target``: Ω given as ``omega`` or as a
+    speed (``sun_rpm``, ``mesh_hz``), which is converted through the gear set with the other
+    values applied (:func:`speed_gearset`, :meth:`~gearchaos.gearset.GearSet.omega_at`).
+    More than one of them is refused."""
+    check_one_operating_point(target, values)
+    speeds = speed_names(target, values)
+    if not speeds:
+        return split_omega(values)
+    rest = dict(values)
+    value = rest.pop(speeds[0])
+    return _speed_omega(target, speeds[0], value, rest), rest
+
+
+def speeds_at(model: Any, omega: float) -> dict[str, float]:
+    """The speeds (``sun_rpm``, ``mesh_hz``) at Ω of a model built from a gear set; ``{}``
+    for a model without one. Tables and figures show them beside Ω."""
+    if isinstance(model, PlanetaryModel) and model.gearset is not None:
+        return {name: model.gearset.speed(name, float(omega)) for name in SPEEDS}
+    return {}
 
 
 def _gearset_model(gs: GearSet, changes: tuple[tuple[str, str, Any], ...]) -> Any:
@@ -140,8 +224,9 @@ def resolve(
     target
         A :class:`~gearchaos.gearset.GearSet` or a :class:`System`.
     values
-        Parameters by name: ``omega`` (Ω), gear-set names (``backlash.sun_planet``, ``xi``) or
-        model fields of a system (``zeta``).
+        Parameters by name: ``omega`` (Ω) or a speed that sets it (``sun_rpm``, ``mesh_hz``:
+        a gear set's, through its ω_n and tooth numbers), gear-set names
+        (``backlash.sun_planet``, ``xi``) or model fields of a system (``zeta``).
     default_omega
         Ω when ``values`` has none: a gear set needs one (else :class:`ParameterError`); a
         system keeps its own Ω when neither is given.
@@ -153,7 +238,7 @@ def resolve(
         )
     if default_omega is not None:
         default_omega = check_omega(default_omega)
-    omega, changes = split_omega(values or {})
+    omega, changes = operating_omega(target, values or {})
     if omega is None:
         if default_omega is not None:
             omega = check_omega(default_omega)

@@ -14,7 +14,7 @@ import numpy as np
 
 from .._text import escape_text
 from ..errors import ParameterError
-from ..gearset.schema import OMEGA, describe
+from ..gearset.schema import MODULE_BOUNDED, OMEGA, describe
 from ..model.planetary import PlanetaryModel
 
 #: ``gid`` of the vertical lines where a mesh harmonic meets a natural frequency.
@@ -83,7 +83,13 @@ def given(name: str, value: Any, symbols: Mapping[str, str] | None = None) -> st
     ``$\\delta$ = 0.25``; an unknown name as it is, a value that is no number as written.
     ``symbols`` as for :func:`axis_symbol`."""
     number = isinstance(value, int | float | np.number) and not isinstance(value, bool)
-    return f"{axis_symbol(name, symbols)} = {fmt(value) if number else figure_text(value)}"
+    field = describe(name)
+    unit = f" {field.unit}" if number and field is not None and field.unit in _SPEED_UNITS else ""
+    return f"{axis_symbol(name, symbols)} = {fmt(value) if number else figure_text(value)}{unit}"
+
+
+#: Units written after a value in titles (a speed: ``$n_s$ = 7500 rpm``).
+_SPEED_UNITS = ("rpm", "Hz")
 
 
 def subject(attrs: Any, gearset: Any = None) -> str:
@@ -145,9 +151,11 @@ def given_values(
     shown = {str(n) for n in leave_out}
     out: list[str] = []
     symbols = parameter_symbols(attrs) if gearset is None else {}
+    metres = clearances_in_metres(gearset)
     for k, v in fixed.items():
-        if isinstance(v, int | float | np.number) and not isinstance(v, bool) and k not in shown:
-            out.append(given(k, v, symbols))
+        number = isinstance(v, int | float | np.number) and not isinstance(v, bool)
+        if number and k not in shown and k not in metres:  # those: b̄ and µm from the gear set
+            out.append(given(k, v, symbols) + (speed_text(v, gearset) if k == OMEGA else ""))
             shown.add(k)
     if gearset is None:  # a reference system or a user model: its parameters with a symbol
         text = str(attrs.get("model_parameters", "") or "")
@@ -162,12 +170,35 @@ def given_values(
         ("backlash.planet_ring", brp),
         ("clearance.sun_bearing", gearset.sun_bearing_clearance_bar()),
     ):
-        if key not in shown:
-            out.append(given(key, value))
+        if key not in shown:  # b̄, and the µm the gear set gives it in (units "m")
+            um = f" ({fmt(metres[key] * 1e6, '.4g')} µm)" if key in metres else ""
+            out.append(given(key, value) + um)
     d = gearset.damping
     if not _DAMPING & shown and d.sun_planet == d.planet_ring == d.sun_bearing:
         out.append(given("xi", d.sun_planet))
     return out
+
+
+def speed_text(omega: Any, gearset: Any) -> str:
+    """`` (7589 rpm)``: the sun speed that ``gearset`` (with its fixed values applied) turns Ω
+    into, written beside Ω in titles; ``""`` without a gear set."""
+    if gearset is None:
+        return ""
+    return f" ({fmt(gearset.sun_speed_rpm(float(omega)), '.5g')} rpm)"
+
+
+def clearances_in_metres(gearset: Any) -> dict[str, float]:
+    """The clearances that ``gearset`` gives in metres (their ``units`` field ``m``), by
+    name, in metres; ``{}`` without a gear set."""
+    if gearset is None:
+        return {}
+    from ..gearset.mapping import get_value
+
+    return {
+        name: float(get_value(gearset, name))  # type: ignore[arg-type]
+        for name, units in MODULE_BOUNDED.items()
+        if units is not None and get_value(gearset, units) == "m"
+    }
 
 
 def at_line(values: list[str], width: int = 80) -> str:

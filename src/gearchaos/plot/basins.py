@@ -31,6 +31,8 @@ from ._common import (
     given,
     model_symbols,
     parameter_symbols,
+    speed_text,
+    stored_gearset,
     subject,
     var_symbol,
 )
@@ -79,6 +81,18 @@ def _scales(attrs: Any) -> PhysicalScales:
 
         rpm = GearSet.from_toml_string(attrs["gearset_toml"]).sun_speed_rpm(1.0)
     return PhysicalScales(length_m=length, omega_n=omega_n, rpm_per_omega=rpm)
+
+
+def _point_gearset(attrs: Any, values: Mapping[str, Any]) -> Any:
+    """The stored gear set with the basin point's other values applied (``None`` for a
+    model's store, or when they are no gear-set values): it turns Ω into the sun speed."""
+    gs = stored_gearset(attrs)
+    if gs is None:
+        return None
+    try:
+        return gs.evolve({k: v for k, v in values.items() if k != "omega"})
+    except (ParameterError, TypeError):
+        return gs
 
 
 def _physical(ax: Any, axis: str, name: str, attrs: Any) -> None:
@@ -257,7 +271,11 @@ def basins_figure(ds: Any) -> Any:
     if "omega" not in spec["values"] and "omega" in ds.attrs and ds.attrs["dims"][0] != "omega":
         spec["values"] = {"omega": float(ds.attrs["omega"]), **spec["values"]}
     psym = parameter_symbols(ds.attrs)
-    point = ", ".join(given(k, v, psym) for k, v in spec["values"].items())
+    gs = _point_gearset(ds.attrs, spec["values"])
+    point = ", ".join(
+        given(k, v, psym) + (speed_text(v, gs) if k == "omega" else "")
+        for k, v in spec["values"].items()
+    )
     if kind == "basins":
         basin_image(ds, ax)
         title = f"{subject(ds.attrs)}: basins of attraction" + (f" at {point}" if point else "")

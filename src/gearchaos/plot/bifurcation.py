@@ -52,6 +52,7 @@ from .units import (
     clearance_notes,
     fit_to_data,
     notes_clear_of,
+    physical_axis,
     secondary_axis,
     var_quantity,
 )
@@ -333,8 +334,8 @@ def bifurcation(
     if physical:
         scales = PhysicalScales.of_sweep(res)
         secondary_axis(ax, "y", var_quantity(var), scales)
-        if x_name == "omega":
-            secondary_axis(ax, "x", "omega", scales)
+        # rpm opposite Ω, µm opposite a clearance in b_c (a clearance in metres read in µm)
+        physical_axis(ax, "x", x_name, scales, res.gearset)
     if lay.directions or (
         (clearance_lines or resonances or branches) and ax.get_legend_handles_labels()[0]
     ):
@@ -492,6 +493,7 @@ def bifurcation_figure(
             )
         if regimes:
             regime_band(res, bands[k], select=select)
+            bands[k].set_xlabel(ax.get_xlabel())  # the diagram's: µm for a clearance in metres
             ax.set_xlabel("")
             ax.tick_params(axis="x", labelbottom=False)
     for ax in axs[len(values) :]:

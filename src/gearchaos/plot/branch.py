@@ -38,7 +38,14 @@ from ._common import (
     var_symbol,
 )
 from .placement import EVENT_LABEL_GID, LABEL_PLACES, place_event_labels
-from .units import PhysicalScales, clearance_notes, fit_to_data, secondary_axis, var_quantity
+from .units import (
+    PhysicalScales,
+    clearance_notes,
+    fit_to_data,
+    physical_axis,
+    secondary_axis,
+    var_quantity,
+)
 
 __all__ = [
     "BRANCH_COLOURS",
@@ -410,8 +417,8 @@ def branch_figure(
 
         scales = PhysicalScales.of_model(PlanetaryModel.from_gearset(gs))
         secondary_axis(ax, "y", var_quantity(var), scales)
-        if name == "omega":
-            secondary_axis(ax, "x", "omega", scales)
+        # rpm opposite Ω, µm opposite a clearance in b_c (a clearance in metres read in µm)
+        physical_axis(ax, "x", name, scales, gs)
     ax.legend(loc="best", fontsize="small")
     fig.suptitle(_title(branches, var, planet), fontsize="medium")
     place_event_labels(fig)  # last: the layout is final

@@ -31,10 +31,14 @@ GALLERY_EXTRAS = ("phase", "spectrum")
 
 
 def gallery_title(param: str, value: float, summary: dict[str, Any] | None) -> str:
-    """Panel title ``Ω = 1.875 · 2T · λ₁ = −0.012`` (mathtext symbols; the LLE only when
+    """Panel title ``Ω = 1.875 (9485 rpm) · 2T · λ₁ = −0.012`` (mathtext symbols; the sun
+    speed of a gear set's summary; the LLE only when
     the summary has one, with its standard error when the verdict estimated it —
     ``λ₁ = 0.065 ± 0.005`` —, ``failed`` for a failed integration)."""
     parts = [f"{axis_symbol(param)} = {fmt(value)}"]
+    rpm = (summary or {}).get("sun_speed_rpm") if param == "omega" else None
+    if rpm is not None:  # a gear set's: the sun speed beside Ω
+        parts[0] += f" ({fmt(rpm, '.5g')} rpm)"
     if summary is not None:
         parts.append(str(summary.get("motion", "?")))
         lle = summary.get("lle")

@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from ..gearset.schema import OMEGA
+from ..gearset.schema import MODULE_BOUNDED, OMEGA
 from ._common import axis_symbol, fmt
 
 __all__ = [
@@ -173,21 +173,59 @@ def physical_axis(
     symbol: str | None = None,
 ) -> Any:
     """The physical axis opposite the dimensionless axis of ``name`` (top for x, right for
-    y), for every map and chart over parameters or states: the sun speed in rpm opposite Ω,
-    µm opposite a clearance that ``gearset`` gives in units of b_c (``backlash.*``,
-    ``clearance.*``), µm, mm/s or N opposite a state (:func:`var_quantity`, labelled
+    y), for every map, diagram and chart over parameters or states: the sun speed in rpm
+    opposite Ω, µm opposite a clearance that ``gearset`` gives in units of b_c (``backlash.*``,
+    ``clearance.sun_bearing``), µm, mm/s or N opposite a state (:func:`var_quantity`, labelled
     ``symbol``); nothing where the scales do not define it (a reference system) or the axis
-    is physical already (a torque in N m, a clearance in metres). Returns the axis or None."""
+    is physical already (a torque in N m). A clearance that ``gearset`` gives in metres
+    (``backlash.units = "m"``) is read in µm (the axis relabelled ``b_sp [µm]``, its ticks
+    in µm: :func:`metres_axis`) with b̄ = b/b_c opposite. Returns the axis or None."""
     if name == OMEGA:
         found = scales.factor("omega")
         return None if found is None else linear_axis(ax, axis, found[0], found[1])
-    if name.startswith(("backlash.", "clearance.")):
-        group = getattr(gearset, name.partition(".")[0], None) if gearset is not None else None
-        if getattr(group, "units", None) != "dimensionless":
+    if MODULE_BOUNDED.get(name):
+        units = _units(gearset, name)
+        if units == "m":
+            return metres_axis(ax, axis, name, scales)
+        if units != "dimensionless":
             return None
-        sym = symbol or axis_symbol(name).replace("\\bar ", "")
+        sym = symbol or _unbarred(name)
         return secondary_axis(ax, axis, "length", scales, symbol=sym)
     return secondary_axis(ax, axis, var_quantity(name), scales, symbol=symbol or "")
+
+
+def _unbarred(name: str) -> str:
+    """The symbol of a clearance in metres: ``$b_{sp}$`` (its b̄ without the bar)."""
+    return axis_symbol(name).replace("\\bar ", "")
+
+
+def _units(gearset: Any, name: str) -> str | None:
+    """The units (``dimensionless`` or ``m``) in which ``gearset`` gives the clearance
+    ``name``; None without a gear set."""
+    if gearset is None:
+        return None
+    from ..gearset.mapping import get_value
+
+    return str(get_value(gearset, str(MODULE_BOUNDED[name])))
+
+
+def metres_axis(ax: Any, axis: str, name: str, scales: PhysicalScales) -> Any:
+    """The axis of a clearance ``name`` whose values are in metres, read in µm: labelled
+    ``$b_{sp}$ [µm]`` with ticks 10⁶ times the values, and b̄ = b/b_c (the model's
+    dimensionless clearance) opposite where b_c is defined. Returns the opposite axis or
+    None."""
+    from matplotlib.ticker import FuncFormatter
+
+    label = f"{_unbarred(name)} [µm]"
+    shared = ax.get_shared_x_axes() if axis == "x" else ax.get_shared_y_axes()
+    for other in shared.get_siblings(ax):  # a regime band below shares the axis and its label
+        target = other.xaxis if axis == "x" else other.yaxis
+        if other is ax or target.get_label_text():
+            target.set_major_formatter(FuncFormatter(lambda v, _: fmt(v * 1e6, ".4g")))
+            target.set_label_text(label)
+    if not scales.length_m:
+        return None
+    return linear_axis(ax, axis, 1.0 / scales.length_m, axis_symbol(name))
 
 
 def linear_axis(ax: Any, axis: str, k: float, label: str) -> Any:

@@ -34,6 +34,7 @@ from .integrity import StoreLock
 from .orbits import ORBIT_VARIABLES, status_attrs, task_orbits
 from .progress import _Bar
 from .spec import DEFAULT_OBSERVE, SweepSpec, sweep_keywords
+from .speeds import given_speed, omega_spec, speed_coords
 from .store import SweepStore
 from .verdicts import VERDICT_VARIABLES, task_verdicts, verdict_attrs
 
@@ -52,8 +53,10 @@ STEP_COUNTS = {
 class _Layout:
     """Store variables of a sweep and how to fill them from kernel outputs."""
 
-    def __init__(self, grid: Grid):
+    def __init__(self, grid: Grid, speed: str | None = None):
         spec, ref = grid.spec, grid.reference
+        # a sweep given by a speed: sun_rpm, mesh_hz along Ω (or at a fixed Ω: attributes)
+        self.speeds, self.speed_attrs = speed_coords(grid.target, spec, speed, ref.omega)
         self.grid = grid
         self.lead_dims = grid.dims
         self.lead_shape = grid.shape
@@ -208,6 +211,7 @@ def _coords(grid: Grid, layout: _Layout) -> dict[str, tuple[tuple[str, ...], np.
         c["direction"] = (("direction",), np.array(spec.directions, dtype="U4"))
     for a in spec.axes:
         c[a.name] = ((a.name,), np.array(a.values, dtype=float))
+    c.update(layout.speeds)
     c["section"] = (("section",), np.arange(int(spec.solver.periods)))
     if any(ob.per_planet for ob in layout.observed):
         c["planet"] = (("planet",), np.array(spec.planets, dtype=np.int64))
@@ -272,14 +276,15 @@ def run_sweep(
     classify: bool = True,
 ) -> Any:
     """Run (or resume) a sweep described by ``spec`` on ``execution`` (default: in-process on
-    all cores) into ``store``; return its :class:`xarray.Dataset`."""
+    all cores) into ``store``; return its :class:`xarray.Dataset`. A speed is run as Ω."""
     overwrite, progress = check_bool("overwrite", overwrite), check_bool("progress", progress)
     classify = check_bool("classify", classify)
-    grid = Grid(target, spec, chunk_points=chunk_points)
-    layout = _Layout(grid)
+    speed = given_speed(target, spec)
+    grid = Grid(target, omega_spec(target, spec), chunk_points=chunk_points)
+    layout = _Layout(grid, speed)
     path = _store_path(store)
     st = SweepStore(path)
-    attrs = _attrs(target, grid)
+    attrs = {**_attrs(target, grid), **layout.speed_attrs}
     lock = StoreLock(path) if path is not None else contextlib.nullcontext()
     with lock:
         return _run_locked(grid, layout, st, attrs, overwrite, execution, progress, classify)
@@ -527,13 +532,15 @@ def bifurcation(
     vary
         One or two axes: ``"omega=0.01:4:800"``, a list of such strings, or a mapping
         ``{"backlash.planet_ring": numpy_array}``. Syntax: ``start:stop:count``,
-        ``log:start:stop:count`` or ``a,b,c``.
+        ``log:start:stop:count`` or ``a,b,c``. A speed ``sun_rpm`` (rpm) or ``mesh_hz`` (Hz) is
+        swept as Ω with both speeds as coordinates along it (:mod:`gearchaos.sweep.speeds`).
     family
         One more axis drawn as separate panels (e.g. ``{"xi": [0.03, 0.05, 0.07, 0.09]}``).
     params
         Fixed parameter values by dotted name (``{"backlash.sun_planet": 2.4}``), ``omega``
-        included when it is not swept; parameters whose names are Python identifiers may also
-        be given by name (``omega=1.5``, ``xi=0.05``).
+        included when it is not swept (or ``sun_rpm``/``mesh_hz``, stored as Ω and the
+        attributes ``sun_rpm_fixed``, ``mesh_hz_fixed``); parameters whose names are Python
+        identifiers may also be given by name (``omega=1.5``, ``sun_rpm=7500``, ``xi=0.05``).
     settings
         A :class:`~gearchaos.integrate.settings.SolverSettings` (default: 100 transient and
         100 recorded periods); settings given by name (``periods=200``) override it.
