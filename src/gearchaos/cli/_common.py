@@ -291,9 +291,8 @@ def parse_sets(items: Sequence[str]) -> tuple[float | None, dict[str, object]]:
     Raises
     ------
     ParameterError
-        For an item without ``=``, a value that does not parse as its field's kind,
-        ``omega`` not a finite number > 0 in its plausible range, or Ω set twice (``omega``
-        and a speed, or two speeds).
+        For an item without ``=``, a value that does not parse as its field's kind, ``omega``
+        not finite, > 0 and plausible, or Ω set twice (``omega`` and a speed, or two speeds).
     """
     omega: float | None = None
     changes: dict[str, object] = {}
@@ -354,8 +353,7 @@ def load_target(
 ) -> Any:
     """The gear set of ``--preset``/``--gearset`` with ``changes`` (:func:`load_gearset`), or,
     with ``--model``, a :class:`~gearchaos.model.System` of that model class with ``changes``
-    as its parameters (at Ω = DEFAULT_OMEGA until a command sets Ω). A speed among
-    ``changes`` is no gear-set field (:func:`point_omega` reads it); a model refuses it."""
+    as its parameters (at Ω = DEFAULT_OMEGA until a command sets Ω; a model refuses a speed)."""
     if model is None:
         return load_gearset(preset, gearset_file, changes)
     if preset is not None or gearset_file is not None:
