@@ -1,5 +1,5 @@
 """Command-line interface: ``gearchaos simulate | info | presets | init-gearset |
-bifurcation | response | plot | classify | explore | poincare | reproduce | calibrate``.
+bifurcation | classify | plot | response | explore | poincare | reproduce | calibrate``.
 
 Every command takes the gear set the same way: ``--preset NAME`` (default ``sheng2016``) or
 ``--gearset FILE.toml`` (one of the two), then any number of ``--set NAME=VALUE`` changes by
@@ -8,14 +8,15 @@ the dotted parameter names of :mod:`gearchaos.gearset.schema` (``backlash.sun_pl
 frequency Ω = ω/ω_n) is a simulation setting, not a gear-set field, but is given with
 ``--set omega=1.5`` as well, so that a command line reads like a point of a sweep.
 
-One module per group of commands (:mod:`.simulate`, :mod:`.gearset`, :mod:`.sweep`,
+One module per group of commands (:mod:`.simulate`, :mod:`.gearset`, :mod:`.sweep`, :mod:`.plot`,
 :mod:`.gallery`, :mod:`.paper`); what they share — the app, error handling and exit codes,
 ``--set`` parsing, options — is in :mod:`._common`, tables for people in :mod:`._render`.
 """
 
 # isort: off
 # the import order is the order of the commands in `gearchaos --help`
-from . import simulate, gearset, sweep, response, gallery, orbits, basins, paper, export, explore  # noqa: F401
+from . import simulate, gearset, sweep, plot, response, gallery  # noqa: F401
+from . import orbits, basins, paper, export, explore  # noqa: F401
 from . import boundary  # noqa: F401
 
 # isort: on
@@ -50,6 +51,7 @@ __all__ = [
     "orbits",
     "paper",
     "parse_sets",
+    "plot",
     "simulate",
     "sweep",
 ]

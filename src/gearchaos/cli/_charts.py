@@ -53,3 +53,69 @@ def chart_figure(
         planet=1 if planet is None else planet,
         quantity="amplitude" if quantity is None else quantity,
     )
+
+
+def contact_chart(res: Any, given: dict[str, Any]) -> Any:
+    """The contact figure of a 1-D sweep or response store (``--contact``); the other
+    options of ``gearchaos plot`` that do not apply to it are refused by name."""
+    from ..plot.contact import contact_figure
+
+    wrong = [name for name, value in given.items() if value not in (None, False, [])]
+    if wrong:
+        raise ParameterError(
+            "--contact draws the contact regime of every mesh of a 1-D sweep: "
+            f"{', '.join(wrong)} does not apply to it"
+        )
+    return contact_figure(res)
+
+
+def contact_table(res: Any, *, title: str) -> Any:
+    """A rich table of the contact ranges of a 1-D sweep
+    (:func:`~gearchaos.sweep.contact.contact_ranges`): per mesh and sweep direction the runs
+    of one regime, their swept values, the sun speed in rpm (over Ω, where the gear set
+    defines it) and the largest peak contact force in newtons (a response store)."""
+    from rich.table import Table
+
+    from ..plot._common import axis_symbol
+    from ..plot.units import PhysicalScales
+    from ..sweep.contact import contact_ranges
+    from ._render import escape
+
+    ranges = contact_ranges(res)
+    x_name = res.line_axis("contact ranges", "contact_sp")
+    scales = PhysicalScales.of_sweep(res)
+    rpm = scales.factor("omega") if x_name == "omega" else None
+    force = scales.factor("force")
+    has_force = any(r.peak_force is not None for r in ranges)
+    has_direction = any(r.direction for r in ranges)
+    symbol = "Ω" if x_name == "omega" else axis_symbol(x_name).strip("$")
+    table = Table(title=escape(title), title_justify="left")
+    table.add_column("mesh", no_wrap=True)
+    if has_direction:
+        table.add_column("sweep", no_wrap=True)
+    table.add_column("contact regime")
+    table.add_column(escape(symbol), justify="right", no_wrap=True)
+    if rpm is not None:
+        table.add_column(escape("sun speed [rpm]"), justify="right", no_wrap=True)
+    if has_force:
+        unit = "N" if force is not None else "k_m,sp b_c"
+        table.add_column(escape(f"peak contact force [{unit}]"), justify="right", no_wrap=True)
+
+    def span(lo: float, hi: float, spec: str) -> str:
+        a, b = format(lo, spec), format(hi, spec)
+        return a if a == b else f"{a} … {b}"
+
+    for r in ranges:
+        cells = [r.mesh.replace("_", "–")]
+        if has_direction:
+            cells.append(r.direction or "")
+        cells += [r.describe(), span(r.start, r.stop, ".4g")]
+        if rpm is not None:
+            cells.append(span(r.start * rpm[0], r.stop * rpm[0], ".0f"))
+        if has_force:
+            f = r.peak_force
+            cells.append(
+                "—" if f is None else (f"{f * force[0]:.0f}" if force is not None else f"{f:.4g}")
+            )
+        table.add_row(*cells)
+    return table

@@ -6,13 +6,15 @@ Every plotting function takes ``ax=None`` (a new figure when not given) and retu
 :func:`regime_band` and :func:`regime_map` (motion labels in the one palette
 :data:`REGIME_COLOURS`). :func:`summary_figure` puts a simulation on one page,
 :func:`poincare_gallery` several (Poincaré maps titled with value, motion and LLE),
-:func:`bifurcation_figure` and :func:`sweep_figure` a sweep (one panel per family value);
+:func:`bifurcation_figure` and :func:`sweep_figure` a sweep (one panel per family value),
+:func:`contact_figure` the contact regime of every mesh along a 1-D sweep (rattle against speed);
 :func:`savefig` writes PNG, PDF or SVG by suffix. Symbols follow the seed:
 X̄_sp1 = δ_sp1/b_c, time in mesh periods τΩ/2π.
 """
 
 from ._common import axis_label, axis_symbol
 from .bifurcation import bifurcation, bifurcation_figure
+from .contact import contact_figure
 from .figure import savefig, summary_figure
 from .gallery import poincare_gallery
 from .maps import distinct_counts, distinct_map, sweep_figure
@@ -34,6 +36,7 @@ __all__ = [
     "axis_symbol",
     "bifurcation",
     "bifurcation_figure",
+    "contact_figure",
     "distinct_counts",
     "distinct_map",
     "phase_portrait",

@@ -1,6 +1,7 @@
 """Sweeps: bifurcation diagrams and 2-D maps over any parameter, resumable, on any executor."""
 
 from .classify import classify_dataset, classify_store
+from .contact import ContactRange, contact_ranges
 from .execute import Execution
 from .frequency import find_jumps, response
 from .result import SweepLayout, SweepResult
@@ -10,6 +11,7 @@ from .store import SweepStore, open_sweep
 
 __all__ = [
     "Axis",
+    "ContactRange",
     "Execution",
     "SweepLayout",
     "SweepResult",
@@ -18,6 +20,7 @@ __all__ = [
     "bifurcation",
     "classify_dataset",
     "classify_store",
+    "contact_ranges",
     "find_jumps",
     "open_sweep",
     "parse_axis",

@@ -1,0 +1,291 @@
+"""``gearchaos plot``: draw a sweep, response or basin store, branch files of ``gearchaos
+continue`` or curve files of ``gearchaos boundary``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+from ..errors import ParameterError
+from . import _common as c
+from .sweep import open_store
+
+
+def _is_branch(path: Path) -> bool:
+    """Whether ``path`` names a branch file of `gearchaos continue` (netCDF, or a Zarr branch
+    with its chunk manifest) rather than a sweep store."""
+    from ..dynamics.branch import MANIFEST
+
+    if path.suffix.lower() in (".nc", ".nc4", ".h5"):
+        return True
+    return path.is_dir() and (path / MANIFEST).is_file()
+
+
+def _is_basin_store(path: Path) -> bool:
+    """Whether ``path`` is a store of `gearchaos basins` or `basin-fractions`."""
+    from ..sweep._basin_store import KINDS
+    from ..sweep.integrity import read_json
+
+    try:  # never blocking on a FIFO, never reading a device without end
+        attrs = read_json(str(path / ".zattrs"))
+    except (OSError, ValueError):
+        return False
+    return isinstance(attrs, dict) and attrs.get("kind") in KINDS
+
+
+def _plot_basins(store: Path, output: Path, **unused: Any) -> None:
+    """Draw a basin store (image, or fractions across the parameter)."""
+    from ..plot import savefig
+    from ..plot.basins import basins_figure
+    from ..sweep._basin_store import open_basins
+
+    given = [f"--{k}" for k, v in unused.items() if v not in (None, False, [])]
+    if given:
+        raise ParameterError(f"{', '.join(given)} do(es) not apply to the basin store {store}")
+    fig = basins_figure(open_basins(store))
+    if output.parent != Path(""):
+        output.parent.mkdir(parents=True, exist_ok=True)
+    savefig(fig, output)
+    c.wrote(output)
+
+
+@c.app.command()
+def plot(
+    stores: Annotated[
+        list[Path],
+        typer.Argument(
+            help="A sweep store of `gearchaos bifurcation` or `response`, or one or more branch "
+            "files of `gearchaos continue` (drawn on their own).",
+            show_default=False,
+        ),
+    ],
+    output: Annotated[
+        Path,
+        typer.Option("--output", "-o", help="Figure file: .png, .pdf or .svg.", show_default=False),
+    ],
+    var: Annotated[
+        str | None,
+        typer.Option(
+            "--var",
+            help="Section variable: delta_sp (X̄_sp), delta_sp_dot, delta_rp, x_s, ... "
+            "[default: delta_sp]",
+            show_default=False,
+        ),
+    ] = None,
+    planet: Annotated[
+        int | None,
+        typer.Option(
+            "--planet", help="Planet of per-planet variables. [default: 1]", show_default=False
+        ),
+    ] = None,
+    clearance: Annotated[
+        bool,
+        typer.Option("--clearance-lines", help="Dashed lines at ±b̄ of the variable's clearance."),
+    ] = False,
+    resonances: Annotated[
+        bool,
+        typer.Option(
+            "--resonances",
+            help="Vertical lines where the 1st–3rd mesh harmonic meets a natural frequency "
+            "(Ω sweeps).",
+        ),
+    ] = False,
+    branch: Annotated[
+        list[Path] | None,
+        typer.Option(
+            "--branch",
+            help="Branch file of `gearchaos continue`, repeatable: drawn over the diagrams of its "
+            "parameter (stable solid, unstable dashed, events marked and named).",
+            show_default=False,
+        ),
+    ] = None,
+    sections: Annotated[
+        bool,
+        typer.Option(
+            "--sections",
+            help="For a store of `gearchaos response`: draw its bifurcation diagram instead of "
+            "the response curves.",
+        ),
+    ] = False,
+    boundaries: Annotated[
+        list[Path] | None,
+        typer.Option(
+            "--boundaries",
+            help="Curve file of `gearchaos boundary`, repeatable: the stability chart, boundary "
+            "curves over the 2-D regime map of the same two parameters (physical axes "
+            "opposite, a legend naming each kind of boundary).",
+            show_default=False,
+        ),
+    ] = None,
+    impact: Annotated[
+        str | None,
+        typer.Option(
+            "--impact",
+            help="For a classified 2-D sweep of a gear set: the impact map of this mesh "
+            "(sun_planet or planet_ring): no impact, single- or double-sided impact at every "
+            "point, for --planet (default 1).",
+            show_default=False,
+        ),
+    ] = None,
+    quantity: Annotated[
+        str | None,
+        typer.Option(
+            "--quantity",
+            help="For a response store with --branch: amplitude (max − min of --var) or "
+            "force_peak (peak contact force of its mesh, as the response curves name it). "
+            "[default: amplitude]",
+            show_default=False,
+        ),
+    ] = None,
+    contact: Annotated[
+        bool,
+        typer.Option(
+            "--contact",
+            help="For a 1-D sweep or response store of a gear set: the contact regime of every "
+            "mesh (none, single- or double-sided impact; per direction, per planet where they "
+            "differ) against the swept parameter, sun speed in rpm over Ω, with the peak "
+            "contact force in N of a response store.",
+        ),
+    ] = False,
+    table: Annotated[
+        bool,
+        typer.Option(
+            "--table",
+            help="With --contact: also print the ranges of the swept parameter (and sun "
+            "speed) in each contact regime, with their peak contact force.",
+        ),
+    ] = False,
+    model: c.FromModelOpt = None,
+) -> None:
+    """Draw a sweep store: bifurcation diagrams (one panel per family value, with a band of
+    motion labels under each) for a 1-D sweep, maps coloured by motion label (1T, 2T, …, QP,
+    chaos) for a 2-D sweep, frequency-response curves (peak and RMS contact force, load
+    factor, RMS DTE; up and down branches, jumps marked; Ω with sun rpm and mesh Hz) for a
+    store of `gearchaos response`. Branch files of `gearchaos continue` are drawn on their own
+    (section values against the continued parameter, stable solid, unstable dashed, events
+    named), or over a sweep's diagram with --branch.
+
+    With --boundaries, curves of `gearchaos boundary` over the 2-D map (a stability chart);
+    curve files alone are drawn as a chart without a map.
+
+    With --contact, the contact regime of every mesh along a 1-D sweep (does it rattle, and
+    from which speed?); --table prints its ranges.
+
+    Example: **gearchaos plot fig4.zarr -o fig4.png --clearance-lines**, **gearchaos plot
+    branch.nc -o branch.png**, **gearchaos plot map.zarr --boundaries pd.nc -o chart.png**,
+    **gearchaos plot response.zarr --contact --table -o rattle.png**
+    """
+    from ..plot.figure import SAVE_FORMATS
+    from ._start import name_model
+
+    with c.reported_errors():
+        name_model(model)  # symbols of your own model's variables: only with your consent
+        if table and not contact:
+            raise ParameterError("--table prints the contact ranges: it needs --contact")
+        if output.suffix.lower() not in SAVE_FORMATS:
+            raise ParameterError(
+                f"--output must end in one of {', '.join(SAVE_FORMATS)}: got {str(output)!r}"
+            )
+        import matplotlib
+
+        matplotlib.use("Agg")
+        from ..dynamics.cascade import open_cascade
+        from ..plot import savefig, sweep_figure
+
+        if all(_is_branch(p) for p in stores):
+            if contact:
+                raise ParameterError(
+                    "--contact draws a sweep or response store, not branch or curve files"
+                )
+            from .boundary import boundaries_figure, is_curve_file
+
+            if all(is_curve_file(p) for p in stores):  # a stability chart without a map
+                fig = boundaries_figure([*stores, *(boundaries or [])], None)
+                if output.parent != Path(""):
+                    output.parent.mkdir(parents=True, exist_ok=True)
+                savefig(fig, output)
+                c.wrote(output)
+                return
+            if sections or quantity:
+                raise ParameterError(
+                    f"{'--sections' if sections else '--quantity'} applies to response stores, "
+                    "not branch files"
+                )
+            from ..plot.branch import branch_figure
+
+            fig = branch_figure(
+                [br for b in [*stores, *(branch or [])] for br in open_cascade(b)],
+                var=var,
+                planet=1 if planet is None else planet,
+                clearance_lines=clearance,
+                resonances=resonances,
+            )
+            if output.parent != Path(""):
+                output.parent.mkdir(parents=True, exist_ok=True)
+            savefig(fig, output)
+            c.wrote(output)
+            return
+        if len(stores) > 1:
+            raise ParameterError(
+                "STORE must be one sweep store, or branch files only: got "
+                f"{', '.join(str(p) for p in stores)}; draw branches over a sweep with "
+                "--branch BRANCH.nc"
+            )
+        store = stores[0]
+        from ._charts import chart_figure, check_quantity, contact_chart, contact_table
+
+        if _is_basin_store(store):
+            check_quantity(quantity, False)
+            _plot_basins(
+                store, output, var=var, planet=planet, branch=branch, sections=sections,
+                contact=contact,
+            )  # fmt: skip
+            return
+        res = open_store(store)
+        branches = [br for b in branch or [] for br in open_cascade(b)]
+        response = res.ds.attrs.get("kind") == "response"
+        if not contact:
+            check_quantity(
+                quantity, bool(branches and response) and not (sections or boundaries or impact)
+            )
+        if contact:
+            fig = contact_chart(res, {
+                "--var": var, "--planet": planet, "--clearance-lines": clearance,
+                "--resonances": resonances, "--branch": branch, "--sections": sections,
+                "--boundaries": boundaries, "--impact": impact, "--quantity": quantity,
+            })  # fmt: skip
+        elif boundaries:
+            from .boundary import boundaries_figure
+
+            fig = boundaries_figure(list(boundaries), res)
+        elif impact is not None or (branches and response and not sections):
+            fig = chart_figure(res, impact, branches, var, planet, sections, quantity)
+        elif response and not sections:
+            from ..plot import response_figure
+
+            given = [o for o, v in (("--var", var), ("--planet", planet)) if v is not None]
+            if given:  # the response curves draw every mesh's contact force, no section
+                raise ParameterError(
+                    f"{' and '.join(given)} {'does' if len(given) == 1 else 'do'} not apply to "
+                    "the frequency-response figure of "
+                    f"{store}; add --sections to draw its bifurcation diagram of one variable"
+                )
+
+            fig = response_figure(res)
+        else:
+            fig = sweep_figure(
+                res,
+                var="delta_sp" if var is None else var,
+                planet=1 if planet is None else planet,
+                clearance_lines=clearance,
+                resonances=resonances,
+                branches=branches,
+            )
+        if output.parent != Path(""):
+            output.parent.mkdir(parents=True, exist_ok=True)
+        savefig(fig, output)
+    c.wrote(output)
+    if table:
+        c.stdout().print(contact_table(res, title=f"contact regimes of {store}"))
