@@ -30,8 +30,7 @@ from fuzz_helpers import (
     reals_outside,
     refused,
 )
-from hypothesis import given
-from hypothesis import strategies as st
+from hypothesis import given, strategies as st
 from test_fuzz_gearset import BASE, culprits, invalid_values
 
 import gearchaos as gc

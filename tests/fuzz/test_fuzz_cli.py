@@ -39,8 +39,7 @@ from fuzz_helpers import (
     profiles,
     reals_outside,
 )
-from hypothesis import given
-from hypothesis import strategies as st
+from hypothesis import given, strategies as st
 from test_fuzz_api import malformed_spec
 from test_fuzz_gearset import invalid_values
 

@@ -35,8 +35,7 @@ from typing import Any
 import numpy as np
 import pytest
 from fuzz_helpers import Hung, alarm
-from hypothesis import HealthCheck, given, settings
-from hypothesis import strategies as st
+from hypothesis import HealthCheck, given, settings, strategies as st
 
 from gearchaos.errors import ParameterError, StoreError
 from gearchaos.gearset import GearSet, preset

@@ -32,8 +32,7 @@ from fuzz_helpers import (
     reals_outside,
     refused,
 )
-from hypothesis import given
-from hypothesis import strategies as st
+from hypothesis import given, strategies as st
 
 import gearchaos as gc
 from gearchaos.dynamics.lyapunov import lyapunov_spectrum, max_lyapunov

@@ -37,8 +37,7 @@ from fuzz_helpers import (
     reals_outside,
     refused,
 )
-from hypothesis import given
-from hypothesis import strategies as st
+from hypothesis import given, strategies as st
 from test_fuzz_api import invalid_setting
 from test_fuzz_cli import SETTINGS_TEXT, int_text, invalid_set
 from test_fuzz_keywords import (

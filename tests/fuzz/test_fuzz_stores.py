@@ -45,8 +45,7 @@ from fuzz_helpers import (
     profiles,
     refused,
 )
-from hypothesis import given
-from hypothesis import strategies as st
+from hypothesis import given, strategies as st
 
 import gearchaos as gc
 from gearchaos.errors import StoreError

@@ -11,8 +11,7 @@ import re
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
-from hypothesis import strategies as st
+from hypothesis import HealthCheck, given, settings, strategies as st
 
 from gearchaos.errors import ParameterError
 from gearchaos.gearset import GearSet, preset

@@ -26,8 +26,7 @@ import numpy as np
 import optuna
 import pytest
 import xarray as xr
-from hypothesis import given, settings
-from hypothesis import strategies as st
+from hypothesis import given, settings, strategies as st
 
 from gearchaos.gearset import GearSet, preset
 from gearchaos.paper import calibrate as cal

@@ -24,8 +24,9 @@ import gearchaos as gc
 from gearchaos.errors import ParameterError
 from gearchaos.integrate.settings import SolverSettings
 from gearchaos.sweep import SweepSpec
-from gearchaos.sweep.orbits import ORBIT_STATUS, orbit_checks
+from gearchaos.sweep.orbits import orbit_checks
 from gearchaos.sweep.store import SweepStore, foreign_files_ignored
+from gearchaos.sweep.variables import ORBIT_STATUS
 
 KW = {"transient_periods": 600, "periods": 64}
 

@@ -32,8 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .chaos01 import MIN_LENGTH as MIN_LENGTH_01
-from .chaos01 import chaos01
+from .chaos01 import MIN_LENGTH as MIN_LENGTH_01, chaos01
 
 __all__ = ["BandTests", "band_count", "band_tests", "circle_order", "uniform_return"]
 

@@ -41,8 +41,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from .chaos01 import MIN_LENGTH as MIN_LENGTH_01
-from .chaos01 import chaos01
+from .chaos01 import MIN_LENGTH as MIN_LENGTH_01, chaos01
 from .periodicity import period_label, periods_of
 from .spectral import spectral_broadband
 

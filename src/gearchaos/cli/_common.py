@@ -34,14 +34,30 @@ from .._version import __version__
 from ..errors import IntegrationError, ParameterError, StoreError
 from ..gearset.parsing import parse_text
 from ..model.target import DEFAULT_OMEGA, OMEGA, check_omega
+from ._options import (  # the shared options, re-exported: c.PresetOpt …
+    DEFAULT_PRESET as DEFAULT_PRESET,
+    AtolOpt as AtolOpt,
+    FromModelOpt as FromModelOpt,
+    GearsetOpt as GearsetOpt,
+    JsonOpt as JsonOpt,
+    ModelOpt as ModelOpt,
+    OverwriteOpt as OverwriteOpt,
+    PeriodsOpt as PeriodsOpt,
+    PerturbationOpt as PerturbationOpt,
+    PresetOpt as PresetOpt,
+    QuietOpt as QuietOpt,
+    RtolOpt as RtolOpt,
+    SetOpt as SetOpt,
+    SettleOpt as SettleOpt,
+    TransientOpt as TransientOpt,
+    WorkersOpt as WorkersOpt,
+)
 from ._speeds import one_point, point_omega, without_speeds
 
 if TYPE_CHECKING:
     from ..gearset import GearSet
     from ..integrate.settings import SolverSettings
 
-#: Gear set used when neither ``--preset`` nor ``--gearset`` is given.
-DEFAULT_PRESET = "sheng2016"
 
 EXIT_FAILURE = 1
 EXIT_INVALID = 2
@@ -313,8 +329,7 @@ def load_gearset(
     preset: str | None, gearset_file: Path | None, changes: Mapping[str, object] | None = None
 ) -> GearSet:
     """The gear set of ``--preset`` / ``--gearset`` (default preset), with ``changes``."""
-    from ..gearset import GearSet
-    from ..gearset import preset as load_preset
+    from ..gearset import GearSet, preset as load_preset
 
     if preset is not None and gearset_file is not None:
         raise ParameterError(
@@ -464,117 +479,6 @@ def setting_option(name: str | None) -> str | None:
 
 #: Solver settings whose option is not their field name spelled with hyphens.
 _SHORTENED = {"transient_periods": "--transient"}
-
-
-# --------------------------------------------------------------------------- shared options
-PresetOpt = Annotated[
-    str | None,
-    typer.Option(
-        "--preset",
-        "-p",
-        help=f"Built-in gear set (see `gearchaos presets`). Default: {DEFAULT_PRESET}.",
-        show_default=False,
-    ),
-]
-GearsetOpt = Annotated[
-    Path | None,
-    typer.Option(
-        "--gearset",
-        "-g",
-        help="Gear-set TOML file (start from `gearchaos init-gearset`). Excludes --preset.",
-        dir_okay=False,
-        show_default=False,
-    ),
-]
-ModelOpt = Annotated[
-    str | None,
-    typer.Option(
-        "--model",
-        "-m",
-        help="Your own model instead of a gear set: FILE.py:CLASS, MODULE:CLASS or an installed "
-        "name (see docs/howto/own-model.md); --set NAME=VALUE sets its parameters. Excludes "
-        "--preset and --gearset. With --from, the model the file records: naming it is your "
-        "consent to run its code, which a file alone never gets.",
-        show_default=False,
-    ),
-]
-FromModelOpt = Annotated[
-    str | None,
-    typer.Option(
-        "--model",
-        "-m",
-        help="The model a file records, when it is your own (FILE.py:CLASS, MODULE:CLASS or an "
-        "installed name; see docs/howto/own-model.md): naming it is your consent to run its "
-        "code, which a file alone never gets.",
-        show_default=False,
-    ),
-]
-SetOpt = Annotated[
-    list[str] | None,
-    typer.Option(
-        "--set",
-        "-s",
-        help=(
-            "NAME=VALUE, repeatable: omega=1.5 (the dimensionless mesh frequency Ω), "
-            "xi=0.05 (all damping ratios), or any dotted gear-set parameter such as "
-            "backlash.sun_planet=3, clearance.sun_bearing=2, torque.input=1500; with --model, "
-            "omega and the model's own parameters (its field names)."
-        ),
-        show_default=False,
-    ),
-]
-JsonOpt = Annotated[
-    bool, typer.Option("--json", help="Print the result as JSON on stdout, and nothing else.")
-]
-QuietOpt = Annotated[
-    bool, typer.Option("--quiet", "-q", help="No progress bar and no summary (errors only).")
-]
-TransientOpt = Annotated[
-    float, typer.Option("--transient", help="Mesh periods discarded before recording.")
-]
-SettleOpt = Annotated[
-    str,
-    typer.Option(
-        "--settle",
-        help=(
-            "off: always --transient periods of transient; auto: end it early once the Poincaré "
-            "sections repeat (period ≤ 64), never later than --transient."
-        ),
-    ),
-]
-PerturbationOpt = Annotated[
-    float | None,
-    typer.Option(
-        "--perturbation",
-        help=(
-            "Size of the reproducible perturbation of the start from rest that breaks the "
-            "planets' symmetry as in any real gearbox (default 1e-6; 0: the exact symmetric "
-            "start)."
-        ),
-        show_default=False,
-    ),
-]
-PeriodsOpt = Annotated[
-    int, typer.Option("--periods", help="Mesh periods recorded (one Poincaré point each).")
-]
-RtolOpt = Annotated[
-    float,
-    typer.Option("--rtol", help="Relative tolerance of the integrator (Dormand–Prince 5(4))."),
-]
-AtolOpt = Annotated[float, typer.Option("--atol", help="Absolute tolerance of the integrator.")]
-WorkersOpt = Annotated[
-    int | None,
-    typer.Option(
-        "--workers",
-        "-w",
-        help="Local worker processes (default: in-process on all cores).",
-        show_default=False,
-    ),
-]
-OverwriteOpt = Annotated[
-    bool,
-    typer.Option("--overwrite", help="Replace an existing store made with other settings."),
-]
 
 
 @app.callback(invoke_without_command=True)

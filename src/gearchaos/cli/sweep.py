@@ -281,7 +281,7 @@ def bifurcation(
     if orbits:
         import numpy as np
 
-        from ..sweep.orbits import ORBIT_STATUS
+        from ..sweep.variables import ORBIT_STATUS
 
         codes = np.asarray(res.ds["orbit_status"].values).ravel()
         result["orbits"] = {

@@ -31,8 +31,7 @@ from typing import Any
 import numpy as np
 
 from ..analysis.bands import circle_order, uniform_return
-from ..analysis.chaos01 import MIN_LENGTH as MIN_LENGTH_01
-from ..analysis.chaos01 import chaos01
+from ..analysis.chaos01 import MIN_LENGTH as MIN_LENGTH_01, chaos01
 from ..analysis.classify import K_CHAOS, K_REGULAR
 from .evidence import Verdict
 

@@ -231,8 +231,7 @@ def run_gallery(
             )
             bar.advance(task)
     if title is None:
-        from ..plot._common import given as given_text
-        from ..plot._common import variable
+        from ..plot._common import given as given_text, variable
 
         given = [given_text(k, fv) for k, fv in fixed_values.items() if _is_number(fv)]
 

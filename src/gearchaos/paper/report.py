@@ -41,8 +41,7 @@ from typing import Any
 from .._marks import fill_mark, placeholder
 from .._output import check_replaceable, file_has_mark, write_file
 from ..sweep.result import SweepResult
-from .accounting import count_text, verdict_counts
-from .accounting import landmark_rows as accounting_rows
+from .accounting import count_text, landmark_rows as accounting_rows, verdict_counts
 
 __all__ = ["FIGURES", "HONESTY", "build_report", "render_html", "report_counts"]
 

@@ -118,8 +118,7 @@ def _store_kind(path: str) -> str | None:
 
 
 def _open_store(path: str) -> Any:
-    from ._basin_store import KINDS as BASIN_KINDS
-    from ._basin_store import open_basins
+    from ._basin_store import KINDS as BASIN_KINDS, open_basins
     from .store import open_sweep
 
     kind = _store_kind(path)

@@ -30,51 +30,12 @@ import numpy as np
 
 from ..integrate.settings import SolverSettings
 from .classify import label_periods
+from .variables import ORBIT_STATUS, ORBIT_VARIABLES
 
 __all__ = ["MAX_ORBIT_PERIOD", "ORBIT_STATUS", "ORBIT_VARIABLES", "orbit_checks"]
 
 #: The longest period confirmed by shooting.
 MAX_ORBIT_PERIOD = 8
-
-#: Flag values of ``orbit_status`` (−1: the point was not computed yet).
-ORBIT_STATUS = {
-    "not_computed": -1,
-    "confirmed": 0,
-    "unstable": 1,
-    "shorter_period": 2,
-    "not_converged": 3,
-    "failed": 4,
-    "not_periodic": 5,
-    "period_too_long": 6,
-}
-
-#: Per-point variables (name → long name, dtype, fill value).
-ORBIT_VARIABLES: dict[str, tuple[str, str, Any]] = {
-    "orbit_residual": (
-        "residual ‖Pⁿ(y*) − y*‖ / max(1, ‖y*‖) of the period-n orbit that confirms an nT label",
-        "float64",
-        np.nan,
-    ),
-    "orbit_max_multiplier": (
-        "largest Floquet multiplier modulus max |μ| of that orbit",
-        "float64",
-        np.nan,
-    ),
-    "orbit_period": ("period n that was shot (0: none)", "int16", 0),
-    "orbit_status": (
-        "outcome of the shooting at the point (see flag_meanings)",
-        "int8",
-        ORBIT_STATUS["not_computed"],
-    ),
-}
-
-
-def status_attrs() -> dict[str, Any]:
-    """``flag_values`` / ``flag_meanings`` of ``orbit_status``."""
-    return {
-        "flag_values": list(ORBIT_STATUS.values()),
-        "flag_meanings": " ".join(ORBIT_STATUS),
-    }
 
 
 def empty(shape: tuple[int, ...]) -> dict[str, np.ndarray]:

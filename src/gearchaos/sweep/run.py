@@ -31,23 +31,15 @@ from ._response_store import response_extract, response_variables
 from .execute import EXECUTION_OPTIONS, Execution, InProcess, executor
 from .grid import Grid, Task
 from .integrity import StoreLock
-from .orbits import ORBIT_VARIABLES, status_attrs, task_orbits
+from .orbits import task_orbits
 from .progress import _Bar
 from .spec import DEFAULT_OBSERVE, SweepSpec, sweep_keywords
 from .speeds import given_speed, omega_spec, speed_coords
 from .store import SweepStore
+from .variables import ORBIT_VARIABLES, SKIPPED, STEP_COUNTS, status_attrs
 from .verdicts import VERDICT_VARIABLES, task_verdicts, verdict_attrs
 
 __all__ = ["bifurcation", "run_sweep"]
-
-#: Per-point variable of a ``settle="auto"`` sweep: transient periods skipped (0: full transient).
-SKIPPED = "transient_skipped"
-#: the step counts stored per point, with their descriptions
-STEP_COUNTS = {
-    "steps_accepted": "steps accepted",
-    "steps_rejected": "steps rejected",
-    "steps_switch": "steps retried to end on a contact switch",
-}
 
 
 class _Layout:

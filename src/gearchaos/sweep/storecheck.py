@@ -252,8 +252,7 @@ def _verify_element_types(root: str, ds: Any, spec: Any) -> None:
     value) would read every stored float's bits as a huge integer. Stores written since the
     manifest records a digest of every array's metadata are checked whole by
     :func:`~gearchaos.sweep.integrity.verify_manifest`; this check also covers older ones."""
-    from .orbits import ORBIT_VARIABLES
-    from .run import SKIPPED, STEP_COUNTS
+    from .variables import ORBIT_VARIABLES, SKIPPED, STEP_COUNTS
     from .verdicts import VERDICT_VARIABLES
 
     expected: dict[str, Any] = {name: np.float64 for name in spec.observe}
