@@ -2,8 +2,9 @@
 
 Run from the repository root with the project's environment:
 ``.venv/bin/python docs/make_doc_numbers.py [--check] [--fast]``. Every number of README.md,
-the tutorial, the reproduce how-to and docs/reproduction.md that a command printed (or that the
-committed report holds) sits between markers, and this script rewrites what is between them::
+the tutorial, the reproduce and rattle how-tos and docs/reproduction.md that a command printed
+(or that the committed report holds) sits between markers, and this script rewrites what is
+between them::
 
     |μ| ≈ <!-- gen:gallery.mu-3.5 -->0.97<!-- /gen --> per two periods
 
@@ -26,8 +27,9 @@ around it stays true) with an optional format after ``|``.
 A source whose output no longer supports the prose around its numbers (the README's two
 attractors at Ω = 1.5, say) raises :class:`ProseOutOfDate` with what to rewrite.
 ``--check`` rewrites nothing and exits 1 listing the stale numbers; ``--fast`` leaves out the
-sources marked slow (the tutorial's 800-point sweep). ``tests/docs/test_doc_numbers.py``
-runs the fast sources and the report in CI and the slow one under ``-m slow``.
+sources marked slow (the tutorial's 800-point sweep, the rattle how-to's commands).
+``tests/docs/test_doc_numbers.py`` runs the fast sources and the report in CI and the slow ones
+under ``-m slow``.
 """
 
 from __future__ import annotations
@@ -45,6 +47,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "docs"))
+sys.path.insert(0, str(ROOT / "docs"))
 
 from tutorial_blocks import TUTORIAL, runnable  # noqa: E402
 
@@ -53,7 +56,9 @@ PAGES = (
     TUTORIAL,
     ROOT / "docs" / "howto" / "reproduce.md",
     ROOT / "docs" / "reproduction.md",
+    ROOT / "docs" / "howto" / "rattle.md",
 )
+RATTLE = ROOT / "docs" / "howto" / "rattle.md"
 REPORT = ROOT / "docs" / "report" / "report.json"
 MARK = re.compile(r"<!-- gen:(?P<name>[^ ]+) -->(?P<body>.*?)<!-- /gen -->", re.S)
 COLUMNS = 100
@@ -272,6 +277,84 @@ def _slug(verdict: str) -> str:
     return re.sub(r"[^a-z]+", "-", verdict.lower()).strip("-")
 
 
+def titled_table(text: str, title: str) -> Block:
+    """The table of ``text`` printed under the line ``title``, as printed."""
+    lines = text.splitlines()
+    start = next((i for i, line in enumerate(lines) if line.strip() == title), None)
+    if start is None:
+        raise ProseOutOfDate(f"the command no longer prints a table titled {title!r}")
+    end = next(i for i in range(start, len(lines)) if lines[i].startswith(("└", "┗")))
+    return Block("\n".join(line.rstrip() for line in lines[start : end + 1]) + "\n")
+
+
+def _rattle(work: Path) -> dict[str, str]:
+    """The rattle how-to's commands, run as the page shows them (its bash blocks, in a fresh
+    directory), and what its table and its prose say about the store they write."""
+    import numpy as np
+    from make_howto_figures import environment, page_script
+
+    import gearchaos as gc
+    from gearchaos.model.derived import gearset_info
+    from gearchaos.plot.units import PhysicalScales
+    from gearchaos.sweep import SweepResult, contact_ranges
+    from gearchaos.sweep.spec import RESPONSE_SOLVER
+
+    env = {**environment(), "COLUMNS": str(COLUMNS), "NO_COLOR": "1"}
+    env.pop("FORCE_COLOR", None)
+    script = page_script(RATTLE.name)
+    proc = subprocess.run(["bash", "-c", script], cwd=work, env=env, capture_output=True, text=True)
+    if proc.returncode != 0:
+        raise RuntimeError(f"{RATTLE.name}: its commands failed:\n{proc.stderr[-3000:]}")
+    res = SweepResult(gc.open_sweep(work / "rattle.zarr"))
+    ranges = contact_ranges(res)
+    scales = PhysicalScales.of_sweep(res)
+    rpm, newton = scales.factor("omega"), scales.factor("force")
+    if rpm is None or newton is None:
+        raise ProseOutOfDate("the rattle store has no sun speed or force scale")
+
+    def onset(direction: str) -> tuple[float, list[str]]:
+        loud = [r for r in ranges if r.direction == direction and r.regime != "none"]
+        if not loud:
+            raise ProseOutOfDate(f"no mesh separates sweeping {direction} (rattle.md, step 3)")
+        first = min(r.start for r in loud)
+        return first, [r.mesh for r in loud if r.start == first]
+
+    up, up_meshes = onset("up")
+    down, _ = onset("down")
+    if not down < up:
+        raise ProseOutOfDate(
+            "rattle.md says the run-down rattles below the run-up's first separation: "
+            f"up from Ω = {up:g}, down from Ω = {down:g}"
+        )
+    ds = res.ds
+    best = (-1.0, "", "", 0.0, 0.0)
+    for key, mesh in (("sp", "sun_planet"), ("rp", "planet_ring")):
+        peak = ds[f"force_peak_{key}"].max("planet_all")
+        for direction in ("up", "down"):
+            y = np.asarray(peak.sel(direction=direction).values, dtype=float)
+            k = int(np.nanargmax(y))
+            if y[k] > best[0]:
+                factor = float(ds[f"load_factor_{key}"].sel(direction=direction).values[k])
+                best = (float(y[k]), mesh, direction, float(ds.omega.values[k]), factor)
+    force, mesh, direction, omega, factor = best
+    words = {"sun_planet": "sun–planet", "planet_ring": "planet–ring"}
+    static = gearset_info(res.gearset)["static_mesh_force_N"]
+    return {
+        "table": titled_table(proc.stdout, "contact regimes of rattle.zarr"),
+        "transient": f"{RESPONSE_SOLVER.transient_periods:g}",
+        "periods": f"{RESPONSE_SOLVER.periods:d}",
+        "up.rpm": f"{up * rpm[0]:.0f}",
+        "up.meshes": " and ".join(words[m] for m in sorted(set(up_meshes), reverse=True)),
+        "down.rpm": f"{down * rpm[0]:.0f}",
+        "peak.N": f"{force * newton[0]:.0f}",
+        "peak.mesh": words[mesh],
+        "peak.rpm": f"{omega * rpm[0]:.0f}",
+        "peak.direction": direction,
+        "peak.factor": f"{factor:.1f}",
+        "static": f"{static:.0f}",
+    }
+
+
 def _report(_: Path) -> dict[str, str]:
     """Counts and run time of the committed report (``docs/report/report.json``), counted by
     the report's own code (:func:`gearchaos.paper.accounting.verdict_counts`): keys
@@ -319,6 +402,9 @@ SOURCES: dict[str, Source] = {
         slow=True,
     ),
     "report": Source(None, _report),
+    "rattle": Source(
+        "gearchaos plot rattle.zarr --contact --table -o rattle.png", _rattle, slow=True
+    ),
 }
 
 

@@ -73,6 +73,7 @@ PAGES: dict[str, Page] = {
     "hysteresis.md": Page(0.5),
     "maps.md": Page(0.5),
     "own-model.md": Page(1, files=("examples/kahraman_singh_1991.py",)),
+    "rattle.md": Page(1.5),
     "reproduce.md": Page(0),
     "response.md": Page(0.5),
     "resume.md": Page(0),

@@ -159,7 +159,7 @@ def test_planets_that_differ_get_a_band_each_and_words_in_the_table(store) -> No
     ranges = contact_ranges(ds)
     odd = [r for r in ranges if r.mesh == "sun_planet" and r.direction == "up" and not r.uniform]
     assert [(r.start, r.stop, r.regime) for r in odd] == [(2.0, 2.0, "double_sided")]
-    assert odd[0].describe() == "double-sided: planets 2; single-sided: 1, 3, 4, 5"
+    assert odd[0].describe() == "double-sided: planet 2; single-sided: 1, 3, 4, 5"
     fig = contact_figure(ds)
     labels = [t.get_text() for t in fig.axes[1].get_yticklabels()]
     assert labels[:6] == [f"sun–planet {p} ↑" for p in range(1, 6)] + ["sun–planet ↓"]
@@ -196,13 +196,13 @@ def test_command_writes_the_figure_and_prints_the_ranges(store, tmp_path) -> Non
     ranges = contact_ranges(gc.open_sweep(store))
     assert len(rows) == len(ranges)
     header = next(ln for ln in result.output.splitlines() if ln.startswith("┃"))
-    assert "sun speed [rpm]" in header and "peak contact force [N]" in header
+    assert "sun speed [rpm]" in header and "peak force [N]" in header
     gs = gc.preset("sheng2016")
     for line, r in zip(rows, ranges, strict=True):
         cells = [c.strip() for c in line.strip("│").split("│")]
         assert cells[0] == r.mesh.replace("_", "–") and cells[1] == r.direction
-        assert cells[2] == r.describe()
-        lo = float(re.split(r" … ", cells[4])[0])
+        assert cells[4] == r.describe()
+        lo = float(re.split(r" … ", cells[2])[0])
         assert lo == pytest.approx(gs.sun_speed_rpm(r.start), abs=0.5)
 
 

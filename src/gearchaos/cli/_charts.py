@@ -72,8 +72,9 @@ def contact_chart(res: Any, given: dict[str, Any]) -> Any:
 def contact_table(res: Any, *, title: str) -> Any:
     """A rich table of the contact ranges of a 1-D sweep
     (:func:`~gearchaos.sweep.contact.contact_ranges`): per mesh and sweep direction the runs
-    of one regime, their swept values, the sun speed in rpm (over Ω, where the gear set
-    defines it) and the largest peak contact force in newtons (a response store)."""
+    of one regime with their swept values — the sun speed in rpm first over Ω, where the gear
+    set defines it — and the largest peak contact force in newtons (a response store). The
+    regime column wraps (planets that differ are named), the others never do."""
     from rich.table import Table
 
     from ..plot._common import axis_symbol
@@ -93,13 +94,13 @@ def contact_table(res: Any, *, title: str) -> Any:
     table.add_column("mesh", no_wrap=True)
     if has_direction:
         table.add_column("sweep", no_wrap=True)
-    table.add_column("contact regime")
-    table.add_column(escape(symbol), justify="right", no_wrap=True)
     if rpm is not None:
         table.add_column(escape("sun speed [rpm]"), justify="right", no_wrap=True)
+    table.add_column(escape(symbol), justify="right", no_wrap=True)
+    table.add_column("contact regime", ratio=1)
     if has_force:
         unit = "N" if force is not None else "k_m,sp b_c"
-        table.add_column(escape(f"peak contact force [{unit}]"), justify="right", no_wrap=True)
+        table.add_column(escape(f"peak force [{unit}]"), justify="right", no_wrap=True)
 
     def span(lo: float, hi: float, spec: str) -> str:
         a, b = format(lo, spec), format(hi, spec)
@@ -109,9 +110,9 @@ def contact_table(res: Any, *, title: str) -> Any:
         cells = [r.mesh.replace("_", "–")]
         if has_direction:
             cells.append(r.direction or "")
-        cells += [r.describe(), span(r.start, r.stop, ".4g")]
         if rpm is not None:
             cells.append(span(r.start * rpm[0], r.stop * rpm[0], ".0f"))
+        cells += [span(r.start, r.stop, ".3f" if x_name == "omega" else ".4g"), r.describe()]
         if has_force:
             f = r.peak_force
             cells.append(

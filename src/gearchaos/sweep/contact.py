@@ -80,13 +80,13 @@ class ContactRange:
 
     def describe(self) -> str:
         """The regime in words: ``single-sided``, or per planet where they differ
-        (``single-sided: planets 1, 3; none: 2, 4``)."""
+        (``single-sided: planets 1, 3; none: 2, 4``, ``double-sided: planet 2; none: 1, 3``)."""
         if self.uniform:
             return regime_words(self.regimes[0])
         parts: list[str] = []
         for regime in sorted(set(self.regimes), key=_severity, reverse=True):
             who = [str(p) for p, r in zip(self.planets, self.regimes, strict=True) if r == regime]
-            prefix = "planets " if not parts else ""
+            prefix = ("planet " if len(who) == 1 else "planets ") if not parts else ""
             parts.append(f"{regime_words(regime)}: {prefix}{', '.join(who)}")
         return "; ".join(parts)
 
