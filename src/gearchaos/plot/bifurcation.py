@@ -9,8 +9,8 @@ a :class:`~gearchaos.sweep.SweepResult`) and never simulate:
 * :func:`bifurcation` — section values of one variable against one swept parameter, the seed's
   bifurcation diagram (Fig. 4: X̄_sp1 against Ω);
 * :func:`bifurcation_figure` — one panel per family value, titled ``(a) ξ = 0.03`` … like the
-  seed's figures; up and down continuation branches overlaid in two colours, with a regime band
-  under every panel when the store has motion labels.
+  seed's figures; up and down continuation branches overlaid in two colours outside the regime
+  palette, with a regime band under every panel when the store has motion labels.
 
 Maps of 2-D sweeps are in :mod:`gearchaos.plot.maps`.
 """
@@ -59,7 +59,12 @@ from .units import (
 
 __all__ = ["bifurcation", "bifurcation_figure", "resolve_var", "suptitle"]
 
-_DIRECTION_COLOURS = {"up": "C0", "down": "C3"}
+#: Colours of the up and down branches of a continuation sweep: dark teal and dark brown, none
+#: of them a regime colour (:data:`~gearchaos.plot.regimes.REGIME_COLOURS`: the dots of a
+#: branch say where it went, not what motion it is) and told apart with every common colour
+#: vision (CIEDE2000 ΔE ≥ 10 from every regime colour and ≥ 15 from each other under
+#: simulated protan-, deutan- and tritanopia; tests/plot/test_palette_contrast.py).
+DIRECTION_COLOURS = {"up": "#01665e", "down": "#543005"}
 _NOT_RUN = int(Status.NOT_RUN)
 
 
@@ -161,9 +166,9 @@ def bifurcation(
         the h-th mesh harmonic (h = 1 solid, 2 dashed, 3 dotted) meets a natural frequency
         ω_k of the linear model (:func:`gearchaos.model.derived.gearset_info`).
     color, s
-        Dot colour (default black; up/down branches C0/C3) and size in points² (default:
-        from 0.3 for 10⁴ or more drawn values up to 6 for a few hundred, so that a coarse
-        sweep stays visible and a fine one keeps its structure).
+        Dot colour (default black; up/down branches :data:`DIRECTION_COLOURS`) and size in
+        points² (default: from 0.3 for 10⁴ or more drawn values up to 6 for a few hundred, so
+        that a coarse sweep stays visible and a fine one keeps its structure).
     branches
         Continued branches of periodic orbits (:func:`gearchaos.continuation`) to overlay:
         those of the x-axis parameter whose fixed values agree with ``select`` are drawn,
@@ -239,7 +244,7 @@ def bifurcation(
             c = "k" if color is None else color
             label = None
         else:
-            c = _DIRECTION_COLOURS.get(direction, "C2") if color is None else color
+            c = DIRECTION_COLOURS.get(direction, "0.4") if color is None else color
             arrow = "increasing" if direction == "up" else "decreasing"
             label = f"{direction} ({arrow} {axis_symbol(x_name, psym)})"
         ax.scatter(
@@ -414,8 +419,8 @@ def bifurcation_figure(
     """Bifurcation diagrams of a 1-D sweep, one panel per family value.
 
     Panels are titled ``(a) ξ = 0.03``, ``(b) ξ = 0.05`` … like the seed's figures (no letter
-    when there is one panel); for ``direction="both"`` each panel overlays the up (C0) and
-    down (C3) branches. Options as in :func:`bifurcation`.
+    when there is one panel); for ``direction="both"`` each panel overlays the up (dark teal)
+    and down (dark brown) branches. Options as in :func:`bifurcation`.
 
     With ``regimes`` (default: when the dataset has ``motion`` labels, as every store written
     by :func:`gearchaos.bifurcation` does) each panel gets a thin band below it coloured by

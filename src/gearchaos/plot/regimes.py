@@ -63,15 +63,18 @@ REGIME_ORDER: tuple[str, ...] = (
     NOT_RUN,
 )
 
-#: The palette: display category → colour (hex). Periodic orbits in blues, greens and earth
-#: tones, quasi-periodic orange, chaos red, unresolved grey, failed black, not run white.
+#: The palette: display category → colour (hex). Periodic orbits in blues, greens, olive,
+#: indigo and pink, quasi-periodic orange, chaos red, unresolved grey, failed black, not run
+#: white. 5T is Tol's indigo, not the brown it was: brown sat as close to the unresolved grey
+#: and to chaos red as CIEDE2000 ΔE 16 and 10 under simulated deutan- and protanopia, indigo
+#: stands ≥ 19 from every other colour of the palette under every colour vision.
 REGIME_COLOURS: Mapping[str, str] = MappingProxyType(
     {
         "1T": "#1f77b4",
         "2T": "#17becf",
         "3T": "#2ca02c",
         "4T": "#bcbd22",
-        "5T": "#8c564b",
+        "5T": "#332288",
         "6T": "#e377c2",
         "7T": "#9edae5",
         "8T": "#98df8a",
