@@ -66,6 +66,7 @@ def test_reproduce_all_quick_writes_every_figure_and_the_report(tmp_path: Path) 
     assert "id='landmarks'" in page and "paper protocol" in page and "acts?" in page
     for fig in ("fig4", "fig6", "fig8", "fig9", "fig11", "fig12"):  # the seed's protocol ran
         assert (out / f"{fig}-quick-paper.zarr").is_dir(), fig
+        assert f"<a href='{fig}-quick-paper.png'>" in page, fig
     printed = res.output.replace("\n", " ")
     assert "holds (constant)" in printed
 

@@ -421,6 +421,13 @@ def render_html(
                 p.append(_gallery_table(res["rows"], getattr(item, "param", "")))
         elif name in stores:
             p.append(_regime_table(stores[name]))
+        seed = res.get("paper_protocol", {}).get("figure")
+        if seed and Path(seed).exists():
+            p.append(
+                f"<p class='note'>The same sweep on the seed's own protocol (exact zero start, "
+                f"labels from the record alone): <a href='{_e(os.path.relpath(seed, outdir))}'>"
+                f"{_e(Path(seed).name)}</a>.</p>"
+            )
         p.append("</div></div>")
     # -- conclusions and landmarks
     p.append("<h2>Conclusions (Section 4) and landmarks (Section 3)</h2>")
