@@ -360,8 +360,8 @@ def _report(_: Path) -> dict[str, str]:
     the report's own code (:func:`gearchaos.paper.accounting.verdict_counts`): keys
     ``PART.VERDICT`` (``landmarks.holds``, ``landmarks.holds-constant`` — a hold where the
     swept parameter does not act, counted apart —, ``conclusions.does-not-hold`` …),
-    ``PART.total``, ``PART.not-ids`` and the paper-protocol column as
-    ``landmarks-paper.VERDICT``."""
+    ``PART.total``, ``PART.VERDICT-ids`` (the ids with that verdict; ``PART.not-ids`` those that
+    do not hold) and the paper-protocol column as ``landmarks-paper.VERDICT``."""
     from gearchaos.paper.accounting import verdict_counts
     from gearchaos.paper.conclusions import VERDICTS as CONCLUSION_VERDICTS
 
@@ -378,6 +378,9 @@ def _report(_: Path) -> dict[str, str]:
         values[f"{part}.total"] = str(len(verdicts))
         for verdict, n in counts.items():
             values[f"{part}.{_slug(verdict)}"] = str(n)
+            values[f"{part}.{_slug(verdict)}-ids"] = ", ".join(
+                str(item["id"]) for item in report[rows] if item.get(key) == verdict
+            )
         values[f"{part}.not-ids"] = ", ".join(
             str(item["id"]) for item in report[rows] if item.get(key) == "does not hold"
         )
