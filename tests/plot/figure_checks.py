@@ -6,6 +6,8 @@ from typing import Any
 
 import numpy as np
 
+from gearchaos.plot.placement import EVENT_LABEL_GID
+
 
 def overlap(a: Any, b: Any, slack: float = 0.5) -> bool:
     """Whether two display boxes (``Bbox``) overlap by more than ``slack`` pixels."""
@@ -86,7 +88,6 @@ def steep_branch(branch: Any, var: str, omega: tuple[float, float], low: float, 
 
 
 #: The short names of events written beside their markers.
-EVENT_SHORT_NAMES = ("fold", "PD", "NS", "BP", "graze")
 
 
 def labels_on_curves(fig: Any, prefix: str) -> list[str]:
@@ -96,7 +97,7 @@ def labels_on_curves(fig: Any, prefix: str) -> list[str]:
     found = []
     for ax in fig.axes:
         for text in ax.texts:
-            if text.get_text() not in EVENT_SHORT_NAMES:
+            if text.get_gid() != EVENT_LABEL_GID:  # an event's name, or a crowd's
                 continue
             box = text.get_window_extent()
             crossed = any(

@@ -423,7 +423,7 @@ def _print_branch(
     events = Table(title="events along the branch", title_justify="left")
     speed_cols = () if rpm is None else ("sun speed [rpm]",)
     for col in ("kind", f"{name} ± uncertainty", *speed_cols, "multiplier", "detail"):
-        events.add_column(escape(col))
+        events.add_column(escape(col), overflow="fold")  # wrapped, never cut off with …
     for e in summary["events"]:
         mu = e.get("multiplier")
         mu_text = "—" if mu is None else f"{mu['re']:.4g}{mu['im']:+.4g}i (|μ| {mu['abs']:.4g})"
@@ -432,7 +432,7 @@ def _print_branch(
             _with_uncertainty(e["value"], e.get("uncertainty")),
             *(() if rpm is None else (f"{e['value'] * rpm:.5g}",)),
             escape(mu_text),
-            escape(str(e.get("detail", ""))),
+            escape(str(e.get("detail", "")).replace(",", ", ")),  # wraps between the meshes
         )
     out.print(events)
 

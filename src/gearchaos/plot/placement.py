@@ -2,17 +2,21 @@
 
 :func:`place_event_labels` moves the short name of every event of a figure (``PD``, ``fold``,
 ``graze`` beside its marker, :func:`~gearchaos.plot.branch.mark_event`) to the side of its
-marker where it covers the fewest curve segments, points, other names and legends: above the
-marker a name sat on a steep branch, on a jump arrow or on the diagram's dots.
+marker where it covers the fewest curve segments, points, other names, other events' markers
+and legends: above the marker a name sat on a steep branch, on a jump arrow or on the
+diagram's dots. Events whose markers crowd together (a fold and two grazings within 0.01 of
+Ω) get one name for the group (``graze ×2, fold``), and a name that finds no free place next
+to its marker may sit two or three times as far away.
 """
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
 
-__all__ = ["EVENT_LABEL_GID", "LABEL_PLACES", "place_event_labels"]
+__all__ = ["CROWDED_PX", "EVENT_LABEL_GID", "LABEL_PLACES", "LABEL_RINGS", "place_event_labels"]
 
 #: ``gid`` of the short names written beside the event markers.
 EVENT_LABEL_GID = "branch:event-label"
@@ -29,9 +33,15 @@ LABEL_PLACES: tuple[tuple[float, float, str, str], ...] = (
     (5.0, -4.0, "left", "top"),
     (-5.0, -4.0, "right", "top"),
 )
+#: How far from the marker a name may sit, as multiples of :data:`LABEL_PLACES`' offsets,
+#: nearest first: a farther ring is taken only where every nearer place covers something.
+LABEL_RINGS: tuple[float, ...] = (1.0, 2.2, 3.4)
+#: Markers closer than this (display pixels at the figure's dpi, per 100 dpi) share one name.
+CROWDED_PX = 14.0
 # what covering costs: a curve's segment, a point (marker, diagram dot), another name or the
-# legend, leaving the axes
+# legend, another event's marker, leaving the axes; and each ring farther out
 _COST_SEGMENT, _COST_POINT, _COST_BOX, _COST_OUTSIDE = 10.0, 1.0, 100.0, 1000.0
+_COST_MARKER, _COST_RING = 60.0, 4.0
 
 
 def place_event_labels(fig: Any) -> None:
@@ -44,35 +54,104 @@ def place_event_labels(fig: Any) -> None:
     if not todo:
         return
     fig.draw_without_rendering()
+    todo = _merge_crowded(fig, todo)
     obstacles = {id(ax): _obstacles(ax) for ax, _ in todo}
+    markers = {id(ax): _event_markers(ax) for ax, _ in todo}
     placed: dict[int, list[Any]] = {}
     for ax, text in todo:
         segments, points, boxes = obstacles[id(ax)]
         boxes = boxes + placed.setdefault(id(ax), [])
         frame = ax.get_window_extent()
-        best, best_cost = LABEL_PLACES[0], np.inf
-        for place in LABEL_PLACES:
-            text.xyann = place[:2]
-            text.set_ha(place[2])
-            text.set_va(place[3])
-            box = text.get_window_extent()
-            cost = _COST_SEGMENT * sum(_crossings(box.padded(1.0), xy) for xy in segments)
-            grown = box.padded(2.0)
-            cost += _COST_POINT * int(
-                np.sum(
-                    (points[:, 0] >= grown.x0) & (points[:, 0] <= grown.x1)
-                    & (points[:, 1] >= grown.y0) & (points[:, 1] <= grown.y1)
-                )
-            )  # fmt: skip
-            cost += _COST_BOX * sum(_overlaps(box, other) for other in boxes)
-            inside = frame.x0 <= box.x0 and box.x1 <= frame.x1
-            cost += 0.0 if inside and frame.y0 <= box.y0 and box.y1 <= frame.y1 else _COST_OUTSIDE
-            if cost < best_cost:
-                best, best_cost = place, cost
+        best, best_cost = (*LABEL_PLACES[0][:2], *LABEL_PLACES[0][2:]), np.inf
+        for ring, scale in enumerate(LABEL_RINGS):
+            for dx, dy, ha, va in LABEL_PLACES:
+                place = (dx * scale, dy * scale, ha, va)
+                text.xyann = place[:2]
+                text.set_ha(ha)
+                text.set_va(va)
+                box = text.get_window_extent()
+                cost = _COST_RING * ring
+                cost += _COST_SEGMENT * sum(_crossings(box.padded(1.0), xy) for xy in segments)
+                grown = box.padded(2.0)
+                cost += _COST_POINT * int(
+                    np.sum(
+                        (points[:, 0] >= grown.x0) & (points[:, 0] <= grown.x1)
+                        & (points[:, 1] >= grown.y0) & (points[:, 1] <= grown.y1)
+                    )
+                )  # fmt: skip
+                cost += _COST_BOX * sum(_overlaps(box, other) for other in boxes)
+                cost += _COST_MARKER * sum(_overlaps(box, m) for m in markers[id(ax)])
+                inside = frame.x0 <= box.x0 and box.x1 <= frame.x1
+                inside = inside and frame.y0 <= box.y0 and box.y1 <= frame.y1
+                cost += 0.0 if inside else _COST_OUTSIDE
+                if cost < best_cost:
+                    best, best_cost = place, cost
+            if best_cost < _COST_POINT * 3:  # free enough: no need to look farther out
+                break
         text.xyann = best[:2]
         text.set_ha(best[2])
         text.set_va(best[3])
         placed[id(ax)].append(text.get_window_extent())
+
+
+def _anchor(ax: Any, text: Any) -> np.ndarray:
+    """The display position of the marker a name belongs to."""
+    return np.asarray(ax.transData.transform(np.asarray(text.xy, dtype=np.float64)))
+
+
+def _merge_crowded(fig: Any, todo: list[tuple[Any, Any]]) -> list[tuple[Any, Any]]:
+    """Give every group of names whose markers lie within :data:`CROWDED_PX` of each other
+    (chained) one name — the kinds in order along x, a repeated one as ``graze ×2`` — written
+    by the group's first name (grey when the kinds differ); the others are removed. Returns
+    the names left."""
+    limit = CROWDED_PX * fig.dpi / 100.0
+    keep: list[tuple[Any, Any]] = []
+    for ax in dict.fromkeys(ax for ax, _ in todo):
+        texts = sorted((t for a, t in todo if a is ax), key=lambda t: float(t.xy[0]))
+        groups: list[list[Any]] = []
+        for t in texts:
+            here = _anchor(ax, t)
+            near = [g for g in groups if any(np.hypot(*(here - _anchor(ax, o))) < limit for o in g)]
+            if not near:
+                groups.append([t])
+                continue
+            for g in near[1:]:  # t joins groups that were apart until now
+                near[0].extend(g)
+                groups.remove(g)
+            near[0].append(t)
+        for group in groups:
+            first = group[0]
+            if len(group) > 1:
+                names = [t.get_text() for t in sorted(group, key=lambda t: float(t.xy[0]))]
+                counts = dict.fromkeys(names, 0)
+                for name in names:
+                    counts[name] += 1
+                first.set_text(", ".join(n if k == 1 else f"{n} ×{k}" for n, k in counts.items()))
+                if len({str(t.get_color()) for t in group}) > 1:
+                    first.set_color("0.25")
+                top = max(group, key=lambda t: float(t.xy[1]))
+                first.xy = top.xy  # beside the highest marker of the group
+                for other in group[1:]:
+                    other.remove()
+            keep.append((ax, first))
+    return keep
+
+
+def _event_markers(ax: Any) -> list[Any]:
+    """Display boxes of the event markers of ``ax`` (``gid`` ``…:event:<kind>``)."""
+    from matplotlib.transforms import Bbox
+
+    boxes = []
+    for coll in ax.collections:
+        if ":event:" not in str(coll.get_gid() or "") or not len(coll.get_offsets()):
+            continue
+        xy = coll.get_offset_transform().transform(np.asarray(coll.get_offsets(), dtype=float))
+        sizes = np.asarray(coll.get_sizes(), dtype=float)
+        r = 0.5 * math.sqrt(float(sizes.max()) if sizes.size else 36.0) * ax.figure.dpi / 72.0
+        boxes += [
+            Bbox([[x - r, y - r], [x + r, y + r]]) for x, y in xy if np.isfinite([x, y]).all()
+        ]
+    return boxes
 
 
 def _obstacles(ax: Any) -> tuple[list[np.ndarray], np.ndarray, list[Any]]:
