@@ -11,7 +11,8 @@ down branch dashed. The curves' own marks follow the verdicts, so that none cont
   that are both periodic (nT) — a chaotic curve scatters from point to point without jumping;
 * **hysteresis** is shaded between the branches only where both directions are periodic at
   the same value and their responses differ: two coexisting periodic motions. Where either
-  branch is QP, chaotic, unresolved or failed, nothing is shaded.
+  branch is QP, chaotic, unresolved or failed, nothing is shaded. The legend names the
+  shading (:data:`HYSTERESIS_LABEL`) when there is one.
 
 A store without motion labels gets neither marks nor band. Over Ω the top axis shows the sun
 speed in rpm and the mesh frequency in Hz, and the force and DTE panels a physical axis (N,
@@ -48,6 +49,8 @@ MESH_LABEL = {"sp": "sun–planet", "rp": "planet–ring", "mesh": "mesh"}
 MESH_COLOR = {"sp": "0.1", "rp": "#9467bd", "mesh": "0.1"}
 #: Relative difference of the branches (to the panel's range) shaded as hysteresis.
 HYSTERESIS_REL = 0.02
+#: The legend entry of the shading between the branches.
+HYSTERESIS_LABEL = "hysteresis (two periodic branches)"
 
 
 def _meshes(ds: Any) -> list[str]:
@@ -128,6 +131,7 @@ def response_figure(
     else:
         axes = list(fig.subplots(len(PANELS), 1, sharex=True))
         band = None
+    shaded = False
     for ax, (q, ylabel, phys) in zip(axes, PANELS, strict=True):
         ys: list[np.ndarray] = []
         for m in meshes:
@@ -163,6 +167,7 @@ def response_figure(
                 differ = np.abs(up - down) > HYSTERESIS_REL * span if span > 0 else both & False
                 shade = both & differ
                 if shade.any():
+                    shaded = True
                     ax.fill_between(
                         x,
                         np.fmin(up, down),
@@ -181,7 +186,13 @@ def response_figure(
                 unit = "F" if phys == "force" else "δ"
                 linear_axis(ax, "y", found[0], f"{unit} {found[1]}")
         ax.grid(alpha=0.3, lw=0.5)
-    axes[0].legend(fontsize="x-small", ncol=2, loc="best")
+    handles, names = axes[0].get_legend_handles_labels()
+    if shaded:  # the shading's colour is each mesh's, faint: one entry says what it means
+        from matplotlib.patches import Patch
+
+        handles.append(Patch(facecolor="0.1", alpha=0.15, lw=0, label=HYSTERESIS_LABEL))
+        names.append(HYSTERESIS_LABEL)
+    axes[0].legend(handles, names, fontsize="x-small", ncol=2, loc="best")
     xlabel = r"$\Omega = \omega/\omega_n$" if xname == "omega" else xname
     bottom = axes[-1]
     if band is not None:
