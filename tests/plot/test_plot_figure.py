@@ -54,6 +54,11 @@ def test_summary_figure_with_one_sample_per_period(tmp_path) -> None:
 
 
 def test_summary_figure_of_a_reference_system(oscillator: gc.SimulationResult, tmp_path) -> None:
+    """No sun coordinates: no empty sun-orbit panel saying so (issue 35), the text in its
+    place; the oscillator's mesh force panel stays."""
     fig = summary_figure(oscillator)
-    assert any("has no sun coordinates" in t.get_text() for t in fig.axes[4].texts)
+    texts = [t.get_text() for ax in fig.axes for t in ax.texts]
+    assert not any("sun coordinates" in t for t in texts)
+    assert [ax.get_title() for ax in fig.axes if ax.get_title().startswith("sun")] == []
+    assert any(ax.get_title().startswith("mesh contact forces") for ax in fig.axes)
     savefig(fig, tmp_path / "osc.png")

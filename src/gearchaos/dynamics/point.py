@@ -182,7 +182,8 @@ def summarize(
 def _finished(system: Any, cfg: SolverSettings, v: Verdict, check: bool) -> SimulationResult:
     """The record the verdict is about, with the protocol's samples: the recorded window
     integrated again from ``periods`` sections before the end of the verdict's continuation of
-    the run, at the section time; its settings say the transient the record follows."""
+    the run, at the section time; its settings are the protocol's and ``extra_periods`` the
+    periods the verdict added to the protocol's transient before the record."""
     assert v.record is not None
     m = int(cfg.periods)
     start = v.record.states[max(0, v.record.states.shape[0] - m)]
@@ -193,8 +194,9 @@ def _finished(system: Any, cfg: SolverSettings, v: Verdict, check: bool) -> Simu
     window = cfg.replace(transient_periods=0.0, section_phase=0.0)
     tau_s = section_fraction(cfg) * system.period
     result = run_simulation(system, window, y0=start, t0=tau_s, check=check)
-    shown = cfg.replace(transient_periods=float(cfg.transient_periods) + v.extra_periods)
-    return dataclasses.replace(result, solver=shown, origin=origin)
+    return dataclasses.replace(
+        result, solver=cfg, extra_periods=int(v.extra_periods), origin=origin
+    )
 
 
 def _verdict_settings(verdict: Any) -> VerdictSettings | None:

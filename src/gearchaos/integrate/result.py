@@ -9,8 +9,9 @@ mesh contact forces, 0 while the teeth are apart and where the mesh force would 
 :func:`gearchaos.model.response.compressive_contact_forces`) with their ``_min``/``_max``
 (planet) and
 ``load_factor_sp``, ``load_factor_rp`` (planet: max |F̄ᶜ| over T̄_D/N); attributes
-``gearset_toml``, ``omega``, ``rtol``, ``atol``, ``transient_periods``, ``periods``,
-``status``, ``version``. With ``samples_per_period > 1``
+``gearset_toml``, ``omega``, ``rtol``, ``atol``, ``transient_periods`` (the protocol's),
+``extra_periods`` (periods a motion verdict added to that transient before the record),
+``periods``, ``status``, ``version``. With ``samples_per_period > 1``
 the full time history is added on dimension ``sample`` (coordinate ``tau_sample``) as
 ``<name>_history``.
 """
@@ -62,6 +63,7 @@ class SimulationResult(Trajectory):
             "model": self.system.name,
             "omega": self.omega,
             **self.solver.attrs(),
+            "extra_periods": int(self.extra_periods),
             "status": self.status.name.lower(),
             "status_message": self.status.message,
             "steps_accepted": self.steps_accepted,

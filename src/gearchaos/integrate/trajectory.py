@@ -64,6 +64,10 @@ class Trajectory(SampleArrays):
     #: Where a run that did not start from ``y0`` or rest comes from, in words (a motion
     #: verdict's record: the confirmed orbit, or the end of its extension); "" otherwise.
     origin: str = ""
+    #: Periods by which a continuation of the run (the motion verdict's, to finish a
+    #: transient) lengthened the transient beyond the protocol's ``solver.transient_periods``
+    #: before this record; 0 for a record that follows the protocol's transient.
+    extra_periods: int = 0
 
     @property
     def samples_per_period(self) -> int:

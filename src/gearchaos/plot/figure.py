@@ -46,6 +46,10 @@ def _text_lines(result: Any, summary: dict[str, Any]) -> list[str]:
         owner,
         rf"$\Omega = \omega/\omega_n$ = {_fmt(summary['omega'])}",
     ]
+    if not gs:  # a model of one's own: what its variables are called in the panels
+        shown = [n for n in result.system.state_names if not n.endswith("_dot")]
+        names = ", ".join(f"${variable(result, n).symbol}$" for n in shown[:6])
+        lines.append(f"variables: {names}" + (" …" if len(shown) > 6 else "") + " (and rates)")
     if summary.get("omega_n_rad_s") is not None:
         lines.append(rf"$\omega_n$ = {_fmt(summary['omega_n_rad_s'], '.5g')} rad/s")
     if summary.get("mesh_frequency_hz") is not None:
@@ -82,9 +86,12 @@ def _text_lines(result: Any, summary: dict[str, Any]) -> list[str]:
     )
     s = result.solver
     lines.append(
-        f"transient {s.transient_periods} + recorded {s.periods} periods, "
+        f"transient {s.transient_periods:g} + recorded {s.periods} periods, "
         f"{s.samples_per_period} samples/period"
     )
+    added = int(summary.get("extra_periods") or 0)
+    if added:
+        lines.append(f"periods added by the verdict to finish the transient: {added}")
     return lines
 
 
@@ -94,7 +101,7 @@ def summary_figure(
     *,
     planet: int = 1,
     history_periods: float = 10,
-    figsize: tuple[float, float] = (16.0, 13.0),
+    figsize: tuple[float, float] | None = None,
 ) -> Any:
     """A one-page figure of one simulation: 2×3 panels over a full-width force panel.
 
@@ -103,8 +110,12 @@ def summary_figure(
     orbit, a text panel, and under them the mesh contact forces of ``planet`` over the same
     periods with the separations shaded (:func:`~gearchaos.plot.timeseries.mesh_force_history`);
     the text panel lists Ω, ω_n, sun speed, distinct section points, contact regimes,
-    status and the gear set name. Works for reference systems too (their first state is
-    shown; the sun-orbit panel then says why it is empty).
+    status and the gear set name. Works for reference systems and models of one's own too
+    (their default observable is shown, and the text names their variables by the model's
+    symbols); a panel that does not apply is left out rather than drawn empty: without sun
+    coordinates the text takes the sun orbit's place, without tracked mesh contact forces
+    (``force_groups``) there is no force panel and the figure is shorter (16 × 9 inches
+    instead of 16 × 13, unless ``figsize`` is given).
 
     Parameters
     ----------
@@ -126,14 +137,17 @@ def summary_figure(
 
     if summary is None:
         summary = summarize(result)
-    fig = Figure(figsize=figsize, layout="constrained")
-    mosaic = fig.subplot_mosaic(
-        [["00", "01", "02"], ["10", "11", "12"], ["force", "force", "force"]],
-        height_ratios=[1.0, 1.0, 0.8],
-    )
-    axs = np.array([[mosaic[f"{r}{c}"] for c in range(3)] for r in range(2)])
     var = None  # the model's default observable
     sun = {"x_s", "y_s"} <= set(result.system.state_names)
+    forces = bool(result.system.force_groups)  # what mesh_force_history draws
+    rows: list[Any] = [["00", "01", "02"], ["10", "11" if sun else "12", "12"]]
+    if forces:
+        rows.append(["force", "force", "force"])
+    if figsize is None:
+        figsize = (16.0, 13.0) if forces else (16.0, 9.0)
+    fig = Figure(figsize=figsize, layout="constrained")
+    mosaic = fig.subplot_mosaic(rows, height_ratios=[1.0, 1.0, 0.8][: len(rows)])
+    axs = np.array([[mosaic.get(f"{r}{c}") for c in range(3)] for r in range(2)], dtype=object)
     periods = min(float(history_periods), float(result.solver.periods))
 
     ax = time_history(result, var, planet, ax=axs[0, 0], periods=periods)
@@ -173,15 +187,11 @@ def summary_figure(
         ax = sun_orbit(result, ax=axs[1, 1], periods=sun_periods)
         ax.set_title(f"sun centre orbit (last {sun_periods:g} periods)")
         ax.legend(loc="upper right", fontsize="small")
-    else:
-        message(axs[1, 1], f"no sun orbit: {result.system.name} has no sun coordinates x_s, y_s")
 
-    try:
+    if forces:
         ax = mesh_force_history(result, planet, ax=mosaic["force"], periods=periods)
         ax.set_title(f"mesh contact forces (last {periods:g} periods; shaded: teeth apart)")
         ax.legend(loc="center left", bbox_to_anchor=(1.06, 0.5), fontsize="small")
-    except ParameterError as e:
-        message(mosaic["force"], str(e))
 
     tx = axs[1, 2]
     tx.set_axis_off()

@@ -55,6 +55,7 @@ _PROTOCOL = (
     "initial_conditions",
     "direction",
     "transient_periods",
+    "extra_periods",
     "periods",
     "samples_per_period",
 )
