@@ -2,9 +2,9 @@
 
 Run from the repository root with the project's environment:
 ``.venv/bin/python docs/make_doc_numbers.py [--check] [--fast]``. Every number of README.md,
-the tutorial, the reproduce and rattle how-tos and docs/reproduction.md that a command printed
-(or that the committed report holds) sits between markers, and this script rewrites what is
-between them::
+the tutorial, the reproduce, rattle, maps and hysteresis how-tos and docs/reproduction.md that a
+command printed (or that the committed report holds, or that a how-to's commands wrote) sits
+between markers, and this script rewrites what is between them::
 
     |μ| ≈ <!-- gen:gallery.mu-3.5 -->0.97<!-- /gen --> per two periods
 
@@ -27,7 +27,7 @@ around it stays true) with an optional format after ``|``.
 A source whose output no longer supports the prose around its numbers (the README's two
 attractors at Ω = 1.5, say) raises :class:`ProseOutOfDate` with what to rewrite.
 ``--check`` rewrites nothing and exits 1 listing the stale numbers; ``--fast`` leaves out the
-sources marked slow (the tutorial's 800-point sweep, the rattle how-to's commands).
+sources marked slow (the tutorial's 800-point sweep, the how-tos' commands).
 ``tests/docs/test_doc_numbers.py`` runs the fast sources and the report in CI and the slow ones
 under ``-m slow``.
 """
@@ -57,8 +57,12 @@ PAGES = (
     ROOT / "docs" / "howto" / "reproduce.md",
     ROOT / "docs" / "reproduction.md",
     ROOT / "docs" / "howto" / "rattle.md",
+    ROOT / "docs" / "howto" / "maps.md",
+    ROOT / "docs" / "howto" / "hysteresis.md",
 )
 RATTLE = ROOT / "docs" / "howto" / "rattle.md"
+MAPS = ROOT / "docs" / "howto" / "maps.md"
+HYSTERESIS = ROOT / "docs" / "howto" / "hysteresis.md"
 REPORT = ROOT / "docs" / "report" / "report.json"
 MARK = re.compile(r"<!-- gen:(?P<name>[^ ]+) -->(?P<body>.*?)<!-- /gen -->", re.S)
 COLUMNS = 100
@@ -287,11 +291,111 @@ def titled_table(text: str, title: str) -> Block:
     return Block("\n".join(line.rstrip() for line in lines[start : end + 1]) + "\n")
 
 
+def run_howto(page: Path, work: Path) -> str:
+    """Run a how-to page's bash blocks (through its last figure) in ``work`` as a reader
+    would (docs/make_howto_figures.py); their stdout."""
+    from make_howto_figures import environment, page_script
+
+    env = {**environment(), "COLUMNS": str(COLUMNS), "NO_COLOR": "1"}
+    env.pop("FORCE_COLOR", None)
+    script = page_script(page.name)
+    proc = subprocess.run(["bash", "-c", script], cwd=work, env=env, capture_output=True, text=True)
+    if proc.returncode != 0:
+        raise RuntimeError(f"{page.name}: its commands failed:\n{proc.stderr[-3000:]}")
+    return proc.stdout
+
+
+def _maps(work: Path) -> dict[str, str]:
+    """The 2-D map of the maps how-to (its commands, run as the page shows them): how many
+    points, and the share of chaotic points at the lowest and the highest damping."""
+    import numpy as np
+
+    import gearchaos as gc
+
+    if not (work / "map.zarr").exists():  # (already there when the figure was just made)
+        run_howto(MAPS, work)
+    ds = gc.open_sweep(work / "map.zarr")
+    xi = np.asarray(ds["xi"].values, dtype=float)
+    chaos = (ds["motion"].astype(str) == "chaos").mean("omega").values
+    lo, hi = int(np.argmin(xi)), int(np.argmax(xi))
+    if not chaos[hi] < chaos[lo]:
+        raise ProseOutOfDate(
+            f"maps.md says damping shrinks the chaotic region: {100 * chaos[lo]:.0f} % chaotic at "
+            f"ξ = {xi[lo]:g}, {100 * chaos[hi]:.0f} % at ξ = {xi[hi]:g}"
+        )
+    return {
+        "points": str(int(ds["motion"].size)),
+        "omega.points": str(int(ds.sizes["omega"])),
+        "xi.lo": f"{xi[lo]:g}",
+        "xi.hi": f"{xi[hi]:g}",
+        "chaos.lo": f"{round(chaos[lo] * ds.sizes['omega'])}",
+        "chaos.hi": f"{round(chaos[hi] * ds.sizes['omega'])}",
+    }
+
+
+def _runs(labels: list[str], accept: Callable[[str], bool]) -> list[tuple[int, int]]:
+    """Maximal runs [i, j] (inclusive) of neighbours whose label ``accept`` takes."""
+    out: list[tuple[int, int]] = []
+    start = None
+    for k, label in enumerate([*labels, ""]):
+        if k < len(labels) and accept(label):
+            start = k if start is None else start
+        elif start is not None:
+            out.append((start, k - 1))
+            start = None
+    return out
+
+
+def _hysteresis(work: Path) -> dict[str, str]:
+    """The up/down sweeps of the hysteresis how-to (its commands, run as the page shows them):
+    where the up branch holds the 1T orbit, where the down branch, coming from above, drops
+    onto it, what it is on before, and the range where both exist."""
+    import numpy as np
+
+    import gearchaos as gc
+
+    if not (work / "hysteresis.zarr").exists():
+        run_howto(HYSTERESIS, work)
+    ds = gc.open_sweep(work / "hysteresis.zarr")
+    omega = np.asarray(ds["omega"].values, dtype=float)
+    up = [str(v) for v in ds["motion"].sel(direction="up").values]
+    down = [str(v) for v in ds["motion"].sel(direction="down").values]
+    ones = _runs(up, lambda m: m == "1T")
+    if not ones:
+        raise ProseOutOfDate("hysteresis.md: the up sweep no longer holds a 1T orbit")
+    i, j = max(ones, key=lambda r: r[1] - r[0])  # the 1T orbit the up sweep lands on
+    held = [r for r in _runs(down, lambda m: m == "1T") if r[0] <= j and r[1] >= i]
+    if not held:
+        raise ProseOutOfDate("hysteresis.md: the down sweep never drops onto the up's 1T orbit")
+    top = max(held, key=lambda r: r[1] - r[0])[1]  # where the down sweep drops onto it
+    if not top < j:
+        raise ProseOutOfDate(
+            f"hysteresis.md: the down sweep holds the 1T orbit up to Ω = {omega[top]:.2f}, "
+            f"as far as the up sweep ({omega[j]:.2f}): no hysteresis"
+        )
+    above = down[top + 1 : j + 1]  # both sweeps here: up on 1T, down on what?
+    irregular = [m for m in above if m in ("QP", "chaos")]
+    if len(irregular) < 0.75 * len(above):
+        raise ProseOutOfDate(
+            f"hysteresis.md: over Ω = {omega[top + 1]:.2f} … {omega[j]:.2f} the down sweep is "
+            f"{above}, not mostly quasi-periodic or chaotic"
+        )
+    names = (("QP", "quasi-periodic"), ("chaos", "chaotic"))
+    x = ds["delta_sp"].sel(direction="up", planet=1).isel(omega=slice(i, j + 1))
+    return {
+        "up.lo": f"{omega[i]:.2f}",
+        "up.hi": f"{omega[j]:.2f}",
+        "up.mean": f"{float(x.mean()):.2f}",
+        "down.kind": " and ".join(w for m, w in names if m in irregular),
+        "down.lo": f"{omega[top + 1]:.2f}",
+        "down.drop": f"{omega[top]:.2f}",
+    }
+
+
 def _rattle(work: Path) -> dict[str, str]:
     """The rattle how-to's commands, run as the page shows them (its bash blocks, in a fresh
     directory), and what its table and its prose say about the store they write."""
     import numpy as np
-    from make_howto_figures import environment, page_script
 
     import gearchaos as gc
     from gearchaos.model.derived import gearset_info
@@ -299,12 +403,7 @@ def _rattle(work: Path) -> dict[str, str]:
     from gearchaos.sweep import SweepResult, contact_ranges
     from gearchaos.sweep.spec import RESPONSE_SOLVER
 
-    env = {**environment(), "COLUMNS": str(COLUMNS), "NO_COLOR": "1"}
-    env.pop("FORCE_COLOR", None)
-    script = page_script(RATTLE.name)
-    proc = subprocess.run(["bash", "-c", script], cwd=work, env=env, capture_output=True, text=True)
-    if proc.returncode != 0:
-        raise RuntimeError(f"{RATTLE.name}: its commands failed:\n{proc.stderr[-3000:]}")
+    stdout = run_howto(RATTLE, work)
     res = SweepResult(gc.open_sweep(work / "rattle.zarr"))
     ranges = contact_ranges(res)
     scales = PhysicalScales.of_sweep(res)
@@ -340,7 +439,7 @@ def _rattle(work: Path) -> dict[str, str]:
     words = {"sun_planet": "sun–planet", "planet_ring": "planet–ring"}
     static = gearset_info(res.gearset)["static_mesh_force_N"]
     return {
-        "table": titled_table(proc.stdout, "contact regimes of rattle.zarr"),
+        "table": titled_table(stdout, "contact regimes of rattle.zarr"),
         "transient": f"{RESPONSE_SOLVER.transient_periods:g}",
         "periods": f"{RESPONSE_SOLVER.periods:d}",
         "up.rpm": f"{up * rpm[0]:.0f}",
@@ -407,6 +506,14 @@ SOURCES: dict[str, Source] = {
     "report": Source(None, _report),
     "rattle": Source(
         "gearchaos plot rattle.zarr --contact --table -o rattle.png", _rattle, slow=True
+    ),
+    "map": Source(
+        "gearchaos bifurcation --vary omega=0.5:3.5:31 --vary xi=0.03:0.11:5 -o map.zarr",
+        _maps,
+        slow=True,
+    ),
+    "hysteresis": Source(
+        "gearchaos plot hysteresis.zarr -o hysteresis.png", _hysteresis, slow=True
     ),
 }
 
