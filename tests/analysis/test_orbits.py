@@ -202,9 +202,15 @@ def test_orbit_api_section_values_contacts_and_summary(sheng: gc.GearSet) -> Non
     summary = orbit.summary()
     assert list(summary) == [
         "period", "minimal_period", "converged", "max_multiplier", "residual", "stable",
-        "multipliers", "x_sp1", "contact", "message",
+        "stability_margin", "multipliers", "x_sp1", "contact", "message",
     ]  # fmt: skip
     assert summary["minimal_period"] == 1  # issue 24: the JSON says the orbit's own period
+    # the stated criterion (issue 32: one margin, 10⁻⁴ as documented): with five planets no
+    # multiplier is structural, so stable means every |μ| < 1 − margin
+    assert summary["stability_margin"] == 1e-4
+    assert summary["stable"] == all(
+        m["abs"] < 1 - summary["stability_margin"] for m in summary["multipliers"]
+    )
     assert summary["max_multiplier"] == pytest.approx(max(m["abs"] for m in summary["multipliers"]))
     assert summary["x_sp1"] == pytest.approx([float(x[0, 0])])
     assert len(summary["multipliers"]) == 16

@@ -184,16 +184,26 @@ def test_plot_of_a_simulation_file_says_what_the_file_is(runner: CliRunner, tmp_
 
 
 def test_a_simulation_file_says_where_its_record_starts(runner: CliRunner, tmp_path: Path) -> None:
-    """Where the motion verdict had to settle a record (Ω = 1.5: a slow approach to the 1T
-    orbit) the saved record is integrated again from the orbit it confirmed, and the file says
-    so instead of 'given'; a record the verdict took as it is (Ω = 0.5) started from rest."""
-    for omega, words in (("1.5", "periodic orbit the motion verdict confirmed"),
+    """Where the motion verdict had to continue a record (Ω = 1.5: a slow approach to the 1T
+    orbit, |μ| ≈ 0.997, so the distance falls by e only every ~330 periods) the saved record is
+    the trajectory's own continuation, integrated again from where it reached, and the file says
+    so instead of 'given', with the periods before it as its transient; a record the verdict
+    took as it is (Ω = 0.5) started from rest after the protocol's 100 periods."""
+    for omega, words in (("1.5", "continuation of the run reached from rest"),
                          ("0.5", "rest, perturbed")):  # fmt: skip
         out = tmp_path / f"sim{omega}"
         result = runner.invoke(app, ["simulate", "--set", f"omega={omega}", "-o", str(out),
                                      "--no-plot"])  # fmt: skip
         assert result.exit_code == 0, result.output
-        assert words in gc.open_simulation(out / "simulation.nc").attrs["initial_state"]
+        ds = gc.open_simulation(out / "simulation.nc")
+        assert words in ds.attrs["initial_state"]
+        # a 1T record: every section lies on the orbit, within the verdict's reach (10⁻³)
+        spread = np.ptp(ds["delta_sp"].values, axis=0)
+        assert np.all(spread < 1e-3)
+        if omega == "1.5":  # ~10 e-folds (0.1 → 10⁻⁵) of ~330 periods each: thousands
+            assert ds.attrs["transient_periods"] > 1000
+        else:
+            assert ds.attrs["transient_periods"] == 100
 
 
 def test_an_installed_model_is_found_by_its_entry_point_name(

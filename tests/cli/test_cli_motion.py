@@ -118,11 +118,13 @@ def test_simulate_lyapunov_json_labels_the_1t_response(runner: CliRunner) -> Non
     # from the record alone: λ₁ only with --lyapunov, the indicators in the table
     result = runner.invoke(app, [*args, "--no-verdict", "--lyapunov", "--json"])
     data = json.loads(result.stdout)
-    assert data["motion"] == "1T" and data["evidence"] == "record"
+    # (the record's own label is named as such, never the motion: issue 32)
+    assert data["motion"] is None and data["record_label"] == "1T"
+    assert data["evidence"] == "record"
     assert data["lle"] is not None and data["lle"] < 0
     assert data["indicators_agree"] is True
     plain = json.loads(runner.invoke(app, [*args, "--no-verdict", "--json"]).stdout)
-    assert plain["lle"] is None and plain["motion"] == "1T"
+    assert plain["lle"] is None and plain["motion"] is None and plain["record_label"] == "1T"
     human = runner.invoke(app, [*args, "--no-verdict", "--lyapunov"]).stdout
     assert "λ₁" in human and "0–1 test K" in human and "indicators agree" in human
 

@@ -22,6 +22,7 @@ KEYS = {
     "converged",
     "residual",
     "stable",
+    "stability_margin",
     "max_multiplier",
     "multipliers",
     "x_sp1",
@@ -49,7 +50,10 @@ def test_orbit_json_has_exactly_the_documented_keys(runner: CliRunner) -> None:
     absolute = [mu["abs"] for mu in mus]
     # sorted by modulus, largest first (a conjugate pair's moduli differ by rounding only)
     assert all(a >= b - 1e-12 for a, b in itertools.pairwise(absolute))
-    assert out["stable"] is (max(absolute) < 1.0)
+    # one stability criterion with its margin stated (10⁻⁴, as documented): five planets
+    # leave no multiplier structural, so stable means every |μ| < 1 − margin
+    assert out["stability_margin"] == 1e-4
+    assert out["stable"] is (max(absolute) < 1.0 - out["stability_margin"])
     # complex multipliers of a real monodromy matrix come in conjugate pairs
     z = np.array([complex(mu["re"], mu["im"]) for mu in mus])
     assert np.sort_complex(z) == pytest.approx(np.sort_complex(np.conj(z)), abs=1e-9)

@@ -16,6 +16,7 @@ from rich.text import Text
 
 from ..dynamics.coexistence import ATTRACTOR_SETTINGS
 from ..dynamics.orbits import ORBIT_SETTINGS
+from ..dynamics.stability import STABILITY_MARGIN
 from ..dynamics.verdict import CONFIRM_PERIODS
 from ..errors import IntegrationError, ParameterError
 from ..gearset.schema import OMEGA, SPEEDS
@@ -140,9 +141,11 @@ def orbit(
     and contact regimes.
 
     The multipliers μ are the eigenvalues of the monodromy matrix; the orbit is stable when
-    every |μ| < 1. **--json** prints exactly {period, minimal_period, converged, residual,
-    stable, max_multiplier, multipliers: [{re, im, abs}], x_sp1: [...], contact: [...],
-    message}; a period-2 shooting that converges on a 1T orbit says minimal_period 1.
+    every |μ| < 1 − 10⁻⁴ (the motion verdict's criterion; a multiplier equal to 1 for a
+    structural reason, a free direction, is set aside). **--json** prints exactly {period,
+    minimal_period, converged, residual, stable, stability_margin, max_multiplier,
+    multipliers: [{re, im, abs}], x_sp1: [...], contact: [...], message}; a period-2
+    shooting that converges on a 1T orbit says minimal_period 1.
 
     The guess is a simulation from rest of --transient mesh periods, settled longer (up to
     16 times) while the shooting lands on no orbit or an unstable one; or the state of a
@@ -186,7 +189,7 @@ def orbit(
         Text("yes" if orb.converged else "no", style="" if orb.converged else "bold red"),
     )
     table.add_row("residual ‖Pⁿ(y) − y‖", f"{orb.residual:.3g}")
-    table.add_row("stable (all |μ| < 1)", "yes" if orb.stable else "no")
+    table.add_row(f"stable (|μ| < 1 − {STABILITY_MARGIN:g})", "yes" if orb.stable else "no")
     table.add_row("largest |μ|", f"{orb.max_multiplier:.6g}")
     table.add_row("minimal period", str(orb.minimal_period))
     xs = summary["x_sp1"]

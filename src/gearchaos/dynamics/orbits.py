@@ -213,7 +213,8 @@ class PeriodicOrbit:
     def summary(self) -> dict[str, Any]:
         """A JSON-serialisable summary: ``period`` (the one shot), ``minimal_period`` (the
         orbit's own: a period-2 shooting may converge on a 1T orbit), ``converged``,
-        ``residual``, ``stable``, ``max_multiplier``, ``multipliers`` ([{re, im, abs}]),
+        ``residual``, ``stable``, ``stability_margin`` (stable: every non-structural
+        |μ| < 1 − margin), ``max_multiplier``, ``multipliers`` ([{re, im, abs}]),
         ``x_sp1`` (the section values of X̄_sp1, or of the first tracked observable of a
         reference system), ``contact`` ([{contact, regime}]) and ``message`` (how it converged
         or why not; how long the guess settled)."""
