@@ -119,3 +119,29 @@ def test_summary_counts_every_distinct_point() -> None:
     s = summarize(res)
     assert s["recorded_section_points"] == 150
     assert 120 < s["distinct_section_points"] <= 150
+
+
+def test_summary_carries_the_verdicts_window_and_coexisting_orbits(
+    planetary: gc.SimulationResult,
+) -> None:
+    """The README's summary contract: ``simulate --json`` (a summary with the verdict) has the
+    window λ₁ was measured over and the stable orbits beside the motion; a record-only summary
+    says that no window ran and names none."""
+    from gearchaos.dynamics.evidence import Verdict
+
+    v = Verdict(
+        "QP",
+        0,
+        "lyapunov",
+        lle=1e-4,
+        lle_error=1e-4,
+        window_start=300,
+        window_periods=800,
+        coexisting=((1, 0.97),),
+    )
+    s = summarize(planetary, verdict=v.to_dict())
+    assert (s["window_start"], s["window_periods"]) == (300, 800)
+    assert s["coexisting"] == [{"period": 1, "max_multiplier": 0.97}]
+    json.dumps(s)
+    r = summarize(planetary)
+    assert (r["window_start"], r["window_periods"], r["coexisting"]) == (-1, 0, [])

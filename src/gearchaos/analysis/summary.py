@@ -78,11 +78,14 @@ def summarize(
     verdict
         The motion verdict's fields (:meth:`gearchaos.dynamics.verdict.Verdict.to_dict`):
         then ``motion`` is its label, ``lle``/``lle_error`` its λ₁ and error, and
-        ``evidence``, ``max_multiplier``, ``extra_periods`` and ``motion_note`` (its reason)
-        say what decided it. Without it ``motion`` is None: the label from the record alone
+        ``evidence``, ``max_multiplier``, ``extra_periods``, ``window_start`` and
+        ``window_periods`` (the window λ₁ was measured over), ``coexisting`` (stable orbits
+        beside the motion) and ``motion_note`` (its reason) say what decided it. Without it
+        ``motion`` is None: the label from the record alone
         (:func:`~gearchaos.analysis.classify.classify_motion`) is ``record_label``, never the
-        motion, and ``evidence`` is ``record``. :func:`gearchaos.summarize` decides the
-        motion of a result with the verdict, as ``gearchaos simulate`` does.
+        motion, ``evidence`` is ``record`` and no window ran (``window_start`` −1).
+        :func:`gearchaos.summarize` decides the motion of a result with the verdict, as
+        ``gearchaos simulate`` does.
 
     Returns
     -------
@@ -159,6 +162,9 @@ def summarize(
         out["max_multiplier"] = verdict["max_multiplier"]
         out["extra_periods"] = verdict["extra_periods"]
         out["record"] = verdict["record"]
+        out["window_start"] = verdict["window_start"]
+        out["window_periods"] = verdict["window_periods"]
+        out["coexisting"] = verdict["coexisting"]
         out["indicators_agree"] = True
         out["window_start"] = verdict.get("window_start", -1)
         out["window_periods"] = verdict.get("window_periods", 0)
@@ -172,6 +178,9 @@ def summarize(
         out["max_multiplier"] = None
         out["extra_periods"] = 0
         out["record"] = "protocol"
+        out["window_start"] = -1
+        out["window_periods"] = 0
+        out["coexisting"] = []
         out["indicators_agree"] = bool(mc.agree)
         out["motion_note"] = mc.note
     out["gearset"] = gs.name if gs is not None else None
