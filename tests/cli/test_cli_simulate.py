@@ -25,6 +25,7 @@ CONTRACT = [
     "sun_speed_rpm",
     "distinct_section_points",
     "motion",
+    "record_label",
     "x_sp1_section_min",
     "x_sp1_section_max",
     "contact",
@@ -53,7 +54,7 @@ def test_json_keys_and_values_match_the_python_api(runner: CliRunner) -> None:
 
     gs = preset("sheng2016")
     # the CLI is analyse_point: the simulation, then the verdict (which may show the
-    # finished record: the run from the confirmed orbit or the extended run)
+    # finished record: the run continued by the verdict, never the orbit's own points)
     cfg = SolverSettings(transient_periods=20, periods=20, samples_per_period=8)
     point = analyse_point(gs, {"omega": 1.5}, cfg)
     res = point.result
