@@ -124,7 +124,7 @@ def test_commands_run_and_their_stores_say_what_the_page_says(tmp_path: Path) ->
         assert proc.returncode == 0, f"{command}\n{proc.stderr[-3000:]}"
         outputs[command.split()[1]] = proc.stdout
     assert re.search(r"motion\s*│\s*1T", outputs["simulate"])
-    assert re.search(r"stable \(all \|μ\| < 1\)\s*│\s*yes", outputs["orbit"])
+    assert re.search(r"stable \(\|μ\| < 1 − 0\.0001\)\s*│\s*yes", outputs["orbit"])
     assert (work / "out" / "simulation.nc").is_file()
     assert (work / "own-model.png").stat().st_size > 10_000
 
