@@ -2,9 +2,10 @@
 
 Run from the repository root with the project's environment:
 ``.venv/bin/python docs/make_doc_numbers.py [--check] [--fast]``. Every number of README.md,
-the tutorial, the reproduce, rattle, maps and hysteresis how-tos and docs/reproduction.md that a
-command printed (or that the committed report holds, or that a how-to's commands wrote) sits
-between markers, and this script rewrites what is between them::
+the tutorial, the reproduce, rattle, maps, hysteresis and basins how-tos, docs/reproduction.md
+and the motion-labels page that a command printed (or that the committed report holds, that a
+how-to's commands wrote, or that the verdict's settings define) sits between markers, and this
+script rewrites what is between them::
 
     |μ| ≈ <!-- gen:gallery.mu-3.5 -->0.97<!-- /gen --> per two periods
 
@@ -20,9 +21,11 @@ A marker's name is ``SOURCE.KEY``. Each source (:data:`SOURCES`) runs one comman
 verbatim in a code block or in inline code of every page that quotes it (checked), in a fresh
 directory with ``COLUMNS=100`` (the width of the excerpts), and reads its output; the
 ``report`` source reads ``docs/report/report.json`` instead, which ``gearchaos reproduce --all
--o docs/report`` wrote. Window keys of the tutorial's Full sweep are ``fig4a.wN.LABEL.lo|hi``
-(the N-th window the page's Python block prints, which must carry LABEL, so that the prose
-around it stays true) with an optional format after ``|``.
+-o docs/report`` wrote, and the ``verdict`` source the defaults of
+:class:`~gearchaos.dynamics.verdict.VerdictSettings` and the constants of the verdict's rules
+(tolerances, window lengths, budgets). Window keys of the tutorial's Full sweep are
+``fig4a.wN.LABEL.lo|hi`` (the N-th window the page's Python block prints, which must carry
+LABEL, so that the prose around it stays true) with an optional format after ``|``.
 
 A source whose output no longer supports the prose around its numbers (the README's two
 attractors at Ω = 1.5, say) raises :class:`ProseOutOfDate` with what to rewrite.
@@ -35,6 +38,7 @@ under ``-m slow``.
 from __future__ import annotations
 
 import json
+import math
 import os
 import re
 import shlex
@@ -59,6 +63,8 @@ PAGES = (
     ROOT / "docs" / "howto" / "rattle.md",
     ROOT / "docs" / "howto" / "maps.md",
     ROOT / "docs" / "howto" / "hysteresis.md",
+    ROOT / "docs" / "concepts" / "motion-labels.md",
+    ROOT / "docs" / "howto" / "basins.md",
 )
 RATTLE = ROOT / "docs" / "howto" / "rattle.md"
 MAPS = ROOT / "docs" / "howto" / "maps.md"
@@ -165,10 +171,11 @@ LYAPUNOV_ROWS = (
 
 def _quickstart(work: Path) -> dict[str, str]:
     rows = table_rows(run(SOURCES["quickstart"].command or "", work))
-    if cell(rows, "motion") != "1T" or "still converging" not in cell(rows, "motion note"):
+    note = cell(rows, "motion note")
+    if cell(rows, "motion") != "1T" or "until its record lay on it" not in note:
         raise ProseOutOfDate(
-            "the quick start is no longer a 1T orbit the record still converges onto "
-            "(README 'Quick start', tutorial step 2)"
+            "the quick start is no longer a 1T orbit that the run from rest reaches only when "
+            "the verdict continues it (README 'Quick start', tutorial step 2)"
         )
     shown, recorded = cell(rows, "distinct section points").split(" of ")
     return {
@@ -176,6 +183,7 @@ def _quickstart(work: Path) -> dict[str, str]:
         "distinct": shown,
         "recorded": recorded,
         "mu": f"{float(cell(rows, 'max |μ| (Floquet)')):.3f}",
+        "added": cell(rows, "periods added to finish the transient"),
     }
 
 
@@ -454,6 +462,65 @@ def _rattle(work: Path) -> dict[str, str]:
     }
 
 
+_SUPERSCRIPT = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
+
+
+def power_text(value: float) -> str:
+    """``10⁻⁴`` for an exact power of ten, else the number as Python writes it shortest."""
+    if value > 0 and float(f"1e{round(math.log10(value))}") == value:
+        return "10" + str(round(math.log10(value))).translate(_SUPERSCRIPT)
+    return f"{value:g}"
+
+
+def _verdict_settings(_: Path) -> dict[str, str]:
+    """The verdict's tolerances, windows and budgets as the docs state them: the defaults of
+    :class:`~gearchaos.dynamics.verdict.VerdictSettings` and the constants its rules use."""
+    from gearchaos.analysis.bands import MIN_BAND_POINTS
+    from gearchaos.analysis.chaos01 import MIN_LENGTH
+    from gearchaos.analysis.classify import K_CHAOS, K_REGULAR
+    from gearchaos.dynamics.stability import FREE_TOL, STRUCTURAL_TOL
+    from gearchaos.dynamics.verdict import CONFIRM_PERIODS, VerdictSettings
+    from gearchaos.dynamics.verdict_rules import K01_STRIDES, MAX_RETURN, MIN_ORDER, MIN_RETURN
+
+    vs = VerdictSettings()
+    windows = [vs.min_extension]  # a record of min_extension periods (a sweep's)
+    while sum(windows) + (nxt := vs.next_window(windows[-1], len(windows))) <= vs.budget_periods:
+        windows.append(nxt)
+    return {
+        "max_period": str(vs.max_period),
+        "longest_period": str(vs.longest_period),
+        "qp_record": str(2 * vs.longest_period),
+        "period_rtol": power_text(vs.period_rtol),
+        "noise_factor": power_text(vs.noise_factor),
+        "margin": power_text(vs.margin),
+        "structural_tol": power_text(STRUCTURAL_TOL),
+        "free_tol": power_text(FREE_TOL),
+        "same_orbit": f"{100 * vs.same_orbit:g} %",
+        "reach": power_text(vs.reach),
+        "approach": f"{100 * vs.approach:g} %",
+        "min_extension": str(vs.min_extension),
+        "max_window": str(vs.max_window),
+        "budget_periods": str(vs.budget_periods),
+        "windows": " + ".join(str(w) for w in windows),
+        "windows_total": str(sum(windows)),
+        "settle_budget": str(vs.settle_budget),
+        "confirm_periods": str(CONFIRM_PERIODS),
+        "max_bands": str(vs.max_bands),
+        "strides": f"{min(K01_STRIDES)}–{max(K01_STRIDES)}",
+        "min_order": f"{100 * MIN_ORDER:g} %",
+        "max_return": f"{100 * MAX_RETURN:g} %",
+        "min_return": power_text(MIN_RETURN),
+        "band_points": str(MIN_BAND_POINTS),
+        "k01_points": str(MIN_LENGTH),
+        "k_chaos": f"{K_CHAOS:g}",
+        "k_regular": f"{K_REGULAR:g}",
+        "blocks": str(vs.blocks),
+        "confidence": f"{vs.confidence:g}",
+        "lle_c": f"{vs.lle_c:g}",
+        "newton_tol": power_text(vs.newton_tol),
+    }
+
+
 def _report(_: Path) -> dict[str, str]:
     """Counts and run time of the committed report (``docs/report/report.json``), counted by
     the report's own code (:func:`gearchaos.paper.accounting.verdict_counts`): keys
@@ -504,6 +571,7 @@ SOURCES: dict[str, Source] = {
         slow=True,
     ),
     "report": Source(None, _report),
+    "verdict": Source(None, _verdict_settings),
     "rattle": Source(
         "gearchaos plot rattle.zarr --contact --table -o rattle.png", _rattle, slow=True
     ),

@@ -1,12 +1,13 @@
 """The numbers the docs quote from a program are what the program prints now.
 
 ``docs/make_doc_numbers.py`` pastes every such number (between ``<!-- gen:… -->`` markers) into
-README.md, the tutorial and the reproduce how-to by running the commands the pages show, and
-reads the report's counts from ``docs/report/report.json``. These tests run the same sources
-and fail when a page differs: the report and the fast commands (about 15 s) here, the
-tutorial's 800-point sweep under ``-m slow``. A failure names the page, the marker, what it
-shows and what the code gives; ``.venv/bin/python docs/make_doc_numbers.py`` rewrites them
-(and says which prose no longer fits).
+README.md, the tutorial, the reproduce how-to and the motion-labels page by running the
+commands the pages show, reads the report's counts from ``docs/report/report.json`` and the
+verdict's tolerances and budgets from its settings. These tests run the same sources and fail
+when a page differs: the report, the verdict's settings and the fast commands (about 15 s)
+here, the tutorial's 800-point sweep under ``-m slow``. A failure names the page, the marker,
+what it shows and what the code gives; ``.venv/bin/python docs/make_doc_numbers.py`` rewrites
+them (and says which prose no longer fits).
 """
 
 from __future__ import annotations
@@ -58,6 +59,18 @@ def test_every_marker_names_a_source_and_every_page_shows_its_command() -> None:
         assert text.count("<!-- gen:") == text.count("<!-- /gen -->"), f"{page.name}: unclosed"
         found += gen.problems(page, text, {})  # no values: only names and commands
     assert not found, "\n".join(found)
+
+
+def test_verdict_numbers_are_the_settings_defaults() -> None:
+    """The tolerances, windows and budgets the pages state are the verdict's defaults."""
+    assert not (stale := _stale(["verdict"])), "\n".join(stale)
+
+
+def test_power_text_writes_powers_of_ten_as_the_pages_do() -> None:
+    assert gen.power_text(1e-4) == "10⁻⁴"
+    assert gen.power_text(1e3) == "10³"
+    assert gen.power_text(1.0) == "10⁰"
+    assert gen.power_text(2e-2) == "0.02"
 
 
 def test_report_counts_are_those_of_report_json() -> None:
