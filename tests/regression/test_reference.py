@@ -33,9 +33,9 @@ VERSION_ATTRS = frozenset(
     {"version", "numba_version", "numpy_version", "scipy_version", "gearchaos_output"}
 )
 
-#: The stores were last regenerated for issue 13 (Newton's method for the predicted switch
-#: time, which moves step ends by less than 1e-9 of a step); simulate.nc for issue 32 (the
-#: samples between sections interpolated).
+#: simulate.nc was last regenerated for issue 32 (the samples between sections interpolated),
+#: the sweep stores for issue 32's verdict (windows, records continued onto their orbit, the λ₁
+#: window stored); both hold every earlier change (issues 12, 24, 25) themselves.
 
 
 def _same_attrs(a: dict[str, object], b: dict[str, object], where: str) -> None:
@@ -54,75 +54,17 @@ def _same_bytes(x: np.ndarray, y: np.ndarray, where: str) -> None:
     assert x.tobytes() == y.tobytes(), f"{where}: not bitwise equal"
 
 
-def _model_repr_issue_12(attrs: dict[str, object]) -> dict[str, object]:
-    """Issue 12 left the backlash oscillator's layout (which gained the contact force) out of
-    its repr, which the store records as ``model_parameters``: compare the parameters only."""
-    out = dict(attrs)
-    text = out.get("model_parameters")
-    if isinstance(text, str) and text.startswith("BacklashOscillator(") and ", kind=" in text:
-        out["model_parameters"] = text.split(", kind=")[0] + ")"
-    return out
-
-
-def _settings_record_issue_25(attrs: dict[str, object]) -> dict[str, object]:
-    """Issue 25 writes the solver settings from one record (``SolverSettings.to_record``): a
-    store's attributes repeat the whole record — the references' start perturbed by 1e-6, as
-    their ``sweep_toml`` says, is now an attribute too."""
-    out = dict(attrs)
-    out["perturbation"] = 1e-06
-    return out
-
-
-def _model_reference_issue_25(new: dict[str, object], ref: dict[str, object]) -> dict[str, object]:
-    """Issue 25 records how to build a model that is not a gear set again (``model_class``,
-    ``model_fields``): the model they build must be the one the reference recorded by its
-    repr (``model_parameters``); then take them."""
-    from gearchaos.model.loading import rebuild_model
-
-    out = dict(ref)
-    if "model_class" in new:
-        model = rebuild_model(new)
-        assert str(new["model_class"]).startswith("gearchaos.model.library:")
-        assert _model_repr_issue_12({"model_parameters": repr(model)}) == {
-            "model_parameters": ref["model_parameters"]
-        }
-        out["model_class"], out["model_fields"] = new["model_class"], new["model_fields"]
-    return out
-
-
-def _switch_retries_issue_25(new: dict[str, object], ref: dict[str, object]) -> dict[str, object]:
-    """Issue 25 counts the step attempts discarded to end a step on a contact switch apart
-    (``steps_switch``) from those the error test rejected (``steps_rejected``), which the
-    reference counted together: check that the two add up to the reference's count and take
-    them. ``new``/``ref``: the step counts by name (numbers or arrays)."""
-    out = dict(ref)
-    total = np.asarray(new["steps_rejected"]) + np.asarray(new["steps_switch"])
-    assert np.array_equal(total, np.asarray(ref["steps_rejected"])), "rejected + switch"
-    assert np.all(np.asarray(new["steps_switch"]) >= 0)
-    out["steps_rejected"], out["steps_switch"] = new["steps_rejected"], new["steps_switch"]
-    return out
-
-
 def _assert_same_store(new: Path, ref: Path) -> None:
     g_new = zarr.open_group(os.fspath(new), mode="r")
     g_ref = zarr.open_group(os.fspath(ref), mode="r")
-    ref_attrs = _settings_record_issue_25(_model_repr_issue_12(dict(g_ref.attrs)))
-    ref_attrs = _model_reference_issue_25(dict(g_new.attrs), ref_attrs)
-    _same_attrs(dict(g_new.attrs), ref_attrs, "store")
+    _same_attrs(dict(g_new.attrs), dict(g_ref.attrs), "store")
     names_new = sorted(k for k, _ in g_new.arrays())
     names_ref = sorted(k for k, _ in g_ref.arrays())
-    assert names_new == sorted([*names_ref, "steps_switch"])
-    counts = {k: np.asarray(g_new[k][...]) for k in ("steps_rejected", "steps_switch")}
-    counts = _switch_retries_issue_25(counts, {"steps_rejected": g_ref["steps_rejected"][...]})
+    assert names_new == names_ref
     for name in names_new:
-        a = g_new[name]
-        b = g_ref["steps_rejected" if name == "steps_switch" else name]
-        if name == "steps_switch":
-            assert dict(a.attrs)["long_name"] == "steps retried to end on a contact switch"
-        else:
-            _same_attrs(dict(a.attrs), dict(b.attrs), name)
-        ref_values = counts[name] if name in counts else np.asarray(b[...])
-        _same_bytes(np.asarray(a[...]), ref_values, name)
+        a, b = g_new[name], g_ref[name]
+        _same_attrs(dict(a.attrs), dict(b.attrs), name)
+        _same_bytes(np.asarray(a[...]), np.asarray(b[...]), name)
 
 
 @pytest.mark.parametrize(
