@@ -2,10 +2,10 @@
 
 Run from the repository root with the project's environment:
 ``.venv/bin/python docs/make_doc_numbers.py [--check] [--fast]``. Every number of README.md,
-the tutorial, the reproduce, rattle, maps, hysteresis and basins how-tos, docs/reproduction.md
-and the motion-labels page that a command printed (or that the committed report holds, that a
-how-to's commands wrote, or that the verdict's settings define) sits between markers, and this
-script rewrites what is between them::
+the tutorial, the reproduce, rattle, maps, hysteresis, basins, cascade, response and
+stability-chart how-tos, docs/reproduction.md and the motion-labels page that a command printed
+(or that the committed report holds, that a how-to's commands wrote, or that the verdict's
+settings define) sits between markers, and this script rewrites what is between them::
 
     |μ| ≈ <!-- gen:gallery.mu-3.5 -->0.97<!-- /gen --> per two periods
 
@@ -37,6 +37,7 @@ under ``-m slow``.
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 import os
@@ -48,6 +49,7 @@ import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "docs"))
@@ -65,9 +67,14 @@ PAGES = (
     ROOT / "docs" / "howto" / "hysteresis.md",
     ROOT / "docs" / "concepts" / "motion-labels.md",
     ROOT / "docs" / "howto" / "basins.md",
+    ROOT / "docs" / "howto" / "cascade-and-impact.md",
+    ROOT / "docs" / "howto" / "response.md",
+    ROOT / "docs" / "howto" / "stability-chart.md",
 )
 RATTLE = ROOT / "docs" / "howto" / "rattle.md"
 MAPS = ROOT / "docs" / "howto" / "maps.md"
+CASCADE = ROOT / "docs" / "howto" / "cascade-and-impact.md"
+RESPONSE = ROOT / "docs" / "howto" / "response.md"
 HYSTERESIS = ROOT / "docs" / "howto" / "hysteresis.md"
 REPORT = ROOT / "docs" / "report" / "report.json"
 MARK = re.compile(r"<!-- gen:(?P<name>[^ ]+) -->(?P<body>.*?)<!-- /gen -->", re.S)
@@ -299,18 +306,66 @@ def titled_table(text: str, title: str) -> Block:
     return Block("\n".join(line.rstrip() for line in lines[start : end + 1]) + "\n")
 
 
-def run_howto(page: Path, work: Path) -> str:
-    """Run a how-to page's bash blocks (through its last figure) in ``work`` as a reader
-    would (docs/make_howto_figures.py); their stdout."""
+def run_howto(page: Path, work: Path, figures: tuple[str, ...] | None = None) -> str:
+    """Run a how-to page's bash blocks (through its last figure, or the blocks of
+    ``figures`` only) in ``work`` as a reader would (docs/make_howto_figures.py); their
+    stdout."""
     from make_howto_figures import environment, page_script
 
     env = {**environment(), "COLUMNS": str(COLUMNS), "NO_COLOR": "1"}
     env.pop("FORCE_COLOR", None)
-    script = page_script(page.name)
+    script = page_script(page.name, figures)
     proc = subprocess.run(["bash", "-c", script], cwd=work, env=env, capture_output=True, text=True)
     if proc.returncode != 0:
         raise RuntimeError(f"{page.name}: its commands failed:\n{proc.stderr[-3000:]}")
     return proc.stdout
+
+
+def _period_doubling(work: Path) -> dict[str, str]:
+    """Where the stability-chart how-to's branch (its first command) has its period doubling."""
+    import gearchaos as gc
+
+    run(SOURCES["period-doubling"].command or "", work)
+    branch = gc.open_branch(work / "branch.nc")
+    found = [
+        float(v)
+        for v, k in zip(branch.event_value.values, branch.event_kind.values, strict=True)
+        if str(k) == "period_doubling"
+    ]
+    if not found:
+        raise ProseOutOfDate("stability-chart.md: the branch no longer has a period doubling")
+    return {"omega": f"{found[0]:.3f}"}
+
+
+def _quick(_: Path) -> dict[str, str]:
+    """The coarse protocol of ``gearchaos reproduce --quick`` (:mod:`gearchaos.paper.recipes`)."""
+    from gearchaos.paper.recipes import QUICK_PERIODS, QUICK_POINTS
+
+    transient, periods = QUICK_PERIODS
+    return {"points": str(QUICK_POINTS), "transient": f"{transient:g}", "periods": str(periods)}
+
+
+def _cascade(work: Path) -> dict[str, str]:
+    """The period doublings of the cascade how-to's branches (its first block, as the page
+    shows it): the one each branch of the cascade ends at, in the order of the cascade."""
+    from gearchaos.dynamics.cascade import open_cascade
+
+    if not (work / "cascade.nc").exists():
+        run_howto(CASCADE, work, ("cascade.png",))
+    pds = []
+    for branch in open_cascade(work / "cascade.nc"):
+        kinds = [str(k) for k in branch.event_kind.values]
+        values = [float(v) for v, k in zip(branch.event_value.values, kinds, strict=True)]
+        found = [v for v, k in zip(values, kinds, strict=True) if k == "period_doubling"]
+        if found:
+            pds.append(found[0])
+    steps = [a - b for a, b in itertools.pairwise(pds)]
+    if len(pds) != 4 or not all(d > 0 for d in steps) or sorted(steps, reverse=True) != steps:
+        raise ProseOutOfDate(
+            "cascade-and-impact.md says four period doublings, each beyond the one before at "
+            f"shrinking distances: the cascade now gives {pds}"
+        )
+    return {f"pd{k + 1}": f"{v:.4f}" for k, v in enumerate(pds)}
 
 
 def _maps(work: Path) -> dict[str, str]:
@@ -398,6 +453,62 @@ def _hysteresis(work: Path) -> dict[str, str]:
         "down.lo": f"{omega[top + 1]:.2f}",
         "down.drop": f"{omega[top]:.2f}",
     }
+
+
+def _ranges(omega: Any, runs: list[tuple[int, int]]) -> str:
+    """``0.70–1.04 and 1.16–2.20`` (a run of one value as that value)."""
+    parts = [f"{omega[i]:.2f}" if i == j else f"{omega[i]:.2f}–{omega[j]:.2f}" for i, j in runs]
+    return ", ".join(parts[:-1]) + (" and " if len(parts) > 1 else "") + parts[-1]
+
+
+def _response(work: Path) -> dict[str, str]:
+    """The frequency response of the response how-to (its commands, as the page shows them):
+    the chaotic ranges of both sweeps, where one is periodic and the other not (nothing shaded
+    there), and that every point is decided."""
+    import numpy as np
+
+    import gearchaos as gc
+    from gearchaos.plot import response_figure
+
+    if not (work / "response.zarr").exists():
+        run_howto(RESPONSE, work)
+    ds = gc.open_sweep(work / "response.zarr")
+    omega = np.asarray(ds["omega"].values, dtype=float)
+    labels = {d: [str(v) for v in ds["motion"].sel(direction=d).values] for d in ("up", "down")}
+    every = sorted({m for m in labels["up"] + labels["down"]}, key=_label_order)
+    if any(m in ("unresolved", "failed", "") for m in every):
+        raise ProseOutOfDate(f"response.md says every point is decided: the labels are {every}")
+    periodic = {d: [m.endswith("T") for m in ms] for d, ms in labels.items()}
+    differ = _runs(
+        [str(u != v) for u, v in zip(periodic["up"], periodic["down"], strict=True)],
+        lambda t: t == "True",
+    )
+    if not differ or any(
+        not (periodic["up"][k] and labels["down"][k] == "chaos") for i, j in differ
+        for k in range(i, j + 1)
+    ):  # fmt: skip
+        raise ProseOutOfDate(
+            "response.md says the branches differ where the up sweep is periodic and the down "
+            f"sweep chaotic: up {labels['up']}, down {labels['down']}"
+        )
+    fig = response_figure(ds)
+    if any(c.get_gid() == "hysteresis" for ax in fig.axes for c in ax.collections):
+        raise ProseOutOfDate("response.md says nothing is shaded: the figure shades hysteresis")
+    chaos = {d: _runs(ms, lambda m: m == "chaos") for d, ms in labels.items()}
+    return {
+        "chaos.up": _ranges(omega, chaos["up"]),
+        "chaos.down": _ranges(omega, chaos["down"]),
+        "differ": _ranges(omega, differ),
+        "points": str(int(ds["motion"].size)),
+        "labels": ", ".join(every[:-1]) + " or " + every[-1] if len(every) > 1 else every[0],
+    }
+
+
+def _label_order(label: str) -> tuple[int, int]:
+    """nT by n, then QP, then chaos."""
+    if label.endswith("T") and label[:-1].isdigit():
+        return (0, int(label[:-1]))
+    return (1, ("QP", "chaos").index(label) if label in ("QP", "chaos") else 2)
 
 
 def _rattle(work: Path) -> dict[str, str]:
@@ -580,6 +691,14 @@ SOURCES: dict[str, Source] = {
         _maps,
         slow=True,
     ),
+    "quick": Source(None, _quick),
+    "period-doubling": Source(
+        "gearchaos continue --preset sheng2016 --vary omega=3.3:3.45 -o branch.nc",
+        _period_doubling,
+        slow=True,
+    ),
+    "response": Source("gearchaos plot response.zarr -o response.png", _response, slow=True),
+    "cascade": Source("gearchaos plot cascade.nc -o cascade.png", _cascade),
     "hysteresis": Source(
         "gearchaos plot hysteresis.zarr -o hysteresis.png", _hysteresis, slow=True
     ),

@@ -35,7 +35,7 @@ def _generator() -> ModuleType:
 
 
 gen = _generator()
-FAST = [n for n in gen.used_sources() if not gen.SOURCES[n].slow and gen.SOURCES[n].command]
+FAST = [n for n in gen.used_sources() if not gen.SOURCES[n].slow]  # with a command or not
 SLOW = [n for n in gen.used_sources() if gen.SOURCES[n].slow]
 
 

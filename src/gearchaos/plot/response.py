@@ -10,7 +10,8 @@ down branch dashed. The curves' own marks follow the verdicts, so that none cont
   :func:`~gearchaos.sweep.frequency.find_jumps`) joins two neighbouring points of one branch
   that are both periodic (nT) — a chaotic curve scatters from point to point without jumping;
 * **hysteresis** is shaded between the branches only where both directions are periodic at
-  the same value and their responses differ: two coexisting periodic motions. Where either
+  the same value and their responses differ, at two neighbouring values at least: two
+  coexisting periodic motions. Where either
   branch is QP, chaotic, unresolved or failed, nothing is shaded. The legend names the
   shading (:data:`HYSTERESIS_LABEL`) when there is one.
 
@@ -166,6 +167,8 @@ def response_figure(
                 )
                 differ = np.abs(up - down) > HYSTERESIS_REL * span if span > 0 else both & False
                 shade = both & differ
+                # a band needs two neighbours: a lone value would be a shading of zero width
+                shade &= np.r_[False, shade[:-1]] | np.r_[shade[1:], False]
                 if shade.any():
                     shaded = True
                     ax.fill_between(
