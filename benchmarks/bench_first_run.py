@@ -67,11 +67,12 @@ compiles = []
 
 class Compiles(event.Listener):
     def on_start(self, ev):
-        stacks[threading.get_ident()].append([time.perf_counter(), time.thread_time(), 0.0, 0.0])
+        stacks[threading.get_ident()].append(
+            [time.perf_counter(), time.thread_time(), 0.0, 0.0, 0.0])
 
     def on_end(self, ev):
         stack = stacks[threading.get_ident()]
-        t0, c0, inner, inner_cpu = stack.pop()
+        t0, c0, inner, inner_cpu, llvm = stack.pop()
         total = time.perf_counter() - t0
         cpu = time.thread_time() - c0
         if stack:
@@ -83,12 +84,28 @@ class Compiles(event.Listener):
             "kernel": f"{f.__module__}.{f.__qualname__}",
             "args": ", ".join(str(a) for a in ev.data["args"]),
             "total": total, "self": total - inner, "depth": len(stack),
-            "total_cpu": cpu, "self_cpu": cpu - inner_cpu,
+            "total_cpu": cpu, "self_cpu": cpu - inner_cpu, "self_llvm_cpu": llvm,
             "failed": bool(exc and exc[0] is not None),
         })
 
+llvm_outside = [0.0]
+llvm_start = {}
+
+class LLVM(event.Listener):  # llvmlite's lock: LLVM's work (optimising, emitting code)
+    def on_start(self, ev):
+        llvm_start[threading.get_ident()] = time.thread_time()
+
+    def on_end(self, ev):
+        tid = threading.get_ident()
+        cpu = time.thread_time() - llvm_start.pop(tid, time.thread_time())
+        if stacks[tid]:
+            stacks[tid][-1][4] += cpu
+        else:
+            llvm_outside[0] += cpu
+
 lock = event.TimingListener()
 event.register("numba:compile", Compiles())
+event.register("numba:llvm_lock", LLVM())
 event.register("numba:compiler_lock", lock)
 t0 = time.perf_counter()
 import gearchaos
@@ -103,7 +120,8 @@ except SystemExit as e:
 if code != 0:
     sys.exit(f"gearchaos {' '.join(spec['args'])} exited with {code}")
 out = {"file": gearchaos.__file__, "import": t_import, "lock": lock.duration,
-       "after_import": time.perf_counter() - t0 - t_import, "compiles": compiles}
+       "after_import": time.perf_counter() - t0 - t_import, "compiles": compiles,
+       "llvm_outside_cpu": llvm_outside[0]}
 print("RESULT" + json.dumps(out))
 """
 
@@ -168,29 +186,31 @@ def _stats(xs: Sequence[float]) -> str:
     return f"{min(xs):6.2f} {statistics.median(xs):6.2f} {max(xs):6.2f}"
 
 
-Row = tuple[str, int, float, float, float, float]
+Row = tuple[str, int, float, float, float, float, float]
+_KEYS = ("self", "self_cpu", "self_llvm_cpu", "total", "total_cpu")
 
 
 def kernel_table(runs: Sequence[dict[str, Any]]) -> list[Row]:
     """(kernel, specialisations per run, then medians over ``runs`` of: self wall seconds, self
-    CPU seconds of the compiling thread, total wall and CPU seconds of its outermost compiles),
-    sorted by self CPU seconds, largest first."""
-    keys = ("self", "self_cpu", "total", "total_cpu")
+    CPU seconds of the compiling thread, the part of them under llvmlite's lock (LLVM
+    optimising and emitting code), total wall and CPU seconds of its outermost compiles),
+    sorted by self CPU seconds, largest first. *Self*: without the kernels compiled while
+    typing it; *total*: with them."""
+    width = 1 + len(_KEYS)
     per_run: list[dict[str, list[float]]] = []
     for r in runs:
-        agg: dict[str, list[float]] = defaultdict(lambda: [0.0] * 5)
+        agg: dict[str, list[float]] = defaultdict(lambda: [0.0] * width)
         for c in r["compiles"]:
             row = agg[c["kernel"]]
             row[0] += 1
-            for i, key in enumerate(keys, 1):
+            for i, key in enumerate(_KEYS, 1):
                 row[i] += c[key] if key.startswith("self") or c["depth"] == 0 else 0.0
         per_run.append(agg)
-    names = {k for agg in per_run for k in agg}
     rows: list[Row] = []
-    for k in names:
-        vals = [agg.get(k, [0.0] * 5) for agg in per_run]
-        med = [statistics.median(v[i] for v in vals) for i in range(5)]
-        rows.append((k, int(med[0]), med[1], med[2], med[3], med[4]))
+    for k in {k for agg in per_run for k in agg}:
+        vals = [agg.get(k, [0.0] * width) for agg in per_run]
+        med = [statistics.median(v[i] for v in vals) for i in range(width)]
+        rows.append((k, int(med[0]), med[1], med[2], med[3], med[4], med[5]))
     return sorted(rows, key=lambda r: -r[3])
 
 
@@ -299,17 +319,18 @@ def report(name: str, runs: Sequence[tuple[dict[str, Any], dict[str, Any]]], row
     outer = [[c for c in r["compiles"] if c["depth"] == 0] for r in firsts]
     wall_s = statistics.median(sum(c["total"] for c in o) for o in outer)
     cpu_s = statistics.median(sum(c["total_cpu"] for c in o) for o in outer)
+    llvm_s = statistics.median(sum(c["self_llvm_cpu"] for c in r["compiles"]) for r in firsts)
     failed = statistics.median(sum(c["failed"] for c in r["compiles"]) for r in firsts)
     print(f"\n  kernels compiled by the first run (numba:compile events, medians): {len(table)} "
           f"kernels, {statistics.median(len(r['compiles']) for r in firsts):.0f} compiles, "
-          f"{wall_s:.2f} s wall, {cpu_s:.2f} s CPU in all; {failed:.0f} compile attempts ended "
-          "in an exception")  # fmt: skip
-    print(f"  {'kernel':58s} {'n':>2s} {'self wall':>9s} {'self CPU':>8s} {'total wall':>10s} "
-          f"{'total CPU':>9s}")  # fmt: skip
+          f"{wall_s:.2f} s wall, {cpu_s:.2f} s CPU in all, {llvm_s:.2f} s of it in LLVM; "
+          f"{failed:.0f} compile attempts ended in an exception")  # fmt: skip
+    print(f"  {'kernel':52s} {'n':>2s} {'self wall':>9s} {'self CPU':>8s} {'of it LLVM':>10s} "
+          f"{'total wall':>10s} {'total CPU':>9s}")  # fmt: skip
     shown = table if rows == 0 else table[:rows]
-    for kernel, n, self_w, self_c, total_w, total_c in shown:
+    for kernel, n, self_w, self_c, llvm_c, total_w, total_c in shown:
         totals = f"{total_w:10.2f} {total_c:9.2f}" if total_w > 0 else f"{'-':>10s} {'-':>9s}"
-        print(f"  {kernel[-58:]:58s} {n:2d} {self_w:9.2f} {self_c:8.2f} {totals}")
+        print(f"  {kernel[-52:]:52s} {n:2d} {self_w:9.2f} {self_c:8.2f} {llvm_c:10.2f} {totals}")
     if len(shown) < len(table):
         rest_w = sum(r[2] for r in table[len(shown) :])
         rest_c = sum(r[3] for r in table[len(shown) :])

@@ -71,11 +71,12 @@ def test_kernel_table_splits_nested_compiles(bench: ModuleType) -> None:
 
     def rec(kernel: str, self_s: float, total_s: float, depth: int) -> dict[str, object]:
         return {"kernel": kernel, "self": self_s, "total": total_s, "depth": depth,
-                "self_cpu": self_s / 2, "total_cpu": total_s / 2, "failed": False}  # fmt: skip
+                "self_cpu": self_s / 2, "total_cpu": total_s / 2,
+                "self_llvm_cpu": self_s / 4, "failed": False}  # fmt: skip
 
     run1 = {"compiles": [rec("b", 2.0, 2.0, 1), rec("b", 4.0, 4.0, 1), rec("a", 4.0, 10.0, 0)]}
     run2 = {"compiles": [rec("b", 3.0, 3.0, 1), rec("b", 3.0, 3.0, 1), rec("a", 2.0, 8.0, 0)]}
     run3 = {"compiles": [rec("b", 1.0, 1.0, 1), rec("b", 1.0, 1.0, 1), rec("a", 6.0, 8.0, 0)]}
     table = bench.kernel_table([run1, run2, run3])
     # b: self 6, 6, 2 -> median 6; a: self 4, 2, 6 -> 4, total 10, 8, 8 -> 8
-    assert table == [("b", 2, 6.0, 3.0, 0.0, 0.0), ("a", 1, 4.0, 2.0, 8.0, 4.0)]
+    assert table == [("b", 2, 6.0, 3.0, 1.5, 0.0, 0.0), ("a", 1, 4.0, 2.0, 1.0, 8.0, 4.0)]
