@@ -19,16 +19,20 @@ Each repetition, for each ``src``:
 2. **second run**: the same command with that cache, now warm (a kernel it compiles again is
    listed: it is not loaded from the cache).
 
-Printed: wall seconds of each run as the user sees them (process start to exit) — min, median
-and max over the repetitions, and the ratio first / second; per run, where the time goes
-(importing gearchaos, time under numba's compiler lock = compiling and saving, or loading from
-the cache, the rest: simulation, analysis, figure and file); and the kernels the first run
-compiles (numba's ``numba:compile`` events, one per dispatcher and signature): seconds of each,
-its own (``self``, without the kernels compiled while typing it) and with them (``total``,
-outermost calls only add up to the compile time), median over the repetitions, sorted.
+Printed: wall seconds of each run as the user sees them (process start to exit) and the child's
+CPU seconds (user + system) — min, median and max over the repetitions, and the ratio first /
+second; per run, where the time goes (importing gearchaos, time under numba's compiler lock =
+compiling and saving, or loading from the cache, the rest: simulation, analysis, figure and
+file); and the kernels the first run compiles (numba's ``numba:compile`` events, one per
+dispatcher and signature), median over the repetitions, sorted: seconds of each, its own
+(``self``, without the kernels compiled while typing it; wall, CPU of the compiling thread and
+the part of that under llvmlite's lock, i.e. LLVM rather than numba's own passes) and with them
+(``total``, outermost compiles only: they add up to the compile time); then the signatures of
+the gearchaos kernels compiled more than once.
 
-Goal (issue 35): first run ≤ 15 s on a quiet 2-core machine. Wall times depend on the load:
-the load average is printed with them.
+Goal (issue 35): first run ≤ 15 s wall on a quiet 2-core machine. Wall times depend on the load
+(printed with them); compiling is single-threaded, so on a loaded machine the CPU seconds are
+the better estimate of the quiet machine's wall seconds.
 """
 
 from __future__ import annotations
