@@ -219,6 +219,7 @@ def test_reproduce_calls_the_recipe_and_prints_json(
     recipes = pytest.importorskip("gearchaos.paper.recipes")
     calls: list[tuple] = []
     gearsets: list[object] = []
+    protocols: list[bool] = []
 
     def fake(
         name: str,
@@ -229,9 +230,11 @@ def test_reproduce_calls_the_recipe_and_prints_json(
         workers: int | None = None,
         overwrite: bool = False,
         gearset: object = None,
+        paper_protocol: bool = False,
     ) -> dict:
         calls.append((name, Path(str(outdir)), quick, progress, workers, overwrite))
         gearsets.append(gearset)
+        protocols.append(paper_protocol)
         return {
             "figure": str(tmp_path / f"{name}.png"),
             "store": str(tmp_path / f"{name}.zarr"),
@@ -253,6 +256,13 @@ def test_reproduce_calls_the_recipe_and_prints_json(
     assert calls[-1] == ("fig4", tmp_path, False, False, 2, True)
     assert result.stdout == ""
     assert gearsets == [None, None]  # the recipe's default preset
+    # one figure runs the seed's own protocol only when asked (--paper-protocol)
+    assert protocols == [False, False]
+    result = runner.invoke(
+        app, ["reproduce", "fig4", "-o", str(tmp_path), "-q", "--paper-protocol"]
+    )
+    assert result.exit_code == 0, result.output
+    assert protocols[-1] is True
 
     # --preset and --gearset reach the recipe as a GearSet; both at once is refused
     import gearchaos
