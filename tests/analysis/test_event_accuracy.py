@@ -102,8 +102,12 @@ def test_cli_continue_reports_each_event_with_its_uncertainty(tmp_path: Path) ->
     assert 0.0 < ns["uncertainty"] <= 1e-7
     assert abs(ns["value"] - fine["value"]) <= ns["uncertainty"]
     assert fine["uncertainty"] < ns["uncertainty"]
+    # a terminal wide enough for the event table's row on one line (the table wraps its
+    # cells on a narrow one rather than cutting them)
     text = runner.invoke(
-        app, ["continue", "--vary", "omega=1.49:1.50", "-o", str(tmp_path / "t.nc")]
+        app,
+        ["continue", "--vary", "omega=1.49:1.50", "-o", str(tmp_path / "t.nc")],
+        env={"COLUMNS": "200"},
     )
     assert text.exit_code == 0, text.output
     (line,) = [ln for ln in text.output.splitlines() if "neimark_sacker" in ln]
