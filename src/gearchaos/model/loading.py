@@ -327,7 +327,11 @@ def stored_model_class(spec: str, *, where: str) -> type:
         return installed
     gave = ""
     if named:
-        gave = f"; --model gave {', '.join(escape_text(c.__qualname__) for c in named)}"
+        # the classes this process was given (a command gives one; a Python session may
+        # have named several): none of them is the recorded one
+        gave = "; the model(s) named with --model in this process: " + ", ".join(
+            escape_text(c.__qualname__) for c in named
+        )
     raise ModelConsentError(
         f"{where} needs the model '{escape_text(spec)}', and gearchaos never runs code that a "
         f"file names: if you trust it, give --model FILE.py:{escape_text(name) or 'CLASS'} "
