@@ -217,3 +217,27 @@ def test_simulate_and_a_sweep_end_in_one_verdict() -> None:
         assert pa.verdict.label == str(ds.motion.values[i]), omega
         lam = float(ds.lle.values[i])
         assert pa.verdict.lle == lam or (math.isnan(lam) and math.isnan(pa.verdict.lle))
+
+
+def test_a_points_exponent_does_not_depend_on_its_batch() -> None:
+    # the same chaotic point (Ω = 2.05) alone and third in a batch of three: bitwise the
+    # same windows and λ₁
+    omegas = [1.5, 2.9, 2.05]
+    systems = [resolve(SHENG, {"omega": w}) for w in omegas]
+    runs = [integrate(s, SEED) for s in systems]
+    batch = decide_motion(
+        SHENG,
+        [{"omega": w} for w in omegas],
+        systems,
+        np.stack([r.states for r in runs]),
+        np.stack([r.final_state for r in runs]),
+        [True] * 3,
+        SEED,
+    )
+    alone = decide_motion(
+        SHENG, [{"omega": 2.05}], systems[2:], runs[2].states[None], runs[2].final_state[None],
+        [True], SEED,
+    )[0]  # fmt: skip
+    assert (batch[2].label, batch[2].window_periods) == (alone.label, alone.window_periods)
+    assert alone.label == "chaos" and math.isfinite(alone.lle)
+    assert batch[2].lle == alone.lle

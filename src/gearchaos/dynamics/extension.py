@@ -55,9 +55,9 @@ def extend(
     tangent_tol: float = 1.0,
 ) -> Any:
     """Integrate K states (at the section of ``settings``) ``periods`` further, with one
-    random tangent vector from ``default_rng(seed)`` (none when ``seed`` is None) whose
-    tolerances are ``tangent_tol`` times the state's; samples at the next ``periods``
-    section times."""
+    random tangent vector from ``default_rng(seed)`` (none when ``seed`` is None), the same
+    start for every point, whose tolerances are ``tangent_tol`` times the state's; samples at
+    the next ``periods`` section times."""
     ref = systems[0]
     K, n = len(systems), ref.n_state
     T = np.array([s.period for s in systems])
@@ -78,7 +78,9 @@ def extend(
         settings,
         y0=states,
         n_tangent=0 if seed is None else 1,
-        tangent_start=None if seed is None else random_tangents(n, 1, seed=seed, points=K),
+        # one start vector per seed for every point: a point's λ₁ must not depend on its
+        # place in a batch (a sweep's task, a single simulate)
+        tangent_start=None if seed is None else np.repeat(random_tangents(n, 1, seed=seed), K, 0),
         tangent_tol=tangent_tol,
     )
     return run_chains(run)
