@@ -459,6 +459,10 @@ def _damage_zarr(path: Path, how: str, draw: Any) -> str:
         data[i] ^= draw(st.integers(1, 255))
         (path / chunk).write_bytes(bytes(data))
     elif how == "added chunk":
+        # beside a data chunk (the manifest also lists the arrays' metadata files, whose
+        # names start with a dot, since it digests them)
+        data_chunks = [c for c in chunks if "/" in c and not c.rsplit("/", 1)[1].startswith(".")]
+        chunk = draw(st.sampled_from(data_chunks))
         name = chunk.rsplit("/", 1)[0] + "/7"
         (path / name).write_bytes(b"\0" * 8)
         return name
