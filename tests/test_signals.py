@@ -43,6 +43,10 @@ def _alive(pid: int) -> bool:
         return False
 
 
+def _default_sigint() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 class Command:
     """A gearchaos command in a subprocess, its stderr read line by line as it comes."""
 
@@ -56,6 +60,10 @@ class Command:
             text=True,
             env=env,
             start_new_session=True,  # a Ctrl-C of the test run reaches only the test
+            # the command starts with Ctrl-C's default action whatever an earlier test left in
+            # this worker (an ignored SIGINT is inherited, and Python then never raises
+            # KeyboardInterrupt)
+            preexec_fn=_default_sigint,
         )
         self.lines: queue.Queue[str | None] = queue.Queue()
         self.seen: list[str] = []
