@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 from ._version import __version__
 from .errors import IntegrationError, ParameterError, Status, StoreError
-from .gearset import GearSet, preset
+from .gearset import GearSet, preset, preset_of
 from .integrate import SimulationResult, open_simulation, simulate
 from .model import (
     System,
@@ -64,6 +64,7 @@ __all__ = [
     "periodic_orbits",
     "planetary_system",
     "preset",
+    "preset_of",
     "response",
     "save_branch",
     "simulate",

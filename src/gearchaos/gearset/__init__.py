@@ -6,7 +6,7 @@ The records of the tables (:class:`Teeth` … :class:`MeshPhasing`) are those of
 
 from . import tables
 from .io import from_toml, from_toml_string, template_toml, to_toml
-from .presets import list_presets, preset
+from .presets import list_presets, preset, preset_of
 from .records import UNITS, GearSet
 from .tables import *  # noqa: F403 - the record classes, listed in tables.__all__
 
@@ -17,6 +17,7 @@ __all__ = [
     "from_toml_string",
     "list_presets",
     "preset",
+    "preset_of",
     "template_toml",
     "to_toml",
 ]

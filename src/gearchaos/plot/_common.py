@@ -94,13 +94,29 @@ _SPEED_UNITS = ("rpm", "Hz")
 
 def subject(attrs: Any, gearset: Any = None) -> str:
     """What a figure of a store or file is of, as its title names it: the gear set's name
-    (``sheng2016``; ``gearset``, else the one of the attribute ``gearset_toml``), else the
+    (``sheng2016``; ``gearset``, else the one of the attribute ``gearset_toml``; see
+    :func:`gearset_title`), else the
     model's (``backlash_oscillator``) — not the record's ``planetary[sheng2016]``."""
     if gearset is None:
         gearset = stored_gearset(attrs)
     if gearset is not None:
-        return figure_text(gearset.name)
+        return figure_text(gearset_title(gearset))
     return figure_text(attrs.get("model", "") or "")
+
+
+def gearset_title(gearset: Any) -> str:
+    """A gear set's name as a figure names it: the name it carries, except that a gear set
+    named after a built-in preset whose values are another preset's is named by those
+    (a store written with the default before issue 34 says ``sheng2016-v1``, not
+    ``sheng2016``)."""
+    from ..gearset import list_presets, preset_of
+
+    name = str(gearset.name)
+    if name in {n for n, _ in list_presets()}:
+        shown = preset_of(gearset)
+        if shown is not None:
+            return shown
+    return name
 
 
 def figure_text(text: Any) -> str:

@@ -42,6 +42,7 @@ from .._files import open_regular_nofollow, read_nofollow
 from .._marks import MARK_KEY, MAX_MARKED_BYTES, file_is_marked, fill_mark, placeholder
 from .._output import check_replaceable, write_file
 from .._version import __version__
+from ..gearset import preset_of
 from .export_table import Column, ExportTables
 
 __all__ = ["MARK", "sections_path", "sidecar_path", "write_csv_export"]
@@ -210,6 +211,7 @@ def _provenance(attrs: dict[str, Any], source: str | None, gearset: Any) -> dict
         "source": source,
         "title": _attr(attrs, "title") if "title" in attrs else None,
         "gearset": None if gearset is None else gearset.name,
+        "preset": None if gearset is None else preset_of(gearset),
     }
     placed.add("title")
     out["specification"] = group(_SPECIFICATION)

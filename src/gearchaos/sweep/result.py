@@ -129,6 +129,18 @@ class SweepResult:
         return float(v)
 
     @property
+    def preset(self) -> str | None:
+        """The built-in preset whose values the stored gear set has (``None`` when none has, or
+        for a reference system): a store written with the default before issue 34 records a
+        gear set named ``sheng2016`` and says ``"sheng2016-v1"``
+        (:func:`~gearchaos.gearset.preset_of`)."""
+        if self.base_gearset is None:
+            return None
+        from ..gearset import preset_of
+
+        return preset_of(self.base_gearset)
+
+    @property
     def gearset(self) -> Any:
         """The stored gear set with the fixed (non-Ω) values applied, or ``None``."""
         if self._gearset is _UNSET:
