@@ -10,7 +10,7 @@ from gearchaos import _numba
 
 
 def _run() -> None:
-    gc.simulate(gc.preset("sheng2016"), omega=1.5, transient_periods=1, periods=1)
+    gc.simulate(gc.preset("sheng2016-v1"), omega=1.5, transient_periods=1, periods=1)
 
 
 @pytest.mark.parametrize("cached", [False, True])

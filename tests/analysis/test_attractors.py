@@ -24,7 +24,7 @@ from gearchaos.cli import app
 
 @pytest.fixture(scope="module")
 def quickstart() -> list:
-    return gc.attractors(gc.preset("sheng2016"), omega=1.5)
+    return gc.attractors(gc.preset("sheng2016-v1"), omega=1.5)
 
 
 def test_quickstart_point_has_a_stable_1T_orbit_and_a_chaotic_attractor(quickstart) -> None:
@@ -39,7 +39,7 @@ def test_quickstart_point_has_a_stable_1T_orbit_and_a_chaotic_attractor(quicksta
     assert len(one.starts) + len(chaos.starts) == 8
     # independent check: the chaotic run, continued, stays chaotic and away from the orbit
     res = gc.simulate(
-        gc.preset("sheng2016"), omega=1.5, y0=chaos.final_state, transient_periods=0, periods=300
+        gc.preset("sheng2016-v1"), omega=1.5, y0=chaos.final_state, transient_periods=0, periods=300
     )
     x = np.asarray(res.series("delta_sp_1"))[res.section_index]
     assert np.ptp(x[-100:]) > 0.3  # still spread over the chaotic band

@@ -166,7 +166,7 @@ def test_folds_match_the_jumps_of_up_and_down_sweeps() -> None:
 
 # ----------------------------------------------------------------------------------- gear sets
 def test_clearance_branch_without_separation_only_shifts_the_deflections() -> None:
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("sheng2016-v1")
     ds = gc.continuation(gs, "backlash.sun_planet=2:4", omega=0.5, max_step=0.1)
     assert ds.attrs["parameter"] == "backlash.sun_planet"
     assert ds.attrs["stop_reason"].startswith("reached the range stop")
@@ -181,13 +181,13 @@ def test_clearance_branch_without_separation_only_shifts_the_deflections() -> No
 
 @pytest.fixture(scope="module")
 def planetary_branch(tmp_path_factory) -> object:
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("sheng2016-v1")
     return gc.continuation(gs, "omega=3.3:3.45", max_step=0.01)
 
 
 def test_branch_dataset_layout_and_provenance(planetary_branch) -> None:
     ds = planetary_branch
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("sheng2016-v1")
     assert ds.attrs["gearset_toml"] == gs.to_toml()
     for key in ("version", "numba_version", "rtol", "atol", "parameter", "period", "fixed"):
         assert key in ds.attrs
@@ -279,7 +279,7 @@ def test_sun_bearing_grazing_where_the_free_orbit_reaches_the_clearance() -> Non
     the bearing exerts no stiffness force (its damping acts everywhere), so the orbit does not
     depend on b̄_s; shrinking b̄_s, the bearing first touches where b̄_s equals the largest
     excursion of the free orbit, on the positive sides of ȳ_s and x̄_s."""
-    gs = gc.preset("sheng2016").evolve({"mesh_phasing.model": "parker"})
+    gs = gc.preset("sheng2016-v1").evolve({"mesh_phasing.model": "parker"})
     ds = gc.continuation(gs, "clearance.sun_bearing=0.0025:0.0015", omega=0.5, max_step=1e-4)
     free = gc.periodic_orbit(gs, omega=0.5, **TIGHT)  # b̄_s = 2: never touches
     res = gc.simulate(

@@ -63,7 +63,7 @@ def fd_jacobian(system: gc.System, y: np.ndarray, h: float = 1e-4) -> np.ndarray
 
 @pytest.fixture(scope="module")
 def sheng() -> gc.GearSet:
-    return gc.preset("sheng2016")
+    return gc.preset("sheng2016-v1")
 
 
 def three_planets(gs: gc.GearSet) -> gc.GearSet:

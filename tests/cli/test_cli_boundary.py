@@ -41,7 +41,7 @@ def test_boundary_command_writes_the_curve_with_provenance(curve_file) -> None:
     assert summary["kind"] == "period_doubling" and summary["parameter2"] == "xi"
     # the gear set of the first point (at its ξ), as branch files record it
     stored = gc.GearSet.from_toml_string(ds.attrs["gearset_toml"])
-    assert stored.name == gc.preset("sheng2016").name
+    assert stored.name == gc.preset("sheng2016-v1").name
     assert "version" in ds.attrs and "rtol" in ds.attrs
     # it starts at the branch's event (ξ = 0.03) and lands on ξ = 0.025 on both sides
     assert np.isclose(ds.omega.values[ds.direction.values == 0][0], pd.value, atol=1e-7)
@@ -72,7 +72,7 @@ def map_store(curve_file):
     where, *_ = curve_file
     store = where / "map.zarr"
     gc.bifurcation(
-        gc.preset("sheng2016"), ["omega=3.3:3.6:7", "xi=0.02:0.035:3"],
+        gc.preset("sheng2016-v1"), ["omega=3.3:3.6:7", "xi=0.02:0.035:3"],
         transient_periods=30, periods=8, progress=False, store=store,
     )  # fmt: skip
     return store
@@ -114,7 +114,7 @@ def test_the_explorer_draws_the_curves_over_the_map(curve_file, map_store) -> No
     labels = [item.label["value"] for item in fig.legend[0].items]
     assert "period doubling" in labels
     one_d = where / "line.zarr"
-    gc.bifurcation(gc.preset("sheng2016"), "omega=3.3:3.6:3", transient_periods=10, periods=4,
+    gc.bifurcation(gc.preset("sheng2016-v1"), "omega=3.3:3.6:3", transient_periods=10, periods=4,
                    progress=False, store=one_d)  # fmt: skip
     with pytest.raises(gc.ParameterError, match="2-D sweep"):
         explore(one_d, boundaries=[curve])

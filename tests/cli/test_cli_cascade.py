@@ -56,7 +56,7 @@ def test_plot_draws_impact_maps_and_response_with_branches(tmp_path) -> None:
     runner = CliRunner()
     store = tmp_path / "map.zarr"
     gc.bifurcation(
-        gc.preset("sheng2016"), ["omega=0.6:2.4:4", "backlash.sun_planet=0.5:4:3"],
+        gc.preset("sheng2016-v1"), ["omega=0.6:2.4:4", "backlash.sun_planet=0.5:4:3"],
         transient_periods=20, periods=8, progress=False, store=store,
     )  # fmt: skip
     png = tmp_path / "impact.png"

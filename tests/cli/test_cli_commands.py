@@ -50,7 +50,7 @@ def test_init_gearset_round_trip(runner: CliRunner, tmp_path) -> None:
     result = runner.invoke(app, ["init-gearset", str(f)])
     assert result.exit_code == 0, result.output
     gs = GearSet.from_toml(f)
-    ref = preset("sheng2016")
+    ref = preset("sheng2016-v1")
     assert gs.evolve({"name": ref.name, "description": ref.description}) == ref
 
     # refuses to overwrite without --force, and leaves the file alone
@@ -82,7 +82,7 @@ def test_info_json(runner: CliRunner) -> None:
     result = runner.invoke(app, ["info", "--json"])
     assert result.exit_code == 0, result.output
     data = json.loads(result.stdout)
-    gs = preset("sheng2016")
+    gs = preset("sheng2016-v1")
     assert data["omega_n_rad_s"] == pytest.approx(gs.omega_n, rel=1e-12)
     freqs = data["natural_frequencies"]
     hz = [f["hz"] for f in freqs]
@@ -97,7 +97,7 @@ def test_info_with_set_and_omega(runner: CliRunner) -> None:
     )
     assert result.exit_code == 0, result.output
     data = json.loads(result.stdout)
-    gs = preset("sheng2016").evolve({"stiffness.sun_planet_mean": 7e8})
+    gs = preset("sheng2016-v1").evolve({"stiffness.sun_planet_mean": 7e8})
     assert data["omega_n_rad_s"] == pytest.approx(gs.omega_n, rel=1e-12)
     assert data["operating_point"]["omega"] == 2.0
     assert data["operating_point"]["sun_speed_rpm"] == pytest.approx(gs.sun_speed_rpm(2.0))

@@ -157,7 +157,7 @@ def test_continue_and_attractors_take_the_model(
     ("args", "needle"),
     [
         (["--model", "nope.py:X"], "no such file"),
-        (["--model", "{file}", "--preset", "sheng2016"], "--model excludes"),
+        (["--model", "{file}", "--preset", "sheng2016-v1"], "--model excludes"),
         (["--model", "{file}", "--set", "gama=0.2"], "did you mean 'gamma'"),
         (["--model", "{stem}:Missing"], "defines no 'Missing'"),
         (["--model", "no_such_model_entry"], "no model of that name"),

@@ -55,7 +55,7 @@ def test_control_characters_of_a_gear_set_never_reach_the_terminal(tmp_path: Pat
     from gearchaos.gearset import preset
 
     f = tmp_path / "g.toml"
-    f.write_text(preset("sheng2016").evolve({"name": "gear\x1b[2J\x1b[31mset"}).to_toml())
+    f.write_text(preset("sheng2016-v1").evolve({"name": "gear\x1b[2J\x1b[31mset"}).to_toml())
     r = CliRunner().invoke(app, ["info", "--gearset", str(f)])
     assert r.exit_code == EXIT_INVALID
     assert "name contains the control character 0x1b" in r.output

@@ -52,7 +52,7 @@ def test_json_keys_and_values_match_the_python_api(runner: CliRunner) -> None:
     out = run_json(runner, "--set", "omega=1.5", "--samples-per-period", "8")
     assert list(out)[: len(CONTRACT)] == CONTRACT
 
-    gs = preset("sheng2016")
+    gs = preset("sheng2016-v1")
     # the CLI is analyse_point: the simulation, then the verdict (which may show the
     # finished record: the run continued by the verdict, never the orbit's own points)
     cfg = SolverSettings(transient_periods=20, periods=20, samples_per_period=8)
@@ -125,7 +125,7 @@ def test_set_changes_the_gear_set_and_files_are_written(runner: CliRunner, tmp_p
         assert "delta_sp" in ds and ds.delta_sp.sizes["section"] == 20
         assert np.all(np.isfinite(ds.delta_sp.sel(planet=1).values))
     # every value as set, and a name that says the gear set is not plain sheng2016 (issue 24)
-    expected = preset("sheng2016").evolve(
+    expected = preset("sheng2016-v1").evolve(
         {
             "xi": 0.05,
             "backlash.sun_planet": 2.5,
@@ -173,8 +173,8 @@ def test_invalid_solver_setting_exits_2(runner: CliRunner) -> None:
 
 def test_preset_and_gearset_are_exclusive(runner: CliRunner, tmp_path) -> None:
     f = tmp_path / "g.toml"
-    f.write_text(gc.preset("sheng2016").to_toml(), encoding="utf-8")
-    result = runner.invoke(app, ["simulate", "--preset", "sheng2016", "--gearset", str(f)])
+    f.write_text(gc.preset("sheng2016-v1").to_toml(), encoding="utf-8")
+    result = runner.invoke(app, ["simulate", "--preset", "sheng2016-v1", "--gearset", str(f)])
     assert result.exit_code == 2
     assert "mutually exclusive" in result.stderr
 

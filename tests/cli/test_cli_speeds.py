@@ -35,7 +35,7 @@ def _omega_at_rpm(gs: GearSet, rpm: float) -> float:
 
 
 def test_info_and_simulate_take_the_sun_speed(runner: CliRunner) -> None:
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("sheng2016-v1")
     result = runner.invoke(app, ["info", "--set", "sun_rpm=7500", "--json"])
     assert result.exit_code == 0, result.output
     point = json.loads(result.stdout)["operating_point"]
@@ -57,7 +57,7 @@ def test_info_and_simulate_take_the_sun_speed(runner: CliRunner) -> None:
 
 def test_info_tables_show_the_sun_speed_of_every_resonance(runner: CliRunner) -> None:
     result = runner.invoke(app, ["info", "--json"])
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("sheng2016-v1")
     for row in json.loads(result.stdout)["omega_at_resonances"]:
         rpm = row["sun_speed_rpm"]
         assert _omega_at_rpm(gs, rpm) == pytest.approx(row["omega"], rel=1e-12)
@@ -103,7 +103,7 @@ def test_bifurcation_over_sun_rpm_stores_omega_and_prints_both(
          str(store)],
     )  # fmt: skip
     assert result.exit_code == 0, result.output
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("sheng2016-v1")
     ds = xr.open_zarr(store)
     expected = [_omega_at_rpm(gs, r) for r in (2000.0, 5000.0, 8000.0)]
     np.testing.assert_allclose(ds["omega"].values, expected, rtol=1e-12)
@@ -114,7 +114,7 @@ def test_bifurcation_over_sun_rpm_stores_omega_and_prints_both(
 
 def test_a_clearance_in_metres_on_a_gear_set_in_b_c_is_warned_about(runner: CliRunner) -> None:
     result = runner.invoke(
-        app, ["info", "--preset", "sheng2016", "--set", "backlash.sun_planet=60e-6"]
+        app, ["info", "--preset", "sheng2016-v1", "--set", "backlash.sun_planet=60e-6"]
     )
     assert result.exit_code == 0, result.output
     text = " ".join(result.stderr.split())

@@ -54,7 +54,7 @@ def test_orbit_period_two_at_3_5_settles_to_the_stable_2t_orbit(runner: CliRunne
     assert out["minimal_period"] == 2
     # the attractor a long simulation from rest ends on is this orbit: its section points
     # alternate between the orbit's two X̄_sp1 values (|μ| ≈ 0.97: settled after 800 periods)
-    sim = gc.simulate(gc.preset("sheng2016"), omega=3.5, transient_periods=800, periods=8)
+    sim = gc.simulate(gc.preset("sheng2016-v1"), omega=3.5, transient_periods=800, periods=8)
     x = sim.section("delta_sp")[:, 0]
     orbit_x = np.array(out["x_sp1"])
     for k, value in enumerate(x):
@@ -65,7 +65,7 @@ def test_orbit_period_two_at_3_5_settles_to_the_stable_2t_orbit(runner: CliRunne
 def test_without_the_settle_the_same_shooting_ends_on_the_unstable_1t_orbit() -> None:
     """What the command returned before: the 50-period guess lies near the unstable 1T orbit
     (so the test above exercises the settle, not a lucky guess)."""
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("sheng2016-v1")
     once = gc.periodic_orbit(gs, period=2, omega=3.5, settle=50)
     assert once.converged and not once.stable and once.minimal_period == 1
     settled = gc.periodic_orbit(gs, period=2, omega=3.5)
@@ -74,7 +74,7 @@ def test_without_the_settle_the_same_shooting_ends_on_the_unstable_1t_orbit() ->
 
 
 def test_settle_is_checked_and_only_for_a_guess_from_rest() -> None:
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("sheng2016-v1")
     with pytest.raises(gc.ParameterError, match="settle"):
         gc.periodic_orbit(gs, omega=1.5, settle=10)  # shorter than transient_periods = 50
     orbit = gc.periodic_orbit(gs, omega=1.5)
@@ -96,7 +96,7 @@ def test_continue_in_backlash_at_1_5_starts_without_a_given_start(
     # the start is the orbit at b̄_sp = 1 itself: shooting again from its state at that value
     # moves it by no more than the tolerance
     again = gc.periodic_orbit(
-        gc.preset("sheng2016"),
+        gc.preset("sheng2016-v1"),
         omega=1.5,
         params={"backlash.sun_planet": 1.0},
         guess=ds["orbit_state"].values[0],
@@ -173,7 +173,7 @@ def test_continue_from_a_store_point_in_another_parameter(
         (["--from", "{store}", "--at", "omega=1.55"], ["omega=1.55", "nearest", "1.5, 1.6"]),
         (["--from", "{store}", "--at", "xi=0.05"], ["xi", "does not sweep", "omega"]),
         (["--from", "{store}", "--at", "omega"], ["NAME=VALUE"]),
-        (["--from", "{store}", "--at", "omega=1.5", "--preset", "sheng2016"], ["--preset"]),
+        (["--from", "{store}", "--at", "omega=1.5", "--preset", "sheng2016-v1"], ["--preset"]),
         (["--from", "{missing}", "--at", "omega=1.5"], ["no such file"]),
     ],
 )
@@ -190,7 +190,7 @@ def test_orbit_output_must_be_netcdf(runner: CliRunner, tmp_path: Path) -> None:
 
 # ------------------------------------------------------------------ the Python front doors
 def test_lyapunov_takes_a_gear_set_and_values_by_name() -> None:
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("sheng2016-v1")
     by_name = gc.max_lyapunov(gs, omega=1.7, periods=60, transient_periods=20)
     system = gc.planetary_system(gs, 1.7)
     direct = gc.max_lyapunov(system, periods=60, transient_periods=20)
@@ -216,7 +216,7 @@ def test_top_level_has_the_orbit_branch_and_lyapunov_doors() -> None:
 
 
 def test_gear_set_getter_by_dotted_name() -> None:
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("sheng2016-v1")
     assert gs["backlash.sun_planet"] == gs.backlash.sun_planet
     assert gs["geometry.planets"] == gs.geometry.planets
     assert gs["xi"] == gs.damping.sun_planet

@@ -171,7 +171,7 @@ def test_one_chaotic_attractor_is_one_entry_as_attractors_says() -> None:
     """sheng2016 at Ω = 1.45 has one chaotic attractor (gc.attractors from its own starts);
     the basin catalogue built from random starts far from it found three before their short
     records were merged by the rule that assigns the starts (two instruments disagreed)."""
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("sheng2016-v1")
     found = gc.attractors(gs, omega=1.45, starts=8)
     assert [a.label for a in found] == ["chaos"]
     out = gc.basin_fractions(gs, "omega=1.45", starts=24, sample=8, seed=0, progress=False)

@@ -55,7 +55,7 @@ def test_oscillator_branch_peak_force_is_the_orbits_contact_force_of_model_md() 
 
 
 def test_planetary_branch_stores_each_planets_peak_force_of_both_meshes() -> None:
-    gs, fixed = gc.preset("sheng2016"), {"xi": 0.05}
+    gs, fixed = gc.preset("sheng2016-v1"), {"xi": 0.05}
     branch = gc.continuation(gs, "omega=1.35:1.45", params=fixed, **TIGHT)
     for mesh in ("sp", "rp"):
         assert branch[f"force_peak_{mesh}"].dims == ("point", "planet_all")

@@ -170,7 +170,7 @@ def test_curve_file_round_trip_resume_and_refusal(folds, tmp_path) -> None:
 
 
 def test_planetary_period_doubling_curve_matches_one_parameter_branches() -> None:
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("sheng2016-v1")
     branch = gc.continuation(gs, "omega=3.3:3.45", max_step=0.01)
     (pd,) = [e for e in events(branch) if e.kind == "period_doubling"]
     # sheng2016 has ξ = 0.03; its period-doubling tongue closes near ξ = 0.032, so every ξ

@@ -27,7 +27,7 @@ from gearchaos.integrate.settings import SolverSettings
 from gearchaos.integrate.simulate import integrate
 from gearchaos.model.target import resolve
 
-GS = gc.preset("sheng2016")
+GS = gc.preset("sheng2016-v1")
 #: the seed's 100 + 100 periods from rest perturbed by 1e-6 (the verdict's protocol)
 SEED = SolverSettings(transient_periods=100, periods=100, perturbation=1e-6)
 

@@ -24,7 +24,7 @@ from gearchaos.integrate.settings import SolverSettings
 from gearchaos.integrate.simulate import integrate
 from gearchaos.model.target import resolve
 
-SHENG = gc.preset("sheng2016")
+SHENG = gc.preset("sheng2016-v1")
 #: the sweeps' protocol: 100 + 100 periods from rest perturbed by 1e-6
 SEED = SolverSettings(transient_periods=100, periods=100, perturbation=1e-6)
 

@@ -21,7 +21,9 @@ LINEAR_PROTOCOL = {"transient_periods": 80, "periods": 8}
 @pytest.fixture(scope="session")
 def gear_store(tmp_path_factory: pytest.TempPathFactory) -> Path:
     path = tmp_path_factory.mktemp("explore") / "gear.zarr"
-    gc.bifurcation(gc.preset("sheng2016"), GEAR_SWEEP, store=path, progress=False, **GEAR_PROTOCOL)
+    gc.bifurcation(
+        gc.preset("sheng2016-v1"), GEAR_SWEEP, store=path, progress=False, **GEAR_PROTOCOL
+    )
     return path
 
 

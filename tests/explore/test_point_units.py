@@ -24,7 +24,7 @@ def _rpm(gs: gc.GearSet, omega: float) -> float:
 
 
 def test_the_point_title_has_the_sun_speed_and_clearances_in_um(gear_store: Path) -> None:
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("sheng2016-v1")
     model = ExploreModel(open_sweep(gear_store))
     point = model.point(3)
     omega = point.values["omega"]

@@ -374,7 +374,10 @@ def test_commands_refuse_stray_arguments_and_wrong_combinations(
         (["--version", "x"], ("x",)),
         (["presets", "extra"], ("extra",)),
         (["simulate", "--preset", "nope"], ("nope",)),
-        (["simulate", "--preset", "sheng2016", "--gearset", "x.toml"], ("--preset", "--gearset")),
+        (
+            ["simulate", "--preset", "sheng2016-v1", "--gearset", "x.toml"],
+            ("--preset", "--gearset"),
+        ),
         (["simulate", *TINY, "-o", ""], ("--output",)),
         (["bifurcation", "-o", "x.zarr", *TINY], ("--vary",)),
         (

@@ -543,7 +543,7 @@ def _acting(text: str) -> list[str]:
 def gearset_orbit(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """An orbit file of the sheng2016 gear set."""
     path = tmp_path_factory.mktemp("gearset_orbit") / "orb.nc"
-    save_orbit(gc.periodic_orbit(gc.preset("sheng2016"), omega=0.5, period=1, **TINY), path)
+    save_orbit(gc.periodic_orbit(gc.preset("sheng2016-v1"), omega=0.5, period=1, **TINY), path)
     return path
 
 

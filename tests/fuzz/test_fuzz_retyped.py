@@ -33,7 +33,7 @@ SHORT = {"transient_periods": 5, "periods": 4, "progress": False}
 @pytest.fixture(scope="module")
 def base(tmp_path_factory: pytest.TempPathFactory) -> Path:
     store = tmp_path_factory.mktemp("retyped") / "base.zarr"
-    gc.bifurcation(gc.preset("sheng2016"), "omega=1.2:2.0:3", store=store, **SHORT)
+    gc.bifurcation(gc.preset("sheng2016-v1"), "omega=1.2:2.0:3", store=store, **SHORT)
     return store
 
 

@@ -291,7 +291,7 @@ def test_every_derived_quantity_is_finite_at_the_corners(gs: GearSet, omega: flo
 def test_planets_that_overlap_are_refused_with_the_numbers() -> None:
     # issue 23: `simulate --set geometry.planets=13` ran; so did teeth 10/40/90 with 10 planets
     # (centres 15.5 modules apart against tip diameters of 42 modules)
-    sheng = preset("sheng2016")  # 33/32/97: (33 + 32)·sin(π/13) = 15.6 < 34 modules
+    sheng = preset("sheng2016-v1")  # 33/32/97: (33 + 32)·sin(π/13) = 15.6 < 34 modules
     with pytest.raises(ParameterError, match=r"geometry.planets = 13: the planets do not fit"):
         sheng.evolve({"geometry.planets": 13})
     with pytest.raises(ParameterError, match=r"= 15\.45 modules .* = 42 modules"):

@@ -53,7 +53,7 @@ def _assert_same_steps(dense: Any, sections: Any) -> None:
 @pytest.mark.parametrize("spp", [64, 3])
 def test_sheng2016_chaotic_transient_takes_the_same_steps_whatever_the_samples(spp: int) -> None:
     """The default protocol (100 + 200 periods from rest) at Ω = 1.2."""
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("sheng2016-v1")
     dense = gc.simulate(gs, omega=1.2, samples_per_period=spp)
     sections = gc.simulate(gs, omega=1.2, samples_per_period=1)
     assert dense.steps_switch > 0  # the meshes open and close: switches are landed on

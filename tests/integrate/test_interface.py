@@ -57,11 +57,11 @@ def test_switch_retries_are_counted_apart_from_rejections() -> None:
     have none, and a budget counts every attempt."""
     smooth = gc.integrate.integrate(gc.linear_oscillator(1.0, zeta=0.1), periods=5)
     assert smooth.steps_switch == 0
-    res = gc.simulate(gc.preset("sheng2016"), omega=1.5, transient_periods=5, periods=5)
+    res = gc.simulate(gc.preset("sheng2016-v1"), omega=1.5, transient_periods=5, periods=5)
     assert res.steps_switch > 0 and res.steps_rejected >= 0
     attempts = res.steps_accepted + res.steps_rejected + res.steps_switch
     capped = gc.simulate(
-        gc.preset("sheng2016"), omega=1.5, transient_periods=5, periods=5,
+        gc.preset("sheng2016-v1"), omega=1.5, transient_periods=5, periods=5,
         max_steps=attempts - 1, check=False,
     )  # fmt: skip
     assert capped.status is Status.MAX_STEPS

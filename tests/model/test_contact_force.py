@@ -126,7 +126,7 @@ def test_quick_start_contact_forces_are_the_compressive_mesh_forces_of_model_md(
     compressive part: ≥ 0 on the drive flank, 0 while apart or pulling."""
     from gearchaos.plot.timeseries import mesh_force_history
 
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("sheng2016-v1")
     omega = 1.5
     res = gc.simulate(gs, omega=omega, transient_periods=100, periods=20, samples_per_period=64)
     # MODEL.md §1, §7: equivalent masses, ω_n, the dimensionless damping and stiffness

@@ -78,12 +78,12 @@ def _seven_planets() -> gc.GearSet:
     """sheng2016 with 7 planets (no compiled kernel of its own): 50 + 2·13 = 76 teeth on the
     ring, (z_s + z_r)/7 = 18 for equal spacing, planets small enough to fit."""
     changes = {"geometry.planets": 7, "teeth.sun": 50, "teeth.planet": 13, "teeth.ring": 76}
-    return gc.preset("sheng2016").evolve(changes)
+    return gc.preset("sheng2016-v1").evolve(changes)
 
 
 def _systems() -> dict[str, System]:
     out = {
-        "planetary sheng2016 (N = 5)": gc.planetary_system(gc.preset("sheng2016"), 1.5),
+        "planetary sheng2016 (N = 5)": gc.planetary_system(gc.preset("sheng2016-v1"), 1.5),
         "planetary hindawi2021": gc.planetary_system(gc.preset("hindawi2021"), 0.8),
         "planetary N = 7 (general kernel)": gc.planetary_system(_seven_planets(), 1.2),
         "backlash oscillator": gc.backlash_oscillator(1.3, eps=0.2, f_alt=0.2),

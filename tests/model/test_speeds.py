@@ -57,7 +57,7 @@ def test_sun_rpm_and_mesh_hz_set_omega_through_the_gear_set(gearset: GearSet) ->
 
 
 def test_a_speed_converts_through_the_gear_set_with_the_other_values_applied() -> None:
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("sheng2016-v1")
     changed = gs.evolve({"stiffness.sun_planet_mean": 3.3e8, "teeth.sun": 28, "teeth.ring": 92})
     omega, rest = operating_omega(
         gs, {"sun_rpm": 6000.0, "stiffness.sun_planet_mean": 3.3e8, "teeth.sun": 28,
@@ -71,7 +71,7 @@ def test_a_speed_converts_through_the_gear_set_with_the_other_values_applied() -
 
 
 def test_the_front_doors_take_a_speed() -> None:
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("sheng2016-v1")
     res = gc.simulate(gs, sun_rpm=7500.0, transient_periods=2, periods=2)
     assert res.system.omega == pytest.approx(_omega_at_rpm(gs, 7500.0), rel=1e-12)
     res = gc.simulate(gs, params={"mesh_hz": 3000.0}, transient_periods=2, periods=2)
@@ -81,18 +81,18 @@ def test_the_front_doors_take_a_speed() -> None:
 @pytest.mark.parametrize("value", [7000.0, 60.0, 1e6])
 def test_an_implausible_omega_is_refused_with_a_hint_at_sun_rpm(value: float) -> None:
     with pytest.raises(gc.ParameterError, match="plausible range") as err:
-        resolve(gc.preset("sheng2016"), {"omega": value})
+        resolve(gc.preset("sheng2016-v1"), {"omega": value})
     assert f"got {value:g}" in str(err.value) and f"sun_rpm={value:g}" in str(err.value)
 
 
 @pytest.mark.parametrize("value", [0.0, -1.5])
 def test_omega_at_or_below_zero_is_refused(value: float) -> None:
     with pytest.raises(gc.ParameterError, match="omega"):
-        resolve(gc.preset("sheng2016"), {"omega": value})
+        resolve(gc.preset("sheng2016-v1"), {"omega": value})
 
 
 def test_speed_refusals_name_the_speed_and_the_value() -> None:
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("sheng2016-v1")
     with pytest.raises(gc.ParameterError, match="omega and sun_rpm each set Ω"):
         resolve(gs, {"omega": 1.5, "sun_rpm": 7500.0})
     with pytest.raises(gc.ParameterError, match="sun_rpm"):
@@ -113,7 +113,7 @@ def test_a_model_without_physical_scales_refuses_a_speed() -> None:
 
 # ----------------------------------------------------------------------------- clearances
 def test_a_clearance_in_metres_given_in_units_of_b_c_is_warned_about() -> None:
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("sheng2016-v1")
     b_c = gs.clearance.characteristic_length
     with pytest.warns(UserWarning, match="value in metres given for a parameter in units of b_c"):
         odd = gs.evolve({"backlash.sun_planet": 60e-6})
@@ -136,4 +136,4 @@ def test_a_clearance_in_metres_given_in_units_of_b_c_is_warned_about() -> None:
 def test_plausible_clearances_are_not_warned_about(changes: dict[str, object]) -> None:
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        gc.preset("sheng2016").evolve(changes)
+        gc.preset("sheng2016-v1").evolve(changes)

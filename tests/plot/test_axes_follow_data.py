@@ -67,7 +67,7 @@ def test_sun_at_rest_shows_the_clearance_not_round_off() -> None:
     must show the bearing clearance and say the sun is at rest, not magnify 1e-13 noise."""
     from gearchaos.plot.phase import sun_orbit
 
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("sheng2016-v1")
     # the exact symmetric start (the default perturbs it by 1e-6, which the sun then shows)
     res = gc.simulate(
         gs, omega=1.5, transient_periods=5, periods=5, samples_per_period=16, perturbation=0.0

@@ -359,9 +359,9 @@ def test_figures_name_the_gear_set_not_the_models_record() -> None:
     from gearchaos.gearset.io import to_toml
     from gearchaos.plot._common import subject
 
-    gs = gc.preset("sheng2016")
-    assert subject({"model": "planetary", "gearset_toml": to_toml(gs)}) == "sheng2016"
-    assert subject({"model": "planetary"}, gs) == "sheng2016"
+    gs = gc.preset("sheng2016-v1")
+    assert subject({"model": "planetary", "gearset_toml": to_toml(gs)}) == "sheng2016-v1"
+    assert subject({"model": "planetary"}, gs) == "sheng2016-v1"
     assert subject({"model": "backlash_oscillator", "gearset_toml": ""}) == "backlash_oscillator"
 
 

@@ -33,7 +33,7 @@ TIGHT = {"rtol": 1e-10, "atol": 1e-12}
 def impact_store(tmp_path_factory: pytest.TempPathFactory):
     path = tmp_path_factory.mktemp("impact") / "map.zarr"
     return gc.bifurcation(
-        gc.preset("sheng2016"), ["omega=0.6:2.4:7", "backlash.sun_planet=0.5:4:4"],
+        gc.preset("sheng2016-v1"), ["omega=0.6:2.4:7", "backlash.sun_planet=0.5:4:4"],
         params={"xi": 0.05}, transient_periods=40, periods=16, progress=False, store=path,
     )  # fmt: skip
 
@@ -105,7 +105,7 @@ def test_regime_map_has_the_physical_axes_of_the_impact_map(impact_store) -> Non
     ax = fig.axes[0]
     (top,) = [c for c in ax.child_axes if c.get_xlabel()]
     (right,) = [c for c in ax.child_axes if c.get_ylabel()]
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("sheng2016-v1")
     np.testing.assert_allclose(top.get_xlim(), np.multiply(ax.get_xlim(), gs.sun_speed_rpm(1.0)))
     um = gs.clearance.characteristic_length * 1e6
     np.testing.assert_allclose(right.get_ylim(), np.multiply(ax.get_ylim(), um))
@@ -238,9 +238,9 @@ def test_amplitude_figure_is_titled_by_the_shared_helper(oscillator_response) ->
     force = amplitude_figure(res, [branch], quantity="force_peak").get_suptitle()
     assert force.startswith(f"backlash_oscillator: peak contact force curves\n{given}\n")
     geared = res.copy()
-    geared.attrs["gearset_toml"] = to_toml(gc.preset("sheng2016"))
+    geared.attrs["gearset_toml"] = to_toml(gc.preset("sheng2016-v1"))
     title = amplitude_figure(geared, [branch]).get_suptitle().splitlines()
-    assert title[0] == "sheng2016: amplitude–frequency curves"
+    assert title[0] == "sheng2016-v1: amplitude–frequency curves"
     assert title[1].startswith(r"at $\bar b_{sp}$ = ")
 
 
@@ -255,7 +255,7 @@ def test_no_physical_axis_where_a_swept_parameter_changes_its_scale(
     from gearchaos.plot.units import PhysicalScales
     from gearchaos.sweep.result import SweepResult
 
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("sheng2016-v1")
     k = gs.stiffness.sun_planet_mean
     res = gc.bifurcation(
         gs, ["omega=1:2:3", f"stiffness.sun_planet_mean={k}:{2 * k}:2"],

@@ -36,7 +36,7 @@ REGIME = {0: "none", 1: "single_sided", 2: "double_sided"}
 def store(tmp_path_factory: pytest.TempPathFactory):
     path = tmp_path_factory.mktemp("contact") / "resp.zarr"
     gc.response(
-        gc.preset("sheng2016"), "omega=0.5:3.5:7", transient_periods=20, periods=16,
+        gc.preset("sheng2016-v1"), "omega=0.5:3.5:7", transient_periods=20, periods=16,
         progress=False, store=path,
     )  # fmt: skip
     return path
@@ -51,7 +51,7 @@ def _expected(ds, key: str, b: float) -> np.ndarray:
 
 def test_ranges_are_the_regimes_of_the_stored_deflections(store) -> None:
     ds = gc.open_sweep(store)
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("sheng2016-v1")
     omega = ds.omega.values
     ranges = contact_ranges(ds)
     for key, mesh, b in (
@@ -107,7 +107,7 @@ def _omega_n(gs) -> float:
 
 def test_figure_bands_speed_axis_and_forces(store) -> None:
     ds = gc.open_sweep(store)
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("sheng2016-v1")
     fig = contact_figure(ds)
     draw(fig)
     top, band = fig.axes[0], fig.axes[1]
@@ -179,7 +179,7 @@ def test_a_sweep_without_forces_draws_the_bands_under_the_speed_axis(store) -> N
 
 def test_two_swept_parameters_are_refused(tmp_path) -> None:
     ds = gc.bifurcation(
-        gc.preset("sheng2016"), ["omega=0.5:1:2", "xi=0.03:0.05:2"], transient_periods=2,
+        gc.preset("sheng2016-v1"), ["omega=0.5:1:2", "xi=0.03:0.05:2"], transient_periods=2,
         periods=2, progress=False,
     )  # fmt: skip
     with pytest.raises(gc.ParameterError, match="needs one swept dimension"):
@@ -197,7 +197,7 @@ def test_command_writes_the_figure_and_prints_the_ranges(store, tmp_path) -> Non
     assert len(rows) == len(ranges)
     header = next(ln for ln in result.output.splitlines() if ln.startswith("┃"))
     assert "sun speed [rpm]" in header and "peak force [N]" in header
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("sheng2016-v1")
     for line, r in zip(rows, ranges, strict=True):
         cells = [c.strip() for c in line.strip("│").split("│")]
         assert cells[0] == r.mesh.replace("_", "–") and cells[1] == r.direction

@@ -52,7 +52,7 @@ def test_parameter_symbols_are_the_models_own_or_none() -> None:
     from gearchaos.gearset.io import to_toml
     from gearchaos.model.loading import load_model_class, model_reference
 
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("sheng2016-v1")
     assert parameter_symbols({"model": "planetary", "gearset_toml": to_toml(gs)}) == {}
     oscillator = gc.backlash_oscillator(1.0).model
     assert parameter_symbols({"model": "backlash_oscillator", **model_reference(oscillator)}) == {}

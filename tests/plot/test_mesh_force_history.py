@@ -33,7 +33,7 @@ def test_separations_are_shaded_where_the_contact_force_vanishes() -> None:
 
 
 def test_summary_figure_has_the_force_panel_with_newtons() -> None:
-    res = gc.simulate(gc.preset("sheng2016"), omega=1.5, transient_periods=20, periods=6)
+    res = gc.simulate(gc.preset("sheng2016-v1"), omega=1.5, transient_periods=20, periods=6)
     fig = summary_figure(res)
     force = [a for a in fig.axes if "contact force" in a.get_ylabel()]
     assert len(force) == 1

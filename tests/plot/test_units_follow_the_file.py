@@ -21,7 +21,7 @@ TINY = {"transient_periods": 2, "periods": 2, "verdicts": False, "progress": Fal
 @pytest.fixture(scope="module")
 def metric() -> GearSet:
     """sheng2016 with its clearances in metres (the issue's user: backlash.units = "m")."""
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("sheng2016-v1")
     b_c = gs.clearance.characteristic_length
     return gs.evolve(
         {
@@ -57,7 +57,7 @@ def test_titles_write_clearances_in_um_beside_b_bar_and_the_sun_speed(metric: Ge
     assert rf"$\bar b_{{sp}}$ = {50e-6 / b_c:.6g} (50 µm)" in got
     assert not any("5e" in g for g in got)
     # a gear set in units of b_c: b̄ alone, as before
-    sheng = gc.preset("sheng2016")
+    sheng = gc.preset("sheng2016-v1")
     assert given_values({}, fixed={}, gearset=sheng)[0] == r"$\bar b_{sp}$ = 3"
 
 

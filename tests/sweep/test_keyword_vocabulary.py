@@ -233,7 +233,7 @@ def test_a_misspelt_keyword_is_refused_naming_the_closest(door, call, wrong, mea
     refused before anything runs, naming the door and the closest of the three (the door's
     keywords read from its signature: `period` for periodic_orbit, not the setting `periods`)."""
     with pytest.raises(gc.ParameterError) as info:
-        call(gc.preset("sheng2016"))
+        call(gc.preset("sheng2016-v1"))
     text = str(info.value)
     assert f"unknown {door} option {wrong!r}; did you mean {meant!r}?" in text
     assert info.value.name == wrong

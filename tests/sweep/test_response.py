@@ -114,7 +114,7 @@ def test_response_figure_axes_follow_the_gear_set(tmp_path) -> None:
     from gearchaos.plot import response_figure
     from gearchaos.plot.bifurcation import suptitle
 
-    gs = gc.preset("sheng2016")
+    gs = gc.preset("sheng2016-v1")
     ds = gc.response(
         gs, "omega=0.6:1.0:3", transient_periods=10, periods=4, samples_per_period=8,
         progress=False,
@@ -151,7 +151,7 @@ def test_response_figure_axes_follow_the_gear_set(tmp_path) -> None:
     # titled like the bifurcation diagram: the gear set's name, not the model's record
     # ("gearchaos frequency response of planetary[sheng2016]" before)
     title = fig.get_suptitle()
-    assert title.splitlines()[0] == "sheng2016: frequency response"
+    assert title.splitlines()[0] == "sheng2016-v1: frequency response"
     assert title == suptitle(ds, "frequency response") and "planetary" not in title
     fig.savefig(tmp_path / "response.png")
 
@@ -182,7 +182,7 @@ def test_response_figure_marks_jumps_and_hysteresis_only_between_periodic_states
     from gearchaos.plot.regimes import REGIME_GID
 
     grid = np.round(np.linspace(0.6, 0.9, 7), 12)
-    ds = gc.response(gc.preset("sheng2016"), {"omega": grid}, progress=False)
+    ds = gc.response(gc.preset("sheng2016-v1"), {"omega": grid}, progress=False)
     motion = {d: ds.motion.sel(direction=d).values.astype(str) for d in ("up", "down")}
     periodic = {d: np.char.endswith(m, "T") for d, m in motion.items()}
     # the case: a large step of the up branch between a periodic and a non-periodic point
@@ -272,7 +272,7 @@ def test_default_response_sweep_decides_its_points(tmp_path) -> None:
     from gearchaos.cli import app
 
     path = tmp_path / "resp.zarr"
-    args = ["response", "--preset", "sheng2016", "--vary", "omega=0.6:1.4:17", "-o", str(path)]
+    args = ["response", "--preset", "sheng2016-v1", "--vary", "omega=0.6:1.4:17", "-o", str(path)]
     out = CliRunner().invoke(app, [*args, "--quiet"])
     assert out.exit_code == 0, out.output
     ds = gc.open_sweep(path)

@@ -66,7 +66,7 @@ def test_values_that_were_accepted_silently_are_refused(tmp_path: Path) -> None:
     with pytest.raises(ParameterError, match=r"rtol must lie in \[1e-14, 0.1\]|rtol"):
         gc.simulate(OSC, omega=1.0, rtol=0.5)
     with pytest.raises(ParameterError, match="rtol must be a finite number in"):
-        natural_frequencies(gc.preset("sheng2016"), rtol=float("nan"))
+        natural_frequencies(gc.preset("sheng2016-v1"), rtol=float("nan"))
     with pytest.raises(ParameterError, match="min_step <= step <= max_step"):
         gc.continuation(OSC, ("omega", 1.5, 1.6), min_step=0.1, max_step=0.001)
     with pytest.raises(ParameterError, match="save_branch needs a branch dataset"):
