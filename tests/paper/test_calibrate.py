@@ -349,7 +349,9 @@ def test_a_study_resumes_after_kill_9_without_losing_a_finished_trial(tmp_path: 
         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
     )  # fmt: skip
     try:
-        # readiness: two finished trials and the third running (its owner recorded)
+        # readiness: two finished trials and the third running inside its objective (its
+        # candidate drawn: "params" is recorded after the draw, just before the objective;
+        # a kill between the owner and the draw would leave a trial with nothing to retry)
         deadline = time.monotonic() + 120.0
         while True:
             assert proc.poll() is None, proc.stderr.read().decode() if proc.stderr else ""
@@ -361,7 +363,7 @@ def test_a_study_resumes_after_kill_9_without_losing_a_finished_trial(tmp_path: 
             states = [t.state.name for t in trials]
             if (
                 states[:3] == ["COMPLETE", "COMPLETE", "RUNNING"]
-                and "owner" in trials[2].user_attrs
+                and "params" in trials[2].user_attrs
             ):
                 break
             time.sleep(0.05)

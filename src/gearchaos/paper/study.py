@@ -180,7 +180,9 @@ def _alive(owner: Any) -> bool | None:
 
 def recover(study: Any) -> list[int]:
     """Mark failed every running trial whose process on this host is gone (a kill -9, a
-    crash) and enqueue it again with the same parameters; returns their numbers."""
+    crash) and enqueue it again with the same parameters; returns the numbers of those
+    enqueued again (a trial killed before it drew its candidate has nothing to repeat: it is
+    only marked failed)."""
     from optuna.trial import TrialState
 
     storage = study._storage
@@ -192,8 +194,9 @@ def recover(study: Any) -> list[int]:
         trial_id = storage.get_trial_id_from_study_id_trial_number(study_id, t.number)
         with contextlib.suppress(RuntimeError, ValueError):  # another process was first
             storage.set_trial_state_values(trial_id, TrialState.FAIL)
-            enqueue(study, t.params, f"retry of #{t.number}")
-            lost.append(t.number)
+            if t.params:
+                enqueue(study, t.params, f"retry of #{t.number}")
+                lost.append(t.number)
     return lost
 
 
