@@ -3,7 +3,8 @@
 
 :mod:`.poincare` (section points, distinct-point count), :mod:`.periodicity` (period-n),
 :mod:`.chaos01` (0–1 test), :mod:`.spectral` (broadband spectra), :mod:`.recurrence`,
-:mod:`.classify` (motion labels from a record), :mod:`.contact` (contact regimes per mesh) and
+:mod:`.motion` (the :class:`Motion` value a label names), :mod:`.classify` (motion labels
+from a record), :mod:`.contact` (contact regimes per mesh) and
 :mod:`.summary` (a JSON-serialisable summary of one simulation). What drives the integrator —
 Lyapunov exponents, periodic orbits, continuation and its events, branch files, attractors and
 the motion verdict — is in :mod:`gearchaos.dynamics`; the linear modal analysis of a gear set
@@ -20,12 +21,15 @@ from .classify import (
     spectral_broadband,
 )
 from .contact import contact_fractions, contact_regime, contact_regimes, separation_fraction
+from .motion import Motion, MotionKind
 from .periodicity import detect_period, period_label
 from .poincare import count_distinct, section_points
 from .summary import format_exponent, summarize
 
 __all__ = [
+    "Motion",
     "MotionClass",
+    "MotionKind",
     "chaos01",
     "classify_motion",
     "classify_sections",

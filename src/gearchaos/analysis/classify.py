@@ -35,14 +35,15 @@ from __future__ import annotations
 import math
 from collections import Counter
 from collections.abc import Iterable
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from typing import Any
 
 import numpy as np
 
 from ..errors import ParameterError
 from .chaos01 import MIN_LENGTH as MIN_LENGTH_01, chaos01
-from .periodicity import period_label, periods_of
+from .motion import LABEL_DTYPE, Motion, MotionKind
+from .periodicity import periods_of
 from .spectral import spectral_broadband
 
 __all__ = [
@@ -68,10 +69,6 @@ K_REGULAR = 0.2
 LLE_C = 10.0
 #: Shortest sequence the spectral indicator is computed on inside the classifier.
 MIN_SPECTRUM_LENGTH = 64
-#: Fixed-width string dtype of label arrays (``unresolved`` is the longest label).
-LABEL_DTYPE = "<U10"
-
-_OTHER_LABELS = ("QP", "chaos", "unresolved")
 
 
 @dataclass(frozen=True)
@@ -113,13 +110,16 @@ class MotionClass:
     peak_fraction: float | None = None
 
     @property
+    def motion(self) -> Motion:
+        """The label as a :class:`~gearchaos.analysis.motion.Motion` (an ``unresolved`` one
+        with the note as its reason)."""
+        m = Motion.parse(self.label)
+        return replace(m, reason=self.note) if m.kind is MotionKind.UNRESOLVED else m
+
+    @property
     def regular(self) -> bool | None:
         """True for ``nT`` and ``QP``, False for ``chaos``, None for ``unresolved``."""
-        if self.label == "chaos":
-            return False
-        if self.label == "unresolved":
-            return None
-        return True
+        return Motion.parse(self.label).regular
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON-serialisable dict of the fields (non-finite floats become None)."""
@@ -221,10 +221,10 @@ def _classify(
     disagree: list[str] = []
     finite = bool(np.all(np.isfinite(p))) and p.shape[0] > 0
 
-    def make(label: str, n: int | None = None) -> MotionClass:
+    def make(motion: Motion) -> MotionClass:
         return MotionClass(
-            label=label,
-            period=n,
+            label=motion.format(),
+            period=motion.period or None,
             lle=lle,
             k01=k01,
             broadband=broadband,
@@ -236,7 +236,7 @@ def _classify(
 
     if not finite:
         reason.append("the section sequence is empty or holds NaN/inf (integration failed)")
-        return make("unresolved")
+        return make(Motion.unresolved())
 
     if period > 0:
         if lle is not None and threshold is not None and lle > threshold:
@@ -252,7 +252,7 @@ def _classify(
             disagree.append(
                 f"the spectrum is broadband, but the section repeats with period {period}"
             )
-        return make(period_label(period), period)
+        return make(Motion.periodic(period))
 
     m = p.shape[0]
     if compute_indicators and k01 is None:
@@ -277,15 +277,15 @@ def _classify(
     # deciding indicator: the LLE, else a decisive 0–1 test
     if lle is not None and threshold is not None:
         if lle > threshold:
-            verdict, label = "chaos", "chaos"
+            verdict, label = "chaos", Motion.chaos()
             why = f"LLE {_fmt(lle)} > threshold {_fmt(threshold)}, no period ≤ {max_period}"
         elif lle >= -threshold:
-            verdict, label = "regular", "QP"
+            verdict, label = "regular", Motion.quasi_periodic()
             why = (
                 f"|LLE| = {_fmt(abs(lle))} ≤ threshold {_fmt(threshold)}, no period ≤ {max_period}"
             )
         else:
-            verdict, label = "regular", "unresolved"
+            verdict, label = "regular", Motion.unresolved()
             why = (
                 f"LLE {_fmt(lle)} < −threshold −{_fmt(threshold)}: a contracting (periodic) "
                 f"attractor, but no period ≤ {max_period} was found (longer period or "
@@ -296,7 +296,7 @@ def _classify(
     elif v01 is not None:
         assert k01 is not None
         verdict = v01
-        label = "chaos" if v01 == "chaos" else "QP"
+        label = Motion.chaos() if v01 == "chaos" else Motion.quasi_periodic()
         reason.append(f"0–1 test K = {_fmt(k01)} (no LLE), no period ≤ {max_period}")
         deciding = "0–1 test"
     else:
@@ -306,7 +306,7 @@ def _classify(
         if broadband is not None:
             why += f", spectrum {sp_text} (not decisive alone)"
         reason.append(why)
-        return make("unresolved")
+        return make(Motion.unresolved())
 
     # confirmation by the other indicators
     if deciding == "LLE" and k01 is not None:
@@ -537,16 +537,16 @@ def classify_sections(
     return out.reshape(lead)
 
 
-def _label_key(label: str) -> tuple[int, int, str]:
-    if label.endswith("T") and label[:-1].isdigit():
-        return (0, int(label[:-1]), label)
-    if label in _OTHER_LABELS:
-        return (1, _OTHER_LABELS.index(label), label)
-    return (2, 0, label)
+def _label_key(label: str) -> tuple[int, tuple[int, int], str]:
+    try:
+        return (0, Motion.parse(label).sort_key, label)
+    except ParameterError:  # not a motion label: after them, in text order
+        return (1, (0, 0), label)
 
 
 def sort_labels(labels: Iterable[str]) -> list[str]:
-    """Distinct labels in display order: 1T, 2T, …, nT, QP, chaos, unresolved, then others."""
+    """Distinct labels in display order (:attr:`~gearchaos.analysis.motion.Motion.sort_key`):
+    1T, 2T, …, nT, QP, chaos, unresolved, failed, not run, then any other text."""
     return sorted({str(x) for x in labels}, key=_label_key)
 
 

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
+from .motion import Motion
 
 __all__ = ["detect_period", "period_label", "periods_of"]
 
@@ -179,4 +180,4 @@ def period_label(n: int) -> str:
     """Seed's name of an n-periodic motion: ``1T``, ``2T``, …, ``nT`` (n ≥ 1)."""
     if not (isinstance(n, int | np.integer) and not isinstance(n, bool) and n >= 1):
         raise ParameterError(f"n (period) must be an integer >= 1: got {n!r}")
-    return f"{int(n)}T"
+    return Motion.periodic(int(n)).format()

@@ -17,6 +17,7 @@ from ..errors import ParameterError
 from ..model.response import response_quantities
 from .classify import classify_motion
 from .contact import contact_regimes, separation_fraction
+from .motion import Motion
 from .poincare import count_distinct, section_points, section_variables
 
 __all__ = ["SUMMARY_KEYS", "format_exponent", "motion_name", "motion_text", "summarize"]
@@ -44,7 +45,7 @@ def motion_name(n: int, max_count: int = 64) -> str:
         return "unknown"
     if n > max_count:
         return "many"
-    return f"{n}T"
+    return Motion.periodic(n).format()
 
 
 def _num(x: Any) -> float | None:

@@ -6,12 +6,14 @@ behind it) and :data:`EVIDENCE` (the kinds of evidence, the flag values of a sto
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
-from .extension import VerdictRecord
+from ..analysis.motion import Motion, MotionKind
+from ..errors import ParameterError
+from .extension import RECORD_SOURCES, VerdictRecord
 
 __all__ = ["EVIDENCE", "Verdict"]
 
@@ -36,9 +38,11 @@ class Verdict:
     Attributes
     ----------
     label
-        ``1T`` … ``nT``, ``QP``, ``chaos``, ``unresolved`` or ``failed``.
+        ``1T`` … ``nT``, ``QP``, ``chaos``, ``unresolved`` or ``failed``: the text of a
+        :class:`~gearchaos.analysis.motion.Motion` (:attr:`motion`).
     period
-        n of an nT label, else 0.
+        n of an nT label, else 0 (the motion's period: a label that does not parse, or a
+        period that is not the label's, is refused).
     evidence
         Key of :data:`EVIDENCE`.
     max_multiplier
@@ -82,10 +86,35 @@ class Verdict:
     window_periods: int = 0
     coexisting: tuple[tuple[int, float], ...] = ()
 
+    def __post_init__(self) -> None:
+        motion = Motion.parse(self.label)
+        if motion.period != self.period:
+            raise ParameterError(
+                f"period must be the label's ({motion.period} for {self.label}): "
+                f"got {self.period!r}",
+                name="period",
+            )
+
+    @property
+    def motion(self) -> Motion:
+        """The label as a :class:`~gearchaos.analysis.motion.Motion`; an ``unresolved`` or
+        ``failed`` one carries the reason."""
+        m = Motion.parse(self.label)
+        if m.kind in (MotionKind.UNRESOLVED, MotionKind.FAILED):
+            return replace(m, reason=self.reason)
+        return m
+
     @property
     def code(self) -> int:
         """The :data:`EVIDENCE` flag value."""
         return EVIDENCE[self.evidence]
+
+    @property
+    def record_code(self) -> int:
+        """Where the record the verdict is about comes from, as a flag value of
+        :data:`~gearchaos.dynamics.extension.RECORD_SOURCES` (``protocol`` without a
+        replacement record)."""
+        return self.record.code if self.record is not None else RECORD_SOURCES["protocol"]
 
     @property
     def periodic(self) -> bool:
