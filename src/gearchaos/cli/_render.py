@@ -14,6 +14,7 @@ from rich.table import Table
 from rich.text import Text
 
 from .._text import escape_text
+from ..analysis.motion import Motion
 from ..analysis.summary import format_exponent
 from ..gearset.mapping import flatten
 from ..gearset.schema import display_symbol as symbol
@@ -252,11 +253,12 @@ def add_motion_rows(table: Table, summary: Mapping[str, Any]) -> None:
         table.add_row("λ₁ measured over", f"periods {start}–{end} after the record")
     for orb in summary.get("coexisting") or []:
         mu = orb.get("max_multiplier")
+        orbit = Motion.periodic(int(orb["period"]))
         table.add_row(
             "coexisting stable orbit",
-            f"{int(orb['period'])}T, max |μ| = {mu:.6g} (not the recorded motion)"
+            f"{orbit}, max |μ| = {mu:.6g} (not the recorded motion)"
             if mu is not None
-            else f"{int(orb['period'])}T (not the recorded motion)",
+            else f"{orbit} (not the recorded motion)",
         )
     note = summary.get("motion_note")
     if note:

@@ -11,7 +11,6 @@ from __future__ import annotations
 import json
 import math
 import os
-import re
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -19,11 +18,11 @@ import numpy as np
 
 from .._checks import check_int, check_real
 from .._text import escape_path, escape_text
+from ..analysis.motion import Motion
 from ..errors import ParameterError, StoreError
 
 OMEGA = "omega"
 DIRECTION = "direction"
-PERIOD_LABEL = re.compile(r"^(\d+)T$")
 
 
 @dataclass(frozen=True)
@@ -346,7 +345,7 @@ def _from_store(path: str, where: dict[str, str]) -> Start:
     if int(point["status"].values) != 0 or not np.all(np.isfinite(state)):
         raise StoreError(f"--from {path} at {text}: that point's integration failed")
     gs, values = point_target(res, chosen)
-    match = PERIOD_LABEL.match(label)
+    period = Motion.parse(label).period  # the empty label of a store without verdicts: 0
     spec = res.spec
     section = {}
     if spec is not None:
@@ -358,7 +357,7 @@ def _from_store(path: str, where: dict[str, str]) -> Start:
         gearset=gs,
         values=values,
         state=state,
-        period=int(match.group(1)) if match else None,
+        period=period or None,
         source=f"{escape_path(os.path.basename(path))} at {text}"
         + (f" ({escape_text(label)})" if label else ""),
         section=section,

@@ -42,6 +42,7 @@ from typing import Any
 import numpy as np
 
 from .._checks import check_int, check_real
+from ..analysis.motion import Motion
 from ..errors import ParameterError
 from ..integrate.settings import SolverSettings
 from .verdict import VerdictSettings, confirmed_settings, decide_motion
@@ -69,7 +70,7 @@ _Q = np.array([0.1, 0.5, 0.9])
 
 
 def _periodic(label: str) -> int:
-    return int(label[:-1]) if label.endswith("T") and label[:-1].isdigit() else 0
+    return Motion.parse(label).period
 
 
 def _number(v: Any) -> float | None:

@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from .._checks import check_int, check_real
+from ..analysis.motion import Motion
 from ..errors import ParameterError
 from ..integrate._chains import ChainRun, run_chains
 from ..integrate.settings import SolverSettings, split_keywords
@@ -292,16 +293,16 @@ def attractors(
     groups: list[list[int]] = []
     for j in runs:
         lab = str(labels[j])
-        periodic = lab.endswith("T") and lab[:-1].isdigit()
+        motion = Motion.parse(lab)
         for g in groups:
             i = g[0]
             if str(labels[i]) != lab:
                 continue
             a, b = states[j] / scale, states[i] / scale
-            n = int(lab[:-1]) if periodic else 0
+            n = motion.period
             same = (
                 _same_periodic(a[-n:], b[-n:], tol)
-                if periodic
+                if motion.is_periodic
                 else _same_set(a, b, spread_fraction)
             )
             if same:
@@ -313,7 +314,7 @@ def attractors(
     found = []
     for g in groups:
         lab = str(labels[g[0]])
-        n = int(lab[:-1]) if lab.endswith("T") and lab[:-1].isdigit() else 0
+        n = Motion.parse(lab).period
         found.append(
             Attractor(
                 label=lab,

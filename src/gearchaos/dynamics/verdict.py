@@ -48,6 +48,7 @@ import numpy as np
 
 from .._checks import check_int, check_real
 from ..analysis.classify import LLE_C
+from ..analysis.motion import Motion
 from ..analysis.periodicity import periods_of
 from ..analysis.recurrence import converging_period, near_period, noise_floor
 from ..errors import ParameterError
@@ -267,7 +268,7 @@ def _floquet(p: _Point, f: Found, system: System, how: str) -> Verdict:
         else f"the run was continued {p.extra} periods until its record lay on it"
     )
     return Verdict(
-        label=f"{d}T",
+        label=Motion.periodic(d).format(),
         period=d,
         evidence="floquet",
         max_multiplier=mu,

@@ -33,6 +33,7 @@ import numpy as np
 from ..analysis.bands import circle_order, uniform_return
 from ..analysis.chaos01 import MIN_LENGTH as MIN_LENGTH_01, chaos01
 from ..analysis.classify import K_CHAOS, K_REGULAR
+from ..analysis.motion import Motion
 from .evidence import Verdict
 
 __all__ = ["SectionTests", "Window", "decide_by_exponent", "section_tests"]
@@ -219,7 +220,7 @@ def decide_by_exponent(p: Any, vs: Any, last: bool) -> Verdict | None:
     if p.long_period and hi < 0:
         n = p.long_period
         return Verdict(
-            label=f"{n}T",
+            label=Motion.periodic(n).format(),
             period=n,
             evidence="record_contracting",
             reason=f"the record repeats with period {n} (too long to shoot) and {text} < 0",
@@ -262,7 +263,7 @@ def decide_by_exponent(p: Any, vs: Any, last: bool) -> Verdict | None:
 def _coexist_text(p: Any) -> str:
     if not p.coexisting:
         return ""
-    parts = [f"{d}T (max |μ| = {mu:.6g})" for d, mu in sorted(p.coexisting.items())]
+    parts = [f"{Motion.periodic(d)} (max |μ| = {mu:.6g})" for d, mu in sorted(p.coexisting.items())]
     return "; a stable " + ", ".join(parts) + " coexists (the record does not approach it)"
 
 

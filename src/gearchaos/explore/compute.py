@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from ..analysis.motion import Motion
 from ..errors import ParameterError, StoreError
 from ..gearset.schema import OMEGA
 
@@ -126,7 +127,7 @@ def compute_point(
     summary = point.summary
     motion = str(summary.get("motion", ""))
     multipliers, note = None, ""
-    n = _period(motion)
+    n = _period(summary.get("motion"))
     if n is not None and point.ok and n <= MAX_ORBIT_PERIOD:
         multipliers, note = _multipliers(target, vals, settings, n, point.result)
     return {
@@ -142,10 +143,9 @@ def compute_point(
     }
 
 
-def _period(motion: str) -> int | None:
-    if motion.endswith("T") and motion[:-1].isdigit():
-        return int(motion[:-1])
-    return None
+def _period(motion: Any) -> int | None:
+    """n of an nT motion label, else None (also without a label)."""
+    return None if motion is None else Motion.parse(str(motion)).period or None
 
 
 def _multipliers(

@@ -7,11 +7,12 @@ from __future__ import annotations
 
 import itertools
 import math
-import re
 from collections.abc import Callable
 from typing import Any
 
 import numpy as np
+
+from ..analysis.motion import Motion
 
 __all__ = [
     "CRISIS_FLOOR",
@@ -38,7 +39,6 @@ CRISIS_RATIO = 2.0
 CRISIS_FLOOR = 0.05
 
 _UNINFORMATIVE = ("unresolved", "failed", "")
-_PERIODIC = re.compile(r"^(\d+)T$")
 
 
 def _labels(ds: Any) -> np.ndarray:
@@ -85,8 +85,7 @@ def _resolved(labels: np.ndarray) -> np.ndarray:
 
 
 def _period(label: str) -> int | None:
-    m = _PERIODIC.match(label)
-    return int(m.group(1)) if m else None
+    return Motion.parse(label).period or None
 
 
 def label_fraction(labels: np.ndarray, which: Callable[[str], bool]) -> float:

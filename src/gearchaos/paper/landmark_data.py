@@ -20,6 +20,7 @@ from types import MappingProxyType
 from typing import Any, Literal
 
 from .._files import read_text_file
+from ..analysis.motion import Motion
 from ..errors import ParameterError
 from ..gearset.mapping import flatten
 
@@ -45,7 +46,8 @@ KINDS = ("label", "transition", "window", "negligible")
 CONTRASTS = ("below", "above")
 #: Gallery → the bifurcation recipe whose sweep covers its statements.
 _GALLERY_RECIPE = {"fig5": "fig4", "fig7": "fig6", "fig10": "fig9"}
-_LABEL_RE = re.compile(r"^(?:[1-9][0-9]*T|nT|QP|chaos)$")
+#: What a landmark's ``expected`` and ``from`` lists name beside decided motions: any nT, n ≥ 2.
+ANY_PERIOD = "nT"
 _REL = 1e-9
 
 Verdict = Literal["holds", "holds (constant)", "partly", "does not hold", "not evaluated"]
@@ -190,10 +192,18 @@ def _number(where: str, key: str, v: Any) -> float:
     return float(v)
 
 
+def _decided(label: str) -> bool:
+    """``label`` names a decided motion (nT, QP or chaos)."""
+    try:
+        return Motion.parse(label).decided
+    except ParameterError:
+        return False
+
+
 def _labels(where: str, key: str, v: Any) -> tuple[str, ...]:
     if not isinstance(v, list) or not v or not all(isinstance(x, str) for x in v):
         raise ParameterError(f"{where}: {key} must be a non-empty list of labels: got {v!r}")
-    bad = [x for x in v if not _LABEL_RE.match(x)]
+    bad = [x for x in v if x != ANY_PERIOD and not _decided(x)]
     if bad:
         raise ParameterError(
             f"{where}: {key} labels must be 1T, 2T, …, nT, QP or chaos: got {', '.join(bad)}"

@@ -52,13 +52,13 @@ are not landmarks, except "affected negligibly" (Fig. 12).
 from __future__ import annotations
 
 import math
-import re
 from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
 
+from ..analysis.motion import Motion
 from ..sweep.result import SweepResult
 from .landmark_data import (
     AXES,
@@ -96,7 +96,6 @@ __all__ = [
 
 #: Labels that say nothing about the motion: skipped when locating changes.
 _NO_LABEL = ("failed", "unresolved")
-_PERIOD_RE = re.compile(r"^([1-9][0-9]*)T$")
 
 
 # ---------------------------------------------------------------------------- evaluation
@@ -104,8 +103,7 @@ def _matches(label: str, accepted: Sequence[str]) -> bool:
     if label in accepted:
         return True
     if "nT" in accepted:
-        m = _PERIOD_RE.match(label)
-        return m is not None and int(m.group(1)) >= 2
+        return Motion.parse(label).period >= 2
     return False
 
 

@@ -40,6 +40,8 @@ from typing import Any
 
 from .._marks import fill_mark, placeholder
 from .._output import check_replaceable, file_has_mark, write_file
+from ..analysis.motion import Motion
+from ..errors import ParameterError
 from ..sweep.result import SweepResult
 from .accounting import count_text, landmark_rows as accounting_rows, verdict_counts
 
@@ -237,9 +239,12 @@ def _regime_rank(label: str) -> tuple[int, int, str]:
 
     if label in REGIME_ORDER:
         return (REGIME_ORDER.index(label), 0, label)
-    head = label[:-1]
-    if label.endswith("T") and head.isdigit():  # a period beyond the named ones: after them
-        return (REGIME_ORDER.index("QP") - 1, int(head), label)
+    try:
+        motion = Motion.parse(label)
+    except ParameterError:  # not a motion label: last
+        return (len(REGIME_ORDER), 0, label)
+    if motion.is_periodic:  # a period beyond the named ones: after them
+        return (REGIME_ORDER.index("QP") - 1, motion.period, label)
     return (len(REGIME_ORDER), 0, label)
 
 

@@ -28,11 +28,12 @@ regimes come with the sweeps.
 from __future__ import annotations
 
 import math
-import re
 from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
+
+from ..analysis.motion import Motion, MotionKind
 
 __all__ = [
     "BACKLASH_AXES",
@@ -58,15 +59,11 @@ BRANCH_POINTS = 60
 #: Code of double-sided contact in the stored contact regimes (MODEL.md §8).
 DOUBLE_SIDED = 2
 
-_PERIOD = re.compile(r"^([1-9][0-9]*)T$")
-
 
 def _region(label: str) -> bool:
     """Chaotic or multi-periodic (nT, n ≥ 2)."""
-    if label == "chaos":
-        return True
-    m = _PERIOD.match(label)
-    return m is not None and int(m.group(1)) >= 2
+    motion = Motion.parse(label)
+    return motion.kind is MotionKind.CHAOS or motion.period >= 2
 
 
 def double_sided_share(stores: Mapping[str, Any]) -> tuple[float, int, int]:

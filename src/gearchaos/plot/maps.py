@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from .._checks import check_bool, check_int, check_real
+from ..analysis.motion import Motion
 from ..errors import ParameterError, Status
 from ..sweep.result import SweepResult
 from ._common import (
@@ -168,7 +169,8 @@ def distinct_map(
     if colorbar:
         fig = ax.figure
         cb = fig.colorbar(mesh, ax=ax, ticks=np.arange(0, max_count + 2))
-        labels = ["failed", *(f"{n}T" for n in range(1, max_count + 1)), "many"]
+        periodic = (Motion.periodic(n).format() for n in range(1, max_count + 1))
+        labels = [Motion.failed().format(), *periodic, "many"]
         cb.ax.set_yticklabels(labels, fontsize="x-small")
         sym = var_symbol(
             var, planet if "planet" in sub[var].dims else None, model_symbols(sub.attrs)

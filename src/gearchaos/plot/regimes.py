@@ -24,12 +24,14 @@ from typing import Any
 
 import numpy as np
 
+from ..analysis.motion import Motion
 from ..errors import ParameterError, Status
 from ..sweep.result import SweepResult
 from ._common import axis_label, edges, get_ax, no_offset, parameter_symbols, resonance_lines
 
 __all__ = [
     "NOT_RUN",
+    "PERIODIC_CATEGORIES",
     "REGIME_COLOURS",
     "REGIME_GID",
     "REGIME_ORDER",
@@ -46,21 +48,30 @@ __all__ = [
 #: Largest period shown in a colour of its own; longer ones are grouped as ``≥ 9T``.
 MAX_OWN_PERIOD = 8
 #: Display category of a point of an interrupted store that was never computed (status 4).
-NOT_RUN = "not run"
+NOT_RUN = Motion.not_run().format()
 #: ``gid`` prefix of the artists drawn by :func:`regime_band` and :func:`regime_map`.
 REGIME_GID = "regime"
 
-_LONG_PERIODS = f"≥ {MAX_OWN_PERIOD + 1}T"
+_LONG_PERIODS = f"≥ {Motion.periodic(MAX_OWN_PERIOD + 1)}"
 
+#: Display categories of periodic motion: 1T … 8T and ``≥ 9T``.
+PERIODIC_CATEGORIES: tuple[str, ...] = (
+    *(Motion.periodic(n).format() for n in range(1, MAX_OWN_PERIOD + 1)),
+    _LONG_PERIODS,
+)
 #: Display categories in legend order.
 REGIME_ORDER: tuple[str, ...] = (
-    *(f"{n}T" for n in range(1, MAX_OWN_PERIOD + 1)),
-    _LONG_PERIODS,
-    "QP",
-    "chaos",
-    "unresolved",
-    "failed",
-    NOT_RUN,
+    *PERIODIC_CATEGORIES,
+    *(
+        m.format()
+        for m in (
+            Motion.quasi_periodic(),
+            Motion.chaos(),
+            Motion.unresolved(),
+            Motion.failed(),
+            Motion.not_run(),
+        )
+    ),
 )
 
 #: The palette: display category → colour (hex). Periodic orbits in blues, greens, olive,
@@ -96,13 +107,15 @@ def regime_category(label: Any) -> str:
     ``≥ 9T``, ``QP``, ``chaos``, ``unresolved``, ``failed``; an empty label is ``not run``,
     anything else (e.g. the old ``many``) ``unresolved``."""
     s = str(label).strip()
-    if s.endswith("T") and s[:-1].isdigit() and int(s[:-1]) >= 1:
-        return s if int(s[:-1]) <= MAX_OWN_PERIOD else _LONG_PERIODS
-    if s in REGIME_COLOURS:
+    if s in REGIME_COLOURS:  # a category already (``≥ 9T`` is one, not a label)
         return s
-    if not s:
-        return NOT_RUN
-    return "unresolved"
+    try:
+        motion = Motion.parse(s)  # the empty text of a store's unset point: not run
+    except ParameterError:
+        return Motion.unresolved().format()
+    if motion.is_periodic and motion.period > MAX_OWN_PERIOD:
+        return _LONG_PERIODS
+    return motion.format()
 
 
 def regime_colour(label: Any) -> str:

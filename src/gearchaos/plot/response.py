@@ -29,7 +29,12 @@ import numpy as np
 from ..sweep import SweepResult
 from ..sweep.frequency import find_jumps
 from .bifurcation import suptitle
-from .regimes import regime_band, regime_categories, regime_category, regime_legend_below
+from .regimes import (
+    PERIODIC_CATEGORIES,
+    regime_band,
+    regime_categories,
+    regime_legend_below,
+)
 from .units import PhysicalScales, fit_to_data, linear_axis
 
 __all__ = ["response_figure"]
@@ -66,7 +71,7 @@ def periodic_mask(ds: Any, direction: str | None) -> np.ndarray | None:
     cats = regime_categories(ds)
     if direction is not None:
         cats = cats.sel(direction=direction)
-    return np.array([regime_category(c).endswith("T") for c in np.ravel(cats.values)])
+    return np.array([c in PERIODIC_CATEGORIES for c in np.ravel(cats.values)])
 
 
 def _branch(ds: Any, name: str, direction: str | None) -> np.ndarray:

@@ -24,13 +24,12 @@ import numpy as np
 
 from .._checks import check_int, check_real
 from .._output import remove_stale_staging, staging_prefix, write_error
+from ..analysis.motion import LABEL_DTYPE, Motion
 from ..errors import ParameterError, Status, StoreError
 from .result import SweepResult
 from .store import SweepStore, consolidate, foreign_files_ignored, open_sweep, set_attributes
 
 __all__ = ["classify_dataset", "classify_store"]
-
-LABEL_DTYPE = "<U10"
 
 #: Default tolerance of period detection, relative to the attractor's size, and the longest
 #: period recognised as nT (of :func:`classify_store` and of the labels ``--orbits`` confirms).
@@ -100,8 +99,8 @@ def _status_label(status: int) -> str | None:
     ``not run`` for a point an interrupted sweep has not computed (never "failed": nothing
     failed), None for a point that ran."""
     if status == int(Status.NOT_RUN):
-        return "not run"
-    return "failed" if status != 0 else None
+        return Motion.not_run().format()
+    return Motion.failed().format() if status != 0 else None
 
 
 def _from_verdicts(res: SweepResult) -> dict[str, Any]:
@@ -114,9 +113,7 @@ def _from_verdicts(res: SweepResult) -> dict[str, Any]:
         labels[idx] = _status_label(int(status[idx])) or labels[idx]
     period = np.zeros(labels.shape, dtype=np.int16)
     for idx in np.ndindex(*labels.shape):
-        lab = str(labels[idx])
-        if lab.endswith("T") and lab[:-1].isdigit():
-            period[idx] = int(lab[:-1])
+        period[idx] = Motion.parse(str(labels[idx])).period
     return {
         "dims": res.lead_dims,
         **_contact(res),
@@ -148,7 +145,7 @@ def _regime_table(res: SweepResult, labels: np.ndarray) -> dict[str, Any]:
 
 
 def _ran(labels: np.ndarray) -> np.ndarray:
-    return labels[labels != "not run"]
+    return labels[labels != Motion.not_run().format()]
 
 
 def label_periods(
@@ -170,9 +167,8 @@ def label_periods(
     labels = classify_sections(pts, **kw)
     out = np.zeros(labels.shape, dtype=int)
     for idx in np.ndindex(*labels.shape):
-        lab = str(labels[idx])
-        if status[idx] == 0 and lab.endswith("T") and lab[:-1].isdigit():
-            out[idx] = int(lab[:-1])
+        if status[idx] == 0:
+            out[idx] = Motion.parse(str(labels[idx])).period
     return out
 
 
