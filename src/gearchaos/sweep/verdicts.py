@@ -18,6 +18,11 @@ integrating them (in the worker, all points of a period together), and writes pe
   record brought onto the orbit it approached); ``orbit`` marks stores of earlier versions,
   which showed a confirmed orbit's own points.
 
+Each variable holds one attribute of the point's :class:`~gearchaos.dynamics.evidence.Verdict`;
+:data:`VERDICT_COLUMNS` is the one table of them (attribute, long name, element type, fill
+value, flag legend), and :data:`NOT_STORED` names the verdict's fields no variable holds and
+why, so a new field of the verdict is either stored or said not to be.
+
 Where the verdict extended a run, the point's stored section values and final state are those
 of the extension (the finished record), so the diagram never shows a label beside the
 transient that preceded it (in a continuation sweep the next point still starts from the end
@@ -27,51 +32,139 @@ so an interrupted sweep resumes with them.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from dataclasses import dataclass
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
 
+from ..analysis.motion import LABEL_DTYPE, UNSET_TEXT
 from ..dynamics.evidence import EVIDENCE
 from ..dynamics.extension import RECORD_SOURCES
 from ..dynamics.verdict import VerdictSettings, decide_motion
 
-__all__ = ["VERDICT_VARIABLES", "task_verdicts", "verdict_attrs"]
+__all__ = [
+    "NOT_STORED",
+    "VERDICT_COLUMNS",
+    "VERDICT_VARIABLES",
+    "VerdictColumn",
+    "task_verdicts",
+    "verdict_attrs",
+    "verdict_row",
+]
 
-#: Per-point variables (name → long name, dtype, fill value).
-VERDICT_VARIABLES: dict[str, tuple[str, str, Any]] = {
-    "motion": ("motion verdict: 1T…nT, QP, chaos, unresolved or failed", "<U10", ""),
-    "verdict": ("what decided the motion label (see flag_meanings)", "int8", -1),
-    "max_multiplier": (
-        "largest Floquet multiplier modulus max |μ| of the orbit shot at the point",
-        "float64",
-        np.nan,
-    ),
-    "lle": ("largest Lyapunov exponent λ_1 per unit τ = ω_n t", "float64", np.nan),
-    "lle_error": (
-        "standard error of λ_1 (block means; 0: exact from the multipliers)",
-        "float64",
-        np.nan,
-    ),
-    "k01": ("0–1 test for chaos K of the record (non-periodic labels)", "float64", np.nan),
-    "extra_periods": ("periods added by the verdict to finish a transient", "int64", -1),
-    "window_start": (
-        "first period of the window λ_1 was measured over, counted after the recorded ones "
-        "(-1: none, λ_1 exact from the multipliers)",
-        "int64",
-        -1,
-    ),
-    "window_periods": ("length of the window λ_1 was measured over, in periods", "int64", 0),
-    "record": ("where the stored section record comes from (see flag_meanings)", "int8", -1),
-}
+
+@dataclass(frozen=True)
+class VerdictColumn:
+    """A store variable that holds one attribute of every point's verdict.
+
+    Attributes
+    ----------
+    source
+        The :class:`~gearchaos.dynamics.evidence.Verdict` attribute (a field, or a property
+        of its fields) the variable holds.
+    long_name, dtype, fill
+        The variable's ``long_name``, element type and fill value (the value of a point not
+        computed yet).
+    flags
+        Flag name → value of a coded variable (its ``flag_meanings`` and ``flag_values``).
+    """
+
+    source: str
+    long_name: str
+    dtype: str
+    fill: Any
+    flags: Mapping[str, int] | None = None
+
+
+#: The verdict's per-point variables: name → the verdict attribute it holds, long name,
+#: element type, fill value and flag legend.
+VERDICT_COLUMNS: Mapping[str, VerdictColumn] = MappingProxyType(
+    {
+        "motion": VerdictColumn(
+            "label",
+            "motion verdict: 1T…nT, QP, chaos, unresolved or failed",
+            LABEL_DTYPE,
+            UNSET_TEXT,
+        ),
+        "verdict": VerdictColumn(
+            "code", "what decided the motion label (see flag_meanings)", "int8", -1, EVIDENCE
+        ),
+        "max_multiplier": VerdictColumn(
+            "max_multiplier",
+            "largest Floquet multiplier modulus max |μ| of the orbit shot at the point",
+            "float64",
+            np.nan,
+        ),
+        "lle": VerdictColumn(
+            "lle", "largest Lyapunov exponent λ_1 per unit τ = ω_n t", "float64", np.nan
+        ),
+        "lle_error": VerdictColumn(
+            "lle_error",
+            "standard error of λ_1 (block means; 0: exact from the multipliers)",
+            "float64",
+            np.nan,
+        ),
+        "k01": VerdictColumn(
+            "k01", "0–1 test for chaos K of the record (non-periodic labels)", "float64", np.nan
+        ),
+        "extra_periods": VerdictColumn(
+            "extra_periods", "periods added by the verdict to finish a transient", "int64", -1
+        ),
+        "window_start": VerdictColumn(
+            "window_start",
+            "first period of the window λ_1 was measured over, counted after the recorded "
+            "ones (-1: none, λ_1 exact from the multipliers)",
+            "int64",
+            -1,
+        ),
+        "window_periods": VerdictColumn(
+            "window_periods",
+            "length of the window λ_1 was measured over, in periods",
+            "int64",
+            0,
+        ),
+        "record": VerdictColumn(
+            "record_code",
+            "where the stored section record comes from (see flag_meanings)",
+            "int8",
+            -1,
+            RECORD_SOURCES,
+        ),
+    }
+)
+
+#: The verdict's fields no store variable holds, and why.
+NOT_STORED: Mapping[str, str] = MappingProxyType(
+    {
+        "period": "the label's period (Motion.parse(motion).period)",
+        "evidence": "stored as its flag value (verdict, from the property code)",
+        "reason": "a sentence for the summary and the point view, rebuilt on demand",
+        "record": "replaces the point's section values and final state; its source is record",
+        "orbit_state": "the confirmed orbit's state: an orbit store (--orbits) holds orbits",
+        "coexisting": "the stable orbits beside the motion: reported by attractors",
+    }
+)
+
+#: Per-point variables (name → long name, dtype, fill value), from :data:`VERDICT_COLUMNS`.
+VERDICT_VARIABLES: Mapping[str, tuple[str, str, Any]] = MappingProxyType(
+    {name: (c.long_name, c.dtype, c.fill) for name, c in VERDICT_COLUMNS.items()}
+)
 
 
 def verdict_attrs(name: str) -> dict[str, Any]:
     """Extra attributes of a verdict variable (the flag legends of ``verdict`` and
     ``record``)."""
-    flags = {"verdict": EVIDENCE, "record": RECORD_SOURCES}.get(name)
+    flags = VERDICT_COLUMNS[name].flags
     if flags is None:
         return {}
     return {"flag_values": list(flags.values()), "flag_meanings": " ".join(flags)}
+
+
+def verdict_row(v: Any) -> dict[str, Any]:
+    """The value of every verdict variable (:data:`VERDICT_COLUMNS`) for the verdict ``v``."""
+    return {name: getattr(v, col.source) for name, col in VERDICT_COLUMNS.items()}
 
 
 def task_verdicts(
@@ -98,24 +191,16 @@ def task_verdicts(
     verdicts = decide_motion(
         grid.target, values, systems, sections, finals, ok, spec.solver, verdict
     )
-    for name, (_, dtype, fill) in VERDICT_VARIABLES.items():
+    for name, col in VERDICT_COLUMNS.items():
         if name not in data:
-            data[name] = np.full(task.shape, fill, dtype=dtype)
+            data[name] = np.full(task.shape, col.fill, dtype=col.dtype)
     for (*_, pos), v in zip(where, verdicts, strict=True):
-        data["motion"][pos] = v.label
-        data["verdict"][pos] = v.code
-        data["max_multiplier"][pos] = v.max_multiplier
-        data["lle"][pos] = v.lle
-        data["lle_error"][pos] = v.lle_error
-        data["k01"][pos] = v.k01
-        data["extra_periods"][pos] = v.extra_periods
-        data["window_start"][pos] = v.window_start
-        data["window_periods"][pos] = v.window_periods
+        for name, value in verdict_row(v).items():
+            data[name][pos] = value
         rec = v.record
-        if rec is None or spp != 1:
+        if rec is None or spp != 1:  # a record sampled more than once a period is not replaced
             data["record"][pos] = RECORD_SOURCES["protocol"]
             continue
-        data["record"][pos] = rec.code
         m = data[observed[0].name][pos].shape[0]
         for ob in observed:
             data[ob.name][pos] = ob.take(rec.states[-m:], rec.observables[-m:])
