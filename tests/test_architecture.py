@@ -1,7 +1,8 @@
 """The package's layering holds: no import cycle between modules, no import from a lower layer
 to a higher one (``gearset → model → integrate → analysis → dynamics → sweep → plot → paper →
 cli``), the layers hold their concepts (analysis pure, the integrator driven from dynamics),
-and no module over 600 lines.
+no module over 600 lines, and the layers above the model read the model contract's record
+instead of probing the model for its members.
 
 Imports are read from the source with :mod:`ast`, *including imports inside functions* (a lazy
 import hides a cycle from Python but not from a reader), and resolved to the module they load:
@@ -12,9 +13,12 @@ import hides a cycle from Python but not from a reader), and resolved to the mod
 from __future__ import annotations
 
 import ast
+import dataclasses
 from pathlib import Path
 
 import pytest
+
+from gearchaos.model.contract import Capabilities
 
 ROOT = Path(__file__).resolve().parents[1] / "src" / "gearchaos"
 
@@ -174,3 +178,52 @@ def test_no_import_cycle() -> None:
 def test_no_module_is_longer_than_600_lines(path: Path) -> None:
     n = len(path.read_text(encoding="utf-8").splitlines())
     assert n <= MAX_LINES, f"{path.relative_to(ROOT)} has {n} lines (split it along its concerns)"
+
+
+#: The members of the model contract (the fields of its record).
+MEMBERS = frozenset(f.name for f in dataclasses.fields(Capabilities))
+#: ``getattr``/``hasattr`` calls naming a member of the model contract that remain outside
+#: ``gearset/`` and ``model/``, by (file, member), each with the reason it stays.
+MEMBER_PROBES_KEPT = {
+    ("dynamics/branch.py", "kind"): "hasattr(start, 'kind') asks whether a branch's start is "
+    "a continuation event (kind, value) or an orbit: no model is probed",
+}
+
+
+def _member_probes(source: str) -> list[tuple[int, str]]:
+    """(line, member) of every ``getattr(x, "member", …)`` or ``hasattr(x, "member")`` in
+    ``source`` whose name is a member of the model contract."""
+    out = []
+    for node in ast.walk(ast.parse(source)):
+        if (
+            isinstance(node, ast.Call)
+            and isinstance(node.func, ast.Name)
+            and node.func.id in ("getattr", "hasattr")
+            and len(node.args) >= 2
+            and isinstance(node.args[1], ast.Constant)
+            and node.args[1].value in MEMBERS
+        ):
+            out.append((node.lineno, str(node.args[1].value)))
+    return out
+
+
+def test_the_layers_above_the_model_read_its_record() -> None:
+    """Issue 36: a member of the model contract is read from the record
+    (``system.capabilities``, ``Capabilities.of(model)``), which gives every model the same
+    defaults, not probed on the model with ``getattr``/``hasattr`` and a default of the
+    caller's own. Outside ``gearset/`` and ``model/`` only the probes listed in
+    :data:`MEMBER_PROBES_KEPT` remain (21 before the record)."""
+    assert _member_probes('getattr(model, "scales", None)\nhasattr(m, "period_name")') == [
+        (1, "scales"),
+        (2, "period_name"),
+    ]
+    found = []
+    for path in sorted(ROOT.rglob("*.py")):
+        rel = path.relative_to(ROOT)
+        if rel.parts[0] in ("gearset", "model"):
+            continue
+        for line, member in _member_probes(path.read_text(encoding="utf-8")):
+            found.append((rel.as_posix(), line, member))
+    unexplained = [f"{f}:{n} probes {m}" for f, n, m in found if (f, m) not in MEMBER_PROBES_KEPT]
+    assert not unexplained, "read the model contract's record instead:\n" + "\n".join(unexplained)
+    assert len(found) <= len(MEMBER_PROBES_KEPT), found

@@ -111,7 +111,6 @@ def summarize(
         are ``None``; for reference systems the ``x_sp1_*`` keys hold the first state.
     """
     system = result.system
-    model = system.model
     x, xd = section_points(result)
     pts = np.column_stack([x, xd])
     n_recorded = int(np.sum(np.all(np.isfinite(pts), axis=1)))
@@ -125,8 +124,8 @@ def summarize(
         compute_indicators=verdict is None,
     )
     finite = x[np.isfinite(x)]
-    scales = getattr(model, "scales", None)
-    gs = getattr(model, "gearset", None)
+    caps = system.capabilities
+    scales, gs = caps.scales, caps.gearset
     omega = float(system.omega)
     try:
         regimes = contact_regimes(result)

@@ -487,11 +487,7 @@ def continuation(
     system0 = br.system(lam0)
     br.system(b)  # the range's other end must be a valid value too (refused before any run)
     check_observe(system0, observe)
-    gs = getattr(system0.model, "gearset", None)
-    if gs is not None and gs.has_eccentricity:
-        from ..gearset.validation import warn_if_eccentric
-
-        warn_if_eccentric(gs, "Poincaré section")
+    system0.warn_for("Poincaré section")
     br.levels = contact_levels(system0)
     if switch is None:
         if guess is None or (isinstance(guess, PeriodicOrbit) and guess.period != n):

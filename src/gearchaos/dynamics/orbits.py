@@ -325,7 +325,7 @@ def model_attrs(system: System) -> dict[str, Any]:
     """The model's provenance: ``model``, ``gearset_toml``, ``model_parameters``, scales and
     clearances (the attributes sweeps and simulations carry)."""
     model = system.model
-    gs = getattr(model, "gearset", None)
+    gs = system.capabilities.gearset
     a: dict[str, Any] = {
         "model": "planetary" if gs is not None else system.name,
         "gearset_toml": gs.to_toml() if gs is not None else "",
@@ -452,11 +452,7 @@ def periodic_orbit(
         values_and_settings, settings, params, ORBIT_SETTINGS, door=periodic_orbit, target=target
     )
     system = resolve(target, values)
-    gs = getattr(system.model, "gearset", None)
-    if gs is not None and gs.has_eccentricity:
-        from ..gearset.validation import warn_if_eccentric
-
-        warn_if_eccentric(gs, "Poincaré section")
+    system.warn_for("Poincaré section")
     eps = check_tol(tol, cfg)
     iters = check_int("max_iterations", max_iterations, lo=1, hi=10_000)
     if guess is None:

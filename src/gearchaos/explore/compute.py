@@ -207,7 +207,7 @@ def _figure_png(result: Any, var: str | None, planet: int, periods: float) -> by
                 va="center", transform=axs[1, 0].transAxes, color="0.4",
             )  # fmt: skip
         spectrum(result, var, planet, ax=axs[1, 1])
-        mesh = getattr(result.system.model, "period_name", "forcing") == "mesh"
+        mesh = result.system.capabilities.period_name == "mesh"
         axs[1, 1].set_title(
             f"amplitude spectrum ({'mesh' if mesh else 'forcing'} harmonics labelled)"
         )

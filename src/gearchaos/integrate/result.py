@@ -54,7 +54,7 @@ class SimulationResult(Trajectory):
 
     @property
     def gearset(self) -> Any:
-        return getattr(self.system.model, "gearset", None)
+        return self.system.capabilities.gearset
 
     # ------------------------------------------------------------------ xarray
     def _attrs(self) -> dict[str, Any]:
@@ -79,20 +79,21 @@ class SimulationResult(Trajectory):
         }
         gs = self.gearset
         attrs["gearset_toml"] = gs.to_toml() if gs is not None else ""
-        model = self.system.model
-        if hasattr(model, "scales"):
-            sc = model.scales
+        caps = self.system.capabilities
+        sc = caps.scales
+        if sc is not None:
             attrs["omega_n_rad_s"] = sc.omega_n
             attrs["characteristic_length_m"] = sc.length
             attrs["mesh_frequency_rad_s"] = self.omega * sc.omega_n
-        for k, v in getattr(model, "clearances", {}).items():
+        for k, v in caps.clearances.items():
             attrs[f"clearance_{k}"] = v
-        attrs.update(model_reference(model))  # to build the model again (not a gear set)
+        # to build the model again (not a gear set)
+        attrs.update(model_reference(self.system.model))
         return attrs
 
     def to_dataset(self) -> Any:
         """The result as an :class:`xarray.Dataset` (see the module docstring for names)."""
-        writer = getattr(self.system.model, "result_dataset", None)
+        writer = self.system.capabilities.result_dataset
         if writer is None:  # the generic layout: one variable per state and observable
             return self._generic_dataset()
         ds = writer(self, self._attrs(), self._series_for)  # the model's own layout

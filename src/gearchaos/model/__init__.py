@@ -3,11 +3,12 @@
 ``nondimensionalise(gearset)`` → :class:`PlanetaryParameters` + :class:`Scales`;
 :func:`planetary_system` builds the :class:`System` the integrator runs; :mod:`.library` holds
 reference systems (single-mesh backlash oscillator, linear systems, Duffing, Lorenz);
-:mod:`.contract` is the model contract every model meets, and :class:`UserModel` the base of a
-model written outside the package (docs/howto/own-model.md).
+:mod:`.contract` is the model contract every model meets, written once as the record
+:class:`Capabilities`, and :class:`UserModel` the base of a model written outside the package
+(docs/howto/own-model.md).
 """
 
-from .contract import Contact, UserModel, check_model
+from .contract import Capabilities, Contact, UserModel, check_model
 from .library import (
     backlash_oscillator,
     duffing,
@@ -29,6 +30,7 @@ from .target import DEFAULT_OMEGA, OMEGA, resolve
 __all__ = [
     "DEFAULT_OMEGA",
     "OMEGA",
+    "Capabilities",
     "Contact",
     "Model",
     "Observable",

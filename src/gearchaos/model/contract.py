@@ -1,106 +1,58 @@
-r"""The model contract: what a model gives gearchaos, and models written outside the package.
+r"""The model contract: what a model gives gearchaos, written once as :class:`Capabilities`.
 
 Every analysis of gearchaos — simulations, sweeps and stores, motion verdicts, periodic orbits,
 continuation, Lyapunov exponents, attractors, plots, the explorer and the command line — works on
 a :class:`~gearchaos.model.System`, a model at one forcing frequency Ω. A *model* is a frozen
-description of a dimensionless system that provides (:class:`Model`):
-
-``name``
-    A short name (titles, store attributes).
-``state_names``, ``n_state``
-    The state components y, in order.
-``obs_names``, ``n_track``
-    The observables the right-hand side writes, in order: first the ``n_track`` *tracked* ones
-    (the integrator records their extrema over every run and lands steps on their switches),
-    then their τ-derivatives (``n_track`` more), then any others (forces, stiffness …).
-``pack(omega)``
-    The float64 parameter vector ``p`` the compiled right-hand side reads, at Ω.
-``kind``
-    The integer that selects the compiled right-hand side (built-in models have fixed kinds;
-    models from outside get theirs from :func:`register_kernels`).
-``switch_widths`` (optional, default: none)
-    Half clearance b_k of the dead zone acting on each tracked observable (``inf``: smooth):
-    the integrator lands a step where a tracked observable crosses ±b_k, where the vector field
-    has a kink.
-``clearances`` (optional)
-    Half clearances by name (store attributes, figures).
-``contacts`` (optional)
-    The :class:`Contact` s whose regime (no impact, single-sided, double-sided) analyses
-    report: a name, the tracked observable it is judged on, its half clearance and its kind.
-``n_contact_forces`` (optional, default 0)
-    How many tracked observables, at the end of the tracked ones, are contact forces (their
-    extrema give peak forces; they have no switch).
-``default_observables`` (optional)
-    The pair of variables sections and labels use (default: the first tracked observable and
-    its derivative).
-``scales`` (optional)
-    Physical scales (``omega_n``, ``length`` …) for axes in SI units.
-``symbols`` (optional)
-    Figure symbols of its variables: variable (or group) name → (mathtext symbol without
-    ``$``, its definition or ``None``, the name of its clearance in ``clearances`` or
-    ``None``, the clearance's symbol or ``None``), e.g. ``{"delta": (r"\bar{\delta}",
-    r"\delta/b_c", "mesh", r"\bar{b}_h")}``; axes and labels of its variables use them.
-``parameter_symbols`` (optional)
-    Figure symbols of its parameters: field name → mathtext symbol without ``$``, e.g.
-    ``{"zeta_h": r"\zeta_h", "f_mean": r"\bar F_m"}``; the axis of a swept or continued
-    parameter and the ``at …`` line of figure titles use them (a parameter without one is
-    named by its field, or left out of titles). Keys must be fields of the model, values
-    strings (:func:`check_model`).
-
-The right-hand side is a compiled function ``rhs(t, y, p, dydt, obs, level)`` writing dy/dτ
-into ``dydt[:n_state]`` and the observables into ``obs`` (at least the first ``2 n_track``;
-``level`` says whether all are needed, :data:`~gearchaos.model.kernels.OBS_ALL`); the optional
-tangent ``tangent(t, y, p, obs, dydt, n, k)`` writes J(τ, y[:n]) applied to the ``k`` vectors
-stored after the state in ``y`` into ``dydt[n:]``. A model without a tangent gets a central
-finite-difference one (:func:`~gearchaos.model.kernels.tangent`).
+description of a dimensionless system. What it gives gearchaos — names and sizes of its state
+and observables, packed parameters and a compiled right-hand side, the switches of its dead
+zones, its contacts and clearances, the physical quantities of its variables and their scales,
+figure symbols, what its forcing period and the members of its variable groups are called,
+the layout of its datasets and its warnings — is one frozen record, :class:`Capabilities`
+(:mod:`gearchaos.model.capabilities`, exported here): one field per member of the contract,
+with its meaning and what a model that does not give it gets. :meth:`Capabilities.of` reads
+the record from the model's members of the same names, in the same way for the package's own
+models (the planetary model, the reference systems of :mod:`~gearchaos.model.library`) as for
+a model written outside the package; the layers above ask the record
+(:attr:`System.capabilities <gearchaos.model.System.capabilities>`), never the model whether
+it has a member.
 
 A model defined outside the package subclasses :class:`UserModel` (a frozen dataclass whose
 fields are its parameters) and names its compiled functions ``rhs`` (and ``tangent``); see the
-how-to *Your own gear model* (``docs/howto/own-model.md``) and ``examples/kahraman_singh_1991.py``.
+how-to *Your own gear model* (``docs/howto/own-model.md``) and
+``examples/kahraman_singh_1991.py``. The how-to's table of members and the member list of
+:class:`UserModel` are generated from :class:`Capabilities` by ``docs/make_contract_docs.py``.
 """
 
 from __future__ import annotations
 
-import hashlib
-import inspect
-from dataclasses import dataclass
+import dataclasses
+import re
+from collections.abc import Mapping
 from typing import Any, ClassVar, Protocol, runtime_checkable
 
 import numpy as np
 
 from ..errors import ParameterError
+from .capabilities import CONTACT_KINDS, QUANTITIES, Capabilities, Contact
 from .layout import FD_MAX_OBS, FD_MAX_STATE
+from .registry import EXTERNAL_KIND_BASE, register_kernels
 
 __all__ = [
+    "EXTERNAL_KIND_BASE",
+    "QUANTITIES",
+    "Capabilities",
     "Contact",
     "Model",
     "UserModel",
-    "contacts_of",
-    "default_observables",
+    "check_model",
     "register_kernels",
 ]
-
-#: Kinds of models from outside the package start here (built-in kinds are below 1000).
-EXTERNAL_KIND_BASE = 1 << 24
-
-
-@dataclass(frozen=True)
-class Contact:
-    """A contact whose regime analyses report: ``name``, the index ``column`` of the tracked
-    observable (a deflection) it is judged on, its half clearance b̄ and its ``kind``
-    (``mesh``: teeth meet at δ = ±b̄, regime from min δ; ``bearing``: a journal touches the
-    bearing at ±b̄, regime from both extrema)."""
-
-    name: str
-    column: int
-    clearance: float
-    kind: str = "mesh"
 
 
 @runtime_checkable
 class Model(Protocol):
-    """What a dimensionless model provides to build a :class:`~gearchaos.model.System` (see
-    the module docstring for the optional members)."""
+    """What a dimensionless model provides to build a :class:`~gearchaos.model.System`: the
+    required members of :class:`Capabilities` (its other fields are optional)."""
 
     name: str
 
@@ -122,100 +74,79 @@ class Model(Protocol):
     def pack(self, omega: float) -> np.ndarray: ...
 
 
-def contacts_of(model: Any) -> tuple[Contact, ...]:
-    """The model's contacts: its ``contacts``, else none."""
-    return tuple(getattr(model, "contacts", ()))
-
-
-def default_observables(model: Any) -> tuple[str, str]:
-    """The (variable, derivative) pair a model's sections and labels use by default."""
-    pair = getattr(model, "default_observables", None)
-    if pair is not None:
-        return (str(pair[0]), str(pair[1]))
-    names = tuple(model.obs_names)
-    n_track = int(model.n_track)
-    if n_track >= 1 and len(names) >= 2 * n_track:
-        return (names[0], names[n_track])
-    states = tuple(model.state_names)
-    return (states[0], states[1] if len(states) > 1 else states[0])
-
-
-# ------------------------------------------------------------------ models from outside
-_REGISTERED: dict[Any, int] = {}
-
-
-def _source_digest(cls: type, rhs: Any, tangent: Any) -> str:
-    """A digest of the code that defines the model: its module's source file (so an edit of
-    the model, or of a helper in the same file, gives a new kind and a new compilation), else
-    the functions' own source."""
-    h = hashlib.sha256(f"{cls.__module__}:{cls.__qualname__}".encode())
-    try:
-        path = inspect.getsourcefile(cls)
-        if path is None:
-            raise TypeError(cls)
-        with open(path, "rb") as f:
-            h.update(f.read())
-    except (OSError, TypeError):
-        for fn in (rhs, tangent):
-            if fn is not None:
-                try:
-                    h.update(inspect.getsource(getattr(fn, "py_func", fn)).encode())
-                except (OSError, TypeError):
-                    h.update(repr(id(fn)).encode())  # no source: this process only
-    return h.hexdigest()
-
-
-def _compiled(cls: type, attr: str) -> Any:
-    fn = inspect.getattr_static(cls, attr, None)
-    if fn is None:
-        return None
-    if isinstance(fn, staticmethod):
-        fn = fn.__func__
-    if not hasattr(fn, "py_func"):
-        raise ParameterError(
-            f"{cls.__name__}.{attr} must be a numba.njit function (decorate it with "
-            f"@numba.njit(cache=True)): got {type(fn).__name__}"
-        )
-    return fn
-
-
-def register_kernels(cls: type) -> int:
-    """The kernel kind of a model class defined outside the package, its ``rhs`` (and
-    ``tangent``, or the finite-difference tangent) registered with the integrator's dispatch
-    on first use. The kind is derived from the model's source, so that numba's on-disk cache
-    serves a second process without compiling again, and an edited model compiles afresh."""
-    kind = _REGISTERED.get(cls)
-    if kind is not None:
-        return kind
-    from .kernels import register_kernel
-
-    rhs = _compiled(cls, "rhs")
-    if rhs is None:
-        raise ParameterError(
-            f"{cls.__name__} needs a compiled right-hand side: rhs = numba.njit(cache=True)("
-            "function(t, y, p, dydt, obs, level))"
-        )
-    tangent = _compiled(cls, "tangent")
-    kind = EXTERNAL_KIND_BASE + int(_source_digest(cls, rhs, tangent)[:10], 16)
-    register_kernel(kind, rhs, tangent)
-    _REGISTERED[cls] = kind
-    return kind
-
-
 class UserModel:
-    """Base of a model written outside gearchaos: subclass it as a frozen dataclass whose
-    fields are the dimensionless parameters, and give it
+    r"""Base of a model written outside gearchaos: subclass it as a frozen dataclass whose
+    fields are the dimensionless parameters. ``System(MyModel(...), omega)`` then runs in every
+    analysis; parameters are changed by field name (``params={"zeta": 0.1}``,
+    ``--set zeta=0.1``). The compiled ``rhs`` and ``tangent`` are class attributes (stored as
+    static methods); ``kind`` and ``n_state`` are given by this base.
 
-    * ``name``, ``state_names``, ``obs_names`` and ``n_track`` (class attributes),
-    * ``rhs`` (and optionally ``tangent``): ``numba.njit(cache=True)`` functions with the
-      signatures of the module docstring,
-    * ``pack(self, omega)``: the parameter vector ``rhs`` reads,
-    * optionally ``switch_widths``, ``clearances``, ``contacts``, ``n_contact_forces``,
-      ``default_observables``, ``scales``, ``symbols`` (of its variables) and
-      ``parameter_symbols`` (of its fields).
+    The members of the model contract (:class:`Capabilities`, from which this list is
+    generated by ``docs/make_contract_docs.py``):
 
-    ``System(MyModel(...), omega)`` then runs in every analysis; parameters are changed by
-    field name (``params={"zeta": 0.1}``, ``--set zeta=0.1``).
+    <!-- members -->
+    * ``name`` (required): a short name for titles and stores.
+    * ``state_names`` (required): the state y, in order.
+    * ``obs_names`` (required): the observables ``rhs`` writes: first ``n_track`` *tracked* ones
+      (the integrator records their extrema over every run and lands steps on their switches), then
+      their τ-derivatives, then any extras (forces, stiffness).
+    * ``n_track`` (required): how many of the observables are tracked (see ``obs_names``).
+    * ``n_state`` (required): the length of the state (a ``UserModel`` gives ``len(state_names)``).
+    * ``kind`` (required): the integer that selects the compiled right-hand side: built-in models
+      have fixed kinds; a ``UserModel`` registers its ``rhs`` and derives its kind from the model's
+      source.
+    * ``pack(self, omega)`` (required): the float64 parameter vector ``p`` that ``rhs`` reads, at Ω.
+    * ``rhs`` (otherwise: required of a ``UserModel``; a built-in model's ``kind`` selects its own):
+      the compiled right-hand side, a ``numba.njit(cache=True)`` function ``rhs(t, y, p, dydt, obs,
+      level)`` writing dy/dτ into ``dydt[:n_state]`` and the observables into ``obs`` (at least the
+      first ``2 n_track``; ``level`` says whether all are needed, ``OBS_ALL``).
+    * ``tangent`` (otherwise: central finite differences of ``rhs``): ``tangent(t, y, p, obs, dydt,
+      n, k)``: the Jacobian J(τ, y[:n]) applied to the ``k`` tangent vectors stored after the state
+      in ``y``, written into ``dydt[n:]``.
+    * ``switch_widths`` (otherwise: ``inf`` for each tracked observable (no switches)): the half
+      clearance b_k of the dead zone on each tracked observable (``inf``: smooth): the integrator
+      lands a step where a tracked observable crosses ±b_k, where the vector field has a kink.
+    * ``contacts`` (otherwise: none): ``Contact(name, column, clearance, kind)`` for each mesh and
+      bearing whose contact regime (no impact, single-sided, double-sided) analyses report.
+    * ``clearances`` (otherwise: the contacts' half clearances by their names): half clearances by
+      name: store attributes ``clearance_NAME``, clearance lines in figures (``symbols`` name them).
+    * ``n_contact_forces`` (otherwise: 0): how many tracked observables, at the end of the tracked
+      ones, are contact forces (their extrema give peak forces; they have no switch).
+    * ``force_groups`` (otherwise: none): (label, contact-force variable, deflection variable) of
+      each kind of mesh whose contact forces are tracked: what ``gearchaos response`` and load
+      factors read.
+    * ``static_mesh_force(self, omega)`` (otherwise: no load factors): the static load of one mesh
+      at Ω, the reference of the dynamic load factor.
+    * ``default_observables`` (otherwise: the first tracked observable and its derivative, else the
+      first two states): the pair (variable, derivative) that sections, diagrams and labels show; a
+      group name (``delta_sp``) stands for its first member.
+    * ``scales`` (otherwise: none: dimensionless axes only): physical scales: ``omega_n`` (ω_n in
+      rad/s, time τ = ω_n t), ``length`` (m) and an attribute for each quantity of ``quantities``
+      (``velocity``, ``force``), for axes in SI units.
+    * ``quantities`` (otherwise: none): the physical quantity of each variable or group: name →
+      ``length``, ``velocity`` or ``force`` (``QUANTITIES``), converted to SI by the attribute of
+      ``scales`` of that name.
+    * ``symbols`` (otherwise: variables drawn by their names): figure symbols of its variables:
+      variable (or group, ``%d`` standing for the member's number) → (mathtext symbol without ``$``,
+      its definition or None, the name of its clearance in ``clearances`` or None, the clearance's
+      symbol or None).
+    * ``parameter_symbols`` (otherwise: parameters named by their fields): figure symbols of its
+      parameters: field → mathtext symbol without ``$``, for the axis of a swept or continued
+      parameter and the *at …* line of figure titles; ``check_model`` refuses a key that is no
+      field.
+    * ``period_name`` (otherwise: ``forcing``): what one forcing period is called in axes, labels
+      and tables (``mesh``: mesh periods, harmonics of the mesh frequency f_m).
+    * ``member_name`` (otherwise: ``member``): what one member of a variable group is called
+      (``planet``: ``delta_sp_1 … delta_sp_N`` are the planets' deflections).
+    * ``gearset`` (otherwise: none): the gear set the model was built from: speeds in rpm and Hz,
+      eccentricity warnings, the gear set's TOML in stores.
+    * ``result_dataset(self, result, attrs, series)`` (otherwise: one variable per state and
+      observable): the dataset of a simulation result in the model's own layout (variables per group
+      member, with long names and units).
+    * ``warn_for(self, analysis)`` (otherwise: no warnings): warn when ``analysis`` (``Poincaré
+      section``) is questionable for this model (a planetary model with eccentricities has no
+      1T-periodic section).
+    <!-- /members -->
     """
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
@@ -232,7 +163,6 @@ class UserModel:
     state_names: ClassVar[tuple[str, ...]]
     obs_names: ClassVar[tuple[str, ...]]
     n_track: ClassVar[int]
-    n_contact_forces: ClassVar[int] = 0
 
     @property
     def kind(self) -> int:
@@ -243,15 +173,6 @@ class UserModel:
     def n_state(self) -> int:
         return len(self.state_names)
 
-    @property
-    def switch_widths(self) -> np.ndarray:
-        """No switches unless the model says otherwise."""
-        return np.full(int(self.n_track), np.inf)
-
-    @property
-    def clearances(self) -> dict[str, float]:
-        return {c.name: c.clearance for c in contacts_of(self)}
-
     def check(self) -> None:
         """Refuse a model that breaks the contract (called by :func:`check_model`)."""
         check_model(self)
@@ -259,39 +180,36 @@ class UserModel:
 
 def check_model(model: Any) -> None:
     """Raise :class:`~gearchaos.errors.ParameterError` naming the member of ``model`` that
-    breaks the contract (names, sizes, packed parameters, switch widths, contacts, parameter
-    symbols)."""
+    breaks the contract (a required member missing, names, sizes, switch widths, contacts,
+    quantities, parameter symbols)."""
     what = type(model).__name__
-    for attr in ("name", "state_names", "obs_names", "n_track", "pack", "kind"):
-        if not hasattr(model, attr):
-            raise ParameterError(f"{what} must define {attr} (the model contract)")
-    states, obs = tuple(model.state_names), tuple(model.obs_names)
-    if len(states) != int(model.n_state) or len(set(states)) != len(states) or not states:
-        raise ParameterError(f"{what}.state_names must be {model.n_state} distinct names")
+    caps = Capabilities.of(model)
+    states, obs = caps.state_names, caps.obs_names
+    if len(states) != caps.n_state or len(set(states)) != len(states) or not states:
+        raise ParameterError(f"{what}.state_names must be {caps.n_state} distinct names")
     if len(set(obs)) != len(obs):
         raise ParameterError(f"{what}.obs_names must be distinct names: got {obs}")
-    n_track = int(model.n_track)
+    n_track = caps.n_track
     if not (0 <= n_track and 2 * n_track <= len(obs)):
         raise ParameterError(
             f"{what}.n_track must be in [0, len(obs_names)/2] (tracked observables and their "
             f"derivatives come first): got {n_track} with {len(obs)} observables"
         )
-    widths = np.asarray(getattr(model, "switch_widths", np.full(n_track, np.inf)), dtype=float)
+    widths = caps.switch_widths
     if widths.shape != (n_track,) or np.any(np.isnan(widths)) or np.any(widths < 0):
         raise ParameterError(
             f"{what}.switch_widths must be {n_track} half clearances >= 0 (inf: no switch): "
             f"got {widths.tolist()}"
         )
-    for c in contacts_of(model):
-        if not 0 <= c.column < n_track or c.kind not in ("mesh", "bearing"):
+    for c in caps.contacts:
+        if not 0 <= c.column < n_track or c.kind not in CONTACT_KINDS:
             raise ParameterError(
                 f"{what}.contacts: {c.name} must be judged on a tracked observable (column in "
                 f"[0, {n_track})) and be a mesh or a bearing: got {c}"
             )
-    _check_parameter_symbols(model, what)
-    if getattr(model, "tangent", None) is None and (
-        len(states) > FD_MAX_STATE or len(obs) > FD_MAX_OBS
-    ):
+    _check_quantities(caps, what)
+    _check_parameter_symbols(model, caps.parameter_symbols, what)
+    if caps.tangent is None and (len(states) > FD_MAX_STATE or len(obs) > FD_MAX_OBS):
         raise ParameterError(
             f"{what} has no tangent and {len(states)} states / {len(obs)} observables: the "
             f"finite-difference tangent handles at most {FD_MAX_STATE} / {FD_MAX_OBS}; give "
@@ -299,20 +217,30 @@ def check_model(model: Any) -> None:
         )
 
 
-def _check_parameter_symbols(model: Any, what: str) -> None:
-    """Refuse ``parameter_symbols`` that are no mapping of the model's field names to
-    mathtext strings."""
-    import dataclasses
-    from collections.abc import Mapping
+def _check_quantities(caps: Capabilities, what: str) -> None:
+    """Refuse ``quantities`` naming no variable or group of the model, or no quantity of
+    :data:`QUANTITIES`, or one its ``scales`` cannot convert."""
+    names = {*caps.state_names, *caps.obs_names}
+    groups = {re.sub(r"_\d+(_dot)?$", lambda m: m.group(1) or "", n) for n in names}
+    for key, quantity in caps.quantities.items():
+        if key not in names and key not in groups:
+            raise ParameterError(
+                f"{what}.quantities: key {key!r} must be a variable or a group of the model"
+            )
+        if quantity not in QUANTITIES:
+            raise ParameterError(
+                f"{what}.quantities[{key!r}] must be one of {', '.join(QUANTITIES)}: got "
+                f"{quantity!r}"
+            )
+        if caps.scales is not None and not hasattr(caps.scales, quantity):
+            raise ParameterError(
+                f"{what}.scales must have a {quantity!r} factor for quantities[{key!r}]"
+            )
 
-    table = getattr(model, "parameter_symbols", None)
-    if table is None:
-        return
-    if not isinstance(table, Mapping):
-        raise ParameterError(
-            f"{what}.parameter_symbols must map field names to mathtext symbols: got "
-            f"{type(table).__name__}"
-        )
+
+def _check_parameter_symbols(model: Any, table: Mapping[str, Any], what: str) -> None:
+    """Refuse ``parameter_symbols`` whose keys are no fields of the model or whose values
+    are no mathtext strings."""
     fields = (
         [f.name for f in dataclasses.fields(model) if f.init]
         if dataclasses.is_dataclass(model)

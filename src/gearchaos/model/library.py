@@ -147,10 +147,6 @@ class LinearSystem:
         n = self.n_state
         return tuple(f"y_{i}" for i in range(n)) + tuple(f"y_{i}_dot" for i in range(n))
 
-    @property
-    def clearances(self) -> dict[str, float]:
-        return {}
-
     def pack(self, omega: float) -> np.ndarray:
         n = self.n_state
         a = np.asarray(self.matrix, dtype=float)
@@ -178,10 +174,6 @@ class Duffing:
         for k in ("delta", "alpha", "beta", "gamma"):
             _check(k, getattr(self, k), "")
 
-    @property
-    def clearances(self) -> dict[str, float]:
-        return {}
-
     def pack(self, omega: float) -> np.ndarray:
         return np.array([omega, self.delta, self.alpha, self.beta, self.gamma])
 
@@ -203,10 +195,6 @@ class Lorenz:
     def __post_init__(self) -> None:
         for k in ("sigma", "rho", "beta"):
             _check(k, getattr(self, k), "")
-
-    @property
-    def clearances(self) -> dict[str, float]:
-        return {}
 
     def pack(self, omega: float) -> np.ndarray:
         return np.array([self.sigma, self.rho, self.beta])

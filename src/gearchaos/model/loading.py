@@ -34,7 +34,7 @@ from typing import Any
 
 from .._text import escape_text
 from ..errors import ParameterError
-from .contract import UserModel, check_model
+from .contract import Capabilities, UserModel, check_model
 from .library import BacklashOscillator, Duffing, LinearSystem, Lorenz
 
 __all__ = [
@@ -255,7 +255,7 @@ def model_reference(model: Any) -> dict[str, str]:
     ``model_class`` (:func:`model_spec`) and ``model_fields`` (JSON of its dataclass fields);
     empty for a gear-set model (its gear set TOML says it all) or a model that is no dataclass
     of JSON values."""
-    if getattr(model, "gearset", None) is not None or not dataclasses.is_dataclass(model):
+    if not dataclasses.is_dataclass(model) or Capabilities.of(model).gearset is not None:
         return {}
     fields = {f.name: getattr(model, f.name) for f in dataclasses.fields(model) if f.init}
     try:

@@ -260,6 +260,10 @@ def pack_planetary(par: PlanetaryParameters, omega: float) -> np.ndarray:
     return p
 
 
+#: The variables and groups of the planetary model that are lengths (in units of b_c).
+_LENGTHS = ("delta_sp", "delta_rp", "x_s", "y_s", "p", "sigma")
+
+
 @dataclass(frozen=True)
 class PlanetaryModel:
     """The planetary gear model: dimensionless parameters, scales and the source gear set."""
@@ -380,6 +384,16 @@ class PlanetaryModel:
                 "sigma": (r"\bar{\sigma}", r"\sigma/b_c", None, None),
             }
         )
+    )
+    #: The physical quantity of each variable and group (converted by :class:`Scales`): the
+    #: displacements and deflections are lengths, their τ-derivatives velocities.
+    quantities: ClassVar[Mapping[str, str]] = MappingProxyType(
+        {
+            **{f"{v}{d}": q for v in _LENGTHS for d, q in (("", "length"), ("_dot", "velocity"))},
+            **dict.fromkeys(
+                ("force_sp", "force_rp", "contact_force_sp", "contact_force_rp"), "force"
+            ),
+        }
     )
     #: What one forcing period is called (axes: "mesh periods", ω/ω_m) and a group member.
     period_name = "mesh"

@@ -161,7 +161,7 @@ def peak_contact_forces(
 def static_mesh_force(system: System) -> float:
     """F̄_static: T̄_D/N (planetary, MODEL.md §10.1, at this Ω) or F_m (oscillator); NaN when
     the model has no static load."""
-    static = getattr(system.model, "static_mesh_force", None)
+    static = system.capabilities.static_mesh_force
     return float(static(system.omega)) if static is not None else float("nan")
 
 

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from .contract import Model
+from .contract import Capabilities, Model
 
 __all__ = ["Model", "Observable", "System"]
 
@@ -143,6 +143,12 @@ class System:
         p.setflags(write=False)
         object.__setattr__(self, "params", p)
 
+    @property
+    def capabilities(self) -> Capabilities:
+        """What the model gives: the model contract's record
+        (:class:`~gearchaos.model.contract.Capabilities`, read once per model)."""
+        return Capabilities.of(self.model)
+
     # -- delegated layout -------------------------------------------------------------
     kind = property(lambda self: int(self.model.kind), doc="Kind of the compiled model.")
     name = property(lambda self: str(self.model.name), doc="Name of the model.")
@@ -206,17 +212,13 @@ class System:
     @property
     def contacts(self) -> tuple[Any, ...]:
         """The model's :class:`~gearchaos.model.contract.Contact` s (none for smooth systems)."""
-        from .contract import contacts_of
-
-        return contacts_of(self.model)
+        return self.capabilities.contacts
 
     @property
     def default_observables(self) -> tuple[str, str]:
         """The (variable, derivative) pair sections and labels use by default (a group name
         such as ``delta_sp`` stands for its members)."""
-        from .contract import default_observables
-
-        return default_observables(self.model)
+        return self.capabilities.default_observables
 
     def section_pair(self, planet: int = 1) -> tuple[str, str]:
         """The default section variables as concrete names: :attr:`default_observables`, a
@@ -260,12 +262,10 @@ class System:
         forces the kernel tracks (empty without contact forces)."""
         if self.n_contact_forces == 0:
             return ()
-        return tuple(
-            (str(a), str(b), str(c)) for a, b, c in getattr(self.model, "force_groups", ())
-        )
+        return self.capabilities.force_groups
 
     n_contact_forces = property(
-        lambda self: int(getattr(self.model, "n_contact_forces", 0)),
+        lambda self: self.capabilities.n_contact_forces,
         doc="How many of the tracked observables, at their end, are mesh contact forces.",
     )
 
@@ -320,10 +320,7 @@ class System:
         The integrator lands steps on the switches obs_k = ±b_k, where the vector field has a
         kink; ``inf`` means the observable has no switch (smooth systems).
         """
-        w = getattr(self.model, "switch_widths", None)
-        if w is None:
-            return np.full(self.n_track, np.inf)
-        return np.asarray(w, dtype=np.float64)
+        return self.capabilities.switch_widths
 
     @property
     def period(self) -> float:
@@ -333,7 +330,7 @@ class System:
     def warn_for(self, analysis: str) -> None:
         """Let the model warn when ``analysis`` is questionable for it (a planetary model with
         eccentricities has no 1T-periodic section, MODEL.md §3)."""
-        hook = getattr(self.model, "warn_for", None)
+        hook = self.capabilities.warn_for
         if hook is not None:
             hook(analysis)
 

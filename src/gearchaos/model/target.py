@@ -24,6 +24,7 @@ from .._checks import check_real
 from ..errors import ParameterError
 from ..gearset import GearSet
 from ..gearset.schema import ALIASES, EXTRA, FIELDS, SPEEDS
+from .contract import Capabilities
 from .planetary import PlanetaryModel
 from .system import System
 
@@ -49,10 +50,9 @@ OMEGA = "omega"
 #: Ω of the command line when it is neither swept nor set (the README's quick-start point).
 DEFAULT_OMEGA = 1.5
 
-#: Fields of a model dataclass that are its layout, not parameters.
-_LAYOUT_FIELDS = frozenset(
-    {"kind", "name", "n_state", "n_track", "n_contact_forces", "state_names", "obs_names"}
-)
+#: Fields of a model dataclass that are members of the model contract (its layout, scales,
+#: source gear set …), not parameters.
+_LAYOUT_FIELDS = frozenset(f.name for f in dataclasses.fields(Capabilities))
 
 
 def _check_target(target: Any) -> None:
@@ -134,8 +134,9 @@ def speed_gearset(target: Any, name: str, changes: Mapping[str, Any] | None = No
     model without one (a reference system, your own model) has no physical scales: refused,
     naming the speed."""
     model = model_for(target, changes or {})
-    if isinstance(model, PlanetaryModel) and model.gearset is not None:
-        return model.gearset
+    gearset = Capabilities.of(model).gearset
+    if gearset is not None:
+        return gearset
     raise ParameterError(
         f"{name} sets Ω through a gear set's ω_n and tooth numbers, but {model.name} is not "
         "built from a gear set (it has no physical scales): give omega (Ω = ω/ω_n) instead",
@@ -175,8 +176,9 @@ def operating_omega(target: Any, values: Mapping[str, Any]) -> tuple[float | Non
 def speeds_at(model: Any, omega: float) -> dict[str, float]:
     """The speeds (``sun_rpm``, ``mesh_hz``) at Ω of a model built from a gear set; ``{}``
     for a model without one. Tables and figures show them beside Ω."""
-    if isinstance(model, PlanetaryModel) and model.gearset is not None:
-        return {name: model.gearset.speed(name, float(omega)) for name in SPEEDS}
+    gearset = Capabilities.of(model).gearset
+    if gearset is not None:
+        return {name: gearset.speed(name, float(omega)) for name in SPEEDS}
     return {}
 
 
@@ -259,10 +261,11 @@ def scale_attrs(model: Any) -> dict[str, float]:
     """A model's scales and clearances as store attributes: ``omega_n_rad_s`` (ω_n),
     ``characteristic_length_m`` (b_c) where the model has physical scales, and
     ``clearance_<name>`` for each of its clearances."""
+    caps = Capabilities.of(model)
     a: dict[str, float] = {}
-    if hasattr(model, "scales"):
-        a["omega_n_rad_s"] = float(model.scales.omega_n)
-        a["characteristic_length_m"] = float(model.scales.length)
-    for k, v in getattr(model, "clearances", {}).items():
+    if caps.scales is not None:
+        a["omega_n_rad_s"] = float(caps.scales.omega_n)
+        a["characteristic_length_m"] = float(caps.scales.length)
+    for k, v in caps.clearances.items():
         a[f"clearance_{k}"] = float(v)
     return a

@@ -15,6 +15,7 @@ import numpy as np
 from .._text import escape_text
 from ..errors import ParameterError
 from ..gearset.schema import MODULE_BOUNDED, OMEGA, describe
+from ..model.contract import Capabilities
 from ..model.planetary import PlanetaryModel
 
 #: ``gid`` of the vertical lines where a mesh harmonic meets a natural frequency.
@@ -243,7 +244,8 @@ def model_symbols(attrs: Any) -> Mapping[str, Any]:
     (its file moved)."""
     if attrs.get("gearset_toml") or attrs.get("model") == "planetary":
         return PlanetaryModel.symbols
-    return dict(getattr(stored_model(attrs), "symbols", None) or {})
+    model = stored_model(attrs)
+    return {} if model is None else dict(Capabilities.of(model).symbols)
 
 
 def parameter_symbols(attrs: Any) -> Mapping[str, str]:
@@ -255,7 +257,8 @@ def parameter_symbols(attrs: Any) -> Mapping[str, str]:
     :func:`axis_label`, :func:`axis_symbol` and :func:`given`."""
     if attrs.get("gearset_toml") or attrs.get("model") == "planetary":
         return {}
-    table = getattr(stored_model(attrs), "parameter_symbols", None) or {}
+    model = stored_model(attrs)
+    table = {} if model is None else Capabilities.of(model).parameter_symbols
     return {str(k): str(v) for k, v in table.items()}
 
 
@@ -403,12 +406,12 @@ class VarInfo:
 
 def period_name(result: Any) -> str:
     """What the model calls its forcing period (``mesh`` for gear trains, else ``forcing``)."""
-    return str(getattr(result.system.model, "period_name", "forcing"))
+    return result.system.capabilities.period_name
 
 
 def has_physical_scales(result: Any) -> bool:
     """Whether the model converts to SI units (a gear set's ω_n, b_c …)."""
-    return getattr(result.system.model, "scales", None) is not None
+    return result.system.capabilities.has_scales
 
 
 def _generic_symbol(name: str) -> str:
@@ -431,10 +434,9 @@ def variable(result: Any, var: str | None = None, planet: int = 1) -> VarInfo:
     default observable, else the first state.
     """
     system = result.system
-    model = system.model
     names = tuple(system.state_names) + tuple(system.obs_names)
-    clearances = dict(getattr(model, "clearances", {}))
-    symbols = dict(getattr(model, "symbols", {}))
+    caps = system.capabilities
+    clearances, symbols = caps.clearances, caps.symbols
     if var is None:
         var = system.default_observables[0]
     if var in symbols:

@@ -69,8 +69,8 @@ def _text_lines(result: Any, summary: dict[str, Any]) -> list[str]:
         )
     contact = summary.get("contact", [])
     if contact:
-        member = getattr(result.system.model, "member_name", None)
-        per = f" ({member}s 1…N)" if member and result.system.group_size else ""
+        member = result.system.capabilities.member_name
+        per = f" ({member}s 1…N)" if result.system.group_size else ""
         lines.append(f"contact regimes{per}:")
         groups: dict[str, list[str]] = {}
         for c in contact:

@@ -295,7 +295,7 @@ def spectrum(
             color="0.35",
             gid=HARMONIC_GID,
         )
-    gs = getattr(getattr(result.system, "model", None), "gearset", None)
+    gs = result.system.capabilities.gearset
     if gs is not None and gs.has_eccentricity:
         # eccentricities modulate the meshes at the sun's speed relative to the carrier,
         # f_s = f_m / z_s: sidebands h f_m ± f_s

@@ -59,10 +59,12 @@ class PhysicalScales:
     @classmethod
     def of_model(cls, model: Any) -> PhysicalScales:
         """The scales of a planetary model (none for reference systems)."""
-        sc = getattr(model, "scales", None)
+        from ..model.contract import Capabilities
+
+        caps = Capabilities.of(model)
+        sc, gs = caps.scales, caps.gearset
         if sc is None:
             return cls()
-        gs = getattr(model, "gearset", None)
         rpm = gs.sun_speed_rpm(1.0) if gs is not None else None
         return cls(float(sc.length), float(sc.omega_n), float(sc.force), rpm)
 
@@ -133,21 +135,19 @@ def _same(a: float | None, b: float | None) -> bool:
     )
 
 
-def var_quantity(var: str) -> str | None:
-    """The physical quantity of a section variable: ``delta_sp`` → ``length``,
-    ``delta_sp_dot`` → ``velocity``, ``force_rp`` and ``contact_force_rp`` → ``force``;
-    ``None`` otherwise."""
+def var_quantity(var: str, quantities: Mapping[str, str] | None = None) -> str | None:
+    """The physical quantity of a section variable, from a model's ``quantities`` (the model
+    contract's; default: the planetary model's): ``delta_sp`` → ``length``, ``delta_sp_dot``
+    → ``velocity``, ``force_rp`` and ``contact_force_rp`` → ``force``; a group's member as
+    its group (``delta_sp_1``, ``p_1_dot``); ``None`` otherwise."""
     import re
 
+    from ..model.planetary import PlanetaryModel
+
+    table = PlanetaryModel.quantities if quantities is None else quantities
     var = re.sub(r"_\d+(_dot)?$", lambda m: m.group(1) or "", var)  # delta_sp_1_dot → …_dot
     var = re.sub(r"_\d+$", "", var)
-    base = var[:-4] if var.endswith("_dot") else var
-    kind = "velocity" if var.endswith("_dot") else "length"
-    if base.startswith(("force_", "contact_force_")):
-        return None if var.endswith("_dot") else "force"
-    if base in ("delta_sp", "delta_rp", "x_s", "y_s", "p", "sigma"):
-        return kind
-    return None
+    return table.get(var)
 
 
 def secondary_axis(

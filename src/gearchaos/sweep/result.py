@@ -22,6 +22,7 @@ import numpy as np
 from .._files import check_path
 from ..errors import ParameterError, Status, StoreError
 from ..gearset.schema import CLEARANCES, FIELDS, OMEGA
+from ..model.contract import Capabilities
 from .store import open_sweep
 
 __all__ = ["NON_SWEEP_DIMS", "SweepLayout", "SweepResult", "open_result"]
@@ -375,8 +376,8 @@ class SweepResult:
             return None
         if model is None:
             return None
-        names = tuple(model.obs_names)
-        found = [c for c in getattr(model, "contacts", ()) if names[c.column] == var]
+        caps = Capabilities.of(model)
+        found = [c for c in caps.contacts if caps.obs_names[c.column] == var]
         if not found:
             return None
         column = found[0].column
