@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from ..integrate._chains import ChainRun, run_chains
-from ..integrate.settings import SampleTimes, SolverSettings
+from ..integrate.settings import SampleTimes, SolverSettings, default_step_budget
 from ..model.system import System
 from .lyapunov import random_tangents
 from .shooting import section_fraction
@@ -62,12 +62,14 @@ def extend(
     K, n = len(systems), ref.n_state
     T = np.array([s.period for s in systems])
     t0 = (section_fraction(settings) * T)[:, None]
-    times = SampleTimes(
-        t_rec=t0 + T[:, None],
-        period=T[:, None].copy(),
-        n_samples=int(periods),
-        t_end=t0 + periods * T[:, None],
-        max_steps=int(100_000 + 50_000 * periods),
+    # one sample at each of the next ``periods`` sections, the run ending on the last
+    times = SampleTimes.over_periods(
+        t0,
+        T[:, None],
+        first=1,
+        periods=int(periods),
+        end=int(periods),
+        max_steps=default_step_budget(periods),
     )
     run = ChainRun.from_arrays(
         ref,

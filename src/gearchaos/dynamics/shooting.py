@@ -29,7 +29,6 @@ solution, so the returned multipliers belong to the returned state.
 from __future__ import annotations
 
 import dataclasses
-import functools
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -118,7 +117,6 @@ def shoot(
     from their section time (:func:`section_time`) in one :func:`run_chains` call (on one
     thread for one or two chains: waking the thread pool costs more than they take).
     ``tangent_tol`` scales the tolerances of the monodromy's columns (1: the state's)."""
-    import numba
 
     C = len(systems)
     ref = systems[0]
@@ -132,13 +130,9 @@ def shoot(
     ts = section_fraction(settings) * T
     t0 = ts[:, None] + np.arange(period)[None, :] * T[:, None]
     # the layout of ChainRun.from_systems without packing point by point (the hot path of
-    # Newton iterations): one sample at the start of each period, no transient
-    times = SampleTimes(
-        t_rec=t0.copy(),
-        period=np.repeat(T[:, None], period, axis=1),
-        n_samples=1,
-        t_end=t0 + T[:, None],
-        max_steps=_step_budget(settings),
+    # Newton iterations): each chain link one period, sampled at its start, no transient
+    times = SampleTimes.over_periods(
+        t0, T[:, None], first=0, periods=1, end=1, max_steps=settings.budget_for(1)
     )
     run = ChainRun.from_arrays(
         ref,
@@ -152,13 +146,8 @@ def shoot(
         continuation=True,
         tangent_tol=tangent_tol,
     )
-    threads = numba.get_num_threads()
     # waking a thread pool costs more than one or two short chains take
-    numba.set_num_threads(1 if C <= 2 else min(C, threads))
-    try:
-        out = run_chains(run)
-    finally:
-        numba.set_num_threads(threads)
+    out = run_chains(run, threads=1 if C <= 2 else None)
     status = np.zeros(C, dtype=np.int64)
     for c in range(C):
         bad = out.status[c][out.status[c] != 0]
@@ -181,12 +170,6 @@ def shoot(
         status=status,
         steps=out.info[:, :, Info.ACCEPTED].sum(axis=1).astype(np.int64),
     )
-
-
-@functools.lru_cache(maxsize=64)
-def _step_budget(settings: SolverSettings) -> int:
-    """The step budget of one period (as :meth:`SolverSettings.sample_times` gives it)."""
-    return settings.replace(transient_periods=0, periods=1).step_budget
 
 
 def sort_multipliers(mu: np.ndarray) -> np.ndarray:

@@ -269,16 +269,24 @@ class ChainOutput(SampleArrays):
         return self.log_sums / ((ns - 1) * dt)[:, :, None]
 
 
-def run_chains(run: ChainRun, *, single_thread: bool = False, tableau: Any = None) -> ChainOutput:
+def run_chains(
+    run: ChainRun,
+    *,
+    single_thread: bool = False,
+    tableau: Any = None,
+    threads: int | None = None,
+) -> ChainOutput:
     """Run the chains of ``run`` with the compiled Dormand–Prince kernel (or, for
     experiments, with the explicit FSAL pair ``tableau``:
     :func:`~gearchaos.integrate.methods.kernels_for`).
 
-    The chains are spread over ``numba.get_num_threads()`` threads (blocks of chains taken in
-    turn, so a slow chain does not hold up a fixed share of the others); ``single_thread``
-    pins this process to one thread (for worker processes that share a machine). Each chain
-    runs the same compiled code whatever the threads, so results are bitwise identical. Never
-    raises on solver failure: each point carries its own status.
+    The chains are spread over ``threads`` threads (default and at most
+    ``numba.get_num_threads()``; blocks of chains taken in turn, so a slow chain does not
+    hold up a fixed share of the others): a caller with a few short chains asks for fewer
+    without changing the process's setting. ``single_thread`` pins this process to one
+    thread (for worker processes that share a machine). Each chain runs the same compiled
+    code whatever the threads, so results are bitwise identical. Never raises on solver
+    failure: each point carries its own status.
     """
     import numba
 
@@ -317,7 +325,9 @@ def run_chains(run: ChainRun, *, single_thread: bool = False, tableau: Any = Non
 
     entry = entry_point(dopri_chains, run.kind, *args(0, C))
     kind = int(run.kind)
-    run_threaded(lambda lo, hi: entry(kind, *args(lo, hi)), C, numba.get_num_threads())
+    most = numba.get_num_threads()
+    use = most if threads is None else max(1, min(int(threads), most))
+    run_threaded(lambda lo, hi: entry(kind, *args(lo, hi)), C, use)
     return out
 
 

@@ -28,6 +28,7 @@ __all__ = [
     "UNRECORDED",
     "SampleTimes",
     "SolverSettings",
+    "default_step_budget",
     "renamed_keyword",
     "rest_direction",
     "split_keywords",
@@ -59,6 +60,12 @@ PERTURBATION_MAX = 1e-2
 PERTURBATION_SEED = 20_161_105
 
 
+def default_step_budget(periods: float) -> int:
+    """The step attempts a run of ``periods`` forcing periods may take when no ``max_steps``
+    is set: 100 000 + 50 000 per period (at least one period)."""
+    return int(100_000 + 50_000 * max(float(periods), 1.0))
+
+
 def rest_direction(n: int) -> np.ndarray:
     """The fixed unit vector u ∈ ℝⁿ along which a start from rest is perturbed: standard
     normal components from ``numpy.random.default_rng(PERTURBATION_SEED)``, normalised.
@@ -87,6 +94,39 @@ class SampleTimes:
     def dt(self) -> Any:
         """The sample interval T/s."""
         return self.period / self.samples_per_period
+
+    @classmethod
+    def over_periods(
+        cls,
+        t0: Any,
+        period: Any,
+        *,
+        first: int,
+        periods: int,
+        end: int,
+        max_steps: int,
+        samples_per_period: int = 1,
+    ) -> SampleTimes:
+        """The samples of a run from τ = ``t0`` (a float, or an array: one run per entry)
+        with forcing period ``period`` (broadcast to ``t0``'s shape): ``periods`` forcing
+        periods of ``samples_per_period`` samples each, the first at the section time
+        t0 + ``first``·T, the run ending at t0 + ``end``·T (``end`` >= ``first`` + ``periods``
+        − 1: a run may stop on its last sample)."""
+        if first < 0 or periods < 1 or end < first + periods - 1:
+            raise ValueError(
+                f"sample times need 0 <= first, periods >= 1 and end >= first + periods - 1: "
+                f"got first={first}, periods={periods}, end={end}"
+            )
+        shape = np.broadcast_shapes(np.shape(t0), np.shape(period))
+        T = np.broadcast_to(np.asarray(period, dtype=float), shape).copy() if shape else period
+        return cls(
+            t_rec=t0 + first * T,
+            period=T,
+            n_samples=int(periods) * int(samples_per_period),
+            t_end=t0 + end * T,
+            max_steps=int(max_steps),
+            samples_per_period=int(samples_per_period),
+        )
 
 
 @dataclass(frozen=True)
@@ -217,10 +257,14 @@ class SolverSettings:
     @property
     def step_budget(self) -> int:
         """``max_steps``, or 100 000 + 50 000 per simulated period (at least one)."""
+        return self.budget_for(float(self.transient_periods) + int(self.periods))
+
+    def budget_for(self, periods: float) -> int:
+        """The step attempts a run of ``periods`` forcing periods may take: ``max_steps``,
+        or :func:`default_step_budget`."""
         if self.max_steps is not None:
             return int(self.max_steps)
-        total = float(self.transient_periods) + int(self.periods)
-        return int(100_000 + 50_000 * max(total, 1.0))
+        return default_step_budget(periods)
 
     def check_span(self, start_periods: float = 0.0) -> None:
         """Refuse a run that would end where the time variable no longer resolves
@@ -258,11 +302,13 @@ class SolverSettings:
         t_rec = t0 + self.transient_periods * T
         if phase != 0.0:
             t_rec = t_rec + phase * T / (2.0 * math.pi)
-        return SampleTimes(
-            t_rec=t_rec,
-            period=T,
-            n_samples=self.n_samples,
-            t_end=t_rec + self.periods * T,
+        periods = int(self.periods)
+        return SampleTimes.over_periods(
+            t_rec,
+            T,
+            first=0,
+            periods=periods,
+            end=periods,
             max_steps=self.step_budget,
             samples_per_period=int(self.samples_per_period),
         )
