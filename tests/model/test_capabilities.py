@@ -292,3 +292,77 @@ def test_the_planetary_quantities_are_lengths_velocities_and_forces() -> None:
     assert {"delta_sp", "delta_rp", "x_s", "y_s", "p", "sigma"} <= set(q)
     assert (caps.period_name, caps.member_name) == ("mesh", "planet")
     assert caps.gearset is not None and caps.result_dataset is not None
+
+
+@numba.njit(cache=True)
+def _half_forced_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
+    """x'' + 2ζx' + x = F cos(Ωτ/2): a forcing that repeats after 2·2π/Ω."""
+    dydt[0] = y[1]
+    dydt[1] = p[2] * math.cos(0.5 * p[0] * t) - 2.0 * p[1] * y[1] - y[0]
+    obs[0] = y[0]
+    obs[1] = y[1]
+
+
+@dataclass(frozen=True)
+class HalfForced(UserModel):
+    """A linear oscillator forced at Ω/2, whose forcing period is T = ``factor``·2π/Ω."""
+
+    zeta: float = 0.1
+    force: float = 1.0
+    factor: float = 2.0
+    name = "half_forced"
+    state_names = ("x", "x_dot")
+    obs_names = ("x", "x_dot")
+    n_track = 1
+    rhs = _half_forced_rhs
+
+    @property
+    def period_factor(self) -> float:
+        return self.factor
+
+    def pack(self, omega: float) -> np.ndarray:
+        return np.array([omega, self.zeta, self.force])
+
+
+def test_a_declared_forcing_period_is_the_period_sections_count() -> None:
+    """With T = 2·2π/Ω declared, the steady response x = A cos(Ωτ/2 − φ) (A = F/√((1 − w²)² +
+    (2ζw)²), tan φ = 2ζw/(1 − w²), w = Ω/2) is one point on the section, x = A cos φ at
+    τ = kT; counted in 2π/Ω instead (factor 1) the section alternates between ±A cos φ. Its
+    spectrum's line lies at ω/Ω = 1/2."""
+    omega, zeta, force = 1.2, 0.1, 1.0
+    w = omega / 2
+    amp = force / math.hypot(1 - w * w, 2 * zeta * w)
+    phi = math.atan2(2 * zeta * w, 1 - w * w)
+    declared = System(HalfForced(zeta, force, 2.0), omega)
+    assert declared.period == pytest.approx(4 * math.pi / omega, rel=1e-15)
+    assert scale_attrs(declared.model)["period_factor"] == 2.0
+    res = gc.simulate(declared, transient_periods=60, periods=8, samples_per_period=16)
+    np.testing.assert_allclose(res.section("x"), amp * math.cos(phi), atol=1e-6)
+    ratio, spec = gc.plot.timeseries.amplitude_spectrum(res, "x")
+    assert ratio[int(np.argmax(spec))] == pytest.approx(0.5)
+    assert np.max(spec) == pytest.approx(amp, rel=1e-4)
+    # the same model counted in 2π/Ω: the section points alternate between ±A cos φ
+    plain = System(HalfForced(zeta, force, 1.0), omega)
+    assert "period_factor" not in scale_attrs(plain.model)
+    x = gc.simulate(plain, transient_periods=120, periods=8).section("x")
+    np.testing.assert_allclose(x, amp * math.cos(phi) * (-1.0) ** np.arange(8), atol=1e-6)
+
+
+@pytest.mark.parametrize("factor", [0.0, -2.0, math.inf, "2", True])
+def test_a_period_factor_must_be_a_positive_number(factor: Any) -> None:
+    with pytest.raises(gc.ParameterError, match=r"HalfForced.period_factor must be a"):
+        check_model(HalfForced(factor=factor))
+
+
+def test_a_sweep_store_records_the_declared_period() -> None:
+    """A store of a model with T = 2·2π/Ω records its period factor, and the store's forcing
+    period (which the record's classification counts in) is 4π/Ω at every point."""
+    from gearchaos.sweep.result import SweepResult
+
+    ds = gc.bifurcation(
+        System(HalfForced(), 1.0), "omega=1.0:1.2:3", transient_periods=30, periods=6,
+        progress=False,
+    )  # fmt: skip
+    assert ds.attrs["period_factor"] == 2.0
+    omega = np.array([1.0, 1.1, 1.2])
+    np.testing.assert_allclose(SweepResult(ds).forcing_period(), 4 * math.pi / omega, rtol=1e-15)

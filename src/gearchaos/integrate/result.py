@@ -87,6 +87,8 @@ class SimulationResult(Trajectory):
             attrs["mesh_frequency_rad_s"] = self.omega * sc.omega_n
         for k, v in caps.clearances.items():
             attrs[f"clearance_{k}"] = v
+        if caps.period_factor != 1.0:
+            attrs["period_factor"] = caps.period_factor
         # to build the model again (not a gear set)
         attrs.update(model_reference(self.system.model))
         return attrs

@@ -6,6 +6,7 @@ re-exports both)."""
 from __future__ import annotations
 
 import dataclasses
+import math
 import threading
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -208,6 +209,15 @@ class Capabilities:
             "parameters named by their fields",
         ),
     )
+    period_factor: float = field(
+        default=1.0,
+        metadata=_doc(
+            "the forcing period T in units of 2π/Ω: T = `period_factor`·2π/Ω, the period of a "
+            "forcing with several frequencies (mesh frequencies Ω and 3Ω/5: 5); sections, "
+            "protocols (transient and recorded periods) and labels (period n) count T",
+            "1: T = 2π/Ω",
+        ),
+    )
     period_name: str = field(
         default="forcing",
         metadata=_doc(
@@ -282,6 +292,12 @@ class Capabilities:
             set_(self, attr, MappingProxyType(dict(value)))
         pair = self.default_observables
         set_(self, "default_observables", _default_pair(self) if pair is None else _pair(pair))
+        factor = self.period_factor
+        if isinstance(factor, bool) or not isinstance(factor, int | float | np.floating):
+            raise ParameterError(f"period_factor must be a number > 0: got {factor!r}")
+        if not (math.isfinite(float(factor)) and float(factor) > 0):
+            raise ParameterError(f"period_factor must be a finite number > 0: got {factor!r}")
+        set_(self, "period_factor", float(factor))
         set_(self, "period_name", str(self.period_name))
         set_(self, "member_name", str(self.member_name))
 

@@ -134,6 +134,10 @@ class UserModel:
       parameters: field → mathtext symbol without ``$``, for the axis of a swept or continued
       parameter and the *at …* line of figure titles; ``check_model`` refuses a key that is no
       field.
+    * ``period_factor`` (otherwise: 1: T = 2π/Ω): the forcing period T in units of 2π/Ω: T =
+      ``period_factor``·2π/Ω, the period of a forcing with several frequencies (mesh frequencies Ω
+      and 3Ω/5: 5); sections, protocols (transient and recorded periods) and labels (period n) count
+      T.
     * ``period_name`` (otherwise: ``forcing``): what one forcing period is called in axes, labels
       and tables (``mesh``: mesh periods, harmonics of the mesh frequency f_m).
     * ``member_name`` (otherwise: ``member``): what one member of a variable group is called

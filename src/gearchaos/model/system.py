@@ -324,8 +324,12 @@ class System:
 
     @property
     def period(self) -> float:
-        """Forcing period T = 2π/Ω in units of τ."""
-        return 2.0 * math.pi / self.omega
+        """Forcing period T = 2π/Ω in units of τ, times the model's ``period_factor`` (the
+        model contract: a forcing with several frequencies declares the multiple of 2π/Ω
+        after which it repeats)."""
+        T = 2.0 * math.pi / self.omega
+        factor = self.capabilities.period_factor
+        return T if factor == 1.0 else factor * T
 
     def warn_for(self, analysis: str) -> None:
         """Let the model warn when ``analysis`` is questionable for it (a planetary model with

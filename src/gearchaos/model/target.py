@@ -259,10 +259,13 @@ def resolve(
 
 def scale_attrs(model: Any) -> dict[str, float]:
     """A model's scales and clearances as store attributes: ``omega_n_rad_s`` (ω_n),
-    ``characteristic_length_m`` (b_c) where the model has physical scales, and
-    ``clearance_<name>`` for each of its clearances."""
+    ``characteristic_length_m`` (b_c) where the model has physical scales,
+    ``clearance_<name>`` for each of its clearances, and ``period_factor`` where its forcing
+    period is not 2π/Ω."""
     caps = Capabilities.of(model)
     a: dict[str, float] = {}
+    if caps.period_factor != 1.0:
+        a["period_factor"] = caps.period_factor
     if caps.scales is not None:
         a["omega_n_rad_s"] = float(caps.scales.omega_n)
         a["characteristic_length_m"] = float(caps.scales.length)

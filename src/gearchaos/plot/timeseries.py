@@ -206,10 +206,11 @@ def amplitude_spectrum(
 
     The recorded window spans an integer number P of forcing periods sampled uniformly with
     ``s = samples_per_period`` samples each, so with the default rectangular window the FFT
-    bins fall exactly on multiples 1/P of the forcing frequency and a periodic response has
-    leakage-free lines at its harmonics: for x_j = a cos(kΩτ_j + φ) the bin at ω/Ω = k holds
-    amplitude ``a``. The mean is removed first. ``window="hann"`` applies a Hann window
-    (amplitudes divided by the window's mean, so lines keep their height) for
+    bins fall exactly on multiples 1/P of the forcing frequency 2π/T and a periodic response
+    has leakage-free lines at its harmonics: for x_j = a cos(kΩτ_j + φ) the bin at ω/Ω = k
+    holds amplitude ``a`` (a model whose forcing period is T = f·2π/Ω, ``period_factor`` f,
+    has bins at multiples 1/(fP) of Ω). The mean is removed first. ``window="hann"`` applies
+    a Hann window (amplitudes divided by the window's mean, so lines keep their height) for
     non-periodic motion.
 
     Returns
@@ -243,7 +244,10 @@ def amplitude_spectrum(
         raise ParameterError(f"window must be 'boxcar' or 'hann': got {window!r}")
     amp = 2.0 * np.abs(np.fft.rfft(x * w)) / w.sum()
     k = np.arange(amp.size)
-    ratio = k / n_periods
+    ratio = k / n_periods  # multiples of 1/T
+    factor = result.system.capabilities.period_factor  # T = factor·2π/Ω
+    if factor != 1.0:
+        ratio = ratio / factor
     if x.size % 2 == 0:
         amp[-1] /= 2.0  # the Nyquist bin is not doubled
     return ratio[1:], amp[1:]

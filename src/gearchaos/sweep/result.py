@@ -317,7 +317,8 @@ class SweepResult:
 
     # ------------------------------------------------------------------ physics
     def forcing_period(self) -> np.ndarray:
-        """T = 2π/Ω at every point of the leading dimensions."""
+        """T = 2π/Ω at every point of the leading dimensions, times the model's
+        ``period_factor`` where the store records one."""
         try:
             omega = self.values(OMEGA)
         except KeyError:
@@ -331,7 +332,9 @@ class SweepResult:
             if not (math.isfinite(float(raw)) and float(raw) > 0):
                 raise StoreError(f"the store's omega_fixed must be > 0: got {raw!r}") from None
             omega = np.full(self.shape, float(raw))
-        return 2.0 * math.pi / omega
+        T = 2.0 * math.pi / omega
+        factor = float(self.ds.attrs.get("period_factor", 1.0))
+        return T if factor == 1.0 else factor * T
 
     def clearance(self, var: str) -> tuple[np.ndarray, str] | None:
         """(b̄, mathtext symbol) of the clearance acting on ``var`` at every point of the
