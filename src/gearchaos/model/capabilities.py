@@ -65,7 +65,7 @@ class Capabilities:
     (``doc``) and, in words, what a model that does not give it gets (``otherwise``: the
     field's default; ``None`` for the required members). ``Capabilities.of(model)`` is the
     one place where a model's members are looked up: the layers above read
-    :attr:`System.capabilities <gearchaos.model.System.capabilities>`.
+    :attr:`~gearchaos.model.System.capabilities`.
     """
 
     # -- required ------------------------------------------------------------------

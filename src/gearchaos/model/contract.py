@@ -13,8 +13,7 @@ with its meaning and what a model that does not give it gets. :meth:`Capabilitie
 the record from the model's members of the same names, in the same way for the package's own
 models (the planetary model, the reference systems of :mod:`~gearchaos.model.library`) as for
 a model written outside the package; the layers above ask the record
-(:attr:`System.capabilities <gearchaos.model.System.capabilities>`), never the model whether
-it has a member.
+(:attr:`~gearchaos.model.System.capabilities`), never the model whether it has a member.
 
 A model defined outside the package subclasses :class:`UserModel` (a frozen dataclass whose
 fields are its parameters) and names its compiled functions ``rhs`` (and ``tangent``); see the
