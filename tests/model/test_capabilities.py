@@ -273,6 +273,13 @@ def test_the_packages_own_models_fill_the_same_record(system: System) -> None:
             assert getattr(caps, name) == value or getattr(caps, name) == tuple(value), name
 
 
+def test_the_model_protocol_is_the_records_required_members() -> None:
+    """The typing view of a model (:class:`Model`) names exactly the required members."""
+    import typing
+
+    assert set(typing._get_protocol_attrs(Model)) == set(Capabilities.REQUIRED)  # type: ignore[attr-defined]
+
+
 def test_the_planetary_quantities_are_lengths_velocities_and_forces() -> None:
     """The planetary model's displacements and deflections are lengths (in units of b_c),
     their τ-derivatives velocities (b_c ω_n), the mesh forces forces (k_m,sp b_c); its scales
