@@ -391,6 +391,32 @@ def test_a_study_resumes_after_kill_9_without_losing_a_finished_trial(tmp_path: 
     assert len(done) == 6 and min(set(done) - set(before)) > 2  # the count continues
 
 
+def test_a_trial_a_peer_finished_first_does_not_stop_the_worker(tmp_path: Path) -> None:
+    """Two workers on one SQLite storage may run the same enqueued trial (SQLite has no row
+    locks), and the slower one's report then meets a finished trial (Optuna raises
+    UpdateFinishedTrialError; on CI this ended a worker of the two-worker test). The worker
+    keeps the peer's result and goes on."""
+    out, url = tmp_path / "c.jsonl", f"sqlite:///{tmp_path / 'c.db'}"
+    peer_values = (-5.0, 0.25)
+
+    class Raced(Stub):
+        def __call__(self, gs: GearSet) -> Evaluation:
+            if len(self.calls) == 2:  # the third trial: a peer finishes it meanwhile
+                st = optuna.load_study(study_name=cal.STUDY, storage=url)
+                (running,) = st.get_trials(states=(optuna.trial.TrialState.RUNNING,))
+                st._storage.set_trial_state_values(
+                    running._trial_id, optuna.trial.TrialState.COMPLETE, list(peer_values)
+                )
+            return super().__call__(gs)
+
+    obj = Raced()
+    res = calibrate(out=out, storage=url, objective=obj, max_candidates=5)
+    trials = _trials(url, cal.STUDY)
+    assert res.stopped == "max_candidates" and len(obj.calls) >= 5
+    assert tuple(trials[2].values) == peer_values  # the peer's result stands
+    assert sum(t.state.name == "COMPLETE" for t in trials) == 5
+
+
 def test_two_worker_processes_share_one_storage(tmp_path: Path) -> None:
     out, url = tmp_path / "c.jsonl", f"sqlite:///{tmp_path / 'c.db'}"
     res = calibrate(out=out, storage=url, objective=Stub(), max_candidates=8, workers=2)
@@ -447,25 +473,28 @@ def test_cli_calibrate_quick_end_to_end_and_resume(tmp_path: Path) -> None:
     assert json.loads(again.stdout)["resumed"] == 1
 
 
-# --------------------------------------------------------------------------- the shipped preset
-LOG = Path(__file__).resolve().parents[2] / "paper" / "calibration.jsonl"
+# --------------------------------------------------------------------------- the shipped presets
+PAPER = Path(__file__).resolve().parents[2] / "paper"
+LOG = PAPER / "calibration.jsonl"
+LOG_V1 = PAPER / "calibration-v1.jsonl"
+CONFIRMATION = PAPER / "confirmation.json"
 
 
-@pytest.mark.skipif(not LOG.is_file(), reason="paper/calibration.jsonl not in this checkout")
-def test_default_preset_is_the_calibrations_best_candidate() -> None:
-    """sheng2016 is the highest-scoring line of the committed calibration log, built on the
-    MODEL.md §9 set (hindawi2021) with only the search variables changed."""
+def _rows(log: Path) -> list[dict]:
+    return [json.loads(x) for x in log.read_text().splitlines() if x.strip()]
+
+
+def _check_preset_is_record(name: str, rec: dict) -> None:
+    """Preset ``name`` is the calibration record ``rec``: built on the MODEL.md §9 set
+    (hindawi2021) with only the search variables changed, every value from the record."""
     import gearchaos
     from gearchaos.paper.calibrate import record_gearset
 
-    rows = [json.loads(x) for x in LOG.read_text().splitlines() if x.strip()]
-    best = min(rows, key=lambda r: (-r["score"], r["index"]))
-    assert all(r["score"] <= best["score"] for r in rows)
-    v = best["variables"]
-    gs = gearchaos.preset("sheng2016")
+    v = rec["variables"]
+    gs = gearchaos.preset(name)
     base = gearchaos.preset("hindawi2021")
-    assert plausibility(cal.candidate_from_record(best)) == []
-    assert gs == record_gearset(best, name=gs.name, description=gs.description)
+    assert plausibility(cal.candidate_from_record(rec)) == []
+    assert gs == record_gearset(rec, name=gs.name, description=gs.description)
     # the calibrated quantities, straight from the log's variables
     assert (gs.n_planets, gs.teeth.sun, gs.teeth.planet, gs.teeth.ring) == (
         v["geometry.planets"],
@@ -503,3 +532,42 @@ def test_default_preset_is_the_calibrations_best_candidate() -> None:
     assert st.sun_planet_mean == base.stiffness.sun_planet_mean
     assert st.sun_bearing == base.stiffness.sun_bearing
     assert gs.clearance.sun_bearing == base.clearance.sun_bearing
+
+
+@pytest.mark.skipif(not LOG_V1.is_file(), reason="paper/calibration-v1.jsonl not in this checkout")
+def test_v1_preset_is_the_first_calibrations_best_candidate() -> None:
+    """sheng2016-v1 (the default before issue 34) is the highest-scoring line of the first
+    calibration's log."""
+    rows = _rows(LOG_V1)
+    best = min(rows, key=lambda r: (-r["score"], r["index"]))
+    assert all(r["score"] <= best["score"] for r in rows)
+    _check_preset_is_record("sheng2016-v1", best)
+
+
+@pytest.mark.skipif(
+    not (LOG.is_file() and CONFIRMATION.is_file()), reason="the calibration is not in this checkout"
+)
+def test_default_preset_is_the_confirmed_winner_of_the_study() -> None:
+    """sheng2016 is the candidate of the study that won the confirmation: among the confirmed
+    candidates (the best plausible ones by landmark score, then structure), the most landmarks
+    holding with their parameter acting, then the fewest not holding, then the rank."""
+    rows = {r["index"]: r for r in _rows(LOG)}
+    conf = json.loads(CONFIRMATION.read_text())
+    ranked = cal.ranked(rows.values())
+    plausible = [r for r in ranked if not plausibility(cal.candidate_from_record(r))]
+    confirmed = conf["confirmed"]
+    assert [c["trial"] for c in confirmed] == [r["index"] for r in plausible[: len(confirmed)]]
+    for c in confirmed:
+        assert c["score"] == rows[c["trial"]]["score"]
+        assert c["rank"] == ranked.index(rows[c["trial"]]) + 1
+
+    def key(c: dict) -> tuple[int, int, int]:
+        lm = c["counts"]["landmarks"]
+        return (-lm.get("holds", 0), lm.get("does not hold", 0), c["rank"])
+
+    winner = min(confirmed, key=key)
+    assert conf["winner"] == winner["trial"]
+    _check_preset_is_record("sheng2016", rows[winner["trial"]])
+    # the winner holds more landmarks with their parameter acting than the previous default
+    prev = conf["previous"]["counts"]["landmarks"]
+    assert winner["counts"]["landmarks"]["holds"] > prev.get("holds", 0)

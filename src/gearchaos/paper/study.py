@@ -312,15 +312,37 @@ def optimize(
     cbs = list(callbacks)
     if job.max_candidates is not None:
         cbs.append(MaxTrialsCallback(job.max_candidates))
+    from optuna.exceptions import UpdateFinishedTrialError
+
+    ran = [0]
+
+    def count(st: Any, tr: Any) -> None:
+        ran[0] += 1
+
     t0 = time.monotonic()
-    study.optimize(
-        _trial_function(job.space, objective, _base()),
-        n_trials=job.trials,
-        timeout=job.timeout,
-        catch=(ParameterError, IntegrationError),
-        callbacks=cbs,
-        gc_after_trial=True,
-    )
+    func = _trial_function(job.space, objective, _base())
+    while True:
+        left = None if job.trials is None else job.trials - ran[0]
+        budget = None if job.timeout is None else job.timeout - (time.monotonic() - t0)
+        if (left is not None and left <= 0) or (budget is not None and budget <= 0):
+            break
+        try:
+            study.optimize(
+                func, n_trials=left, timeout=budget, catch=(ParameterError, IntegrationError),
+                callbacks=[*cbs, count], gc_after_trial=True,
+            )  # fmt: skip
+            break
+        except (UpdateFinishedTrialError, ValueError) as exc:
+            # Another process on the same storage finished this trial first: SQLite has no
+            # row locks, so two workers may pop the same enqueued trial, or a peer declared it
+            # stale. Optuna says so at the write (UpdateFinishedTrialError) or, when it reads
+            # the state first, as "Cannot tell a COMPLETE trial". The recorded result stands;
+            # this worker goes on with the next trial.
+            if isinstance(exc, ValueError) and not str(exc).startswith("Cannot tell a "):
+                raise
+            ran[0] += 1
+            if job.max_candidates is not None and finished_count(study) >= job.max_candidates:
+                break
     if job.max_candidates is not None and finished_count(study) >= job.max_candidates:
         return "max_candidates"
     if job.timeout is not None and time.monotonic() - t0 >= job.timeout:
