@@ -320,6 +320,7 @@ def _block_map(y: np.ndarray, omega: float, stiff, damping: float) -> tuple[np.n
     return s[:2], s[2:].reshape(2, 2, order="F")
 
 
+@pytest.mark.slow  # a fold curve continued to a codimension-2 point (minutes on 2 cores)
 def test_fold_curve_meets_a_period_doubling_at_the_scipy_fold_flip_point() -> None:
     """The Duffing–Mathieu test model (tests/dynamics/duffing_mathieu.py, written as a user
     model): its fold curve in (Ω, q) is the Duffing's fold Ω_fold for every q, and it meets a

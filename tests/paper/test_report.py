@@ -9,6 +9,7 @@ matplotlib.use("Agg")
 import json
 from pathlib import Path
 
+import pytest
 from typer.testing import CliRunner
 
 from gearchaos.cli import app
@@ -17,6 +18,7 @@ from gearchaos.paper.report import FIGURES, HONESTY
 FIGS = ("fig4", "fig5", "fig6", "fig7", "fig8", "fig9", "fig10", "fig11", "fig12")
 
 
+@pytest.mark.slow  # the whole quick report: every figure, branch and landmark (minutes on 2 cores)
 def test_reproduce_all_quick_writes_every_figure_and_the_report(tmp_path: Path) -> None:
     assert FIGURES == FIGS
     out = tmp_path / "report"

@@ -265,6 +265,7 @@ def kill_rounds(path: Path, reference: tuple[Any, Timing], kills: int, seed: int
     return landed
 
 
+@pytest.mark.slow  # three kill-and-resume rounds of a sweep (minutes on 2 cores)
 def test_three_sigkills_in_creation_tasks_and_a_resume_end_bitwise_equal(
     reference: tuple[Any, Timing], tmp_path: Path
 ) -> None:
