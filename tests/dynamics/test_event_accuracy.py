@@ -2,7 +2,7 @@
 accurately (issue 24).
 
 The backlash oscillator (MODEL.md §10.5) with F_a = F_m grazes where Ω² = 1/(2 − 4ζ²) (closed
-form; see tests/analysis/test_continuation.py), folds at Ω ≈ 0.731 and has a period doubling
+form; see tests/dynamics/test_continuation.py), folds at Ω ≈ 0.731 and has a period doubling
 near Ω ≈ 1.95. With
 the default settings (rtol 1e-8) each event's stated uncertainty must
 
