@@ -8,6 +8,11 @@ Imports are read from the source with :mod:`ast`, *including imports inside func
 import hides a cycle from Python but not from a reader), and resolved to the module they load:
 ``from .. import sweep`` loads ``gearchaos.sweep``, ``from .._version import __version__`` loads
 ``gearchaos._version``. A package's ``__init__`` counts as a module of its package's layer.
+
+The tests mirror the source (issue 36, item 7): every folder ``tests/<pkg>/`` but the
+cross-cutting ones is a package ``src/gearchaos/<pkg>/``, and its test modules use that package.
+Outside ``gearset/`` and ``model/``, the lines that ask "is it a gear set?" are counted, and the
+count never grows (issue 36's target is zero).
 """
 
 from __future__ import annotations
@@ -227,3 +232,261 @@ def test_the_layers_above_the_model_read_its_record() -> None:
     unexplained = [f"{f}:{n} probes {m}" for f, n, m in found if (f, m) not in MEMBER_PROBES_KEPT]
     assert not unexplained, "read the model contract's record instead:\n" + "\n".join(unexplained)
     assert len(found) <= len(MEMBER_PROBES_KEPT), found
+
+
+# --------------------------------------------------------------- the tests mirror the source
+
+TESTS = Path(__file__).resolve().parent
+#: Folders of tests/ about behaviour across the layers, which mirror no package.
+CROSS_CUTTING = {
+    "fuzz": "malformed input to every front door",
+    "regression": "stores of whole runs compared with frozen references",
+    "docs": "the documentation's commands, numbers and figures",
+    "examples": "the examples/ scripts, run as users run them",
+    "cli": "the command line, which drives every layer",
+}
+#: Test modules of a package's folder that reach it only through a running process.
+NO_IMPORT = {
+    "explore/test_browser.py": "drives `gearchaos explore` in headless Chromium",
+    "explore/test_server_guard.py": "sends requests to a `gearchaos explore` server process",
+    "explore/test_cli_explore.py": "the `explore` command's refusals, before a server starts",
+}
+
+
+def _facade() -> dict[str, str]:
+    """Package (``dynamics``, ``gearset``, ``errors`` …) of each name of the top-level API, read
+    from ``gearchaos/__init__.py`` (its imports, lazy subpackages and lazy attributes)."""
+    out: dict[str, str] = {}
+    for node in ast.walk(ast.parse((ROOT / "__init__.py").read_text(encoding="utf-8"))):
+        if isinstance(node, ast.ImportFrom) and node.level == 1 and node.module:
+            for alias in node.names:
+                out[alias.asname or alias.name] = node.module.split(".")[0]
+        elif isinstance(node, ast.Assign) and isinstance(node.targets[0], ast.Name):
+            value = ast.literal_eval(node.value) if node.targets[0].id.startswith("_LAZY") else ()
+            if isinstance(value, tuple):
+                out.update({name: name for name in value})
+            elif isinstance(value, dict):
+                out.update({name: where.split(".")[0] for name, where in value.items()})
+    return out
+
+
+def _packages_used(path: Path, facade: dict[str, str]) -> set[str]:
+    """Packages of gearchaos a test module uses: ``gearchaos.<pkg>`` imports, and the package
+    of each top-level name it imports or reads as ``gc.<name>``."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    used: set[str] = set()
+    aliases: set[str] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            for alias in node.names:
+                parts = alias.name.split(".")
+                if parts[0] == "gearchaos" and len(parts) > 1:
+                    used.add(parts[1])
+                elif alias.name == "gearchaos":
+                    aliases.add(alias.asname or "gearchaos")
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            parts = node.module.split(".")
+            if parts[0] == "gearchaos" and len(parts) > 1:
+                used.add(parts[1])
+            elif node.module == "gearchaos":
+                used.update(facade.get(alias.name, alias.name) for alias in node.names)
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name):
+            if node.value.id in aliases:
+                used.add(facade.get(node.attr, node.attr))
+    return used
+
+
+def _test_folders() -> list[Path]:
+    return sorted(
+        d
+        for d in TESTS.iterdir()
+        if d.is_dir() and not d.name.startswith((".", "_")) and any(d.rglob("*.py"))
+    )
+
+
+def test_every_test_folder_mirrors_a_package() -> None:
+    """Issue 36, item 7: ``tests/<pkg>/`` holds the tests of ``src/gearchaos/<pkg>/``."""
+    folders = [d.name for d in _test_folders()]
+    assert {"analysis", "dynamics", "model", "fuzz"} <= set(folders), folders
+    orphans = [
+        name
+        for name in folders
+        if name not in CROSS_CUTTING and not (ROOT / name / "__init__.py").is_file()
+    ]
+    assert not orphans, f"test folders without a package src/gearchaos/<name>/: {orphans}"
+
+
+def test_each_test_module_uses_the_package_its_folder_mirrors() -> None:
+    """A module of ``tests/<pkg>/`` imports from ``gearchaos.<pkg>`` or uses a name of the
+    top-level API that ``gearchaos.<pkg>`` defines (``gc.attractors`` is ``dynamics``'s): a test
+    of code that moved to another package moves with it."""
+    facade = _facade()
+    assert facade["attractors"] == "dynamics" and facade["preset"] == "gearset", facade
+    misplaced = []
+    for folder in _test_folders():
+        if folder.name in CROSS_CUTTING:
+            continue
+        for path in sorted(folder.glob("test_*.py")):
+            key = f"{folder.name}/{path.name}"
+            used = _packages_used(path, facade)
+            if folder.name not in used and key not in NO_IMPORT:
+                misplaced.append(f"tests/{key} uses {sorted(used)}, not gearchaos.{folder.name}")
+    stale = [key for key in NO_IMPORT if not (TESTS / key).is_file()]
+    assert not stale, f"NO_IMPORT names test modules that are gone: {stale}"
+    assert not misplaced, "test modules in the folder of a package they do not use:\n" + (
+        "\n".join(misplaced)
+    )
+
+
+# ------------------------------------------------------------- "is it a gear set?" switches
+
+#: Lines outside ``gearset/`` and ``model/`` that ask "is it a gear set?" (see
+#: :func:`gear_set_switches`). Counted when this test was written (main at b782aa6): 65 lines in
+#: 29 modules (sweep 21, plot 20, cli 7, paper 6, dynamics 4, analysis 3, explore 3, integrate 1).
+#: Issue 36's target is zero: the upper layers ask the model (its contacts, quantities,
+#: names), never whether it is a gear set. Each reduction lowers this number; it never grows.
+GEAR_SET_SWITCHES = 65
+#: Names that hold a gear set, or say whether there is one.
+GEAR_SET_NAMES = {"gs", "gearset", "base_gearset", "planetary", "is_planetary"}
+#: Keys of a summary, store attribute or model member that hold the gear set.
+GEAR_SET_KEYS = {"gearset", "gearset_toml"}
+GEAR_SET_CLASSES = {"GearSet", "PlanetaryModel"}
+#: ``hasattr`` probes that tell a gear set apart (``evolve`` is the gear set's duck type).
+GEAR_SET_PROBES = {"gearset", "evolve"}
+#: The planetary model's mesh labels: a comparison with them asks "is it a planetary train?".
+PLANETARY_MESHES = ("sp", "rp")
+
+
+def _holds_gear_set(node: ast.AST) -> bool:
+    """``gs``, ``res.gearset``, ``summary.get("gearset")``, ``attrs["gearset_toml"]``,
+    ``getattr(model, "gearset", None)``, ``planetary`` …"""
+    if isinstance(node, ast.Name | ast.Attribute):
+        return (node.id if isinstance(node, ast.Name) else node.attr) in GEAR_SET_NAMES
+    if isinstance(node, ast.Subscript):
+        return isinstance(node.slice, ast.Constant) and node.slice.value in GEAR_SET_KEYS
+    if isinstance(node, ast.Call):
+        func, args = node.func, node.args
+        if isinstance(func, ast.Attribute) and func.attr == "get" and args:
+            return isinstance(args[0], ast.Constant) and args[0].value in GEAR_SET_KEYS
+        if isinstance(func, ast.Name) and func.id == "getattr" and len(args) >= 2:
+            return isinstance(args[1], ast.Constant) and args[1].value in GEAR_SET_KEYS
+    return False
+
+
+def _class_names(node: ast.AST) -> set[str]:
+    if isinstance(node, ast.Tuple):
+        return set().union(*(_class_names(e) for e in node.elts))
+    if isinstance(node, ast.BinOp):  # System | GearSet
+        return _class_names(node.left) | _class_names(node.right)
+    return {node.id} if isinstance(node, ast.Name) else set()
+
+
+def _truth_operands(test: ast.AST) -> list[ast.AST]:
+    """What a truth test tests, through ``not``, ``and`` and ``or``."""
+    if isinstance(test, ast.UnaryOp) and isinstance(test.op, ast.Not):
+        return _truth_operands(test.operand)
+    if isinstance(test, ast.BoolOp):
+        return [t for value in test.values for t in _truth_operands(value)]
+    return [test]
+
+
+def _is_switch(node: ast.AST) -> bool:
+    if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and len(node.args) == 2:
+        name, (_, second) = node.func.id, node.args
+        if name == "isinstance":
+            return bool(_class_names(second) & GEAR_SET_CLASSES)
+        if name == "hasattr":
+            return isinstance(second, ast.Constant) and second.value in GEAR_SET_PROBES
+    if isinstance(node, ast.Compare):
+        sides = [node.left, *node.comparators]
+        constants = [s.value for s in sides if isinstance(s, ast.Constant)]
+        meshes = [
+            tuple(e.value if isinstance(e, ast.Constant) else None for e in s.elts)
+            for s in sides
+            if isinstance(s, ast.List | ast.Tuple)
+        ]
+        if "planetary" in constants or PLANETARY_MESHES in meshes:
+            return True
+        return None in constants and any(_holds_gear_set(s) for s in sides)
+    return False
+
+
+def gear_set_switches(source: str) -> list[int]:
+    """Lines of ``source`` that ask "is it a gear set?" (a line counts once):
+
+    * ``isinstance(x, GearSet)`` or ``PlanetaryModel`` (also in a tuple or a union);
+    * ``hasattr(x, "gearset")``, ``hasattr(x, "evolve")``;
+    * a gear set compared with ``None`` (``gs is None``, ``res.gearset is not None``,
+      ``summary.get("gearset") is None``, ``getattr(m, "gearset", None) is None`` …);
+    * a gear set, or whether there is one, as a truth test (``if gs``, ``x if planetary
+      else y``, ``if attrs.get("gearset_toml")``, also in a comprehension's ``if``);
+    * a comparison with the model name ``"planetary"`` or the mesh labels ``["sp", "rp"]``.
+    """
+    lines: set[int] = set()
+    for node in ast.walk(ast.parse(source)):
+        if _is_switch(node):
+            lines.add(node.lineno)
+        tests: list[ast.AST] = []
+        if isinstance(node, ast.If | ast.IfExp | ast.While | ast.Assert):
+            tests = [node.test]
+        elif isinstance(node, ast.comprehension):
+            tests = list(node.ifs)
+        for operand in (t for test in tests for t in _truth_operands(test)):
+            if _holds_gear_set(operand):
+                lines.add(operand.lineno)
+    return sorted(lines)
+
+
+def test_the_switch_counter_sees_every_kind_of_switch() -> None:
+    """The counter on one snippet per pattern, and on code that asks the model instead."""
+    switches = [
+        "ok = isinstance(target, GearSet)",
+        "ok = isinstance(t, System | GearSet)",
+        "ok = isinstance(m, (System, PlanetaryModel))",
+        'ok = hasattr(target, "evolve")',
+        'ok = hasattr(model, "gearset")',
+        "x = 1 if gs is not None else 2",
+        "if res.base_gearset is None:\n    pass",
+        'ok = summary.get("gearset") is None',
+        'ok = getattr(model, "gearset", None) is None',
+        'if attrs.get("gearset_toml"):\n    pass',
+        'ok = [d for d in stores if d.attrs["gearset_toml"]]',
+        "x = 1 if planetary else 2",
+        "while not (a and gs):\n    pass",
+        'ok = attrs.get("model") == "planetary"',
+        'ok = labels == ["sp", "rp"]',
+    ]
+    for snippet in switches:
+        assert gear_set_switches(snippet) == [1], snippet
+    model_asks = [
+        "names = [c.name for c in system.contacts]",
+        'gs = getattr(model, "gearset", None)',  # a probe, not yet a switch
+        "if system.scales is None:\n    pass",
+        "ok = isinstance(target, System)",
+        'ok = hasattr(model, "scales")',
+        'ok = kind == "planet"',
+    ]
+    for snippet in model_asks:
+        assert gear_set_switches(snippet) == [], snippet
+    assert gear_set_switches("if gs is None and planetary:\n    pass") == [1]  # once a line
+
+
+def test_gear_set_switches_outside_gearset_and_model_do_not_grow() -> None:
+    """Issue 36: outside ``gearset/`` and ``model/``, code asks the model, not "is it a gear
+    set?". Today's count is recorded in :data:`GEAR_SET_SWITCHES`; the target is zero."""
+    counts: dict[str, int] = {}
+    for path in sorted(ROOT.rglob("*.py")):
+        rel = path.relative_to(ROOT)
+        if rel.parts[0] in ("gearset", "model"):
+            continue
+        found = gear_set_switches(path.read_text(encoding="utf-8"))
+        if found:
+            counts[rel.as_posix()] = len(found)
+    total = sum(counts.values())
+    table = "\n".join(f"  {n:3d}  {m}" for m, n in sorted(counts.items(), key=lambda kv: -kv[1]))
+    assert total <= GEAR_SET_SWITCHES, (
+        f'{total} lines outside gearset/ and model/ ask "is it a gear set?" (at most '
+        f"{GEAR_SET_SWITCHES}: ask the model for its contacts, quantities and names instead):\n"
+        f"{table}"
+    )
