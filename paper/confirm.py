@@ -28,16 +28,18 @@ import sys
 import time
 from pathlib import Path
 
+from gearchaos.gearset import preset
 from gearchaos.paper.accounting import verdict_counts
 from gearchaos.paper.calibrate import (
     STUDY,
     candidate_from_record,
-    plausibility,
     ranked,
     read_results,
+    record_plausibility,
     study_records,
 )
 from gearchaos.paper.conclusions import VERDICTS as CONCLUSION_VERDICTS
+from gearchaos.paper.loads import load_factors
 from gearchaos.paper.search_space import build_gearset
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -82,6 +84,7 @@ def main() -> None:
     ap.add_argument("--storage", help="Optuna storage URL of the study (else the log)")
     ap.add_argument("--study", default=STUDY)
     ap.add_argument("--top", type=int, default=3)
+    ap.add_argument("--any", action="store_true", help="confirm implausible candidates too")
     ap.add_argument("--preset", default="sheng2016-v1", help="the previous default, for comparison")
     ap.add_argument("--previous-report", help="report.json of the previous default (not rerun)")
     ap.add_argument("--work", default=str(ROOT / "paper" / "confirm"), help="report folders")
@@ -93,7 +96,9 @@ def main() -> None:
     else:
         records = list(read_results(args.log).values())
     order = ranked(records)
-    top = [(i + 1, r) for i, r in enumerate(order) if not plausibility(candidate_from_record(r))]
+    # plausible candidates (ranges, tooth combination, loads where the study measured them);
+    # ``--any`` confirms the best ones whatever their loads (a study without the load check)
+    top = [(i + 1, r) for i, r in enumerate(order) if args.any or not record_plausibility(r)]
     top = top[: args.top]
     work = Path(args.work)
     work.mkdir(parents=True, exist_ok=True)
@@ -108,7 +113,7 @@ def main() -> None:
         rows.append({
             "trial": rec["index"], "origin": rec["origin"], "rank": rank,
             "score": rec["score"], "structure": rec.get("structure"),
-            "variables": rec["variables"], "counts": counts(rep),
+            "variables": rec["variables"], "counts": counts(rep), "loads": load_factors(gs),
         })  # fmt: skip
     if args.previous_report:
         base = json.loads(Path(args.previous_report).read_text(encoding="utf-8"))
@@ -124,6 +129,7 @@ def main() -> None:
         "confirmed": rows,
         "previous": {
             "preset": args.preset,
+            "loads": load_factors(preset(args.preset)),
             "report": args.previous_report or f"reproduce --all -p {args.preset}",
             "counts": counts(base),
         },

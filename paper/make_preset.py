@@ -22,10 +22,9 @@ from gearchaos.paper.calibrate import (
     BASE_PRESET,
     STUDY,
     best_record,
-    candidate_from_record,
-    plausibility,
     read_results,
     record_gearset,
+    record_plausibility,
     study_records,
 )
 
@@ -60,7 +59,7 @@ def preset_text(
             f"{source}: no finished candidate" + ("" if trial is None else f" #{trial}")
         )
     n = len(records)
-    problems = plausibility(candidate_from_record(rec))
+    problems = record_plausibility(rec)
     if problems:
         raise SystemExit(f"best candidate #{rec['index']} is not plausible: {problems}")
     gs = record_gearset(rec, name=NAME, description=DESCRIPTION)

@@ -110,11 +110,13 @@ __all__ = [
     "enumerate_teeth",
     "gearset_changes",
     "landmark_objective",
+    "load_problems",
     "open_study",
     "plausibility",
     "ranked",
     "read_results",
     "record_gearset",
+    "record_plausibility",
     "study_records",
     "sweep_plan",
 ]
@@ -164,15 +166,36 @@ def _is_record(rec: Any) -> bool:
 _R = TypeVar("_R", bound=Mapping[str, Any])
 
 
-def _rank_key(record: Mapping[str, Any]) -> tuple[float, float, int]:
+def load_problems(record: Mapping[str, Any]) -> list[str]:
+    """Why a record's gear set is not plausible in its dynamic loads (:mod:`.loads`): its
+    peak mesh force over the allowable one; empty when it is, or when its loads were not
+    measured (a record of a calibration before the load check)."""
+    parts = record.get("parts")
+    loads = parts.get("loads") if isinstance(parts, Mapping) else None
+    if not isinstance(loads, Mapping) or loads.get("plausible", True):
+        return []
+    return [
+        f"peak mesh force {float(loads['peak_force_N']) / 1e3:.3g} kN (load factor "
+        f"{float(loads['max']):.3g} at Ω = {float(loads['omega']):g}) exceeds the tooth-root "
+        f"strength {float(loads['allowable_force_N']) / 1e3:.3g} kN"
+    ]
+
+
+def record_plausibility(record: Mapping[str, Any], space: SearchSpace = DEFAULT_SPACE) -> list[str]:
+    """Reasons a calibration record is not physically plausible: its candidate's
+    (:func:`plausibility`) and its loads' (:func:`load_problems`)."""
+    return plausibility(candidate_from_record(record, space), space) + load_problems(record)
+
+
+def _rank_key(record: Mapping[str, Any]) -> tuple[bool, float, float, int]:
     structure = record.get("structure")
     s = float(structure) if isinstance(structure, int | float) else 0.0
-    return -float(record["score"]), -s, int(record["index"])
+    return bool(load_problems(record)), -float(record["score"]), -s, int(record["index"])
 
 
 def ranked(records: Iterable[_R]) -> list[_R]:
-    """Calibration records best first: highest landmark score, then highest structure, then
-    the earlier trial."""
+    """Calibration records best first: those plausible in their loads before the others, then
+    highest landmark score, then highest structure, then the earlier trial."""
     return sorted(records, key=_rank_key)
 
 
@@ -377,7 +400,7 @@ def calibrate(
     problems: list[str] = []
     if best is not None:
         cand = candidate_from_record(best, space)
-        problems = plausibility(cand, space)
+        problems = record_plausibility(best, space)
         best_toml = out_path.with_name("best.toml")
         best_toml.write_text(build_gearset(cand).to_toml(), encoding="utf-8")
     evaluated = sum(1 for r in records if r["index"] not in before)

@@ -95,6 +95,9 @@ class SweepSettings:
         Score the event landmarks from continued branches (:data:`BRANCH_STEPS`).
     structure
         Compute the structural term (:mod:`gearchaos.paper.structure`).
+    loads
+        Measure the peak dynamic mesh loads (:mod:`gearchaos.paper.loads`): a candidate whose
+        teeth would break is not plausible, whatever it scores.
     """
 
     points: int = 12
@@ -106,11 +109,12 @@ class SweepSettings:
     lyapunov: bool = True
     branches: bool = True
     structure: bool = True
+    loads: bool = True
 
     def __post_init__(self) -> None:
         check_int("points", self.points, lo=0, hi=10**6)
         check_int("inside", self.inside, lo=1, hi=10**4)
-        for name in ("lyapunov", "branches", "structure"):
+        for name in ("lyapunov", "branches", "structure", "loads"):
             check_bool(name, getattr(self, name))
         _ = self.solver
 
@@ -325,6 +329,10 @@ def landmark_objective(
 
             structure, found = structure_term(gs, stores, settings.solver)
             parts.update(found)
+        if settings.loads:
+            from .loads import load_factors
+
+            parts["loads"] = load_factors(gs)
         per = {str(r.landmark.id): float(r.score) for r in results}
         held = sum(1 for r in results if r.verdict == "holds")
         parts["holds"] = held

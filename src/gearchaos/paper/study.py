@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import math
 import os
 import socket
 import time
@@ -111,7 +112,10 @@ def open_study(
     check_int("seed", seed, lo=0)
     if not isinstance(study, str) or not study.strip():
         raise ParameterError(f"study must be a non-empty name: got {study!r}")
-    sampler = optuna.samplers.TPESampler(seed=seed, multivariate=True, constant_liar=True)
+    with _quiet():  # constraints_func is experimental in Optuna
+        sampler = optuna.samplers.TPESampler(
+            seed=seed, multivariate=True, constant_liar=True, constraints_func=_constraints
+        )
     optuna.logging.set_verbosity(optuna.logging.WARNING)
     st = _storage(storage, heartbeat)
     try:
@@ -278,9 +282,25 @@ def _trial_function(
         trial.set_user_attr("landmarks", dict(ev.landmarks))
         trial.set_user_attr("seconds", round(float(ev.seconds), 3))
         trial.set_user_attr("parts", json.loads(json.dumps(dict(ev.parts), default=str)))
+        trial.set_user_attr("constraints", load_constraints(ev.parts))
         return float(ev.score), float(ev.structure)
 
     return run
+
+
+def load_constraints(parts: Mapping[str, Any]) -> list[float]:
+    """Optuna's constraint of a trial (≤ 0 feasible): F_peak/F_allow − 1 of its loads
+    (:mod:`gearchaos.paper.loads`); 0 (feasible) when they were not measured."""
+    loads = parts.get("loads")
+    if not isinstance(loads, Mapping):
+        return [0.0]
+    peak, allow = float(loads["peak_force_N"]), float(loads["allowable_force_N"])
+    return [peak / allow - 1.0 if math.isfinite(peak) else 1e6]
+
+
+def _constraints(trial: Any) -> Sequence[float]:
+    value = trial.user_attrs.get("constraints")
+    return [float(x) for x in value] if isinstance(value, list) and value else [0.0]
 
 
 def objective_of(job: Job) -> Callable[[Any], Evaluation]:
