@@ -112,10 +112,11 @@ def open_study(
     check_int("seed", seed, lo=0)
     if not isinstance(study, str) or not study.strip():
         raise ParameterError(f"study must be a non-empty name: got {study!r}")
-    with _quiet():  # constraints_func is experimental in Optuna
-        sampler = optuna.samplers.TPESampler(
-            seed=seed, multivariate=True, constant_liar=True, constraints_func=_constraints
-        )
+    kw: dict[str, Any] = {}
+    if not hasattr(optuna.trial.Trial, "set_constraint"):  # Optuna < 5: a constraints function
+        kw["constraints_func"] = _constraints
+    with _quiet():  # constraints are experimental in Optuna 4
+        sampler = optuna.samplers.TPESampler(seed=seed, multivariate=True, constant_liar=True, **kw)
     optuna.logging.set_verbosity(optuna.logging.WARNING)
     st = _storage(storage, heartbeat)
     try:
@@ -282,7 +283,10 @@ def _trial_function(
         trial.set_user_attr("landmarks", dict(ev.landmarks))
         trial.set_user_attr("seconds", round(float(ev.seconds), 3))
         trial.set_user_attr("parts", json.loads(json.dumps(dict(ev.parts), default=str)))
-        trial.set_user_attr("constraints", load_constraints(ev.parts))
+        constraint = load_constraints(ev.parts)
+        trial.set_user_attr("constraints", constraint)
+        if hasattr(trial, "set_constraint"):  # Optuna ≥ 5; before, _constraints reads the attr
+            trial.set_constraint("load", constraint[0])
         return float(ev.score), float(ev.structure)
 
     return run
