@@ -55,6 +55,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "docs"))
 sys.path.insert(0, str(ROOT / "docs"))
 
+from calibration_numbers import Markdown, calibration_values  # noqa: E402
 from tutorial_blocks import TUTORIAL, runnable  # noqa: E402
 
 PAGES = (
@@ -682,6 +683,7 @@ SOURCES: dict[str, Source] = {
         slow=True,
     ),
     "report": Source(None, _report),
+    "calibration": Source(None, lambda _: calibration_values()),
     "verdict": Source(None, _verdict_settings),
     "rattle": Source(
         "gearchaos plot rattle.zarr --contact --table -o rattle.png", _rattle, slow=True
@@ -751,6 +753,8 @@ def render(text: str, values: dict[str, dict[str, str]]) -> str:
         value = values[source][key]
         if isinstance(value, Block):
             body = f"\n\n```text\n{value}```\n\n"
+        elif isinstance(value, Markdown):
+            body = f"\n\n{value}\n\n"
         else:
             body = _formatted(value, fmt)
         return f"<!-- gen:{m['name']} -->{body}<!-- /gen -->"

@@ -85,6 +85,8 @@ def main() -> None:
     ap.add_argument("--study", default=STUDY)
     ap.add_argument("--top", type=int, default=3)
     ap.add_argument("--any", action="store_true", help="confirm implausible candidates too")
+    ap.add_argument("--trial", type=int, action="append", help="confirm this trial (repeatable)")
+    ap.add_argument("--out", default=str(OUT), help="the summary (default paper/confirmation.json)")
     ap.add_argument("--preset", default="sheng2016-v1", help="the previous default, for comparison")
     ap.add_argument("--previous-report", help="report.json of the previous default (not rerun)")
     ap.add_argument("--work", default=str(ROOT / "paper" / "confirm"), help="report folders")
@@ -99,6 +101,8 @@ def main() -> None:
     # plausible candidates (ranges, tooth combination, loads where the study measured them);
     # ``--any`` confirms the best ones whatever their loads (a study without the load check)
     top = [(i + 1, r) for i, r in enumerate(order) if args.any or not record_plausibility(r)]
+    if args.trial:
+        top = [(rank, r) for rank, r in enumerate(order, start=1) if r["index"] in args.trial]
     top = top[: args.top]
     work = Path(args.work)
     work.mkdir(parents=True, exist_ok=True)
@@ -115,16 +119,20 @@ def main() -> None:
             "score": rec["score"], "structure": rec.get("structure"),
             "variables": rec["variables"], "counts": counts(rep), "loads": load_factors(gs),
         })  # fmt: skip
+        why = record_plausibility({**rec, "parts": {"loads": rows[-1]["loads"]}})
+        rows[-1]["problems"] = why
     if args.previous_report:
         base = json.loads(Path(args.previous_report).read_text(encoding="utf-8"))
     else:
         base = _reproduce(["-p", args.preset], work / args.preset)
-    winner = min(rows, key=_key) if rows else None
+    fit = [r for r in rows if not r["problems"]]
+    winner = min(fit, key=_key) if fit else None
     result = {
         "source": f"study {args.study} ({args.storage})" if args.storage else Path(args.log).name,
         "candidates": len(records),
-        "rule": "most landmarks holding with the parameter acting, then fewest not holding, "
-        "then the calibration's rank",
+        "rule": "among the physically plausible ones (ranges, tooth combination, peak mesh force "
+        "within the teeth's strength), most landmarks holding with the parameter acting, then "
+        "fewest not holding, then the calibration's rank",
         "winner": None if winner is None else winner["trial"],
         "confirmed": rows,
         "previous": {
@@ -134,12 +142,13 @@ def main() -> None:
             "counts": counts(base),
         },
     }
-    OUT.write_text(json.dumps(result, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
+    out = Path(args.out)
+    out.write_text(json.dumps(result, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
     for row in rows:
         c = row["counts"]["landmarks"]
         print(f"trial {row['trial']} (rank {row['rank']}, score {row['score']:.2f}): {c}")
     print(f"{args.preset}: {result['previous']['counts']['landmarks']}")
-    print(f"winner: trial {result['winner']}; wrote {OUT}")
+    print(f"winner: trial {result['winner']}; wrote {out}")
 
 
 if __name__ == "__main__":
