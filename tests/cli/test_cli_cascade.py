@@ -81,9 +81,10 @@ def test_plot_draws_impact_maps_and_response_with_branches(tmp_path) -> None:
     assert force.stat().st_size > 0
     # refused by name where it does not apply or is not a quantity, never ignored
     for bad, message in (
-        ([*args, "force"], "quantity must be one of amplitude, force_peak"),
+        ([*args, "force"], "'force' is not one of 'amplitude', 'force_peak'"),
         (["plot", str(resp), "-o", str(force), "--quantity", "force_peak"], "--quantity applies"),
         (["plot", str(branch), "-o", str(force), "--quantity", "amplitude"], "--quantity applies"),
     ):
-        out = runner.invoke(app, bad)
+        out = runner.invoke(app, bad, env={"COLUMNS": "200"})  # the refusal on one line
         assert out.exit_code != 0 and message in out.output, out.output
+        assert "--quantity" in out.output

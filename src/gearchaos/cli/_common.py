@@ -19,9 +19,9 @@ import os
 import select
 import unicodedata
 import warnings
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any, NoReturn
+from typing import TYPE_CHECKING, Annotated, Any, NoReturn, TypeVar, overload
 
 import numpy as np
 import typer
@@ -34,23 +34,24 @@ from .._version import __version__
 from ..errors import IntegrationError, ParameterError, StoreError
 from ..gearset.parsing import parse_text
 from ..model.target import DEFAULT_OMEGA, OMEGA, check_omega
-from ._options import (  # the shared options, re-exported: c.PresetOpt …
+from ._options import (  # the shared options, re-exported: c.Target, c.Direction …
     DEFAULT_PRESET as DEFAULT_PRESET,
-    AtolOpt as AtolOpt,
-    FromModelOpt as FromModelOpt,
-    GearsetOpt as GearsetOpt,
-    JsonOpt as JsonOpt,
-    ModelOpt as ModelOpt,
-    OverwriteOpt as OverwriteOpt,
-    PeriodsOpt as PeriodsOpt,
-    PerturbationOpt as PerturbationOpt,
-    PresetOpt as PresetOpt,
-    QuietOpt as QuietOpt,
-    RtolOpt as RtolOpt,
-    SetOpt as SetOpt,
-    SettleOpt as SettleOpt,
-    TransientOpt as TransientOpt,
-    WorkersOpt as WorkersOpt,
+    RECORDED_MODEL as RECORDED_MODEL,
+    Assess as Assess,
+    Direction as Direction,
+    Execution as Execution,
+    ExportFormat as ExportFormat,
+    InitialConditions as InitialConditions,
+    Output as Output,
+    Protocol as Protocol,
+    Quantity as Quantity,
+    Settle as Settle,
+    Solver as Solver,
+    Target as Target,
+    Verdict as Verdict,
+    choice_value as choice_value,
+    named_options as named_options,
+    spread_groups,
 )
 from ._speeds import one_point, point_omega, without_speeds
 
@@ -146,6 +147,22 @@ app = typer.Typer(
     rich_markup_mode="markdown",
     context_settings={"help_option_names": ["-h", "--help"]},
 )
+
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+
+def command(name: str | None = None) -> Callable[[F], F]:
+    """Register a command of :data:`app` whose option groups (parameters typed
+    :class:`~gearchaos.cli._options.Target`, :class:`~gearchaos.cli._options.Protocol`, …)
+    are spread into their options (:func:`~gearchaos.cli._options.spread_groups`)."""
+
+    def register(fn: F) -> F:
+        run = spread_groups(fn)
+        app.command(name)(run)
+        return run
+
+    return register
 
 
 # --------------------------------------------------------------------------- consoles, errors
@@ -325,12 +342,11 @@ def parse_sets(items: Sequence[str]) -> tuple[float | None, dict[str, object]]:
     return omega, changes
 
 
-def load_gearset(
-    preset: str | None, gearset_file: Path | None, changes: Mapping[str, object] | None = None
-) -> GearSet:
+def load_gearset(target: Target, changes: Mapping[str, object] | None = None) -> GearSet:
     """The gear set of ``--preset`` / ``--gearset`` (default preset), with ``changes``."""
     from ..gearset import GearSet, preset as load_preset
 
+    preset, gearset_file = target.preset, target.gearset
     if preset is not None and gearset_file is not None:
         raise ParameterError(
             f"--preset and --gearset are mutually exclusive: got --preset {preset} and "
@@ -360,18 +376,14 @@ def load_gearset(
     return gs
 
 
-def load_target(
-    preset: str | None,
-    gearset_file: Path | None,
-    model: str | None,
-    changes: Mapping[str, object] | None = None,
-) -> Any:
+def load_target(target: Target, changes: Mapping[str, object] | None = None) -> Any:
     """The gear set of ``--preset``/``--gearset`` with ``changes`` (:func:`load_gearset`), or,
     with ``--model``, a :class:`~gearchaos.model.System` of that model class with ``changes``
     as its parameters (at Ω = DEFAULT_OMEGA until a command sets Ω; a model refuses a speed)."""
+    model = target.model
     if model is None:
-        return load_gearset(preset, gearset_file, changes)
-    if preset is not None or gearset_file is not None:
+        return load_gearset(target, changes)
+    if target.preset is not None or target.gearset is not None:
         raise ParameterError("--model excludes --preset and --gearset: give one of them")
     from ..model import System
     from ..model.loading import build_model, load_model_class
@@ -382,24 +394,34 @@ def load_target(
     return system
 
 
+@overload
+def point_target(target: Target) -> tuple[Any, float | None]: ...
+@overload
+def point_target(target: Target, quiet: bool) -> tuple[Any, float]: ...
+def point_target(target: Target, quiet: bool | None = None) -> tuple[Any, float | None]:
+    """(target, Ω) of a command at one operating point: the target of ``--preset``,
+    ``--gearset`` or ``--model`` changed by ``--set``, and Ω from ``--set omega`` or a speed
+    (``--set sun_rpm``, converted through it); ``None`` when neither is set, or, unless
+    ``quiet`` is None, the default Ω with a note unless ``quiet``."""
+    omega, changes = parse_sets(target.sets or [])
+    built = load_target(target, changes)
+    omega = point_omega(built, omega, changes)  # --set sun_rpm / mesh_hz: through it
+    if omega is None and quiet is not None:
+        omega = DEFAULT_OMEGA
+        default_omega_note(quiet, "set")
+    return built, omega
+
+
 def sweep_target(
-    preset: str | None,
-    gearset_file: Path | None,
-    model: str | None,
-    swept: set[str],
-    omega: float | None,
-    changes: Mapping[str, object],
-    quiet: bool,
-    verb: str = "swept",
+    target: Target, swept: set[str], quiet: bool, verb: str = "swept"
 ) -> tuple[Any, dict[str, Any]]:
-    """(target, fixed values) of a command over a parameter (a sweep, a gallery, a
-    continuation: ``verb``, for the messages): a ``--model``'s parameters are set on the model
-    itself (its fields), a gear set's changes are fixed values (:func:`sweep_fixed`)."""
-    if model is not None:
-        return load_target(preset, gearset_file, model, changes), sweep_fixed(
-            swept, omega, {}, quiet, verb
-        )
-    return load_gearset(preset, gearset_file), sweep_fixed(swept, omega, changes, quiet, verb)
+    """(target, fixed values) of a command over the parameters ``swept`` (a sweep, a gallery,
+    a continuation: ``verb``, for the messages): a ``--model``'s parameters are set on the
+    model itself (its fields), a gear set's changes are fixed values (:func:`sweep_fixed`)."""
+    omega, changes = parse_sets(target.sets or [])
+    if target.model is not None:
+        return load_target(target, changes), sweep_fixed(swept, omega, {}, quiet, verb)
+    return load_gearset(target), sweep_fixed(swept, omega, changes, quiet, verb)
 
 
 def default_omega_note(quiet: bool, what: str = "swept") -> None:
@@ -434,6 +456,20 @@ def sweep_fixed(
             default_omega_note(quiet, verb if note is None else note)
         fixed[OMEGA] = omega
     return fixed
+
+
+def settings(protocol: Protocol, solver: Solver) -> SolverSettings:
+    """The :class:`~gearchaos.integrate.settings.SolverSettings` of a command's protocol and
+    solver options (:func:`solver_settings`)."""
+    return solver_settings(
+        protocol.transient,
+        protocol.periods,
+        solver.rtol,
+        solver.atol,
+        protocol.samples_per_period,
+        str(protocol.settle.value),
+        protocol.perturbation,
+    )
 
 
 def solver_settings(
@@ -503,29 +539,18 @@ def main(
         raise typer.Exit(EXIT_INVALID)
 
 
-def output_path(raw: str | None, option: str = "--output") -> Path | None:
-    """The path of an output option; an empty one is refused (it would mean the current
-    directory by accident)."""
-    if raw is None:
-        return None
-    if not raw.strip():
-        raise ParameterError(f"{option} must be a path: got an empty string")
-    return Path(raw)
-
-
 def run_sweep(
     fn: Any,
     *args: Any,
     settings: Any,
-    output: Path,
-    overwrite: bool,
-    workers: int | None,
-    quiet: bool,
+    output: Output,
+    execution: Execution,
     **options: Any,
 ) -> tuple[Any, float]:
     """``fn(*args, **options)`` (a sweep function of :mod:`gearchaos.sweep`) with the options
-    every sweep command shares — solver settings, store, overwrite, workers, a progress bar
-    unless ``quiet`` — timed; returns its :class:`~gearchaos.sweep.SweepResult` and seconds."""
+    every sweep command shares — solver settings, store and overwrite, the execution options
+    the command offers, a progress bar unless ``--quiet`` — timed; returns its
+    :class:`~gearchaos.sweep.SweepResult` and seconds."""
     import time
 
     from ..sweep import SweepResult
@@ -534,25 +559,23 @@ def run_sweep(
     ds = fn(
         *args,
         settings=settings,
-        store=output,
-        overwrite=overwrite,
-        workers=workers,
-        progress=not quiet,
+        store=output.required_path(),
+        overwrite=output.overwrite,
+        progress=not output.quiet,
+        **execution.offered_values(),
         **options,
     )
     return SweepResult.of(ds), time.perf_counter() - t0
 
 
-def sweep_report(
-    title: str, res: Any, result: Mapping[str, Any], *, json_out: bool, quiet: bool
-) -> Any:
+def sweep_report(title: str, res: Any, result: Mapping[str, Any], output: Output) -> Any:
     """What a sweep command prints of ``result`` (its summary): the JSON with ``--json``,
     nothing with ``--quiet`` (both return None), else the summary table to be completed."""
     from ._render import sweep_table
 
-    if json_out:
+    if output.json:
         print_json(result)
         return None
-    if quiet:
+    if output.quiet:
         return None
     return sweep_table(title, res, result)

@@ -2,11 +2,8 @@
 
 from __future__ import annotations
 
-import contextlib
 import json
 import time
-from collections.abc import Iterator
-from pathlib import Path
 from typing import Annotated, Any
 
 import typer
@@ -19,16 +16,14 @@ from ..errors import ParameterError
 from ..sweep.basins import BASIN_SETTINGS
 from . import _common as c
 
-OutputOpt = Annotated[
-    Path,
-    typer.Option(
-        "--output",
-        "-o",
-        help="Zarr store to write (a directory, e.g. basins.zarr); run the same command again "
-        "after an interruption to resume.",
-        show_default=False,
-    ),
-]
+#: -o and the rest of the output options of basins and basin-fractions.
+OUTPUT = c.Output().offering(
+    help={
+        "file": "Zarr store to write (a directory, e.g. basins.zarr); run the same command "
+        "again after an interruption to resume."
+    },
+    required=("file",),
+)
 SampleOpt = Annotated[
     int,
     typer.Option(
@@ -38,6 +33,7 @@ SampleOpt = Annotated[
     ),
 ]
 SeedOpt = Annotated[int, typer.Option("--seed", help="Seed of the sample (and random starts).")]
+PROTOCOL = c.Protocol.of(BASIN_SETTINGS).offering("transient", "periods")
 BaseOpt = Annotated[
     list[str] | None,
     typer.Option(
@@ -45,20 +41,6 @@ BaseOpt = Annotated[
         help="STATE=VALUE, repeatable: the value of a state coordinate that is not varied "
         "(default 0).",
         show_default=False,
-    ),
-]
-SchedulerOpt = Annotated[
-    str | None,
-    typer.Option(
-        "--scheduler",
-        help="Address of a running dask.distributed scheduler, e.g. tcp://HOST:8786.",
-        show_default=False,
-    ),
-]
-DaskLocalOpt = Annotated[
-    int | None,
-    typer.Option(
-        "--dask-local", help="Start a local Dask cluster with N workers.", show_default=False
     ),
 ]
 
@@ -96,32 +78,6 @@ def _box(items: list[str] | None) -> dict[str, tuple[float, float]] | None:
 _OPTIONS = {"x": "--x", "y": "--y", "base_state": "--base", "starts": "--starts", "box": "--box"}
 
 
-@contextlib.contextmanager
-def _options() -> Iterator[None]:
-    """A refusal of a keyword of the basin doors (its ``name``) names the option it was given
-    as: ``--x: …`` for ``x``."""
-    try:
-        yield
-    except ParameterError as exc:
-        option = _OPTIONS.get(exc.name or "")
-        if option is None:
-            raise
-        text = str(exc)
-        if option == f"--{exc.name}" and text.startswith(f"{exc.name} "):
-            raise ParameterError(f"--{text}", name=exc.name) from None
-        raise ParameterError(f"{option}: {text}", name=exc.name) from None
-
-
-def _target(preset: Any, gearset: Any, model: Any, sets: list[str] | None, quiet: bool) -> Any:
-    omega, changes = c.parse_sets(sets or [])
-    target = c.load_target(preset, gearset, model, changes)
-    omega = c.point_omega(target, omega, changes)  # --set sun_rpm / mesh_hz: through it
-    if omega is None:
-        omega = c.DEFAULT_OMEGA
-        c.default_omega_note(quiet, "set")
-    return target, omega
-
-
 def _legend_table(
     title: str, entries: list[dict[str, Any]], codes: Any, xname: str, column: int
 ) -> Table:
@@ -147,9 +103,8 @@ def _legend_table(
     return table
 
 
-@c.app.command()
+@c.command()
 def basins(
-    output: OutputOpt,
     x: Annotated[
         str,
         typer.Option("--x", help="STATE=start:stop:count, the horizontal state coordinate."),
@@ -158,22 +113,13 @@ def basins(
         str, typer.Option("--y", help="STATE=start:stop:count, the vertical state coordinate.")
     ],
     base: BaseOpt = None,
-    preset: c.PresetOpt = None,
-    gearset: c.GearsetOpt = None,
-    model: c.ModelOpt = None,
-    set_: c.SetOpt = None,
+    target: c.Target = c.Target(),
     sample: SampleOpt = 32,
     seed: SeedOpt = 0,
-    transient: c.TransientOpt = BASIN_SETTINGS.transient_periods,
-    periods: c.PeriodsOpt = BASIN_SETTINGS.periods,
-    rtol: c.RtolOpt = BASIN_SETTINGS.rtol,
-    atol: c.AtolOpt = BASIN_SETTINGS.atol,
-    workers: c.WorkersOpt = None,
-    scheduler: SchedulerOpt = None,
-    dask_local: DaskLocalOpt = None,
-    overwrite: c.OverwriteOpt = False,
-    quiet: c.QuietOpt = False,
-    json_out: c.JsonOpt = False,
+    protocol: c.Protocol = PROTOCOL,
+    solver: c.Solver = c.Solver.of(BASIN_SETTINGS),
+    execution: c.Execution = c.Execution(),
+    output: c.Output = OUTPUT,
 ) -> None:
     """Basin image at one operating point: which attractor each start of a 2-D slice of
     initial states reaches.
@@ -190,35 +136,34 @@ def basins(
     from ..sweep.basins import basins as run
 
     with c.reported_errors(), c.interruptible():
-        target, omega = _target(preset, gearset, model, set_, quiet or json_out)
-        settings = c.solver_settings(transient, periods, rtol, atol)
+        built, omega = c.point_target(target, output.silent)
+        settings = c.settings(protocol, solver)
         t0 = time.perf_counter()
-        with c.warnings_to_stderr(), _options():
+        with c.warnings_to_stderr(), c.named_options(**_OPTIONS):
             ds = run(
-                target,
+                built,
                 x,
                 y,
                 base_state=_base(base),
                 omega=omega,
                 settings=settings,
-                store=output,
-                overwrite=overwrite,
-                progress=not (quiet or json_out),
+                store=output.required_path(),
+                overwrite=output.overwrite,
+                progress=not output.silent,
                 sample=sample,
                 seed=seed,
-                workers=workers,
-                scheduler=scheduler,
-                dask_local=dask_local,
+                **execution.offered_values(),
             )
         seconds = time.perf_counter() - t0
+    path = output.required_path()
     import numpy as np
 
     entries = json.loads(ds.attrs["attractors"])["0"]["entries"]
     codes = np.asarray(ds["attractor"].values)
-    if json_out:
+    if output.json:
         c.print_json(
             {
-                "store": str(output),
+                "store": str(path),
                 "starts": int(codes.size),
                 "seconds": seconds,
                 "attractors": [
@@ -229,7 +174,7 @@ def basins(
             }
         )
         return
-    if quiet:
+    if output.quiet:
         return
     xname = ds.attrs["dims"][1]
     column = [str(s) for s in ds["state"].values].index(xname)
@@ -238,16 +183,15 @@ def basins(
     out.print(_legend_table(title, entries, codes, xname, column))
     out.print(
         Text(
-            f"{seconds:.3g} s; next: gearchaos plot {escape_path(output)} -o "
-            f"{escape_path(output.stem)}.png",
+            f"{seconds:.3g} s; next: gearchaos plot {escape_path(path)} -o "
+            f"{escape_path(path.stem)}.png",
             style="dim",
         )
     )
 
 
-@c.app.command("basin-fractions")
+@c.command("basin-fractions")
 def basin_fractions(
-    output: OutputOpt,
     vary: Annotated[
         str, typer.Option("--vary", "-v", help="NAME=VALUES, the parameter, e.g. omega=1:2:40.")
     ],
@@ -265,22 +209,13 @@ def basin_fractions(
         ),
     ] = None,
     base: BaseOpt = None,
-    preset: c.PresetOpt = None,
-    gearset: c.GearsetOpt = None,
-    model: c.ModelOpt = None,
-    set_: c.SetOpt = None,
+    target: c.Target = c.Target(),
     sample: SampleOpt = 16,
     seed: SeedOpt = 0,
-    transient: c.TransientOpt = BASIN_SETTINGS.transient_periods,
-    periods: c.PeriodsOpt = BASIN_SETTINGS.periods,
-    rtol: c.RtolOpt = BASIN_SETTINGS.rtol,
-    atol: c.AtolOpt = BASIN_SETTINGS.atol,
-    workers: c.WorkersOpt = None,
-    scheduler: SchedulerOpt = None,
-    dask_local: DaskLocalOpt = None,
-    overwrite: c.OverwriteOpt = False,
-    quiet: c.QuietOpt = False,
-    json_out: c.JsonOpt = False,
+    protocol: c.Protocol = PROTOCOL,
+    solver: c.Solver = c.Solver.of(BASIN_SETTINGS),
+    execution: c.Execution = c.Execution(),
+    output: c.Output = OUTPUT,
 ) -> None:
     """Across a parameter, the fraction of random starts ending on each attractor, with 95 %
     Wilson confidence intervals ("how likely is rattle at this speed").
@@ -290,16 +225,16 @@ def basin_fractions(
     from ..sweep.basin_fractions import basin_fractions as run
 
     with c.reported_errors(), c.interruptible():
-        omega, changes = c.parse_sets(set_ or [])
-        target = c.load_target(preset, gearset, model, changes)
-        omega = c.point_omega(target, omega, changes)  # --set sun_rpm / mesh_hz: through it
+        omega, changes = c.parse_sets(target.sets or [])
+        built = c.load_target(target, changes)
+        omega = c.point_omega(built, omega, changes)  # --set sun_rpm / mesh_hz: through it
         name = vary.partition("=")[0].strip()
-        values = c.sweep_fixed({name}, omega, {}, quiet or json_out, "varied", "swept or set")
-        settings = c.solver_settings(transient, periods, rtol, atol)
+        values = c.sweep_fixed({name}, omega, {}, output.silent, "varied", "swept or set")
+        settings = c.settings(protocol, solver)
         t0 = time.perf_counter()
-        with c.warnings_to_stderr(), _options():
+        with c.warnings_to_stderr(), c.named_options(**_OPTIONS):
             ds = run(
-                target,
+                built,
                 vary,
                 starts=starts,
                 box=_box(box),
@@ -307,15 +242,14 @@ def basin_fractions(
                 seed=seed,
                 params=values,
                 settings=settings,
-                store=output,
-                overwrite=overwrite,
-                progress=not (quiet or json_out),
+                store=output.required_path(),
+                overwrite=output.overwrite,
+                progress=not output.silent,
                 sample=sample,
-                workers=workers,
-                scheduler=scheduler,
-                dask_local=dask_local,
+                **execution.offered_values(),
             )
         seconds = time.perf_counter() - t0
+    path = output.required_path()
     from ..dynamics.basins import BasinAttractor
 
     param = ds.attrs["dims"][0]
@@ -340,10 +274,10 @@ def basin_fractions(
                         "high": float(ds["fraction_high"].values[i, j]),
                     }
                 )
-    if json_out:
-        c.print_json({"store": str(output), "seconds": seconds, "fractions": rows})
+    if output.json:
+        c.print_json({"store": str(path), "seconds": seconds, "fractions": rows})
         return
-    if quiet:
+    if output.quiet:
         return
     table = Table(title=f"basin fractions of {starts} starts (95 % Wilson interval)")
     for col in (param, "track", "attractor", "fraction", "interval"):
@@ -360,8 +294,8 @@ def basin_fractions(
     out.print(table)
     out.print(
         Text(
-            f"{seconds:.3g} s; next: gearchaos plot {escape_path(output)} -o "
-            f"{escape_path(output.stem)}.png",
+            f"{seconds:.3g} s; next: gearchaos plot {escape_path(path)} -o "
+            f"{escape_path(path.stem)}.png",
             style="dim",
         )
     )

@@ -52,7 +52,7 @@ def pick_event(found: list[Any], spec: str) -> Any:
     return same[n - 1]
 
 
-@c.app.command()
+@c.command()
 def boundary(
     from_: Annotated[
         Path,
@@ -71,10 +71,6 @@ def boundary(
             "xi=0.01:0.05 (the event's value of it must lie inside).",
             show_default=False,
         ),
-    ],
-    output: Annotated[
-        str,
-        typer.Option("--output", "-o", help="Curve file: CURVE.nc.", show_default=False),
     ],
     event: Annotated[
         str,
@@ -102,13 +98,13 @@ def boundary(
         ),
     ] = None,
     assess: Annotated[
-        str,
+        c.Assess,
         typer.Option(
             "--assess",
             help="Which points state their uncertainty (corrected again 100 times tighter): "
             "landed (the --at points), all (every point, about twice the cost) or none.",
         ),
-    ] = "landed",
+    ] = c.Assess("landed"),
     max_points: Annotated[
         int, typer.Option("--max-points", help="Most new points per direction.")
     ] = 200,
@@ -119,10 +115,10 @@ def boundary(
         bool,
         typer.Option("--resume", help="Extend the unfinished ends of an existing CURVE.nc."),
     ] = False,
-    model: c.FromModelOpt = None,
-    overwrite: c.OverwriteOpt = False,
-    quiet: c.QuietOpt = False,
-    json_out: c.JsonOpt = False,
+    target: c.Target = c.RECORDED_MODEL,
+    output: c.Output = c.Output().offering(
+        help={"file": "Curve file: CURVE.nc."}, required=("file",)
+    ),
 ) -> None:
     """Continue a fold, period doubling, Neimark–Sacker or grazing event of a branch in a
     second parameter: the boundary curve of a stability chart, with its orbit and
@@ -139,15 +135,15 @@ def boundary(
     from ._start import _gearset, name_model
 
     with c.reported_errors():
-        path = c.output_path(output)
-        assert path is not None
+        path = output.required_path()
         if path.suffix.lower() not in (".nc", ".zarr"):
-            raise ParameterError(f"--output must end in .nc or .zarr: got {output!r}")
-        name_model(model)  # the consent to build the branch's own model again
+            raise ParameterError(f"--output must end in .nc or .zarr: got {output.file!r}")
+        quiet, json_out = output.quiet, output.json
+        name_model(target.model)  # the consent to build the branch's own model again
         branch = open_branch(from_)
         if branch.attrs.get("kind") == "boundary_curve":
             raise ParameterError(f"--from {from_} is a boundary curve, not a one-parameter branch")
-        target = _gearset(branch.attrs, str(from_))  # its model, before anything else
+        built = _gearset(branch.attrs, str(from_))  # its model, before anything else
         chosen = pick_event(events(branch), event)
         cfg = SolverSettings.from_record(branch.attrs)
         name = str(branch.attrs["parameter"])
@@ -175,14 +171,12 @@ def boundary(
 
         if not quiet and not json_out:
             err.print(Text(f"continuing {chosen!r} in {vary}", style="dim"))
-        try:
+        with c.named_options(vary="--vary", within="--within", at="--at"):
             curve = boundary_curve(
-                target, chosen, vary, within=within, settings=cfg, at=values, assess=assess,
-                max_points=max_points, max_step=max_step, store=path, resume=resume,
-                overwrite=overwrite, progress=progress,
+                built, chosen, vary, within=within, settings=cfg, at=values,
+                assess=str(assess.value), max_points=max_points, max_step=max_step, store=path,
+                resume=resume, overwrite=output.overwrite, progress=progress,
             )  # fmt: skip
-        except ParameterError as exc:
-            raise as_option(exc) from None
         summary = curve_summary(curve)
         if json_out:
             c.print_json(summary)
@@ -212,15 +206,6 @@ def boundary(
             out.print(Text(f"next: gearchaos plot MAP.zarr --boundaries {shown} -o chart.png",
                            style="dim"))  # fmt: skip
     c.wrote(path)
-
-
-def as_option(exc: ParameterError) -> ParameterError:
-    """A refusal of boundary_curve's keyword ``vary``, ``within`` or ``at`` (its message starts
-    with the keyword) as one of the option ``--vary``, ``--within`` or ``--at``."""
-    text = str(exc)
-    if exc.name in ("vary", "within", "at") and text.startswith(exc.name):
-        return ParameterError("--" + text, name=exc.name)
-    return exc
 
 
 def curve_summary(ds: Any) -> dict[str, Any]:

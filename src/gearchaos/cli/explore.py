@@ -13,7 +13,7 @@ from ..errors import ParameterError
 from . import _common as c
 
 
-@c.app.command()
+@c.command()
 def explore(
     store: Annotated[
         Path,
@@ -42,7 +42,7 @@ def explore(
             show_default=False,
         ),
     ] = None,
-    model: c.FromModelOpt = None,
+    target: c.Target = c.RECORDED_MODEL,
 ) -> None:
     """Explore a sweep store in the browser: its bifurcation diagram with the band of motion
     labels (or the regime map of a 2-D sweep). Click a point, or move the slider, to see its
@@ -57,7 +57,7 @@ def explore(
     from .sweep import open_store
 
     with c.reported_errors():
-        name_model(model)  # a finer sweep of your own model's store: only with your consent
+        name_model(target.model)  # a finer sweep of your own model's store: only with your consent
         if not 0 <= port <= 65535:
             raise ParameterError(f"--port must be an integer in 0..65535: got {port}")
         open_store(store)

@@ -10,7 +10,7 @@ import typer
 from . import _common as c
 
 
-@c.app.command()
+@c.command()
 def export(
     source: Annotated[
         Path,
@@ -19,12 +19,8 @@ def export(
             show_default=False,
         ),
     ],
-    output: Annotated[
-        str,
-        typer.Option("--output", "-o", help="File to write (.csv or .mat).", show_default=False),
-    ],
     to: Annotated[
-        str | None,
+        c.ExportFormat | None,
         typer.Option(
             "--to",
             help="csv (TABLE.csv: one row per point; TABLE.sections.csv: the section samples; "
@@ -33,6 +29,9 @@ def export(
             show_default=False,
         ),
     ] = None,
+    output: c.Output = c.Output().offering(
+        "file", help={"file": "File to write (.csv or .mat)."}, required=("file",)
+    ),
 ) -> None:
     """Export a result for spreadsheets and other tools: CSV tables or a MATLAB .mat file.
 
@@ -53,8 +52,6 @@ def export(
     from ..sweep.exports import write_export
 
     with c.reported_errors():
-        path = c.output_path(output)
-        assert path is not None
-        written = write_export(source, path, to=to)
+        written = write_export(source, output.required_path(), to=c.choice_value(to))
     for p in written:
         c.wrote(p)

@@ -14,7 +14,7 @@ from . import _common as c
 from ._render import gallery_rows_table
 
 
-@c.app.command()
+@c.command()
 def poincare(
     vary: Annotated[
         str | None,
@@ -29,16 +29,7 @@ def poincare(
             show_default=False,
         ),
     ] = None,
-    output: Annotated[
-        Path | None,
-        typer.Option("--output", "-o", help="Figure file: .png, .pdf or .svg.", show_default=False),
-    ] = None,
-    preset: c.PresetOpt = None,
-    gearset: c.GearsetOpt = None,
-    model: c.ModelOpt = None,
-    set_: c.SetOpt = None,
-    transient: c.TransientOpt = GALLERY_SETTINGS.transient_periods,
-    periods: c.PeriodsOpt = GALLERY_SETTINGS.periods,
+    target: c.Target = c.Target(),
     with_: Annotated[
         str | None,
         typer.Option(
@@ -48,10 +39,11 @@ def poincare(
         ),
     ] = None,
     planet: Annotated[int, typer.Option("--planet", help="Planet of X̄_sp.")] = 1,
-    rtol: c.RtolOpt = GALLERY_SETTINGS.rtol,
-    atol: c.AtolOpt = GALLERY_SETTINGS.atol,
-    quiet: c.QuietOpt = False,
-    json_out: c.JsonOpt = False,
+    protocol: c.Protocol = c.Protocol.of(GALLERY_SETTINGS).offering("transient", "periods"),
+    solver: c.Solver = c.Solver.of(GALLERY_SETTINGS),
+    output: c.Output = c.Output().offering(
+        "file", "quiet", "json", help={"file": "Figure file: .png, .pdf or .svg."}
+    ),
 ) -> None:
     """A gallery of Poincaré maps (X̄_sp1 against X̄'_sp1) along a parameter path, each panel
     titled with the value, its motion label and its largest Lyapunov exponent λ₁.
@@ -71,11 +63,12 @@ def poincare(
             raise ParameterError(
                 "--vary is required: give NAME=VALUES, e.g. --vary omega=1.2,1.5,1.875"
             )
-        if output is None:
+        path = output.path()
+        if path is None:
             raise ParameterError("--output is required: the figure file, e.g. -o gallery.png")
-        if output.suffix.lower() not in SAVE_FORMATS:
+        if path.suffix.lower() not in SAVE_FORMATS:
             raise ParameterError(
-                f"--output must end in one of {', '.join(SAVE_FORMATS)}: got {str(output)!r}"
+                f"--output must end in one of {', '.join(SAVE_FORMATS)}: got {str(path)!r}"
             )
         from ..plot.gallery import parse_extras
         from ..sweep.spec import parse_axis
@@ -87,11 +80,8 @@ def poincare(
                 f"--with must be phase, spectrum or phase,spectrum: got {with_!r}"
             ) from None
         axis = parse_axis(vary)
-        omega, changes = c.parse_sets(set_ or [])
-        settings = c.solver_settings(transient, periods, rtol, atol)
-        gs, fixed = c.sweep_target(
-            preset, gearset, model, {axis.name}, omega, changes, quiet or json_out, "varied"
-        )
+        settings = c.settings(protocol, solver)
+        gs, fixed = c.sweep_target(target, {axis.name}, output.silent, "varied")
 
         import matplotlib
 
@@ -106,33 +96,33 @@ def poincare(
             axis.values,
             params=fixed,
             with_=extras,
-            progress=not (quiet or json_out),
+            progress=not output.silent,
             planet=planet,
             settings=settings,
         )
-        if output.parent != Path(""):
-            output.parent.mkdir(parents=True, exist_ok=True)
+        if path.parent != Path(""):
+            path.parent.mkdir(parents=True, exist_ok=True)
         try:
-            savefig(fig, output)
+            savefig(fig, path)
         finally:
             import matplotlib.pyplot as plt
 
             plt.close(fig)
         seconds = time.perf_counter() - t0
-    if json_out:
+    if output.json:
         c.print_json(
             {
-                "figure": str(output),
+                "figure": str(path),
                 "param": axis.name,
                 "fixed": fixed,
-                "transient_periods": transient,
-                "periods": periods,
+                "transient_periods": protocol.transient,
+                "periods": protocol.periods,
                 "seconds": seconds,
                 "rows": rows,
             }
         )
         return
-    if quiet:
+    if output.quiet:
         return
     c.stdout().print(gallery_rows_table(rows, axis.name, title=f"Poincaré gallery of {gs.name}"))
-    c.wrote(output)
+    c.wrote(path)

@@ -14,12 +14,10 @@ from . import _common as c
 from ._render import info_renderables
 
 
-@c.app.command()
+@c.command()
 def info(
-    preset: c.PresetOpt = None,
-    gearset: c.GearsetOpt = None,
-    set_: c.SetOpt = None,
-    json_out: c.JsonOpt = False,
+    target: c.Target = c.Target().offering("preset", "gearset", "sets"),
+    output: c.Output = c.Output().offering("json"),
 ) -> None:
     """Linear properties of a gear set: radii, equivalent masses, ω_n, damping coefficients,
     dimensionless groups, mesh phasing and natural frequencies with their mode classes.
@@ -27,8 +25,8 @@ def info(
     With **--set omega=...** the operating point (mesh frequency, sun speed) is added.
     """
     with c.reported_errors():
-        omega, changes = c.parse_sets(set_ or [])
-        gs = c.load_gearset(preset, gearset, changes)
+        omega, changes = c.parse_sets(target.sets or [])
+        gs = c.load_gearset(target, changes)
         omega = c.point_omega(gs, omega, changes)  # --set sun_rpm / mesh_hz: through gs
         from ..model.derived import gearset_info
 
@@ -40,7 +38,7 @@ def info(
                 "mesh_frequency_hz": omega * gs.omega_n / (2.0 * math.pi),
                 "sun_speed_rpm": gs.sun_speed_rpm(omega),
             }
-    if json_out:
+    if output.json:
         c.print_json(data)
         return
     out = c.stdout()
@@ -52,7 +50,7 @@ def info(
         out.print(renderable)
 
 
-@c.app.command()
+@c.command()
 def presets() -> None:
     """List the built-in gear sets (use one with --preset NAME)."""
     from ..gearset import list_presets
@@ -65,7 +63,7 @@ def presets() -> None:
     c.stdout().print(table)
 
 
-@c.app.command("init-gearset")
+@c.command("init-gearset")
 def init_gearset(
     file: Annotated[
         Path, typer.Argument(help="TOML file to write.", dir_okay=False, show_default=False)

@@ -34,16 +34,6 @@ PeriodOpt = Annotated[
     ),
 ]
 
-GuessOpt = Annotated[
-    float,
-    typer.Option(
-        "--transient",
-        help="Mesh periods simulated from rest for the first guess of the (starting) orbit; "
-        "while the shooting then finds no orbit (or, for orbit, an unstable one), the guess "
-        "settles longer, up to 16 times as long.",
-    ),
-]
-
 FromOpt = Annotated[
     str | None,
     typer.Option(
@@ -66,6 +56,17 @@ AtOpt = Annotated[
 ]
 
 
+#: The protocol of orbit and continue: --transient simulates the first guess; one period.
+GUESS = c.Protocol.of(ORBIT_SETTINGS, periods=1).offering(
+    "transient",
+    help={
+        "transient": "Mesh periods simulated from rest for the first guess of the (starting) "
+        "orbit; while the shooting then finds no orbit (or, for orbit, an unstable one), the "
+        "guess settles longer, up to 16 times as long."
+    },
+)
+
+
 def _period(period: int | None, start: Any) -> int:
     """--period, else the period the start knows, else 1."""
     if period is not None:
@@ -74,32 +75,26 @@ def _period(period: int | None, start: Any) -> int:
 
 
 def _start_values(
-    from_: str | None,
-    at: str | None,
-    preset: str | None,
-    gearset: Path | None,
-    sets: list[str],
-    model: str | None = None,
+    from_: str | None, at: str | None, target: c.Target
 ) -> tuple[Any, dict[str, Any], Any]:
     """(gear set, parameter values, start or None) of ``orbit`` and ``continue``: from
     ``--from``/``--at`` when given (its gear set and values, ``--set`` on top), else the gear
     set of ``--preset``/``--gearset`` changed by ``--set`` and Ω alone as a value."""
     from ._start import load_start
 
-    omega, changes = c.parse_sets(sets)
     if from_ is None:
         if at is not None:
             raise ParameterError(f"--at picks a point of --from, which is missing: got --at {at}")
-        target = c.load_target(preset, gearset, model, changes)
-        omega = c.point_omega(target, omega, changes)  # --set sun_rpm / mesh_hz: through it
+        built, omega = c.point_target(target)
         values: dict[str, Any] = {} if omega is None else {OMEGA: omega}
-        return target, values, None
-    if preset is not None or gearset is not None:
+        return built, values, None
+    omega, changes = c.parse_sets(target.sets or [])
+    if target.preset is not None or target.gearset is not None:
         raise ParameterError(
             "--from brings the gear set it was computed for: drop --preset/--gearset (change "
             "values with --set)"
         )
-    start = load_start(from_, at, model)
+    start = load_start(from_, at, target.model)
     values = {**start.values, **c.without_speeds(changes)}
     omega = c.point_omega(start.gearset, omega, changes, values)
     if omega is not None:
@@ -112,29 +107,22 @@ def _spinner(text: str, quiet: bool) -> contextlib.AbstractContextManager[Any]:
     return err.status(text) if (not quiet and err.is_terminal) else contextlib.nullcontext()
 
 
-@c.app.command()
+@c.command()
 def orbit(
-    preset: c.PresetOpt = None,
-    gearset: c.GearsetOpt = None,
-    model: c.ModelOpt = None,
-    set_: c.SetOpt = None,
+    target: c.Target = c.Target(),
     period: PeriodOpt = None,
-    transient: GuessOpt = ORBIT_SETTINGS.transient_periods,
+    protocol: c.Protocol = GUESS,
     from_: FromOpt = None,
     at: AtOpt = None,
-    output: Annotated[
-        str | None,
-        typer.Option(
-            "--output",
-            "-o",
-            help="Also write the orbit to ORBIT.nc (state, multipliers, monodromy, gear set, "
-            "values, settings): a start for gearchaos continue --from ORBIT.nc.",
-            show_default=False,
-        ),
-    ] = None,
-    rtol: c.RtolOpt = ORBIT_SETTINGS.rtol,
-    atol: c.AtolOpt = ORBIT_SETTINGS.atol,
-    json_out: c.JsonOpt = False,
+    solver: c.Solver = c.Solver.of(ORBIT_SETTINGS),
+    output: c.Output = c.Output().offering(
+        "file",
+        "json",
+        help={
+            "file": "Also write the orbit to ORBIT.nc (state, multipliers, monodromy, gear set, "
+            "values, settings): a start for gearchaos continue --from ORBIT.nc."
+        },
+    ),
 ) -> None:
     """Find the period-n orbit at one operating point by shooting (Newton on Pⁿ(y) − y = 0,
     the Jacobian from the variational equations) and print its Floquet multipliers, stability
@@ -156,21 +144,21 @@ def orbit(
     from ..dynamics.orbits import periodic_orbit
 
     with c.reported_errors():
-        gs, values, start = _start_values(from_, at, preset, gearset, set_ or [], model)
+        gs, values, start = _start_values(from_, at, target)
         values.setdefault("omega", c.DEFAULT_OMEGA)
         omega = values["omega"]
-        settings = c.solver_settings(transient, 1, rtol, atol)
+        settings = c.settings(protocol, solver)
         period = _period(period, start)
         if period < 1 or period > 64:
             raise ParameterError(f"--period must be an integer in [1, 64]: got {period}")
-        path = c.output_path(output)
+        path = output.path()
         if path is not None and path.suffix.lower() != ".nc":
-            raise ParameterError(f"--output must end in .nc (an orbit file): got {output!r}")
+            raise ParameterError(f"--output must end in .nc (an orbit file): got {output.file!r}")
         guess = None
         if start is not None:
             settings = settings.replace(**start.section)
             guess = start.state
-        with _spinner(f"shooting the period-{period} orbit at Ω = {omega:g}…", json_out):
+        with _spinner(f"shooting the period-{period} orbit at Ω = {omega:g}…", output.json):
             with c.warnings_to_stderr():
                 orb = periodic_orbit(
                     gs, period=period, guess=guess, settings=settings, params=values
@@ -178,7 +166,7 @@ def orbit(
         summary = orb.summary()
         if path is not None:
             orb.save(path)
-    if json_out:
+    if output.json:
         c.print_json(summary)  # exactly the keys of PeriodicOrbit.summary()
         return
     out = c.stdout()
@@ -211,17 +199,8 @@ def orbit(
         c.wrote(path)
 
 
-@c.app.command("continue")
+@c.command("continue")
 def continue_(
-    output: Annotated[
-        str,
-        typer.Option(
-            "--output",
-            "-o",
-            help="Branch file: BRANCH.nc (netCDF) or BRANCH.zarr.",
-            show_default=False,
-        ),
-    ],
     vary: Annotated[
         str | None,
         typer.Option(
@@ -232,16 +211,12 @@ def continue_(
             show_default=False,
         ),
     ] = None,
-    preset: c.PresetOpt = None,
-    gearset: c.GearsetOpt = None,
-    model: c.ModelOpt = None,
-    set_: c.SetOpt = None,
+    target: c.Target = c.Target(),
     period: PeriodOpt = None,
-    transient: GuessOpt = ORBIT_SETTINGS.transient_periods,
+    protocol: c.Protocol = GUESS,
     from_: FromOpt = None,
     at: AtOpt = None,
-    rtol: c.RtolOpt = ORBIT_SETTINGS.rtol,
-    atol: c.AtolOpt = ORBIT_SETTINGS.atol,
+    solver: c.Solver = c.Solver.of(ORBIT_SETTINGS),
     max_points: Annotated[
         int, typer.Option("--max-points", help="Most points of the branch.")
     ] = 2000,
@@ -263,9 +238,9 @@ def continue_(
             "both sides.",
         ),
     ] = False,
-    overwrite: c.OverwriteOpt = False,
-    quiet: c.QuietOpt = False,
-    json_out: c.JsonOpt = False,
+    output: c.Output = c.Output().offering(
+        help={"file": "Branch file: BRANCH.nc (netCDF) or BRANCH.zarr."}, required=("file",)
+    ),
 ) -> None:
     """Continue a branch of period-n orbits in one parameter (pseudo-arclength, so folds are
     passed) and locate its events: folds (μ through +1), period doublings (μ through −1),
@@ -290,32 +265,28 @@ def continue_(
             raise ParameterError(
                 f"--vary is required: NAME=START:STOP, e.g. --vary omega=0.2:4: got {vary!r}"
             )
-        path = c.output_path(output)
-        assert path is not None
+        path = output.required_path()
         if path.suffix.lower() not in (".nc", ".zarr"):
-            raise ParameterError(f"--output must end in .nc or .zarr: got {output!r}")
+            raise ParameterError(f"--output must end in .nc or .zarr: got {output.file!r}")
         if cascade is not None and path.suffix.lower() != ".nc":
             raise ParameterError(
                 f"--cascade writes every branch into one netCDF file: --output must end in "
-                f".nc: got {output!r}"
+                f".nc: got {output.file!r}"
             )
         if cascade_all and cascade is None:
             raise ParameterError("--cascade-all needs --cascade K: got no --cascade")
         name = vary.partition("=")[0].strip()
-        set_names = {item.partition("=")[0].strip() for item in set_ or []}
+        set_names = {item.partition("=")[0].strip() for item in target.sets or []}
         if name in set_names:
             raise ParameterError(f"{name} is both continued and set with --set; choose one")
         if from_ is None:
-            omega, changes = c.parse_sets(set_ or [])
-            gs, values = c.sweep_target(
-                preset, gearset, model, {name}, omega, changes, quiet or json_out, "continued"
-            )
+            gs, values = c.sweep_target(target, {name}, output.silent, "continued")
             start = None
         else:
-            gs, values, start = _start_values(from_, at, preset, gearset, set_ or [], model)
+            gs, values, start = _start_values(from_, at, target)
         if name in SPEEDS:  # a branch in Ω: the speed's range converted through the gear set
             vary, name = speed_range(gs, vary, values), OMEGA
-        settings = c.solver_settings(transient, 1, rtol, atol)
+        settings = c.settings(protocol, solver)
         period = _period(period, start)
         first = None
         if start is not None:  # the orbit at the file's point: the branch starts there
@@ -335,7 +306,7 @@ def continue_(
                 )
             values.pop(name)
         t0 = time.perf_counter()
-        with _spinner(f"continuing the period-{period} branch in {name}…", quiet or json_out):
+        with _spinner(f"continuing the period-{period} branch in {name}…", output.silent):
             with c.warnings_to_stderr():
                 ds = continuation(
                     gs,
@@ -346,7 +317,7 @@ def continue_(
                     params=values,
                     max_points=max_points,
                     store=path,
-                    overwrite=overwrite,
+                    overwrite=output.overwrite,
                     cascade=cascade,
                     cascade_every=cascade_all,
                 )
@@ -357,10 +328,10 @@ def continue_(
         if cascade is not None:
             summary["cascade"] = [_cascade_entry(b) for b in branches[1:]]
             summary["cascade_skipped"] = json.loads(branches[0].attrs["cascade_skipped"])
-    if json_out:
+    if output.json:
         c.print_json(summary)
         return
-    if quiet:
+    if output.quiet:
         return
     out = c.stdout()
     rpm = speeds_per_omega(gs, values).get("sun_rpm") if name == OMEGA else None
@@ -449,12 +420,9 @@ def _with_uncertainty(value: float, u: float | None) -> str:
     return f"{value:.{digits}f} ± {u:.1g}" if digits <= 15 else f"{value:.15g} ± {u:.1g}"
 
 
-@c.app.command()
+@c.command()
 def attractors(
-    preset: c.PresetOpt = None,
-    gearset: c.GearsetOpt = None,
-    model: c.ModelOpt = None,
-    set_: c.SetOpt = None,
+    target: c.Target = c.Target(),
     starts: Annotated[
         int,
         typer.Option(
@@ -474,11 +442,9 @@ def attractors(
             "it is that orbit's run).",
         ),
     ] = CONFIRM_PERIODS,
-    transient: c.TransientOpt = ATTRACTOR_SETTINGS.transient_periods,
-    periods: c.PeriodsOpt = ATTRACTOR_SETTINGS.periods,
-    rtol: c.RtolOpt = ATTRACTOR_SETTINGS.rtol,
-    atol: c.AtolOpt = ATTRACTOR_SETTINGS.atol,
-    json_out: c.JsonOpt = False,
+    protocol: c.Protocol = c.Protocol.of(ATTRACTOR_SETTINGS).offering("transient", "periods"),
+    solver: c.Solver = c.Solver.of(ATTRACTOR_SETTINGS),
+    output: c.Output = c.Output().offering("json"),
 ) -> None:
     """List the distinct attractors at one operating point, from several initial conditions.
 
@@ -495,14 +461,9 @@ def attractors(
     from ..dynamics.coexistence import attractors as find
 
     with c.reported_errors():
-        omega, changes = c.parse_sets(set_ or [])
-        gs = c.load_target(preset, gearset, model, changes)
-        omega = c.point_omega(gs, omega, changes)  # --set sun_rpm / mesh_hz: through gs
-        if omega is None:
-            omega = c.DEFAULT_OMEGA
-            c.default_omega_note(json_out, "set")
-        settings = c.solver_settings(transient, periods, rtol, atol)
-        with _spinner(f"simulating {starts} starts at Ω = {omega:g}…", json_out):
+        gs, omega = c.point_target(target, output.json)
+        settings = c.settings(protocol, solver)
+        with _spinner(f"simulating {starts} starts at Ω = {omega:g}…", output.json):
             with c.warnings_to_stderr():
                 found = find(
                     gs,
@@ -513,7 +474,7 @@ def attractors(
                     confirm_periods=confirm,
                 )
     items = [a.summary() for a in found]
-    if json_out:
+    if output.json:
         c.print_json(items)
         return
     out = c.stdout()

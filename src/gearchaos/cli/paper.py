@@ -22,7 +22,7 @@ PAPER_FIGURES = ("fig4", "fig5", "fig6", "fig7", "fig8", "fig9", "fig10", "fig11
 GALLERY_FIGURES = ("fig5", "fig7", "fig10")
 
 
-@c.app.command()
+@c.command()
 def reproduce(
     figure: Annotated[
         str | None,
@@ -41,19 +41,6 @@ def reproduce(
             ),
         ),
     ] = False,
-    output: Annotated[
-        Path | None,
-        typer.Option(
-            "--output",
-            "-o",
-            help=(
-                "Directory for FIG.png and the sweep store FIG.zarr (galleries: FIG.json and "
-                "FIG.csv); created if missing. Required with --all (the report)."
-            ),
-            file_okay=False,
-            show_default=False,
-        ),
-    ] = None,
     quick: Annotated[
         bool, typer.Option("--quick", help="A coarse version (fewer points and periods), for CI.")
     ] = False,
@@ -69,12 +56,14 @@ def reproduce(
             show_default=False,
         ),
     ] = None,
-    workers: c.WorkersOpt = None,
-    overwrite: c.OverwriteOpt = False,
-    preset: c.PresetOpt = None,
-    gearset: c.GearsetOpt = None,
-    quiet: c.QuietOpt = False,
-    json_out: c.JsonOpt = False,
+    target: c.Target = c.Target().offering("preset", "gearset"),
+    execution: c.Execution = c.Execution().offering("workers"),
+    output: c.Output = c.Output().offering(
+        help={
+            "file": "Directory for FIG.png and the sweep store FIG.zarr (galleries: FIG.json "
+            "and FIG.csv); created if missing. Required with --all (the report)."
+        }
+    ),
 ) -> None:
     """Run the exact sweep of one of the seed paper's bifurcation figures with the default gear
     set (or --preset / --gearset) and draw it in the paper's layout (resumable like
@@ -100,18 +89,25 @@ def reproduce(
     """
     gs = None
     label = None
+    workers = execution.workers
+    quiet, json_out = output.quiet, output.json
     with c.reported_errors():
         from ..sweep.execute import Execution
 
         Execution(workers=workers)  # refused before any directory is made
-    if preset is not None or gearset is not None:
+        directory = output.directory()
+    if target.preset is not None or target.gearset is not None:
         with c.reported_errors():
-            gs = c.load_gearset(preset, gearset)
-        label = f"preset {preset}" if preset is not None else f"file {gearset} ({gs.name})"
+            gs = c.load_gearset(target)
+        label = (
+            f"preset {target.preset}"
+            if target.preset is not None
+            else f"file {target.gearset} ({gs.name})"
+        )
     if all_figures:
         if figure is not None:
             c.fail("give either FIG or --all, not both", c.EXIT_INVALID)
-        if output is None:
+        if directory is None:
             c.fail(
                 "--all writes a report of many files: give its directory with -o, e.g. -o report/",
                 c.EXIT_INVALID,
@@ -120,7 +116,7 @@ def reproduce(
             from ..paper.report import build_report
 
             index = build_report(
-                output,
+                directory,
                 quick=quick,
                 progress=not (quiet or json_out),
                 workers=workers,
@@ -137,7 +133,7 @@ def reproduce(
         return
     if figure is None:
         c.fail("give a figure (FIG) or --all", c.EXIT_INVALID)
-    output = Path(".") if output is None else output
+    directory = Path(".") if directory is None else directory
     with c.reported_errors(), c.interruptible():
         name = figure.strip().lower()
         if name not in PAPER_FIGURES:
@@ -165,24 +161,24 @@ def reproduce(
             matplotlib.use("Agg")
             from ..paper.galleries import reproduce_gallery
 
-            output.mkdir(parents=True, exist_ok=True)
+            directory.mkdir(parents=True, exist_ok=True)
             result = dict(
                 reproduce_gallery(
-                    name, output, quick=quick, progress=not (quiet or json_out), gearset=gs
+                    name, directory, quick=quick, progress=not (quiet or json_out), gearset=gs
                 )
             )
         else:
             from ..paper.recipes import reproduce as run_recipe
 
-            output.mkdir(parents=True, exist_ok=True)
+            directory.mkdir(parents=True, exist_ok=True)
             result = dict(
                 run_recipe(
                     name,
-                    output,
+                    directory,
                     quick=quick,
                     progress=not quiet,
                     workers=workers,
-                    overwrite=overwrite,
+                    overwrite=output.overwrite,
                     gearset=gs,
                     paper_protocol=bool(paper_protocol),
                 )
@@ -240,7 +236,7 @@ def _counts_table(counts: Mapping[str, Mapping[str, int]]) -> Any:
     return table
 
 
-@c.app.command()
+@c.command()
 def calibrate(
     landmarks: Annotated[
         Path | None,
@@ -310,29 +306,15 @@ def calibrate(
     quick: Annotated[
         bool, typer.Option("--quick", help="At most 3 trials on tiny sweeps, for CI.")
     ] = False,
-    workers: c.WorkersOpt = None,
-    scheduler: Annotated[
-        str | None,
-        typer.Option(
-            "--scheduler",
-            help=(
-                "Run one optimising worker per worker of the dask.distributed scheduler at this "
-                "address (tcp://HOST:8786, one you trust: Dask exchanges pickles); --storage must "
-                "be reachable from every worker."
-            ),
-            show_default=False,
-        ),
-    ] = None,
-    dask_local: Annotated[
-        int | None,
-        typer.Option(
-            "--dask-local",
-            help="Run the trials on a local Dask cluster with N workers.",
-            show_default=False,
-        ),
-    ] = None,
-    quiet: c.QuietOpt = False,
-    json_out: c.JsonOpt = False,
+    execution: c.Execution = c.Execution().offering(
+        help={
+            "scheduler": "Run one optimising worker per worker of the dask.distributed "
+            "scheduler at this address (tcp://HOST:8786, one you trust: Dask exchanges "
+            "pickles); --storage must be reachable from every worker.",
+            "dask_local": "Run the trials on a local Dask cluster with N workers.",
+        }
+    ),
+    output: c.Output = c.Output().offering("quiet", "json"),
 ) -> None:
     """Search the quantities of the seed's lost Table 1 (N and tooth numbers, input torque,
     transmission-error amplitude, stiffness ratios, mass ratios, b_c, load mode) with Optuna
@@ -347,7 +329,7 @@ def calibrate(
     """
     from ..paper.calibrate import calibrate as run_calibration
 
-    show = not (quiet or json_out)
+    show = not output.silent
     err = c.stderr()
 
     def on_record(rec: Mapping[str, Any], now: bool) -> None:
@@ -376,9 +358,7 @@ def calibrate(
             seed=seed,
             quick=quick,
             on_record=on_record,
-            workers=workers,
-            scheduler=scheduler,
-            dask_local=dask_local,
+            **execution.offered_values(),
         )
     summary = {
         "out": str(out),
@@ -394,9 +374,9 @@ def calibrate(
         "best": result.best,
         "top": result.top(3),
     }
-    if json_out:
+    if output.json:
         c.print_json(summary)
-    elif not quiet:
+    elif not output.quiet:
         table = pairs_table("gearchaos calibrate: best candidate" + (" (quick)" if quick else ""))
         best = result.best or {}
         table.add_row("landmark score", escape(fmt(best.get("score"))))

@@ -51,7 +51,7 @@ def _plot_basins(store: Path, output: Path, **unused: Any) -> None:
     c.wrote(output)
 
 
-@c.app.command()
+@c.command()
 def plot(
     stores: Annotated[
         list[Path],
@@ -60,10 +60,6 @@ def plot(
             "files of `gearchaos continue` (drawn on their own).",
             show_default=False,
         ),
-    ],
-    output: Annotated[
-        Path,
-        typer.Option("--output", "-o", help="Figure file: .png, .pdf or .svg.", show_default=False),
     ],
     var: Annotated[
         str | None,
@@ -129,8 +125,8 @@ def plot(
             show_default=False,
         ),
     ] = None,
-    quantity: Annotated[
-        str | None,
+    chosen: Annotated[
+        c.Quantity | None,
         typer.Option(
             "--quantity",
             help="For a response store with --branch: amplitude (max − min of --var) or "
@@ -157,7 +153,10 @@ def plot(
             "speed) in each contact regime, with their peak contact force.",
         ),
     ] = False,
-    model: c.FromModelOpt = None,
+    target: c.Target = c.RECORDED_MODEL,
+    output: c.Output = c.Output().offering(
+        "file", help={"file": "Figure file: .png, .pdf or .svg."}, required=("file",)
+    ),
 ) -> None:
     """Draw a sweep store: bifurcation diagrams (one panel per family value, with a band of
     motion labels under each) for a 1-D sweep, maps coloured by motion label (1T, 2T, …, QP,
@@ -181,12 +180,14 @@ def plot(
     from ._start import name_model
 
     with c.reported_errors():
-        name_model(model)  # symbols of your own model's variables: only with your consent
+        name_model(target.model)  # symbols of your own model's variables: only with consent
+        quantity = c.choice_value(chosen)
         if table and not contact:
             raise ParameterError("--table prints the contact ranges: it needs --contact")
-        if output.suffix.lower() not in SAVE_FORMATS:
+        figure = output.required_path()
+        if figure.suffix.lower() not in SAVE_FORMATS:
             raise ParameterError(
-                f"--output must end in one of {', '.join(SAVE_FORMATS)}: got {str(output)!r}"
+                f"--output must end in one of {', '.join(SAVE_FORMATS)}: got {str(figure)!r}"
             )
         import matplotlib
 
@@ -203,10 +204,10 @@ def plot(
 
             if all(is_curve_file(p) for p in stores):  # a stability chart without a map
                 fig = boundaries_figure([*stores, *(boundaries or [])], None)
-                if output.parent != Path(""):
-                    output.parent.mkdir(parents=True, exist_ok=True)
-                savefig(fig, output)
-                c.wrote(output)
+                if figure.parent != Path(""):
+                    figure.parent.mkdir(parents=True, exist_ok=True)
+                savefig(fig, figure)
+                c.wrote(figure)
                 return
             if sections or quantity:
                 raise ParameterError(
@@ -222,10 +223,10 @@ def plot(
                 clearance_lines=clearance,
                 resonances=resonances,
             )
-            if output.parent != Path(""):
-                output.parent.mkdir(parents=True, exist_ok=True)
-            savefig(fig, output)
-            c.wrote(output)
+            if figure.parent != Path(""):
+                figure.parent.mkdir(parents=True, exist_ok=True)
+            savefig(fig, figure)
+            c.wrote(figure)
             return
         if len(stores) > 1:
             raise ParameterError(
@@ -239,7 +240,7 @@ def plot(
         if _is_basin_store(store):
             check_quantity(quantity, False)
             _plot_basins(
-                store, output, var=var, planet=planet, branch=branch, sections=sections,
+                store, figure, var=var, planet=planet, branch=branch, sections=sections,
                 contact=contact,
             )  # fmt: skip
             return
@@ -283,9 +284,9 @@ def plot(
                 resonances=resonances,
                 branches=branches,
             )
-        if output.parent != Path(""):
-            output.parent.mkdir(parents=True, exist_ok=True)
-        savefig(fig, output)
-    c.wrote(output)
+        if figure.parent != Path(""):
+            figure.parent.mkdir(parents=True, exist_ok=True)
+        savefig(fig, figure)
+    c.wrote(figure)
     if table:
         c.stdout().print(contact_table(res, title=f"contact regimes of {store}"))

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Annotated
 
 import typer
@@ -10,23 +9,13 @@ from rich.markup import escape
 from rich.text import Text
 
 from .._text import escape_path
-from ..errors import ParameterError
 from ..sweep.spec import RESPONSE_SOLVER
 from . import _common as c
 from ._render import sweep_summary
 
 
-@c.app.command()
+@c.command()
 def response(
-    output: Annotated[
-        Path,
-        typer.Option(
-            "--output",
-            "-o",
-            help="Zarr store to write (e.g. response.zarr); run again to resume.",
-            show_default=False,
-        ),
-    ],
     vary: Annotated[
         str,
         typer.Option(
@@ -37,32 +26,24 @@ def response(
             show_default=False,
         ),
     ],
-    preset: c.PresetOpt = None,
-    gearset: c.GearsetOpt = None,
-    model: c.ModelOpt = None,
-    set_: c.SetOpt = None,
+    target: c.Target = c.Target(),
     direction: Annotated[
-        str,
+        c.Direction,
         typer.Option(
             "--direction",
-            help="up, down or both: continuation in that direction (both shows the jumps "
-            "between coexisting branches).",
+            help="Continuation up, down or both (both shows the jumps between coexisting "
+            "branches).",
         ),
-    ] = "both",
-    transient: c.TransientOpt = RESPONSE_SOLVER.transient_periods,
-    periods: Annotated[
-        int, typer.Option("--periods", help="Mesh periods recorded at every point.")
-    ] = RESPONSE_SOLVER.periods,
-    samples_per_period: Annotated[
-        int,
-        typer.Option("--samples-per-period", help="Samples per mesh period for the RMS values."),
-    ] = RESPONSE_SOLVER.samples_per_period,
-    rtol: c.RtolOpt = RESPONSE_SOLVER.rtol,
-    atol: c.AtolOpt = RESPONSE_SOLVER.atol,
-    workers: c.WorkersOpt = None,
-    overwrite: c.OverwriteOpt = False,
-    quiet: c.QuietOpt = False,
-    json_out: c.JsonOpt = False,
+    ] = c.Direction("both"),
+    protocol: c.Protocol = c.Protocol.of(RESPONSE_SOLVER).offering(
+        "transient", "periods", "samples_per_period"
+    ),
+    solver: c.Solver = c.Solver.of(RESPONSE_SOLVER),
+    execution: c.Execution = c.Execution().offering("workers"),
+    output: c.Output = c.Output().offering(
+        help={"file": "Zarr store to write (e.g. response.zarr); run again to resume."},
+        required=("file",),
+    ),
 ) -> None:
     """Frequency response: dynamic mesh forces, load factors and transmission errors along a
     parameter, swept up and down by continuation.
@@ -80,45 +61,42 @@ def response(
     """
 
     with c.reported_errors(), c.interruptible():
-        if direction not in ("up", "down", "both"):
-            raise ParameterError(f"--direction must be up, down or both: got {direction!r}")
-        settings = c.solver_settings(transient, periods, rtol, atol, samples_per_period)
-        omega, changes = c.parse_sets(set_ or [])
+        settings = c.settings(protocol, solver)
         swept = {vary.split("=", 1)[0].strip()}
-        gs, fixed = c.sweep_target(preset, gearset, model, swept, omega, changes, quiet or json_out)
+        gs, fixed = c.sweep_target(target, swept, output.silent)
 
         from .. import sweep
 
-        res, seconds = c.run_sweep(
-            sweep.response,
-            gs,
-            vary,
-            settings=settings,
-            output=output,
-            overwrite=overwrite,
-            workers=workers,
-            quiet=quiet,
-            direction=direction,
-            params=fixed,
-        )
+        with c.named_options(direction="--direction"):
+            res, seconds = c.run_sweep(
+                sweep.response,
+                gs,
+                vary,
+                settings=settings,
+                output=output,
+                execution=execution,
+                direction=str(direction.value),
+                params=fixed,
+            )
         ds = res.ds
         lf = {
             m: float(ds[f"load_factor_{m}"].max()) for m in ("sp", "rp") if f"load_factor_{m}" in ds
         }
 
+    path = output.required_path()
     result = {
-        **sweep_summary(res, output, seconds),
+        **sweep_summary(res, path, seconds),
         **{f"load_factor_{m}_max": v for m, v in lf.items()},
     }
     title = f"gearchaos frequency response of {gs.name}"
-    table = c.sweep_report(title, res, result, json_out=json_out, quiet=quiet)
+    table = c.sweep_report(title, res, result, output)
     if table is None:
         return
     for m, v in lf.items():
         table.add_row(f"largest load factor {m}", f"{v:.4g}")
     table.add_row("seconds", f"{seconds:.3g}")
-    table.add_row("store", escape(str(output)))
+    table.add_row("store", escape(str(path)))
     out = c.stdout()
     out.print(table)
-    shown, stem = escape_path(output), escape_path(output.stem)
+    shown, stem = escape_path(path), escape_path(path.stem)
     out.print(Text(f"next: gearchaos plot {shown} -o {stem}.png", style="dim"))

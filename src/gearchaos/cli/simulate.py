@@ -10,61 +10,37 @@ import typer
 from rich.text import Text
 
 from .._text import escape_path
-from ..errors import ParameterError
 from ..integrate.settings import SIMULATION
 from . import _common as c
 from ._render import add_motion_rows
 from ._speeds import speed_note
 
 
-@c.app.command()
+@c.command()
 def simulate(
-    preset: c.PresetOpt = None,
-    gearset: c.GearsetOpt = None,
-    model: c.ModelOpt = None,
-    set_: c.SetOpt = None,
-    transient: c.TransientOpt = SIMULATION.transient_periods,
-    settle: c.SettleOpt = "off",
-    perturbation: c.PerturbationOpt = None,
-    periods: c.PeriodsOpt = SIMULATION.periods,
-    samples_per_period: Annotated[
-        int,
-        typer.Option(
-            "--samples-per-period",
-            help="Samples per mesh period of the time history (figure, spectra, RMS values).",
-        ),
-    ] = SIMULATION.samples_per_period,
-    rtol: c.RtolOpt = SIMULATION.rtol,
-    atol: c.AtolOpt = SIMULATION.atol,
-    output_dir: Annotated[
-        str | None,
-        typer.Option(
-            "--output",
-            "-o",
-            help=(
-                "Directory for simulation.nc (netCDF, all samples and the gear set) and "
-                "simulation.png (summary figure); created if missing. "
-                "Without -o nothing is written."
-            ),
-            show_default=False,
-        ),
-    ] = None,
-    json_out: c.JsonOpt = False,
+    target: c.Target = c.Target(),
+    protocol: c.Protocol = c.Protocol.of(SIMULATION),
+    solver: c.Solver = c.Solver.of(SIMULATION),
+    output: c.Output = c.Output().offering(
+        "file",
+        "json",
+        help={
+            "file": "Directory for simulation.nc (netCDF, all samples and the gear set) and "
+            "simulation.png (summary figure); created if missing. Without -o nothing is "
+            "written."
+        },
+    ),
     plot: Annotated[
         bool, typer.Option("--plot/--no-plot", help="Write the summary figure (with -o).")
     ] = True,
-    verdict: Annotated[
-        bool,
-        typer.Option(
-            "--verdict/--no-verdict",
-            help=(
-                "Decide the motion: an nT label confirmed by shooting (Floquet multipliers), "
-                "chaos or QP by λ₁ with its error from an extension of the run, transients "
-                "finished, the start from rest perturbed by 1e-6. Default: labels from the "
-                "record alone."
-            ),
-        ),
-    ] = True,
+    verdict: c.Verdict = c.Verdict().offering(
+        help={
+            "verdict": "Decide the motion: an nT label confirmed by shooting (Floquet "
+            "multipliers), chaos or QP by λ₁ with its error from an extension of the run, "
+            "transients finished, the start from rest perturbed by 1e-6 (default). "
+            "--no-verdict: labels from the record alone."
+        }
+    ),
     lyapunov: Annotated[
         bool,
         typer.Option(
@@ -91,25 +67,20 @@ def simulate(
     Example: **gearchaos simulate --preset sheng2016 --set omega=1.5 --set xi=0.05 -o out/**
     """
     with c.reported_errors():
-        output = c.output_path(output_dir)
-        if output is not None and output.exists() and not output.is_dir():
-            raise ParameterError(f"--output must be a directory: {str(output)!r} is a file")
-        omega, changes = c.parse_sets(set_ or [])
-        gs = c.load_target(preset, gearset, model, changes)
-        omega = c.point_omega(gs, omega, changes)  # --set sun_rpm / mesh_hz: through gs
+        directory = output.directory()
+        gs, omega = c.point_target(target)
         omega = c.DEFAULT_OMEGA if omega is None else omega
-        settings = c.solver_settings(
-            transient, periods, rtol, atol, samples_per_period, settle, perturbation
-        )
-        if output is not None:
-            output.mkdir(parents=True, exist_ok=True)
+        settings = c.settings(protocol, solver)
+        decided = verdict.decided()
+        if directory is not None:
+            directory.mkdir(parents=True, exist_ok=True)
         from ..dynamics.point import analyse_point
 
         err = c.stderr()
         spinner: contextlib.AbstractContextManager[Any] = contextlib.nullcontext()
-        if not json_out and err.is_terminal:
-            total = transient + periods
-            what = " and the verdict" if verdict else (" and λ₁" if lyapunov else "")
+        if not output.json and err.is_terminal:
+            total = protocol.transient + protocol.periods
+            what = " and the verdict" if decided else (" and λ₁" if lyapunov else "")
             spinner = err.status(
                 f"integrating {gs.name} at Ω = {omega:g}, {total:g} mesh periods{what}…"
             )
@@ -120,20 +91,20 @@ def simulate(
                 settings,
                 lyapunov=lyapunov,
                 check=True,
-                verdict=verdict,
+                verdict=decided,
             )
         if lyapunov and point.lle is None and point.lyapunov_status is not None:
             c.warn(f"the Lyapunov exponent could not be computed: {point.lyapunov_status.message}")
         result, summary = point.result, point.summary
         written: list[Path] = []
-        if output is not None:
-            nc = output / "simulation.nc"
+        if directory is not None:
+            nc = directory / "simulation.nc"
             result.save(nc)
             written.append(nc)
             if plot:
-                written.append(_save_figure(result, summary, output / "simulation.png"))
+                written.append(_save_figure(result, summary, directory / "simulation.png"))
 
-    if json_out:
+    if output.json:
         c.print_json(summary)
         for path in written:
             c.stderr().print(Text(f"wrote {escape_path(path)}"), soft_wrap=True)
@@ -147,8 +118,8 @@ def simulate(
     out.print(table)
     out.print(
         Text(
-            f"{transient:g} transient + {periods} recorded mesh periods, "
-            f"rtol {rtol:g}, atol {atol:g}",
+            f"{protocol.transient:g} transient + {protocol.periods} recorded mesh periods, "
+            f"rtol {solver.rtol:g}, atol {solver.atol:g}",
             style="dim",
         )
     )

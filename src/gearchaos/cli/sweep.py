@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -13,15 +12,16 @@ from rich.text import Text
 from .._text import escape_path
 from ..errors import ParameterError
 from ..gearset.parsing import parse_int
+from ..sweep.classify import MAX_PERIOD, PERIOD_RTOL
 from ..sweep.spec import SWEEP_SOLVER
 from . import _common as c
 from ._render import regime_table, sweep_summary
 
 
-def _initial_conditions(value: str | None, old: str | None) -> str:
-    """``--initial-conditions`` (the name of the Python keyword ``initial_conditions=`` and of
-    the store attribute), or its deprecated spelling ``--ic`` with a warning; both refused."""
-    option = "--initial-conditions"
+def _initial_conditions(value: c.InitialConditions | None, old: str | None) -> tuple[str, str]:
+    """(value, option) of ``--initial-conditions`` (the name of the Python keyword
+    ``initial_conditions=`` and of the store attribute), or of its deprecated spelling ``--ic``
+    with a warning (its value is checked by the library, under its name); both refused."""
     if old is not None:
         if value is not None:
             raise ParameterError(
@@ -31,11 +31,8 @@ def _initial_conditions(value: str | None, old: str | None) -> str:
             "--ic is deprecated and will be removed in the next release; use "
             "--initial-conditions (the spelling of the Python keyword initial_conditions=)"
         )
-        option, value = "--ic", old
-    value = "fresh" if value is None else value
-    if value not in ("fresh", "continuation"):
-        raise ParameterError(f"{option} must be fresh or continuation: got {value!r}")
-    return value
+        return old, "--ic"
+    return c.choice_value(value) or "fresh", "--initial-conditions"
 
 
 def _parse_planets(raw: str | None) -> tuple[int, ...]:
@@ -44,10 +41,7 @@ def _parse_planets(raw: str | None) -> tuple[int, ...]:
     items = [item.strip() for item in raw.split(",")]
     if not all(items):
         raise ParameterError(f"--planets must be planet numbers such as 1,2: got {raw!r}")
-    planets = tuple(parse_int("--planets", item) for item in items)
-    if any(p < 1 for p in planets):
-        raise ParameterError(f"--planets must be planet numbers >= 1: got {raw!r}")
-    return planets
+    return tuple(parse_int("--planets", item) for item in items)  # >= 1: the library's rule
 
 
 def _axis_name(item: str) -> str:
@@ -68,20 +62,8 @@ StoreArg = Annotated[
 ]
 
 
-@c.app.command()
+@c.command()
 def bifurcation(
-    output: Annotated[
-        Path,
-        typer.Option(
-            "--output",
-            "-o",
-            help=(
-                "Zarr store to write (a directory, e.g. run.zarr). Written chunk by chunk; run "
-                "the same command again after an interruption to resume."
-            ),
-            show_default=False,
-        ),
-    ],
     vary: Annotated[
         list[str] | None,
         typer.Option(
@@ -104,10 +86,7 @@ def bifurcation(
             show_default=False,
         ),
     ] = None,
-    preset: c.PresetOpt = None,
-    gearset: c.GearsetOpt = None,
-    model: c.ModelOpt = None,
-    set_: c.SetOpt = None,
+    target: c.Target = c.Target(),
     observe: Annotated[
         list[str] | None,
         typer.Option(
@@ -126,7 +105,7 @@ def bifurcation(
         ),
     ] = None,
     initial_conditions: Annotated[
-        str | None,
+        c.InitialConditions | None,
         typer.Option(
             "--initial-conditions",
             help=(
@@ -142,42 +121,17 @@ def bifurcation(
         typer.Option("--ic", hidden=True, help="Deprecated spelling of --initial-conditions."),
     ] = None,
     direction: Annotated[
-        str,
+        c.Direction,
         typer.Option(
             "--direction",
-            help="up, down or both (continuation only; both overlays the branches).",
+            help="Continuation only: up, down or both (both overlays the branches).",
         ),
-    ] = "up",
-    transient: c.TransientOpt = SWEEP_SOLVER.transient_periods,
-    settle: c.SettleOpt = SWEEP_SOLVER.settle,
-    perturbation: c.PerturbationOpt = None,
-    periods: Annotated[
-        int,
-        typer.Option("--periods", help="Mesh periods recorded at every point (section points)."),
-    ] = SWEEP_SOLVER.periods,
-    rtol: c.RtolOpt = SWEEP_SOLVER.rtol,
-    atol: c.AtolOpt = SWEEP_SOLVER.atol,
-    workers: c.WorkersOpt = None,
-    scheduler: Annotated[
-        str | None,
-        typer.Option(
-            "--scheduler",
-            help=(
-                "Address of a running dask.distributed scheduler, e.g. tcp://HOST:8786 — one "
-                "you trust: Dask exchanges pickles, which run code when read."
-            ),
-            show_default=False,
-        ),
-    ] = None,
-    dask_local: Annotated[
-        int | None,
-        typer.Option(
-            "--dask-local",
-            help="Start a local Dask cluster with N workers on this machine.",
-            show_default=False,
-        ),
-    ] = None,
-    overwrite: c.OverwriteOpt = False,
+    ] = c.Direction("up"),
+    protocol: c.Protocol = c.Protocol.of(SWEEP_SOLVER).offering(
+        "transient", "settle", "perturbation", "periods"
+    ),
+    solver: c.Solver = c.Solver.of(SWEEP_SOLVER),
+    execution: c.Execution = c.Execution(),
     lyapunov: Annotated[
         bool,
         typer.Option(
@@ -188,17 +142,13 @@ def bifurcation(
             ),
         ),
     ] = False,
-    verdicts: Annotated[
-        bool,
-        typer.Option(
-            "--verdicts/--no-verdicts",
-            help=(
-                "Decide every point's motion with the verdict: nT confirmed by shooting "
-                "(Floquet multipliers), chaos and QP by λ₁ ± its error, transients finished. "
-                "--no-verdicts labels from the records alone (faster)."
-            ),
-        ),
-    ] = True,
+    verdict: c.Verdict = c.Verdict().offering(
+        help={
+            "verdict": "Decide every point's motion with the verdict: nT confirmed by shooting "
+            "(Floquet multipliers), chaos and QP by λ₁ ± its error, transients finished "
+            "(default). --no-verdict labels from the records alone (faster)."
+        }
+    ),
     orbits: Annotated[
         bool,
         typer.Option(
@@ -210,8 +160,13 @@ def bifurcation(
             ),
         ),
     ] = False,
-    quiet: c.QuietOpt = False,
-    json_out: c.JsonOpt = False,
+    output: c.Output = c.Output().offering(
+        help={
+            "file": "Zarr store to write (a directory, e.g. run.zarr). Written chunk by chunk; "
+            "run the same command again after an interruption to resume."
+        },
+        required=("file",),
+    ),
 ) -> None:
     """Sweep one or two parameters and store the Poincaré section values of every point.
 
@@ -238,46 +193,42 @@ def bifurcation(
             raise ParameterError(
                 f"--vary may be given once or twice (two make a 2-D map): got {len(vary)}"
             )
-        ic = _initial_conditions(initial_conditions, ic)
-        if direction not in ("up", "down", "both"):
-            raise ParameterError(f"--direction must be up, down or both: got {direction!r}")
-        if direction != "up" and ic != "continuation":
+        ic, ic_option = _initial_conditions(initial_conditions, ic)
+        way = str(direction.value)
+        if way != "up" and ic == "fresh":  # the library's rule, in the options' words
             raise ParameterError(
-                f"--direction {direction} needs --initial-conditions continuation "
+                f"--direction {way} needs {ic_option} continuation "
                 "(fresh starts do not depend on the sweep direction)"
             )
-        settings = c.solver_settings(
-            transient, periods, rtol, atol, settle=settle, perturbation=perturbation
-        )
-        omega, changes = c.parse_sets(set_ or [])
+        settings = c.settings(protocol, solver)
         swept = {_axis_name(v) for v in vary} | ({_axis_name(family)} if family else set())
-        gs, fixed = c.sweep_target(preset, gearset, model, swept, omega, changes, quiet or json_out)
+        gs, fixed = c.sweep_target(target, swept, output.silent)
 
         from .. import sweep
 
-        res, seconds = c.run_sweep(
-            sweep.bifurcation,
-            gs,
-            list(vary),
-            settings=settings,
-            output=output,
-            overwrite=overwrite,
-            workers=workers,
-            quiet=quiet,
-            family=family,
-            params=fixed,
-            observe=tuple(observe) if observe else None,
-            planets=_parse_planets(planets),
-            initial_conditions=ic,
-            direction=direction,
-            lyapunov=lyapunov,
-            orbits=orbits,
-            verdicts=verdicts,
-            scheduler=scheduler,
-            dask_local=dask_local,
-        )
+        with c.named_options(
+            initial_conditions=ic_option, direction="--direction", planets="--planets"
+        ):
+            res, seconds = c.run_sweep(
+                sweep.bifurcation,
+                gs,
+                list(vary),
+                settings=settings,
+                output=output,
+                execution=execution,
+                family=family,
+                params=fixed,
+                observe=tuple(observe) if observe else None,
+                planets=_parse_planets(planets),
+                initial_conditions=ic,
+                direction=way,
+                lyapunov=lyapunov,
+                orbits=orbits,
+                verdicts=verdict.decided(),
+            )
 
-    result: dict[str, Any] = sweep_summary(res, output, seconds)
+    path = output.required_path()
+    result: dict[str, Any] = sweep_summary(res, path, seconds)
     if orbits:
         import numpy as np
 
@@ -288,19 +239,19 @@ def bifurcation(
             k: int(np.sum(codes == v)) for k, v in ORBIT_STATUS.items() if np.any(codes == v)
         }
     title = f"gearchaos bifurcation of {gs.name}"
-    table = c.sweep_report(title, res, result, json_out=json_out, quiet=quiet)
+    table = c.sweep_report(title, res, result, output)
     if table is None:
         return
     table.add_row("seconds", f"{seconds:.3g}")
     if seconds > 0:
         table.add_row("points/s", f"{result['points'] / seconds:.3g}")
-    table.add_row("store", escape(str(output)))
+    table.add_row("store", escape(str(path)))
     out = c.stdout()
     out.print(table)
     out.print(
         Text(
-            f"{transient:g} transient + {periods} recorded mesh periods, {ic} initial "
-            f"conditions, rtol {rtol:g}, atol {atol:g}"
+            f"{protocol.transient:g} transient + {protocol.periods} recorded mesh periods, {ic} "
+            f"initial conditions, rtol {solver.rtol:g}, atol {solver.atol:g}"
             + (", largest Lyapunov exponents" if lyapunov else "")
             + (", nT labels checked by periodic orbits" if orbits else ""),
             style="dim",
@@ -312,11 +263,11 @@ def bifurcation(
     regimes = res.regime_table()
     if regimes:
         out.print(regime_table(regimes, title="motion regimes (fraction of the swept points)"))
-    shown, stem = escape_path(output), escape_path(output.stem)
+    shown, stem = escape_path(path), escape_path(path.stem)
     out.print(Text(f"next: gearchaos plot {shown} -o {stem}.png", style="dim"))
 
 
-@c.app.command()
+@c.command()
 def classify(
     store: StoreArg,
     period_rtol: Annotated[
@@ -325,7 +276,7 @@ def classify(
             "--period-rtol",
             help=(
                 "Tolerance of period detection, relative to the attractor's size: section "
-                "points closer than this repeat. [default: 1e-3]"
+                f"points closer than this repeat. [default: {PERIOD_RTOL:g}]"
             ),
             show_default=False,
         ),
@@ -336,8 +287,8 @@ def classify(
     ] = None,
     max_period: Annotated[
         int, typer.Option("--max-period", help="Longest period n recognised as nT.")
-    ] = 64,
-    json_out: c.JsonOpt = False,
+    ] = MAX_PERIOD,
+    output: c.Output = c.Output().offering("json"),
 ) -> None:
     """(Re)label every point of a sweep store without re-simulating: 1T … nT (period of the
     stored section sequence), QP or chaos (by the stored largest Lyapunov exponent when the
@@ -360,16 +311,13 @@ def classify(
                 "integrator's rtol; use --period-rtol"
             )
             option, tol = "--rtol", rtol
-        tol = 1e-3 if tol is None else tol
-        if not (math.isfinite(tol) and 0.0 < tol < 1.0):
-            raise ParameterError(f"{option} must be a number in (0, 1): got {tol!r}")
-        if max_period < 1:
-            raise ParameterError(f"--max-period must be an integer >= 1: got {max_period!r}")
+        tol = PERIOD_RTOL if tol is None else tol
         open_store(store)
         from ..sweep import classify_store
 
-        table = classify_store(store, period_rtol=tol, max_period=max_period)
-    if json_out:
+        with c.named_options(period_rtol=option, max_period="--max-period"):
+            table = classify_store(store, period_rtol=tol, max_period=max_period)
+    if output.json:
         c.print_json(table)
         return
     out = c.stdout()
