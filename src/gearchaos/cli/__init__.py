@@ -9,8 +9,9 @@ frequency Ω = ω/ω_n) is a simulation setting, not a gear-set field, but is gi
 ``--set omega=1.5`` as well, so that a command line reads like a point of a sweep.
 
 One module per group of commands (:mod:`.simulate`, :mod:`.gearset`, :mod:`.sweep`, :mod:`.plot`,
-:mod:`.gallery`, :mod:`.paper`); what they share — the app, error handling and exit codes,
-``--set`` parsing, options — is in :mod:`._common`, tables for people in :mod:`._render`.
+:mod:`.gallery`, :mod:`.paper`); the options many of them share are declared once, in groups
+passed on as one object, in :mod:`._options`; what else they share — the app, error handling
+and exit codes, ``--set`` parsing — is in :mod:`._common`, tables for people in :mod:`._render`.
 """
 
 # isort: off

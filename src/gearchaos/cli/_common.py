@@ -1,5 +1,8 @@
-"""What every command shares: the Typer app, consoles, error handling, ``--set`` parsing, the
-gear-set options and the solver options.
+"""What every command shares: the Typer app and :func:`command`, consoles, error handling,
+``--set`` parsing, loading the target of the :class:`~gearchaos.cli._options.Target` options and
+the solver settings of the :class:`~gearchaos.cli._options.Protocol` and
+:class:`~gearchaos.cli._options.Solver` options (the option groups themselves are declared in
+:mod:`._options` and re-exported here: ``c.Target``).
 
 Exit codes: 0 success; 2 invalid input (unknown or invalid parameter, conflicting options,
 missing gear-set file, a sweep store made with other settings or damaged) — the message names

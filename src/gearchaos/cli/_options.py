@@ -14,11 +14,11 @@ A group is a frozen record whose fields are the options (``typer.Option`` in ``A
         ...
     ) -> None:
 
-and :func:`command` spreads it into its options on the command line (in the group's panel of
-``--help``) and gathers them back into one record before the command runs. The default record
-gives the command's defaults (:meth:`Protocol.of` takes them from the library's
-:class:`~gearchaos.integrate.settings.SolverSettings`), :meth:`OptionGroup.offering` the subset
-of the group's options it takes, its own help for some and which are required.
+and :func:`~gearchaos.cli._common.command` spreads it into its options on the command line (in
+the group's panel of ``--help``) and gathers them back into one record before the command
+runs. The default record gives the command's defaults (:meth:`Protocol.of` takes them from the
+library's :class:`~gearchaos.integrate.settings.SolverSettings`), :meth:`OptionGroup.offering`
+the subset of the group's options it takes, its own help for some and which are required.
 
 Choices are enumerations built from the library's own tuples (:data:`Direction` from
 :data:`gearchaos.sweep.spec.DIRECTIONS`, …): ``--help`` lists them and the command line refuses
@@ -395,6 +395,18 @@ class Output(OptionGroup):
         path = self.path()
         if path is None:  # a command that requires -o never runs without it
             raise ParameterError("--output is required")
+        return path
+
+    def figure(self) -> Path | None:
+        """The path of ``-o`` naming a figure file: its suffix one the figures are saved as
+        (:data:`gearchaos.plot.figure.SAVE_FORMATS`)."""
+        from ..plot.figure import SAVE_FORMATS
+
+        path = self.path()
+        if path is not None and path.suffix.lower() not in SAVE_FORMATS:
+            raise ParameterError(
+                f"--output must end in one of {', '.join(SAVE_FORMATS)}: got {str(path)!r}"
+            )
         return path
 
     def directory(self) -> Path | None:

@@ -56,20 +56,14 @@ def poincare(
     Example: **gearchaos poincare --vary omega=1.2,1.35,1.5,1.7,1.875,1.926,2.02,2.3
     --with phase -o gallery.png**
     """
-    from ..plot.figure import SAVE_FORMATS
-
     with c.reported_errors():
         if not vary:
             raise ParameterError(
                 "--vary is required: give NAME=VALUES, e.g. --vary omega=1.2,1.5,1.875"
             )
-        path = output.path()
+        path = output.figure()
         if path is None:
             raise ParameterError("--output is required: the figure file, e.g. -o gallery.png")
-        if path.suffix.lower() not in SAVE_FORMATS:
-            raise ParameterError(
-                f"--output must end in one of {', '.join(SAVE_FORMATS)}: got {str(path)!r}"
-            )
         from ..plot.gallery import parse_extras
         from ..sweep.spec import parse_axis
 
