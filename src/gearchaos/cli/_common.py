@@ -349,7 +349,7 @@ def load_gearset(target: Target, changes: Mapping[str, object] | None = None) ->
     """The gear set of ``--preset`` / ``--gearset`` (default preset), with ``changes``."""
     from ..gearset import GearSet, preset as load_preset
 
-    preset, gearset_file = target.preset, target.gearset
+    preset, gearset_file = target.preset, target.gearset_file
     if preset is not None and gearset_file is not None:
         raise ParameterError(
             f"--preset and --gearset are mutually exclusive: got --preset {preset} and "
@@ -386,7 +386,7 @@ def load_target(target: Target, changes: Mapping[str, object] | None = None) -> 
     model = target.model
     if model is None:
         return load_gearset(target, changes)
-    if target.preset is not None or target.gearset is not None:
+    if target.names_gear_set:
         raise ParameterError("--model excludes --preset and --gearset: give one of them")
     from ..model import System
     from ..model.loading import build_model, load_model_class

@@ -187,7 +187,7 @@ class Target(OptionGroup):
             show_default=False,
         ),
     ] = None
-    gearset: Annotated[
+    gearset_file: Annotated[
         Path | None,
         typer.Option(
             "--gearset",
@@ -224,6 +224,11 @@ class Target(OptionGroup):
             show_default=False,
         ),
     ] = None
+
+    @property
+    def names_gear_set(self) -> bool:
+        """Whether ``--preset`` or ``--gearset`` is given."""
+        return self.preset is not None or self.gearset_file is not None
 
 
 #: ``--model`` of a command that reads a file recording the model (plot, explore, boundary).

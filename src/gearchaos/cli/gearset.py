@@ -16,7 +16,7 @@ from ._render import info_renderables
 
 @c.command()
 def info(
-    target: c.Target = c.Target().offering("preset", "gearset", "sets"),
+    target: c.Target = c.Target().offering("preset", "gearset_file", "sets"),
     output: c.Output = c.Output().offering("json"),
 ) -> None:
     """Linear properties of a gear set: radii, equivalent masses, ω_n, damping coefficients,

@@ -89,7 +89,7 @@ def _start_values(
         values: dict[str, Any] = {} if omega is None else {OMEGA: omega}
         return built, values, None
     omega, changes = c.parse_sets(target.sets or [])
-    if target.preset is not None or target.gearset is not None:
+    if target.names_gear_set:
         raise ParameterError(
             "--from brings the gear set it was computed for: drop --preset/--gearset (change "
             "values with --set)"

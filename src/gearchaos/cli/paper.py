@@ -56,7 +56,7 @@ def reproduce(
             show_default=False,
         ),
     ] = None,
-    target: c.Target = c.Target().offering("preset", "gearset"),
+    target: c.Target = c.Target().offering("preset", "gearset_file"),
     execution: c.Execution = c.Execution().offering("workers"),
     output: c.Output = c.Output().offering(
         help={
@@ -96,13 +96,13 @@ def reproduce(
 
         Execution(workers=workers)  # refused before any directory is made
         directory = output.directory()
-    if target.preset is not None or target.gearset is not None:
+    if target.names_gear_set:
         with c.reported_errors():
             gs = c.load_gearset(target)
         label = (
             f"preset {target.preset}"
             if target.preset is not None
-            else f"file {target.gearset} ({gs.name})"
+            else f"file {target.gearset_file} ({gs.name})"
         )
     if all_figures:
         if figure is not None:
