@@ -41,7 +41,7 @@ def test_boundary_command_writes_the_curve_with_provenance(curve_file) -> None:
     assert summary["kind"] == "period_doubling" and summary["parameter2"] == "xi"
     # the gear set of the first point (at its ξ), as branch files record it
     stored = gc.GearSet.from_toml_string(ds.attrs["gearset_toml"])
-    assert stored.name == gc.preset("sheng2016-v1").name
+    assert stored.name == gc.preset("sheng2016").name  # the default
     assert "version" in ds.attrs and "rtol" in ds.attrs
     # it starts at the branch's event (ξ = 0.03) and lands on ξ = 0.025 on both sides
     assert np.isclose(ds.omega.values[ds.direction.values == 0][0], pd.value, atol=1e-7)

@@ -52,7 +52,7 @@ def test_json_keys_and_values_match_the_python_api(runner: CliRunner) -> None:
     out = run_json(runner, "--set", "omega=1.5", "--samples-per-period", "8")
     assert list(out)[: len(CONTRACT)] == CONTRACT
 
-    gs = preset("sheng2016-v1")
+    gs = preset("sheng2016")  # the CLI's default
     # the CLI is analyse_point: the simulation, then the verdict (which may show the
     # finished record: the run continued by the verdict, never the orbit's own points)
     cfg = SolverSettings(transient_periods=20, periods=20, samples_per_period=8)
@@ -125,7 +125,7 @@ def test_set_changes_the_gear_set_and_files_are_written(runner: CliRunner, tmp_p
         assert "delta_sp" in ds and ds.delta_sp.sizes["section"] == 20
         assert np.all(np.isfinite(ds.delta_sp.sel(planet=1).values))
     # every value as set, and a name that says the gear set is not plain sheng2016 (issue 24)
-    expected = preset("sheng2016-v1").evolve(
+    expected = preset("sheng2016").evolve(
         {
             "xi": 0.05,
             "backlash.sun_planet": 2.5,

@@ -49,7 +49,9 @@ def test_bifurcation_json_and_store(omega_store: tuple[Path, dict]) -> None:
     assert ds.planet.values.tolist() == [1]
     for key in ("gearset_toml", "sweep_toml", "rtol", "atol", "transient_periods", "periods"):
         assert key in ds.attrs
-    assert gc.GearSet.from_toml_string(ds.attrs["gearset_toml"]) == gc.preset("sheng2016-v1")
+    assert gc.GearSet.from_toml_string(ds.attrs["gearset_toml"]) == gc.preset(
+        "sheng2016"
+    )  # the default
 
 
 def test_rerun_is_a_resume_and_other_settings_are_refused(
