@@ -12,7 +12,7 @@ import os
 import shutil
 import subprocess
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import numpy as np
@@ -455,3 +455,82 @@ def test_concurrent_writers_of_one_output_leave_one_complete_result(tmp_path: Pa
     assert gc.open_simulation(tmp_path / "both-simulation.nc").attrs["title"]
     assert file_has_mark(str(tmp_path / "both-f.png"))
     assert not [p for p in tmp_path.rglob("*") if "partial" in p.name]
+
+
+def _other_writer_at(
+    monkeypatch: pytest.MonkeyPatch, target: Path, moment: str, write: Callable[[], None]
+) -> list[str]:
+    """Make ``write`` (another writer of ``target``) run whole at one moment of the next
+    replace of ``target``: ``"in"`` just before the rename of a new directory onto it,
+    ``"aside"`` just after the rename of what was there away from it — the two moments where
+    a concurrent writer met ``Directory not empty`` under load. Returns the list that records
+    that it ran."""
+    real = os.rename
+    fired: list[str] = []
+    want = os.path.abspath(target)
+
+    def rename(src, dst, *args, **kwargs):  # type: ignore[no-untyped-def]
+        if fired:
+            return real(src, dst, *args, **kwargs)
+        if moment == "in" and os.path.abspath(dst) == want:
+            fired.append(moment)
+            write()
+        elif moment == "aside" and os.path.abspath(src) == want:
+            real(src, dst, *args, **kwargs)
+            fired.append(moment)
+            write()
+            return None
+        return real(src, dst, *args, **kwargs)
+
+    monkeypatch.setattr(os, "rename", rename)
+    return fired
+
+
+@pytest.mark.parametrize(("moment", "existing"), [("in", False), ("in", True), ("aside", True)])
+def test_a_writer_replacing_a_directory_meets_the_other_writer_s_new_one(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, moment: str, existing: bool
+) -> None:
+    # under load one `continue -o b.zarr` failed with "cannot write branch store …: Directory
+    # not empty": between its two renames (the old store aside, its own in) the other writer
+    # put its store in. The interleaving is forced here, the same in every run
+    short, long = _branch(), gc.continuation(OSC, ("omega", 1.5, 1.7), max_points=6)
+    target = tmp_path / "b.zarr"
+    if existing:
+        save_branch(short, target)
+    fired = _other_writer_at(
+        monkeypatch, target, moment, lambda: save_branch(short, target, overwrite=True)
+    )
+    save_branch(long, target, overwrite=True)
+    monkeypatch.undo()
+    assert fired == [moment]
+    got = open_branch(target)  # complete: every chunk in its manifest, every digest right
+    assert got.sizes == long.sizes  # the writer that renamed last holds the path
+    np.testing.assert_array_equal(got.multiplier_re.values, long.multiplier_re.values)
+    assert [p.name for p in tmp_path.iterdir()] == ["b.zarr"]  # nothing aside, no temporary
+
+
+@pytest.mark.parametrize("moment", ["in", "aside"])
+def test_replace_dir_leaves_exactly_the_last_directory(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, moment: str
+) -> None:
+    from gearchaos._output import replace_dir
+
+    target, trash = tmp_path / "out", tmp_path / "trash"
+    for d, text in ((target, "old"), (tmp_path / "a", "a"), (tmp_path / "b", "b")):
+        d.mkdir()
+        (d / "data").write_text(text)
+    trash.mkdir()
+    fired = _other_writer_at(
+        monkeypatch,
+        target,
+        moment,
+        lambda: replace_dir(str(tmp_path / "b"), str(target), str(trash / "b")),
+    )
+    (trash / "b").mkdir()
+    replace_dir(str(tmp_path / "a"), str(target), str(trash))
+    monkeypatch.undo()
+    assert fired == [moment]
+    assert (target / "data").read_text() == "a"
+    # everything replaced went into the trash of the writer that moved it, nothing is lost
+    moved = sorted(p.read_text() for p in trash.rglob("data"))
+    assert moved == ["b", "old"]

@@ -12,7 +12,9 @@ thesis, a file of another program, a symbolic link — anything else is refused 
 **The one way to write.** :func:`staged_file` and :func:`staged_dir` give the writer a
 temporary path beside the target with a unique name, created exclusively (``O_EXCL``: a
 symbolic link planted under any name is never followed), and on success flush it to disk and
-rename it over the target in one step; on every error path the temporary is removed. Its name
+rename it over the target in one step (a directory, which cannot be renamed over another,
+by :func:`replace_dir`: atomic against a concurrent writer of the same output); on every
+error path the temporary is removed. Its name
 says whose it is (``.NAME.HOST-PID-random.partial``: a digest of this host's name and the
 writer's pid), so a later write of the same output removes what a killed writer (even by
 SIGKILL) left (:func:`remove_stale_staging`), and nothing a live writer still fills. An
@@ -47,6 +49,7 @@ __all__ = [
     "file_has_mark",
     "is_own_zarr",
     "remove_stale_staging",
+    "replace_dir",
     "staged_dir",
     "staged_file",
     "staging_prefix",
@@ -212,11 +215,11 @@ def write_file(path: str, data: bytes | memoryview, *, what: str, clean: bool = 
 @contextlib.contextmanager
 def staged_dir(path: str, *, what: str) -> Iterator[str]:
     """A temporary directory beside ``path`` for a writer to fill; put in place of ``path``
-    when the block ends without error (an existing ``path`` — which the caller has checked
-    with :func:`check_replaceable` — is moved aside first and removed after), removed
-    otherwise. The temporaries of ``path`` that killed writers left are removed first
-    (:func:`remove_stale_staging`)."""
-    parent, name = _parent(path)
+    when the block ends without error (by :func:`replace_dir`: an existing ``path`` — which
+    the caller has checked with :func:`check_replaceable` — is moved aside into a temporary of
+    this writer and removed after), removed otherwise. The temporaries of ``path`` that killed
+    writers left are removed first (:func:`remove_stale_staging`)."""
+    parent, _ = _parent(path)
     try:
         os.makedirs(parent, exist_ok=True)
         remove_stale_staging(path)
@@ -224,23 +227,53 @@ def staged_dir(path: str, *, what: str) -> Iterator[str]:
     except OSError as exc:
         raise write_error(exc, what, path) from None
     done = False
+    trash = None
     try:
         yield tmp
-        if os.path.lexists(path):
-            trash = tempfile.mkdtemp(prefix=f".{name}.", suffix=".old", dir=parent)
-            os.rename(path, os.path.join(trash, name))
-            os.rename(tmp, path)
-            done = True
-            shutil.rmtree(trash, ignore_errors=True)
-        else:
-            os.rename(tmp, path)
-            done = True
+        trash = tempfile.mkdtemp(prefix=staging_prefix(path), suffix=".partial", dir=parent)
+        replace_dir(tmp, path, trash)
+        done = True
         _fsync_dir(parent)
     except OSError as exc:
         raise write_error(exc, what, path) from None
     finally:
         if not done:
             _remove(tmp)
+        if trash is not None:
+            shutil.rmtree(trash, ignore_errors=True)
+
+
+#: What ``rename(directory, path)`` fails with when ``path`` is taken: a non-empty directory
+#: (``ENOTEMPTY``, or ``EEXIST`` on some systems), a file (``ENOTDIR``).
+_TAKEN = frozenset({errno.ENOTEMPTY, errno.EEXIST, errno.ENOTDIR, errno.EISDIR})
+#: How often :func:`replace_dir` may find ``path`` taken again by another writer.
+_RACES = 1000
+
+
+def replace_dir(new: str, path: str, trash: str) -> None:
+    """Rename the directory ``new`` to ``path`` in place of whatever is there, which is moved
+    into ``trash`` (an empty directory of this writer on the same file system, that the caller
+    removes afterwards).
+
+    A directory cannot be renamed over a non-empty one, so a replace takes two renames — the
+    old one aside, the new one in — and between them another writer of ``path`` may put its
+    own in (or move the old one aside first). So the new directory is renamed in, and only when
+    ``path`` is taken is what holds it moved aside (gone already: another writer moved it) and
+    the rename tried again: each retry follows another writer's success, and the last rename
+    leaves exactly one complete directory at ``path``, never a failure because of the other
+    writer. The caller has checked that ``path`` may be replaced
+    (:func:`check_replaceable`)."""
+    name = os.path.basename(os.path.abspath(path).rstrip(os.sep)) or "output"
+    for attempt in range(_RACES):
+        try:
+            os.rename(new, path)
+            return
+        except OSError as exc:
+            if exc.errno not in _TAKEN:
+                raise
+        with contextlib.suppress(FileNotFoundError):  # another writer moved it aside first
+            os.rename(path, os.path.join(trash, f"{attempt}-{name}"))
+    raise OSError(errno.EBUSY, f"other writers replaced it {_RACES} times meanwhile")
 
 
 def file_has_mark(path: str) -> bool:

@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from .._checks import check_int, check_real
-from .._output import remove_stale_staging, staging_prefix, write_error
+from .._output import remove_stale_staging, replace_dir, staging_prefix, write_error
 from ..analysis.motion import LABEL_DTYPE, Motion
 from ..errors import ParameterError, Status, StoreError
 from .result import SweepResult
@@ -200,15 +200,15 @@ def _staging(zstore: Any) -> str | None:
 
 def _swap_in(staging: str, zstore: str, attrs: dict[str, Any]) -> None:
     """Put the arrays written under ``staging`` in place of the store's (renames, which need
-    no space), then its attributes (one atomic write)."""
+    no space; the old arrays go into ``staging``, removed by the caller; a concurrent
+    classification of the store never makes it fail: :func:`replace_dir`), then its attributes
+    (one atomic write)."""
+    trash = tempfile.mkdtemp(prefix=".old-", dir=staging)
     for name in sorted(os.listdir(staging)):
         new = os.path.join(staging, name)
         if name.startswith(".") or not os.path.isdir(new):
             continue
-        old = os.path.join(zstore, name)
-        if os.path.isdir(old):
-            os.rename(old, os.path.join(staging, f".old-{name}"))
-        os.rename(new, old)
+        replace_dir(new, os.path.join(zstore, name), trash)
     set_attributes(zstore, attrs)
 
 
