@@ -11,6 +11,7 @@ bounds below only end a test that hangs; they are minutes, far from any normal p
 
 from __future__ import annotations
 
+import contextlib
 import os
 import queue
 import signal
@@ -48,12 +49,17 @@ def _default_sigint() -> None:
 
 
 class Command:
-    """A gearchaos command in a subprocess, its stderr read line by line as it comes."""
+    """A gearchaos command in a subprocess, its stderr read line by line as it comes; a
+    ``prelude`` (Python source) runs in that process before the command."""
 
-    def __init__(self, args: list[str]):
+    def __init__(self, args: list[str], prelude: str | None = None):
         env = {**os.environ, READY_ENV: "1"}
+        run = GEARCHAOS
+        if prelude is not None:
+            main = "import runpy; runpy.run_module('gearchaos', run_name='__main__')"
+            run = [sys.executable, "-c", f"{prelude}\n{main}"]
         self.proc = subprocess.Popen(
-            [*GEARCHAOS, *args],
+            [*run, *args],
             stdin=subprocess.DEVNULL,
             stdout=subprocess.DEVNULL,
             stderr=subprocess.PIPE,
@@ -109,8 +115,10 @@ class Command:
             self.proc.wait()
 
 
-def _interrupt(args: list[str], sig: int) -> tuple[int, list[str], list[int]]:
-    cmd = Command(args)
+def _interrupt(
+    args: list[str], sig: int, prelude: str | None = None
+) -> tuple[int, list[str], list[int]]:
+    cmd = Command(args, prelude)
     try:
         cmd.wait_for(READY_LINE)
         workers = _children(cmd.proc.pid)
@@ -174,3 +182,86 @@ def test_a_signal_stops_a_sweep_of_long_points_quietly(
     assert len(said) == 1 and said[0].startswith("error: interrupted"), lines
     assert not _all_gone(workers)
     assert store.exists()  # resumable: the next run computes what is left
+
+
+#: Makes the wakeup of ``concurrent.futures``' exit hook (``_python_exit``) lose its race with
+#: a pool's management thread that still runs at exit: the hook finds the thread's pipe open,
+#: the thread closes it, then the hook writes (CPython takes no lock there). Only a pool whose
+#: management thread was not joined before the exit hooks can lose.
+EXIT_RACE_LOST = """
+from concurrent.futures import process
+
+def wakeup(self, real=process._ThreadWakeup.wakeup):
+    if process._global_shutdown and not self._closed:
+        for thread, other in list(process._threads_wakeups.items()):
+            if other is self:
+                thread.join()
+        self._writer.send_bytes(b"")
+    else:
+        real(self)
+
+process._ThreadWakeup.wakeup = wakeup
+"""
+#: Ctrl-C again at the moment an interrupted pool of workers is shut down.
+SECOND_SIGNAL = """
+import os, signal
+from concurrent.futures import ProcessPoolExecutor
+
+def shutdown(self, wait=True, *, cancel_futures=False, real=ProcessPoolExecutor.shutdown):
+    if cancel_futures:
+        os.kill(os.getpid(), signal.SIGINT)
+    real(self, wait, cancel_futures=cancel_futures)
+
+ProcessPoolExecutor.shutdown = shutdown
+"""
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+@pytest.mark.parametrize(
+    "prelude", [EXIT_RACE_LOST, EXIT_RACE_LOST + SECOND_SIGNAL], ids=["once", "twice"]
+)
+def test_interrupted_workers_leave_nothing_to_the_exit_hooks(tmp_path: Path, prelude: str) -> None:
+    # under load an interrupted `bifurcation --workers 2` printed its one line, then "Exception
+    # ignored in atexit callback" and a traceback through concurrent/futures/process.py
+    # _python_exit: the pool was shut down without waiting, its management thread left running
+    # to the exit hooks, whose wakeup raced the thread closing its pipe. Here the hook loses
+    # that race whenever it can, and (twice) Ctrl-C comes again while the pool is ended
+    store = tmp_path / "long.zarr"
+    args = ["bifurcation", "-v", "omega=1:2:4", "--transient", "2e6", "--no-verdicts", "-q"]
+    rc, lines, workers = _interrupt(
+        [*args, "-o", str(store), "--workers", "2"], signal.SIGINT, prelude
+    )
+    assert rc == 130, lines
+    said = _quiet(lines)
+    assert len(said) == 1 and said[0].startswith("error: interrupted"), lines
+    assert not _all_gone(workers)
+    assert store.exists()
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+def test_an_interrupted_pool_is_ended_before_the_interrupt_goes_on() -> None:
+    # a pool left to the exit hooks fails there (the test above) or, with a worker that
+    # SIGTERM does not end, hangs the exit joining it; ended by executor(), nothing is left:
+    # no worker, no management thread, its wakeup pipe closed (the exit hook skips it)
+    from concurrent.futures import process
+
+    from gearchaos.sweep.execute import Execution, executor
+
+    pids: list[int] = []
+    try:
+        with pytest.raises(KeyboardInterrupt), executor(Execution(workers=1)) as (ex, _, _):
+            # this worker outlives SIGTERM: one that has not ended when the exit hooks run
+            ignored = ex.submit(signal.signal, signal.SIGTERM, signal.SIG_IGN)
+            assert ignored.result(timeout=COMPILE_BOUND) == signal.SIG_DFL
+            ex.submit(time.sleep, 3600.0)
+            pids = list(ex._processes)
+            manager = ex._executor_manager_thread
+            wakeup = process._threads_wakeups[manager]
+            raise KeyboardInterrupt
+        assert not manager.is_alive()
+        assert wakeup._closed
+        assert pids and not [p for p in pids if _alive(p)]
+    finally:  # the old way left the worker running
+        for p in pids:
+            with contextlib.suppress(OSError):
+                os.kill(p, signal.SIGKILL)

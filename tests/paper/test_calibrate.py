@@ -391,6 +391,94 @@ def test_a_study_resumes_after_kill_9_without_losing_a_finished_trial(tmp_path: 
     assert len(done) == 6 and min(set(done) - set(before)) > 2  # the count continues
 
 
+def _running(pid: int) -> bool:
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            return f.read().split()[2] != "Z"
+    except OSError:
+        return False
+
+
+PARALLEL = textwrap.dedent(
+    """
+    import os, sys, threading
+    from gearchaos.paper.calibrate import calibrate
+
+    class Blocking:
+        def __call__(self, gs):  # every trial of a worker blocks: the test interrupts then
+            os.write(2, b"trial running\\n")
+            threading.Event().wait()
+
+    if __name__ == "__main__":
+        res = calibrate(
+            out=sys.argv[1], storage=sys.argv[2], objective=Blocking(), max_candidates=6,
+            workers=2,
+        )
+        print(res.stopped, flush=True)
+    """
+)
+
+
+def test_an_interrupted_parallel_calibration_ends_its_workers(tmp_path: Path) -> None:
+    # Ctrl-C to a calibration with --workers waited for the whole run of every worker (the
+    # pool's `with` shut it down waiting); its workers are ended at once, and their trials run
+    # again when the study goes on
+    import queue
+    import threading
+
+    out, url = tmp_path / "c.jsonl", f"sqlite:///{tmp_path / 'c.db'}"
+    script = tmp_path / "run.py"
+    script.write_text(PARALLEL)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    proc = subprocess.Popen(
+        [sys.executable, str(script), str(out), url], env=env, stdin=subprocess.DEVNULL,
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+    )  # fmt: skip
+    lines: queue.Queue[str | None] = queue.Queue()
+
+    def read() -> None:
+        assert proc.stderr is not None
+        for line in proc.stderr:
+            lines.put(line.rstrip("\n"))
+        lines.put(None)
+
+    reader = threading.Thread(target=read, daemon=True)
+    reader.start()
+    seen: list[str] = []
+    workers: list[int] = []
+    try:
+        while seen.count("trial running") < 2:  # readiness: both workers inside a trial
+            line = lines.get(timeout=600.0)  # a bound on a hang only
+            assert line is not None, seen
+            seen.append(line)
+        workers = [int(x) for x in subprocess.run(
+            ["pgrep", "-P", str(proc.pid)], capture_output=True, text=True
+        ).stdout.split()]  # fmt: skip
+        proc.send_signal(signal.SIGINT)
+        stdout, _ = proc.communicate(timeout=120.0)  # a bound on a hang only
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait(timeout=30)
+    reader.join(timeout=30)
+    while (line := lines.get()) is not None:
+        seen.append(line)
+    assert proc.returncode == 0 and stdout.split() == ["interrupted"], (stdout, seen)
+    assert not [x for x in seen if "Traceback" in x or "Exception ignored" in x], seen
+    deadline = time.monotonic() + 120.0  # the children end with it (a bound on a hang only)
+    while (left := [p for p in workers if _running(p)]) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert workers and not left, left
+    running = [t for t in _trials(url, cal.STUDY) if t.state.name == "RUNNING"]
+    assert len(running) == 2 and all(t.params for t in running)
+    res = calibrate(out=out, storage=url, objective=Stub(), max_candidates=6)
+    assert sorted(res.retried) == sorted(t.number for t in running)
+    trials = _trials(url, cal.STUDY)
+    for t in running:  # each ended trial ran again with its parameters
+        again = [u for u in trials if u.user_attrs.get("origin") == f"retry of #{t.number}"]
+        assert len(again) == 1 and again[0].params == t.params
+
+
 def test_a_trial_a_peer_finished_first_does_not_stop_the_worker(tmp_path: Path) -> None:
     """Two workers on one SQLite storage may run the same enqueued trial (SQLite has no row
     locks), and the slower one's report then meets a finished trial (Optuna raises

@@ -410,15 +410,28 @@ def calibrate(
 
 
 def _parallel(job: Job, where: Any, progress: Callable[[], None]) -> str:
-    """Run :func:`run_worker` on every worker of ``where`` and wait, showing progress."""
+    """Run :func:`run_worker` on every worker of ``where`` and wait, showing progress.
+
+    Interrupted, local worker processes are ended at once and completely
+    (:func:`~gearchaos.sweep.execute.end_pool`; the trial each one ran is enqueued again by
+    :func:`~gearchaos.paper.study.recover` when the study goes on): waiting for them would take
+    their whole run, and a pool left running fails in Python's exit hooks."""
     import concurrent.futures as cf
     import multiprocessing
 
+    from ..sweep.execute import end_pool
+
     if where.workers is not None:
         ctx = multiprocessing.get_context("spawn")
-        with cf.ProcessPoolExecutor(where.workers, mp_context=ctx) as pool:
+        pool = cf.ProcessPoolExecutor(where.workers, mp_context=ctx)
+        try:
             futures = [pool.submit(run_worker, job, i) for i in range(where.workers)]
-            return _wait(futures, progress)
+            stopped = _wait(futures, progress)
+        except BaseException:  # interrupted (a worker's error comes once every one ended)
+            end_pool(pool)
+            raise
+        pool.shutdown(wait=True)
+        return stopped
     from dask.distributed import Client, LocalCluster
 
     if where.scheduler is not None:

@@ -31,7 +31,14 @@ from .._checks import check_int
 from ..errors import ParameterError
 from ..integrate._chains import run_chains
 
-__all__ = ["EXECUTION_OPTIONS", "Execution", "InProcess", "executor", "watch_parent"]
+__all__ = [
+    "EXECUTION_OPTIONS",
+    "Execution",
+    "InProcess",
+    "end_pool",
+    "executor",
+    "watch_parent",
+]
 
 
 #: Seconds between two looks of a worker at its parent (the portable fallback of the death
@@ -88,11 +95,12 @@ class InProcess:
 
 
 @contextlib.contextmanager
-def _signals_deferred() -> Iterator[None]:
+def _signals_deferred(insist: bool = True) -> Iterator[None]:
     """Hold Ctrl-C and SIGTERM until the block ends, then raise ``KeyboardInterrupt`` if one
     came: a Dask cluster interrupted while it starts can be neither used nor closed (Dask
-    tries again at exit and fails with a traceback). A second signal is not held: whoever
-    insists is not kept waiting by a start that hangs."""
+    tries again at exit and fails with a traceback). With ``insist`` a second signal is not
+    held: whoever insists is not kept waiting by a start that hangs; without, every signal is
+    held (a block that ends within a bound, such as :func:`end_pool`)."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
@@ -100,7 +108,7 @@ def _signals_deferred() -> Iterator[None]:
 
     def hold(signum: int, frame: Any) -> None:
         came.append(signum)
-        if len(came) > 1:
+        if insist and len(came) > 1:
             raise KeyboardInterrupt(f"signal {signum}")
 
     old = {s: signal.signal(s, hold) for s in (signal.SIGINT, signal.SIGTERM)}
@@ -162,6 +170,39 @@ def _end_cluster(client: Any, cluster: Any) -> None:
     cluster.close()
 
 
+#: Seconds :func:`end_pool` waits for the killed workers and for the pool's management
+#: thread: a bound against a hang only (a killed process is gone at once).
+END_BOUND = 60.0
+
+
+def end_pool(ex: cf.ProcessPoolExecutor) -> None:
+    """End a local process pool at once and completely (an interrupted or failed sweep or
+    calibration reads none of its results): the calls not started are cancelled, the workers
+    are killed (SIGKILL: SIGTERM leaves a worker that handles or ignores it running, and a
+    compiled block would only finish for nobody) and reaped, and the pool's management thread
+    is joined once it has seen them end, each within :data:`END_BOUND` seconds. Ctrl-C and
+    SIGTERM are held meanwhile (:func:`_signals_deferred`; one that came is raised after).
+
+    So nothing is left to Python's exit hooks. A pool only shut down without waiting
+    (``shutdown(wait=False)``) leaves its management thread running, and at exit
+    ``concurrent.futures``' hook (``_python_exit``) wakes it through a pipe that the thread
+    may close at the same moment — that wakeup takes no lock (CPython issues 84176, 125451;
+    Python 3.11 has it): "Exception ignored … OSError: handle is closed" after the message —
+    then joins it (a worker SIGTERM did not end keeps the exit waiting)."""
+    with _signals_deferred(insist=False):
+        processes = list((getattr(ex, "_processes", None) or {}).values())
+        manager = getattr(ex, "_executor_manager_thread", None)
+        ex.shutdown(wait=False, cancel_futures=True)
+        for proc in processes:
+            with contextlib.suppress(OSError, ValueError):  # gone already, or closed
+                proc.kill()
+        for proc in processes:
+            with contextlib.suppress(OSError, ValueError, AssertionError):
+                proc.join(END_BOUND)
+        if manager is not None and manager is not threading.current_thread():
+            manager.join(END_BOUND)
+
+
 #: The keyword names of :class:`Execution`.
 EXECUTION_OPTIONS = ("workers", "scheduler", "dask_local")
 
@@ -210,9 +251,7 @@ def executor(execution: Execution | None = None) -> Iterator[tuple[Any, Any, str
         except BaseException:
             # interrupted or failed: end the workers now (a clean shutdown would wait for the
             # blocks they compute, seconds of compiled code whose result nobody reads)
-            for proc in list(getattr(ex, "_processes", {}).values()):
-                proc.terminate()
-            ex.shutdown(wait=False, cancel_futures=True)
+            end_pool(ex)
             raise
         ex.shutdown(wait=True)
         return
