@@ -217,7 +217,10 @@ def decide_by_exponent(p: Any, vs: Any, last: bool) -> Verdict | None:
     coexist = _coexist_text(p)
     hi = w.lle + c * w.err
     why = _chaotic_window(w, tests, c)
-    if p.long_period and hi < 0:
+    # a stable orbit found by shooting that the record may still be approaching (its
+    # approach not yet measurable) explains a contracting record whose recurrence gaps fall
+    # below the noise floor at some long n (a slow spiral onto a 1T looks 17-periodic): run on
+    if p.long_period and hi < 0 and not p.approaching:
         n = p.long_period
         return Verdict(
             label=Motion.periodic(n).format(),

@@ -1,0 +1,86 @@
+"""Slow approaches to a stable orbit: the verdict names the orbit the record approaches, or
+says why it could not, never a period the record only seems to have.
+
+Independent truths here: orbits and multipliers of the single-point shooting
+(:func:`gearchaos.periodic_orbit`, its own Newton from its own start, at 100 times tighter
+tolerances), and a long plain run's distance from that orbit. The gear set is the frozen
+``sheng2016-v1`` (the default's values before its recalibration).
+"""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+
+import gearchaos as gc
+from gearchaos.analysis.recurrence import distance_to_orbit
+from gearchaos.dynamics import periodic_orbit
+from gearchaos.dynamics.point import point_verdict
+from gearchaos.dynamics.verdict import VerdictSettings
+from gearchaos.dynamics.verdict_rules import Window, decide_by_exponent
+from gearchaos.integrate.settings import SolverSettings
+from gearchaos.integrate.simulate import integrate
+from gearchaos.model.target import resolve
+
+V1 = gc.preset("sheng2016-v1")
+
+
+def _reference(values, period):
+    ref = periodic_orbit(V1, period=period, rtol=1e-10, atol=1e-12, **values)
+    assert ref.converged, ref.message
+    return ref
+
+
+def test_a_slow_spiral_onto_a_1t_is_that_1t_not_a_long_period() -> None:
+    # Ω = 3.59, ξ = 0.032 after 150 + 16 periods: the record spirals onto a 1T (a complex pair
+    # |μ| ≈ 0.977 turning ~0.92 rad a period) within the noise floor of the recurrence test,
+    # whose gaps then fit a period of 17; the verdict said 17T (record_contracting)
+    values = {"omega": 3.59, "xi": 0.032}
+    res = gc.simulate(V1, transient_periods=150, periods=16, **values)
+    ref = _reference(values, 1)
+    assert ref.minimal_period == 1 and ref.max_multiplier < 1 - 1e-3
+    # the truth: the motion from rest ends on that 1T (a long plain run)
+    system = resolve(V1, values)
+    long = integrate(system, SolverSettings(transient_periods=2000, periods=8))
+    assert np.max(distance_to_orbit(long.states, ref.sections)) < 1e-8
+    summary = gc.summarize(res)
+    assert summary["motion"] != "17T" and summary["evidence"] != "record_contracting"
+    assert summary["motion"] == "1T", summary["motion_note"]
+    assert summary["evidence"] == "floquet"
+    assert abs(summary["max_multiplier"] - ref.max_multiplier) <= 1e-6
+    assert summary["distinct_section_points"] == 1  # the record shown agrees with the label
+    v = point_verdict(V1, values, res)
+    assert v.label == "1T" and v.record is not None
+    d = distance_to_orbit(v.record.states[-16:], ref.sections)
+    assert np.max(d) < 1e-5  # the recorded sections lie on the shot orbit
+
+
+def test_a_long_period_is_not_decided_while_a_stable_orbit_may_be_approached() -> None:
+    # the rule itself: a record that repeats with a long period and contracts, while the
+    # shooting found a stable 1T it may still approach (too close to measure), runs on, and
+    # when the budget ends it is unresolved with 'converging', never that period
+    rng = np.random.default_rng(3)
+    x = 3.0 + 1e-6 * rng.standard_normal((100, 4))
+    p = SimpleNamespace(
+        windows=[Window(0, 100, -0.02, 0.004, 0.06)],
+        fresh=True,
+        sections=x,
+        history=x,
+        long_period=17,
+        approaching=1,
+        unstable=None,
+        coexisting={},
+        extra=100,
+        record=None,
+        tests=None,
+        prev_tests=None,
+    )
+    vs = VerdictSettings()
+    assert decide_by_exponent(p, vs, last=False) is None
+    v = decide_by_exponent(p, vs, last=True)
+    assert v is not None and v.label == "unresolved" and v.evidence == "converging", v
+    # without the stable orbit the same record is the long period
+    p.approaching = 0
+    v = decide_by_exponent(p, vs, last=False)
+    assert v is not None and (v.label, v.evidence) == ("17T", "record_contracting")
