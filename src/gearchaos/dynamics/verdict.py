@@ -16,10 +16,12 @@ asks them, for K points at once (a sweep task, or one point):
    of :mod:`~gearchaos.dynamics.stability` (every other |μ| < 1 − ``margin``). A stable orbit
    is the label only when the record lies within ``reach`` of it; when the record's distance
    from it shrinks at a rate its multipliers allow, the run is continued until it does
-   (``settle_budget``), and the record shown is that continuation — never the orbit's own
-   points in place of the trajectory. A stable orbit the record does not approach *coexists*:
-   it is reported with the verdict, not as its label. An unstable orbit the record sits on is
-   left along its unstable eigenvector.
+   (``settle_budget``; a record too short to measure that at the slowest rate the multipliers
+   predict is first continued until it is long enough), and the record shown is the
+   continuation's last periods (the protocol's number, run on their own so that their extrema
+   are theirs) — never the orbit's own points in place of the trajectory. A stable orbit the
+   record does not approach *coexists*: it is reported with the verdict, not as its label. An
+   unstable orbit the record sits on is left along its unstable eigenvector.
 3. **Windows with a Lyapunov exponent** (:mod:`~gearchaos.dynamics.verdict_rules`): every point
    not decided is integrated further, one window at a time (the first as long as the record,
    at least ``min_extension``, the second as long, each next one twice as long, at most
@@ -46,8 +48,6 @@ from typing import Any
 
 import numpy as np
 
-from .._checks import check_int, check_real
-from ..analysis.classify import LLE_C
 from ..analysis.motion import Motion
 from ..analysis.periodicity import periods_of
 from ..analysis.recurrence import converging_period, near_period, noise_floor
@@ -56,158 +56,25 @@ from ..integrate.settings import SolverSettings
 from ..model.system import System
 from .evidence import Verdict
 from .extension import VerdictRecord, extend
-from .lyapunov import LYAPUNOV_BLOCKS, exponent_estimate
-from .stability import STABILITY_MARGIN
-from .verdict_orbits import Found, Settle, approach_rate, shoot_candidates
+from .lyapunov import exponent_estimate
+from .verdict_orbits import (
+    Found,
+    Settle,
+    approach_rate,
+    beyond_budget,
+    measure_periods,
+    shoot_candidates,
+)
 from .verdict_rules import SectionTests, Window, decide_by_exponent
+from .verdict_settings import CONFIRM_PERIODS, VerdictSettings, confirmed_settings
 
 __all__ = ["CONFIRM_PERIODS", "VerdictSettings", "confirmed_settings", "decide_motion"]
 
-#: Default length of the last window behind a chaos or QP entry of ``attractors``, ``basins``
-#: and ``basin_fractions``: a long continuation that a chaotic transient rarely survives.
-CONFIRM_PERIODS = 2000
-
-
-@dataclass(frozen=True)
-class VerdictSettings:
-    """Tolerances and budget of :func:`decide_motion`.
-
-    Parameters
-    ----------
-    max_period
-        Longest period confirmed by shooting (Newton with the full monodromy over n periods).
-    longest_period
-        Longest period recognised in a record at all; QP is considered only once the record
-        is at least twice this long.
-    period_rtol
-        Recurrence tolerance relative to the attractor's size S.
-    noise_factor
-        The noise floor ε = noise_factor · (atol + rtol · max|x|) of the section points.
-    margin
-        Stability margin: a stable orbit has every non-structural |μ| < 1 − margin
-        (:data:`~gearchaos.dynamics.stability.STABILITY_MARGIN`).
-    same_orbit
-        Largest distance (∞-norm, relative to max(1, ‖y*‖)) between the final state and an
-        unstable orbit's section points for the motion to sit on it.
-    reach
-        A record lies on its orbit when every recorded section is within reach ·
-        max(1, ‖y*‖) (∞-norm) of the orbit's section points: the tolerance of every nT
-        label's record.
-    approach
-        A record whose recurrence gaps over its last quarter stay within this fraction of
-        max(1, max|x|) lingers near a periodic orbit: that period is shot.
-    extension_periods
-        Length of the first window (None: the record's length, at least ``min_extension``).
-    min_extension
-        Shortest first window when ``extension_periods`` is None.
-    max_window
-        Longest window (each window is twice as long as the one before).
-    budget_periods
-        Most periods added to a point by windows.
-    settle_budget
-        Most periods integrated to bring a record that approaches a stable orbit onto it.
-    confirm_periods
-        Chaos and QP need a last window at least this long (0: any; ``attractors`` and the
-        basin tools use 2000, a long continuation that a chaotic transient rarely survives).
-    max_bands
-        Most curves or bands of the section the torus test looks for.
-    newton_iterations, newton_contraction, newton_tol
-        The shooting's iteration limit, early give-up factor over three iterations and
-        tolerance (relative to max(1, ‖y‖)).
-    tangent_tol
-        Factor on the integrator's tolerances for the Newton iteration's monodromy columns
-        (cheap tangents for Newton; the multipliers stated are computed once more at the
-        state's tolerances, factor 1).
-    lyapunov_tol
-        The same factor for a window's Lyapunov vector (infinite: the vector takes the state's
-        steps, and the state is bitwise that of a plain run).
-    blocks, confidence
-        Block means of the λ₁ error estimate, and the half-width c of its interval in
-        standard errors.
-    lle_c
-        c_θ of the finite-time bias bound θ = c_θ / t.
-    seed
-        Seed of the random initial tangent vectors.
-    """
-
-    max_period: int = 8
-    longest_period: int = 64
-    period_rtol: float = 1e-3
-    noise_factor: float = 1e3
-    margin: float = STABILITY_MARGIN
-    same_orbit: float = 1e-2
-    reach: float = 1e-3
-    approach: float = 2e-2
-    extension_periods: int | None = None
-    min_extension: int = 100
-    max_window: int = 1600
-    budget_periods: int = 6300
-    settle_budget: int = 6000
-    confirm_periods: int = 0
-    max_bands: int = 8
-    tangent_tol: float = 1000.0
-    lyapunov_tol: float = math.inf
-    newton_tol: float = 1e-7
-    newton_iterations: int = 10
-    newton_contraction: float = 0.25
-    blocks: int = LYAPUNOV_BLOCKS
-    confidence: float = 2.0
-    lle_c: float = LLE_C
-    seed: int = 0
-
-    def __post_init__(self) -> None:
-        check_int("max_period", self.max_period, lo=1, hi=64)
-        check_int("longest_period", self.longest_period, lo=self.max_period, hi=10_000)
-        check_real("period_rtol", self.period_rtol, lo=0.0, hi=0.5, lo_open=True)
-        check_real("noise_factor", self.noise_factor, lo=1.0)
-        check_real("margin", self.margin, lo=0.0, hi=0.5)
-        check_real("same_orbit", self.same_orbit, lo=0.0, hi=1.0, lo_open=True)
-        check_real("reach", self.reach, lo=0.0, hi=1.0, lo_open=True)
-        check_real("approach", self.approach, lo=0.0, hi=1.0)
-        if self.extension_periods is not None:
-            check_int("extension_periods", self.extension_periods, lo=2 * self.blocks + 1)
-        check_int("min_extension", self.min_extension, lo=2 * self.blocks + 1, hi=10**6)
-        check_int("max_window", self.max_window, lo=2 * self.blocks + 1, hi=10**7)
-        check_int("budget_periods", self.budget_periods, lo=0, hi=10**7)
-        check_int("settle_budget", self.settle_budget, lo=0, hi=10**7)
-        check_int("confirm_periods", self.confirm_periods, lo=0, hi=10**7)
-        check_int("max_bands", self.max_bands, lo=1, hi=64)
-        check_real("tangent_tol", self.tangent_tol, lo=1.0, hi=1e6)
-        if not (isinstance(self.lyapunov_tol, int | float) and self.lyapunov_tol == math.inf):
-            check_real("lyapunov_tol", self.lyapunov_tol, lo=1.0, hi=1e8)
-        check_real("newton_tol", self.newton_tol, lo=0.0, hi=1e-3, lo_open=True)
-        check_int("newton_iterations", self.newton_iterations, lo=1, hi=100)
-        check_real("newton_contraction", self.newton_contraction, lo=0.0, hi=1.0, lo_open=True)
-        check_int("blocks", self.blocks, lo=2, hi=1000)
-        check_real("confidence", self.confidence, lo=0.0, lo_open=True)
-        check_real("lle_c", self.lle_c, lo=0.0, lo_open=True)
-        check_int("seed", self.seed, lo=0)
-
-    def extension_for(self, record_periods: int) -> int:
-        """Periods of the first window after a record of ``record_periods``."""
-        if self.extension_periods is not None:
-            return int(self.extension_periods)
-        return min(max(int(record_periods), self.min_extension), self.max_window)
-
-    def next_window(self, previous: int, count: int) -> int:
-        """Periods of the window after ``count`` windows, the last of ``previous`` periods:
-        the second as long as the first (a later window to confirm what the first says),
-        each one after it twice as long (θ and σ shrink for a weak exponent), at most
-        ``max_window``, and at least ``confirm_periods`` once a window has run."""
-        grow = 1 if count == 1 else 2
-        return max(min(grow * int(previous), self.max_window), self.confirm_periods)
-
-
-def confirmed_settings(confirm_periods: int = CONFIRM_PERIODS) -> VerdictSettings:
-    """The verdict of the attractor tools: chaos and QP need a last window of at least
-    ``confirm_periods`` (and the budget for two such windows after the first)."""
-    c = check_int("confirm_periods", confirm_periods, lo=0, hi=10**6)
-    base = VerdictSettings()
-    return VerdictSettings(confirm_periods=c, budget_periods=max(base.budget_periods, 2 * c + 600))
-
-
-#: Most section states of a point's contiguous history kept (slow approaches are measured
-#: over it).
+#: Fewest section states of a point's contiguous history kept (approaches are measured over
+#: it). A point keeps at least its latest window too, and, once a stable orbit is found whose
+#: slowest predicted rate needs a longer record to be measured
+#: (:func:`~gearchaos.dynamics.verdict_orbits.measure_periods`), that many: the run is then
+#: continued for the missing periods, within ``settle_budget``.
 HISTORY = 1000
 
 
@@ -219,6 +86,8 @@ class _Point:
     sections: np.ndarray  # the latest record (window)
     final: np.ndarray
     history: np.ndarray  # the contiguous records so far, newest last (capped)
+    keep: int  # most sections of history kept (at least the latest window)
+    shown: int  # sections of the record shown (the protocol's): a settle's record
     extra: int = 0
     windows: list[Window] = field(default_factory=list)
     tests: SectionTests | None = None
@@ -285,7 +154,12 @@ def _floquet(p: _Point, f: Found, system: System, how: str) -> Verdict:
     )
 
 
-def _reach(f: Found, record: np.ndarray, settings: SolverSettings, vs: VerdictSettings) -> float:
+def _on(f: Found, record: np.ndarray, settings: SolverSettings, vs: VerdictSettings) -> bool:
+    """Whether every section of ``record`` lies within reach of orbit f."""
+    return float(np.max(f.distances(record))) <= _reach(f, settings, vs)
+
+
+def _reach(f: Found, settings: SolverSettings, vs: VerdictSettings) -> float:
     """How close every recorded section must lie to orbit f for the record to be on it:
     ``reach`` · max(1, ‖y*‖), and at most half the recurrence tolerance of the record
     (period_rtol · S + ε, S the orbit's size, ε the noise floor at unit magnitude): a record
@@ -327,7 +201,7 @@ def _judge(
             vec = np.real(v[:, int(np.argmax(np.abs(w)))])
             p.unstable = (f.period, f.max_multiplier, vec / max(float(np.max(np.abs(vec))), 1e-300))
         return False
-    target = _reach(f, rec, settings, vs)
+    target = _reach(f, settings, vs)
     if float(np.max(d)) <= target:
         done[k] = _floquet(p, f, systems[k], how)
         return True
@@ -335,20 +209,28 @@ def _judge(
     # distances are known to the orbit's accuracy (Newton's tolerance, the integration's)
     floor = (vs.newton_tol + settings.rtol) * scale + settings.atol
     how_close, rate = approach_rate(hist, floor, f.rates)
-    if how_close == "unmeasured":  # too short a record to tell: the next window will
-        p.tried.discard(f.period)
-        p.approaching = f.period
-        return False
     if how_close == "inconsistent":
         p.coexisting[f.period] = f.max_multiplier
         return False
-    # periods until the distance falls below the reach at the slower of the observed rate
-    # and the slowest the multipliers predict (it dominates in the end), then a record's
-    # length on the orbit
-    slow = max(rate, float(np.max(f.rates)))
-    need = math.log(target / max(float(hist[-1]), target)) / slow
-    periods = math.ceil(need) + rec.shape[0]
-    p.settle = Settle(f, periods, rate)
+    # ln of the fall still needed, and the slowest rate the multipliers predict (it
+    # dominates in the end): the periods until the record lies within reach at that rate
+    fall, slowest = math.log(target / max(float(hist[-1]), target)), float(np.max(f.rates))
+    if how_close == "unmeasured":
+        have, need = p.history.shape[0], measure_periods(f.rates)
+        if have < need:  # too short a record for the slowest predicted rate: run on for it
+            p.keep = max(p.keep, need)
+            p.settle = Settle(
+                f, need - have, math.nan, p.shown, math.ceil(fall / slowest), measure=True
+            )
+            return True
+        # long enough, but already within the orbit's accuracy: the next window will tell
+        p.tried.discard(f.period)
+        p.approaching = f.period
+        return False
+    # at the slower of the observed rate and the slowest predicted, then the record shown
+    # (a record's length) on the orbit
+    need = math.ceil(fall / max(rate, slowest))
+    p.settle = Settle(f, need + p.shown, rate, p.shown, need)
     return True
 
 
@@ -400,8 +282,13 @@ def decide_motion(
         if not okv[k] or not np.all(np.isfinite(fin[k])) or not np.all(np.isfinite(sec[k])):
             done[k] = Verdict("failed", 0, "failed", reason="the integration failed")
         else:
-            pts[k] = _Point(sections=sec[k], final=fin[k].copy(), history=sec[k])
-    keep = max(2 * vs.longest_period + 2, sec.shape[1], HISTORY)
+            pts[k] = _Point(
+                sections=sec[k],
+                final=fin[k].copy(),
+                history=sec[k],
+                keep=max(2 * vs.longest_period + 2, sec.shape[1], HISTORY),
+                shown=sec.shape[1],
+            )
     length = {k: vs.extension_for(sec.shape[1]) for k in pts}
     while True:
         live = [k for k in pts if k not in done]
@@ -412,7 +299,7 @@ def decide_motion(
             p = pts[k]
             if p.settle is not None:
                 f = p.settle.orbit
-                if float(np.max(f.distances(p.sections))) <= _reach(f, p.sections, settings, vs):
+                if _on(f, p.sections, settings, vs):  # the settle's own record
                     done[k] = _floquet(p, f, systems[k], "approach")
                 else:  # not there yet: every candidate may be shot again
                     p.tried.clear()
@@ -469,25 +356,11 @@ def decide_motion(
         for k in todo:  # settling beyond its budget: unresolved with what was found
             p = pts[k]
             if p.settle is not None and p.settled_extra + p.settle.periods > vs.settle_budget:
-                f = p.settle.orbit
-                done[k] = Verdict(
-                    label="unresolved",
-                    period=0,
-                    evidence="converging",
-                    max_multiplier=f.max_multiplier,
-                    extra_periods=p.extra,
-                    record=p.record,
-                    reason=(
-                        f"the record approaches a stable period-{f.period} orbit (max |μ| = "
-                        f"{f.max_multiplier:.6g}) at the rate its multipliers allow, but would "
-                        f"reach it within {vs.reach:g} only after {p.settle.periods} more "
-                        f"periods (settle budget {vs.settle_budget})"
-                    ),
-                )
+                done[k] = beyond_budget(p.settle, p, vs)
         todo = [k for k in todo if k not in done]
         if not todo:
             break
-        _extend(todo, pts, done, systems, settings, vs, length, keep)
+        _extend(todo, pts, done, systems, settings, vs, length)
     return [done[k] for k in range(K)]
 
 
@@ -499,57 +372,68 @@ def _extend(
     settings: SolverSettings,
     vs: VerdictSettings,
     length: dict[int, int],
-    keep: int,
 ) -> None:
     """Run every point of ``todo`` on: a settling point without tangents for its settle
-    length, the others for their next window with one tangent vector (λ₁)."""
-    groups: dict[tuple[int, bool], list[int]] = {}
+    length — the approach, then its last ``record`` periods as a run of their own, so that
+    the record (its sections and the extrema between them) is only the part that must lie on
+    the orbit —, the others for their next window with one tangent vector (λ₁)."""
+    groups: dict[tuple[int, int, bool], list[int]] = {}
     for k in todo:
         p = pts[k]
         if p.settle is not None:
-            groups.setdefault((p.settle.periods, False), []).append(k)
+            s = p.settle
+            groups.setdefault((s.periods, min(s.record, s.periods), False), []).append(k)
         else:
             if p.windows:
                 length[k] = vs.next_window(length[k], len(p.windows))
-            groups.setdefault((length[k], True), []).append(k)
+            groups.setdefault((length[k], length[k], True), []).append(k)
     n_state = systems[0].n_state
-    for (periods, tangents), ks in sorted(groups.items()):
-        starts = []
-        for k in ks:
-            p = pts[k]
-            y = p.final.copy()
-            if p.unstable is not None:  # leave the unstable orbit along its eigenvector
-                y = y + 1e-3 * max(1.0, float(np.max(np.abs(y)))) * p.unstable[2]
-            starts.append(y)
+    for (periods, shown, tangents), ks in sorted(groups.items()):
+        starts = {k: _start(pts[k]) for k in ks}
+        lead: dict[int, np.ndarray] = {}  # the approach's sections, before the record
+        if periods > shown:
+            out = extend(
+                [systems[k] for k in ks],
+                np.array([starts[k] for k in ks]),
+                settings,
+                periods - shown,
+                None,
+                tangent_tol=vs.lyapunov_tol,
+            )
+            for i, k in enumerate(ks):
+                if int(out.status[i, 0]) != 0:
+                    _failed(pts[k], k, periods, tangents, done)
+                    continue
+                lead[k] = out.states[i, 0, :, :n_state].copy()
+                starts[k] = out.final_state[i, 0, :n_state].copy()
+            ks = [k for k in ks if k not in done]
+            if not ks:
+                continue
         seed = (vs.seed + len(pts[ks[0]].windows)) if tangents else None
         out = extend(
             [systems[k] for k in ks],
-            np.array(starts),
+            np.array([starts[k] for k in ks]),
             settings,
-            periods,
+            shown,
             seed,
             tangent_tol=vs.lyapunov_tol,
         )
         stretch = out.stretch(n_state) if tangents else None
         for i, k in enumerate(ks):
             p = pts[k]
+            if int(out.status[i, 0]) != 0:
+                _failed(p, k, periods, tangents, done)
+                continue
             start = p.extra
             p.extra += periods
             p.fresh = tangents
             if not tangents:
                 p.settled_extra += periods
-            if int(out.status[i, 0]) != 0:
-                done[k] = Verdict(
-                    "failed",
-                    0,
-                    "failed",
-                    extra_periods=p.extra,
-                    reason="the integration failed while the run was continued",
-                )
-                continue
             states = out.states[i, 0, :, :n_state].copy()
+            run = states if k not in lead else np.concatenate([lead[k], states])
             contiguous = p.unstable is None
-            p.history = np.concatenate([p.history, states])[-keep:] if contiguous else states
+            keep = max(p.keep, run.shape[0])
+            p.history = np.concatenate([p.history, run])[-keep:] if contiguous else run
             p.sections = states
             p.final = out.final_state[i, 0, :n_state].copy()
             p.record = VerdictRecord(
@@ -566,3 +450,25 @@ def _extend(
                 theta = vs.lle_c / ((periods - 1) * T)
                 p.prev_tests = p.tests
                 p.windows.append(Window(start, periods, lam, err, theta))
+
+
+def _start(p: _Point) -> np.ndarray:
+    """Where point p runs on from: its final state, pushed off an unstable orbit it sits on
+    along the orbit's unstable eigenvector."""
+    y = p.final.copy()
+    if p.unstable is not None:
+        y = y + 1e-3 * max(1.0, float(np.max(np.abs(y)))) * p.unstable[2]
+    return y
+
+
+def _failed(p: _Point, k: int, periods: int, tangents: bool, done: dict[int, Verdict]) -> None:
+    p.extra += periods
+    if not tangents:
+        p.settled_extra += periods
+    done[k] = Verdict(
+        "failed",
+        0,
+        "failed",
+        extra_periods=p.extra,
+        reason="the integration failed while the run was continued",
+    )

@@ -31,12 +31,27 @@ from typing import Any
 import numpy as np
 
 from ..analysis.recurrence import distance_to_orbit
+from ..errors import ParameterError
 from ..integrate.settings import SolverSettings
 from ..model.system import System
+from .evidence import Verdict
 from .shooting import multipliers_of, shoot
 from .stability import stability_of, structural_multipliers
 
-__all__ = ["Found", "Settle", "approach_rate", "shoot_candidates"]
+__all__ = [
+    "Found",
+    "Settle",
+    "approach_rate",
+    "beyond_budget",
+    "measure_periods",
+    "shoot_candidates",
+]
+
+#: Least fall of ln d over the half record an approach is measured on, at the slowest rate
+#: the multipliers predict, for :func:`approach_rate` to measure it (a fall by 1.25²).
+MEASURE_FALL = 2.0 * math.log(1.25)
+#: Fewest sections of the half record an approach is measured on.
+MEASURE_MIN = 16
 
 
 @dataclass(frozen=True, eq=False)
@@ -61,12 +76,62 @@ class Found:
 
 @dataclass(frozen=True, eq=False)
 class Settle:
-    """A record approaching a stable orbit at the rate its multipliers allow: continue for
-    ``periods`` and check that the record then lies within reach."""
+    """A run continued towards a stable orbit for ``periods`` (no tangents), whose last
+    ``record`` periods are run on their own (the record, its sections and extrema) and must
+    lie within reach of it: a record approaching the orbit at
+    the rate its multipliers allow (observed slope ``rate`` of ln d per section), or, with
+    ``measure``, a record too short to measure that approach at the slowest rate the
+    multipliers predict (it is measured afterwards, over ``periods`` more sections).
+    ``predicted``: the periods until the record would lie within reach at the slowest rate
+    the multipliers predict, ln(reach/d)/max(ln|μ_j|/d)."""
 
     orbit: Found
     periods: int
     rate: float
+    record: int
+    predicted: int
+    measure: bool = False
+
+
+def beyond_budget(s: Settle, p: Any, vs: Any) -> Verdict:
+    """``unresolved`` (evidence ``converging``) for point ``p`` whose settle ``s`` would pass
+    ``vs.settle_budget``: the periods the approach predicts against that budget."""
+    f = s.orbit
+    spent = f", after {p.settled_extra} spent on it" if p.settled_extra else ""
+    orbit = f"a stable period-{f.period} orbit (max |μ| = {f.max_multiplier:.6g})"
+    if s.measure:
+        what = (
+            f"lies near {orbit}, but measuring its approach at the slowest rate the "
+            f"multipliers predict ({float(np.max(f.rates)):.3g} per period) needs a record of "
+            f"{measure_periods(f.rates)} periods ({s.periods} more), and reaching it within "
+            f"{vs.reach:g} about {s.predicted}"
+        )
+    else:
+        what = (
+            f"approaches {orbit} at the rate its multipliers allow, but would reach it within "
+            f"{vs.reach:g} only after {s.predicted} more periods (and {s.record} on it)"
+        )
+    return Verdict(
+        label="unresolved",
+        period=0,
+        evidence="converging",
+        max_multiplier=f.max_multiplier,
+        extra_periods=p.extra,
+        record=p.record,
+        reason=f"the record {what}{spent}: beyond the settle budget of {vs.settle_budget} periods",
+    )
+
+
+def measure_periods(rates: np.ndarray) -> int:
+    """Sections of record :func:`approach_rate` needs to measure an approach at the slowest
+    rate the multipliers predict, ``max(rates)`` (ln|μ_j|/d per section): twice the half
+    record over which that rate falls by :data:`MEASURE_FALL`, 2 · max(16,
+    ⌈MEASURE_FALL/|max rates|⌉) (|μ| = 0.9985 per period: 596; 0.9995: 1786). Undefined (a
+    ParameterError) for rates that do not all fall."""
+    slowest = float(np.max(rates)) if np.size(rates) else math.nan
+    if not slowest < 0:
+        raise ParameterError(f"rates must all be < 0 (a stable orbit): got max {slowest!r}")
+    return 2 * max(MEASURE_MIN, math.ceil(MEASURE_FALL / -slowest))
 
 
 def approach_rate(d: np.ndarray, floor: float, rates: np.ndarray) -> tuple[str, float]:
@@ -89,7 +154,7 @@ def approach_rate(d: np.ndarray, floor: float, rates: np.ndarray) -> tuple[str, 
     slowest, fastest = float(np.max(rates)), float(np.min(rates))
     if slowest >= 0:
         return "inconsistent", math.nan
-    if half.size < 16 or -slowest * half.size < 2.0 * math.log(1.25):
+    if half.size < MEASURE_MIN or -slowest * half.size < MEASURE_FALL:
         return "unmeasured", math.nan
     blocks = np.array_split(np.arange(half.size), 8)
     centres = np.array([b.mean() for b in blocks])
