@@ -46,3 +46,38 @@ def test_basin_fractions_command(tmp_path):
     r = CliRunner().invoke(app, ["basin-fractions", *MODEL, "--vary", "delta=0.3", "--box",
                                  "x=1", "-o", str(tmp_path / "g.zarr")])  # fmt: skip
     assert r.exit_code == 2 and "--box must be STATE=LOW:HIGH" in r.output
+
+
+#: Twin-well Duffing with chaotic transients of hundreds of periods onto its one stable 1T
+#: (tests/dynamics/test_basins.py checks that against scipy).
+TRANSIENT = [*MODEL[:4], "--set", "delta=0.15", "--set", "omega=1"]
+
+
+def test_confirm_periods_reach_the_verdict_and_the_store(tmp_path):
+    from gearchaos.sweep.basins import open_basins
+
+    grid = ["--set", "gamma=0.32", "--x", "x=-2:2:4", "--y", "x_dot=-2:2:4"]
+    box = ["--vary", "gamma=0.32", "--starts", "16", "--seed", "1", "--box", "x=-2:2", "--box",
+           "x_dot=-2:2"]  # fmt: skip
+    found = {}
+    for confirm in ([], ["--confirm-periods", "0"]):
+        key = "0" if confirm else "default"
+        out = tmp_path / f"b{key}.zarr"
+        r = CliRunner().invoke(app, ["basins", *TRANSIENT, *grid, *confirm, "-o", str(out),
+                                     "--json"])  # fmt: skip
+        assert r.exit_code == 0, r.output
+        image = {a["label"] for a in json.loads(r.stdout)["attractors"]}
+        assert open_basins(out).attrs["confirm_periods"] == (0 if confirm else 2000)
+        out = tmp_path / f"f{key}.zarr"
+        r = CliRunner().invoke(app, ["basin-fractions", *TRANSIENT, *box, *confirm, "-o",
+                                     str(out), "--json"])  # fmt: skip
+        assert r.exit_code == 0, r.output
+        shares = {row["attractor"].split(" ")[0] for row in json.loads(r.stdout)["fractions"]}
+        assert open_basins(out).attrs["confirm_periods"] == (0 if confirm else 2000)
+        found[key] = (image, shares)
+    # two windows of 100 periods take a chaotic transient for an attractor; 2000 do not
+    assert found["0"] == ({"1T", "chaos"}, {"1T", "chaos"})
+    assert found["default"] == ({"1T"}, {"1T"})
+    r = CliRunner().invoke(app, ["basins", *TRANSIENT, *grid, "--confirm-periods", "-1", "-o",
+                                 str(tmp_path / "bad.zarr")])  # fmt: skip
+    assert r.exit_code == 2 and "--confirm-periods" in r.output and ">= 0" in r.output

@@ -178,3 +178,41 @@ def test_one_chaotic_attractor_is_one_entry_as_attractors_says() -> None:
     present = out["present"].values[0]
     assert int(np.sum(present)) == 1
     assert float(out["fraction"].values[0][present][0]) == 1.0
+
+
+def test_a_chaotic_transient_is_confirmed_as_the_orbit_it_ends_on() -> None:
+    """Twin-well Duffing, δ = 0.15, Ω = 1, γ = 0.32: some starts wander chaotically for
+    hundreds of periods before they settle on the one stable 1T. Decided over two windows of
+    100 periods (``confirm_periods=0``), such a start is a chaotic attractor; over a last
+    window of 2000 periods (the default) it is the 1T. The truth: scipy's DOP853 from every
+    start called chaos ends on the 1T that shooting finds from rest."""
+    from scipy.integrate import solve_ivp
+
+    from gearchaos.dynamics.verdict import CONFIRM_PERIODS
+
+    delta, gamma, omega = 0.15, 0.32, 1.0
+    system = gc.duffing(omega, delta=delta, alpha=-1.0, beta=1.0, gamma=gamma)
+    grid = ("x=-2:2:4", "x_dot=-2:2:4")
+    short = gc.basins(system, *grid, confirm_periods=0, progress=False)
+    full = gc.basins(system, *grid, progress=False)
+    assert short.attrs["confirm_periods"] == 0
+    assert full.attrs["confirm_periods"] == CONFIRM_PERIODS == 2000
+    assert json.loads(full.attrs["basin_spec"])["confirm_periods"] == CONFIRM_PERIODS
+    chaos = np.argwhere(short["label"].values == "chaos")
+    assert chaos.size  # the short window takes a transient for an attractor
+    ref = gc.periodic_orbit(system, period=1, rtol=1e-11, atol=1e-11, transient_periods=3000)
+    assert ref.converged and ref.stable and ref.minimal_period == 1
+    (one,) = entries(full)
+    assert one.label == "1T" and np.all(full["label"].values == "1T")
+    assert one.max_multiplier == pytest.approx(ref.max_multiplier, abs=1e-6)
+    np.testing.assert_allclose(one.section_states[0], ref.sections[0], atol=1e-6)
+    T = 2 * math.pi / omega
+
+    def rhs(t, y):
+        return [y[1], -delta * y[1] + y[0] - y[0] ** 3 + gamma * math.cos(omega * t)]
+
+    for i, j in chaos:
+        y0 = [short["x"].values[j], short["x_dot"].values[i]]
+        sol = solve_ivp(rhs, (0, 2000 * T), y0, method="DOP853", rtol=1e-9, atol=1e-9,
+                        t_eval=[2000 * T])  # fmt: skip
+        assert np.max(np.abs(sol.y[:, -1] - ref.sections[0])) < 1e-5

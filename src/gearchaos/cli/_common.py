@@ -41,6 +41,7 @@ from ._options import (  # the shared options, re-exported: c.Target, c.Directio
     DEFAULT_PRESET as DEFAULT_PRESET,
     RECORDED_MODEL as RECORDED_MODEL,
     Assess as Assess,
+    Confirm as Confirm,
     Direction as Direction,
     Execution as Execution,
     ExportFormat as ExportFormat,

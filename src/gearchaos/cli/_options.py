@@ -4,8 +4,9 @@ A group is a frozen record whose fields are the options (``typer.Option`` in ``A
 :class:`Target` (``--preset``, ``--gearset``, ``--model``, ``--set``), :class:`Protocol`
 (``--transient``, ``--settle``, ``--perturbation``, ``--periods``, ``--samples-per-period``),
 :class:`Solver` (``--rtol``, ``--atol``), :class:`Execution` (``--workers``, ``--scheduler``,
-``--dask-local``), :class:`Output` (``-o``, ``--overwrite``, ``--quiet``, ``--json``) and
-:class:`Verdict` (``--verdict/--no-verdict``). A command names a group as one parameter::
+``--dask-local``), :class:`Output` (``-o``, ``--overwrite``, ``--quiet``, ``--json``),
+:class:`Verdict` (``--verdict/--no-verdict``) and :class:`Confirm` (``--confirm-periods``, the
+attractor tools'). A command names a group as one parameter::
 
     @c.command()
     def simulate(
@@ -50,6 +51,7 @@ from typing import (
 import typer
 
 from ..dynamics.boundary import ASSESS
+from ..dynamics.verdict_settings import CONFIRM_PERIODS
 from ..errors import ParameterError
 from ..integrate.settings import SETTLE_CHOICES, SolverSettings
 from ..plot.amplitude import QUANTITIES
@@ -462,6 +464,23 @@ class Verdict(OptionGroup):
             )
         chosen = self.verdict if self.verdict is not None else self.verdicts
         return True if chosen is None else chosen
+
+
+@dataclass(frozen=True)
+class Confirm(OptionGroup):
+    """How the attractor tools (``attractors``, ``basins``, ``basin-fractions``) confirm a
+    chaotic or quasi-periodic attractor: by a last window of at least ``--confirm-periods``
+    periods (:func:`~gearchaos.dynamics.verdict.confirmed_settings`)."""
+
+    confirm_periods: Annotated[
+        int,
+        typer.Option(
+            "--confirm-periods",
+            help="A chaotic or quasi-periodic attractor is listed only after a last window of "
+            "this many periods confirms it (a chaotic transient that ends on an orbit within "
+            "it is that orbit's run).",
+        ),
+    ] = CONFIRM_PERIODS
 
 
 # --------------------------------------------------------------------------- commands

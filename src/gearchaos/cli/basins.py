@@ -75,7 +75,14 @@ def _box(items: list[str] | None) -> dict[str, tuple[float, float]] | None:
 
 
 #: The options of the keywords of basins() and basin_fractions() that refusals name.
-_OPTIONS = {"x": "--x", "y": "--y", "base_state": "--base", "starts": "--starts", "box": "--box"}
+_OPTIONS = {
+    "x": "--x",
+    "y": "--y",
+    "base_state": "--base",
+    "starts": "--starts",
+    "box": "--box",
+    "confirm_periods": "--confirm-periods",
+}
 
 
 def _legend_table(
@@ -116,6 +123,7 @@ def basins(
     target: c.Target = c.Target(),
     sample: SampleOpt = 32,
     seed: SeedOpt = 0,
+    confirm: c.Confirm = c.Confirm(),
     protocol: c.Protocol = PROTOCOL,
     solver: c.Solver = c.Solver.of(BASIN_SETTINGS),
     execution: c.Execution = c.Execution(),
@@ -125,8 +133,9 @@ def basins(
     initial states reaches.
 
     The attractors are found first from --sample starts (each decided by the motion verdict:
-    orbits confirmed by shooting with their multipliers, chaos by λ₁), then every start's
-    record is matched against them (unmatched starts get the verdict). Draw it with
+    orbits confirmed by shooting with their multipliers, chaos and QP by λ₁ over a last window
+    of at least CONFIRM_PERIODS periods (2000)), then every start's record is matched against
+    them (unmatched starts get the verdict). Draw it with
     **gearchaos plot STORE -o basins.png**.
 
     Example (twin-well Duffing): **gearchaos basins --model gearchaos.model.library:Duffing
@@ -152,6 +161,7 @@ def basins(
                 progress=not output.silent,
                 sample=sample,
                 seed=seed,
+                confirm_periods=confirm.confirm_periods,
                 **execution.offered_values(),
             )
         seconds = time.perf_counter() - t0
@@ -212,13 +222,15 @@ def basin_fractions(
     target: c.Target = c.Target(),
     sample: SampleOpt = 16,
     seed: SeedOpt = 0,
+    confirm: c.Confirm = c.Confirm(),
     protocol: c.Protocol = PROTOCOL,
     solver: c.Solver = c.Solver.of(BASIN_SETTINGS),
     execution: c.Execution = c.Execution(),
     output: c.Output = OUTPUT,
 ) -> None:
     """Across a parameter, the fraction of random starts ending on each attractor, with 95 %
-    Wilson confidence intervals ("how likely is rattle at this speed").
+    Wilson confidence intervals ("how likely is rattle at this speed"). Each start is labelled
+    as by **gearchaos basins** (chaos and QP confirmed over --confirm-periods).
 
     Example: **gearchaos basin-fractions --vary omega=1:2:21 --starts 200 -o fractions.zarr**
     """
@@ -246,6 +258,7 @@ def basin_fractions(
                 overwrite=output.overwrite,
                 progress=not output.silent,
                 sample=sample,
+                confirm_periods=confirm.confirm_periods,
                 **execution.offered_values(),
             )
         seconds = time.perf_counter() - t0

@@ -17,7 +17,6 @@ from rich.text import Text
 from ..dynamics.coexistence import ATTRACTOR_SETTINGS
 from ..dynamics.orbits import ORBIT_SETTINGS
 from ..dynamics.stability import STABILITY_MARGIN
-from ..dynamics.verdict import CONFIRM_PERIODS
 from ..errors import IntegrationError, ParameterError
 from ..gearset.schema import OMEGA, SPEEDS
 from . import _common as c
@@ -433,15 +432,7 @@ def attractors(
         ),
     ] = 8,
     seed: Annotated[int, typer.Option("--seed", help="Seed of the random starts.")] = 0,
-    confirm: Annotated[
-        int,
-        typer.Option(
-            "--confirm-periods",
-            help="A chaotic or quasi-periodic attractor is listed only after a last window of "
-            "this many periods confirms it (a chaotic transient that ends on an orbit within "
-            "it is that orbit's run).",
-        ),
-    ] = CONFIRM_PERIODS,
+    confirm: c.Confirm = c.Confirm(),
     protocol: c.Protocol = c.Protocol.of(ATTRACTOR_SETTINGS).offering("transient", "periods"),
     solver: c.Solver = c.Solver.of(ATTRACTOR_SETTINGS),
     output: c.Output = c.Output().offering("json"),
@@ -471,7 +462,7 @@ def attractors(
                     seed=seed,
                     settings=settings,
                     omega=omega,
-                    confirm_periods=confirm,
+                    confirm_periods=confirm.confirm_periods,
                 )
     items = [a.summary() for a in found]
     if output.json:

@@ -45,7 +45,7 @@ from .._checks import check_int, check_real
 from ..analysis.motion import Motion
 from ..errors import ParameterError
 from ..integrate.settings import SolverSettings
-from .verdict import VerdictSettings, confirmed_settings, decide_motion
+from .verdict import CONFIRM_PERIODS, VerdictSettings, confirmed_settings, decide_motion
 
 __all__ = [
     "FAILED",
@@ -315,10 +315,12 @@ def catalogue_from_sample(
     *,
     tol: float = 1e-4,
     spread_fraction: float = 0.25,
+    confirm_periods: int = CONFIRM_PERIODS,
 ) -> Catalogue:
     """The attractors reached from ``starts`` (K, n_state), by
-    :func:`~gearchaos.dynamics.coexistence.attractors` with the same rules; the scale is
-    max(1, the spread of their section states) per component."""
+    :func:`~gearchaos.dynamics.coexistence.attractors` with the same rules (a chaotic or QP
+    one confirmed over a last window of ``confirm_periods``); the scale is max(1, the spread
+    of their section states) per component."""
     from .coexistence import attractors
 
     found = attractors(
@@ -328,6 +330,7 @@ def catalogue_from_sample(
         params=dict(values),
         tol=tol,
         spread_fraction=spread_fraction,
+        confirm_periods=confirm_periods,
     )
     entries = []
     for a in found:
@@ -384,8 +387,11 @@ def identify(
     section states, ``finals`` (K, n_state), ``ok`` (K,) whether its integration succeeded.
 
     Records that match the catalogue take its code; the others are decided ``batch`` at a
-    time by the motion verdict, matched again with its label and record, and added to
-    ``catalogue`` (which grows) when still unknown; failed runs get :data:`FAILED`."""
+    time by the motion verdict (``verdict``; default
+    :func:`~gearchaos.dynamics.verdict.confirmed_settings`, chaos and QP confirmed over a last
+    window of :data:`~gearchaos.dynamics.verdict.CONFIRM_PERIODS`), matched again with its
+    label and record, and added to ``catalogue`` (which grows) when still unknown; failed runs
+    get :data:`FAILED`."""
     batch = check_int("batch", batch, lo=1, hi=10_000)
     sec = np.asarray(sections, dtype=np.float64)
     fin = np.asarray(finals, dtype=np.float64)

@@ -21,6 +21,7 @@ import numpy as np
 
 from .._checks import check_bool, check_int, check_real
 from ..dynamics.basins import FAILED
+from ..dynamics.verdict import CONFIRM_PERIODS
 from ..errors import ParameterError
 from ..integrate.settings import SolverSettings
 from ..model.target import resolve
@@ -105,6 +106,7 @@ def basin_fractions(
     sample: int = 16,
     tol: float = 1e-4,
     spread_fraction: float = 0.25,
+    confirm_periods: int = CONFIRM_PERIODS,
     chunk_points: int = 1000,
     **values_and_settings: Any,
 ) -> Any:
@@ -115,7 +117,9 @@ def basin_fractions(
     ``base_state``; None: every state in mid ± 2·range of the motion from rest there), with
     the same seeded draws at every value. Each start is labelled as in :func:`basins`;
     attractors of neighbouring values are linked into tracks
-    (:func:`~gearchaos.dynamics.basins.link_tracks`). Other arguments as for :func:`basins`.
+    (:func:`~gearchaos.dynamics.basins.link_tracks`). Other arguments as for :func:`basins`
+    (``confirm_periods``: the last window that confirms a chaotic or QP attractor, default
+    2000, stored in the ``confirm_periods`` attribute).
 
     Returns
     -------
@@ -134,7 +138,7 @@ def basin_fractions(
     seed = check_int("seed", seed, lo=0)
     sample = check_int("sample", sample, lo=1, hi=10_000)
     check_real("confidence", confidence, lo=0.0, hi=1.0, lo_open=True, hi_open=True)
-    match = _match_options(tol, spread_fraction)
+    match = _match_options(tol, spread_fraction, confirm_periods)
     row_values = [{**values, ax.name: v} for v in ax.values]
     n_state = resolve(target, row_values[0]).n_state
     check_starts_memory(

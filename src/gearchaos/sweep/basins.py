@@ -30,13 +30,14 @@ import json
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypedDict
 
 import numpy as np
 
 from .._checks import check_bool, check_int, check_memory, check_real
 from .._version import provenance
 from ..dynamics.basins import FAILED, Catalogue, catalogue_from_sample, identify, link_tracks
+from ..dynamics.verdict import CONFIRM_PERIODS, confirmed_settings
 from ..errors import ParameterError, Status, StoreError
 from ..integrate._chains import ChainRun
 from ..integrate.interface import Info
@@ -153,6 +154,7 @@ class _Job:
             "model_parameters": "" if planetary else repr(t.model),
             **({} if planetary else model_reference(t.model)),
             "basin_spec": json.dumps(self.spec, sort_keys=True),
+            "confirm_periods": int(self.spec["confirm_periods"]),
             **self.cfg.to_record(),
             "dims": list(self.dims),
             "omega": float(ref.omega),
@@ -169,7 +171,7 @@ def _run(
     progress: bool,
     sample: int,
     seed: int,
-    match: dict[str, float],
+    match: _Rules,
 ) -> Any:
     path = _store_path(store)
     st = BasinStore(path)
@@ -252,7 +254,7 @@ def _drive(
     cats: dict[str, Catalogue],
     sample: int,
     seed: int,
-    match: dict[str, float],
+    match: _Rules,
 ) -> None:
     """Integrate the tasks on ``ex`` (``width`` in flight), identify and write them here in
     task order, so the catalogue grows the same way whatever the executor."""
@@ -295,7 +297,7 @@ def _identify_task(
     cats: dict[str, Catalogue],
     sample: int,
     seed: int,
-    match: dict[str, float],
+    match: _Rules,
 ) -> dict[str, np.ndarray]:
     rows = range(task.rows.start, task.rows.stop)
     nr, S, n = len(rows), job.S, job.n
@@ -316,7 +318,15 @@ def _identify_task(
                 job.target, values, flat[np.sort(pick)], job.cfg, **match
             )
         codes[i] = identify(
-            cats[key], job.target, values, job.systems[g], job.cfg, sec[i], fin[i], status[i] == 0
+            cats[key],
+            job.target,
+            values,
+            job.systems[g],
+            job.cfg,
+            sec[i],
+            fin[i],
+            status[i] == 0,
+            verdict=confirmed_settings(match["confirm_periods"]),
         )
     labels = np.full((nr, S), "", dtype="<U10")
     for i, r in enumerate(rows):
@@ -442,12 +452,22 @@ def _split(
     return values, cfg.replace(samples_per_period=1), where
 
 
-def _match_options(tol: float, spread_fraction: float) -> dict[str, float]:
+class _Rules(TypedDict):
+    """The rules that make a start's attractor (:func:`catalogue_from_sample`'s keywords):
+    the matching tolerances and the last window that confirms chaos and QP."""
+
+    tol: float
+    spread_fraction: float
+    confirm_periods: int
+
+
+def _match_options(tol: float, spread_fraction: float, confirm_periods: int) -> _Rules:
     return {
         "tol": check_real("tol", tol, lo=0.0, lo_open=True),
         "spread_fraction": check_real(
             "spread_fraction", spread_fraction, lo=0.0, hi=1.0, lo_open=True
         ),
+        "confirm_periods": check_int("confirm_periods", confirm_periods, lo=0, hi=10**6),
     }
 
 
@@ -466,6 +486,7 @@ def basins(
     seed: int = 0,
     tol: float = 1e-4,
     spread_fraction: float = 0.25,
+    confirm_periods: int = CONFIRM_PERIODS,
     chunk_points: int = 1000,
     **values_and_settings: Any,
 ) -> Any:
@@ -493,6 +514,12 @@ def basins(
         built before the image is matched against it.
     tol, spread_fraction
         The matching rules (:mod:`gearchaos.dynamics.basins`).
+    confirm_periods
+        A chaotic or quasi-periodic attractor is catalogued only after a last window of at
+        least this many periods confirms it (default 2000, as for
+        :func:`~gearchaos.dynamics.coexistence.attractors`): a chaotic transient that ends on
+        an orbit within it is that orbit's start. Stored in the ``confirm_periods`` attribute
+        (and ``basin_spec``).
     chunk_points
         Starts per task (one compiled call each).
 
@@ -501,7 +528,7 @@ def basins(
     xarray.Dataset
         Dims (y, x); ``attractor`` codes (index into ``attrs["attractors"]["0"]["entries"]``,
         −2 failed), ``label``, ``status``, ``steps_accepted``, ``final_state``; attributes with
-        the model or gear set, ``basin_spec``, the settings and versions.
+        the model or gear set, ``basin_spec``, ``confirm_periods``, the settings and versions.
     """
     kw = dict(values_and_settings)
     values, cfg, where = _split(kw, settings, params, basins, target)
@@ -521,7 +548,7 @@ def basins(
     starts[..., names.index(ay.name)] = Y
     sample = check_int("sample", sample, lo=1, hi=10_000)
     seed = check_int("seed", seed, lo=0)
-    match = _match_options(tol, spread_fraction)
+    match = _match_options(tol, spread_fraction, confirm_periods)
     spec = {
         "x": [ax.name, list(ax.values)],
         "y": [ay.name, list(ay.values)],
