@@ -130,3 +130,38 @@ def test_an_approach_beyond_the_budget_says_how_long_it_needs(slow_2t) -> None:
     )
     assert found is not None, v.reason
     assert int(found.group(1)) > 500
+
+
+def test_a_measured_approach_shows_a_record_as_long_as_the_protocols() -> None:
+    # x'' + 2ζx' + x = F cos Ωτ: its 1T and the approach to it are known exactly, y_k = y* +
+    # Mᵏ e₀ with M = exp(A T) and |μ| = exp(−ζT) (0.976 a period). The record of 20 sections
+    # starts just outside the reach of the 1T; measuring the approach needs a longer record,
+    # so the run is continued, and it ends on the orbit: the record shown must still be the
+    # protocol's 20 periods (a sweep stores that many), all on the orbit
+    from scipy.linalg import expm
+
+    from gearchaos.dynamics.verdict import decide_motion
+
+    zeta, force, omega, m = 0.005, 0.5, 1.3, 20
+    system = gc.linear_oscillator(omega, zeta=zeta, force=force)
+    settings = SolverSettings(transient_periods=0, periods=m)
+    vs = VerdictSettings()
+    T = 2 * math.pi / omega
+    X = force / (1 - omega**2 + 2j * zeta * omega)
+    y_star = np.array([X.real, -omega * X.imag])  # at τ = kT
+    M = expm(np.array([[0.0, 1.0], [-1.0, -2 * zeta]]) * T)
+    e = np.array([1.0, 0.0])
+    devs = [np.linalg.matrix_power(M, k) @ e for k in range(3 * m)]
+    size = np.array([np.max(np.abs(d)) for d in devs])
+    reach = 0.5 * vs.noise_factor * (settings.atol + settings.rtol)  # half the recurrence tol
+    scale = 1.2 * reach / np.max(size[:m])
+    assert np.max(size[m:]) * scale < 0.8 * reach  # the next periods lie within reach
+    record = np.array([y_star + scale * d for d in devs[:m]])
+    final = y_star + scale * devs[m - 1]
+    v = decide_motion(
+        system, [{"omega": omega}], [system], record[None], final[None], [True], settings, vs
+    )[0]
+    assert (v.label, v.evidence) == ("1T", "floquet"), v.reason
+    assert v.max_multiplier == pytest.approx(math.exp(-zeta * T), rel=1e-6)
+    assert v.record is not None and v.record.states.shape[0] >= m
+    assert np.max(np.abs(v.record.states[-m:] - y_star)) <= reach

@@ -218,10 +218,11 @@ def _judge(
     if how_close == "unmeasured":
         have, need = p.history.shape[0], measure_periods(f.rates)
         if have < need:  # too short a record for the slowest predicted rate: run on for it
+            # (at least a record's length: the run's last periods are a record, on the orbit
+            # or not)
             p.keep = max(p.keep, need)
-            p.settle = Settle(
-                f, need - have, math.nan, p.shown, math.ceil(fall / slowest), measure=True
-            )
+            more = max(need - have, p.shown)
+            p.settle = Settle(f, more, math.nan, p.shown, math.ceil(fall / slowest), measure=True)
             return True
         # long enough, but already within the orbit's accuracy: the next window will tell
         p.tried.discard(f.period)
