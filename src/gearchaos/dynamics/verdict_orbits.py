@@ -103,13 +103,14 @@ def beyond_budget(s: Settle, p: Any, vs: Any) -> Verdict:
         what = (
             f"lies near {orbit}, but measuring its approach at the slowest rate the "
             f"multipliers predict ({float(np.max(f.rates)):.3g} per period) needs a record of "
-            f"{measure_periods(f.rates)} periods ({s.periods} more), and reaching it within "
-            f"{vs.reach:g} about {s.predicted}"
+            f"{measure_periods(f.rates)} periods ({s.periods} more), and reaching it (every "
+            f"section within the reach of its record) about {s.predicted}"
         )
     else:
         what = (
-            f"approaches {orbit} at the rate its multipliers allow, but would reach it within "
-            f"{vs.reach:g} only after {s.predicted} more periods (and {s.record} on it)"
+            f"approaches {orbit} at the rate its multipliers allow, but would reach it (every "
+            f"section within the reach of its record) only after {s.predicted} more periods "
+            f"(and {s.record} on it)"
         )
     return Verdict(
         label="unresolved",
