@@ -592,7 +592,7 @@ def _verdict_settings(_: Path) -> dict[str, str]:
     from gearchaos.analysis.classify import K_CHAOS, K_REGULAR
     from gearchaos.dynamics.stability import FREE_TOL, STRUCTURAL_TOL
     from gearchaos.dynamics.verdict import CONFIRM_PERIODS, VerdictSettings
-    from gearchaos.dynamics.verdict_orbits import MEASURE_FALL
+    from gearchaos.dynamics.verdict_orbits import MEASURE_FALL, MEASURE_TARGET
     from gearchaos.dynamics.verdict_rules import K01_STRIDES, MAX_RETURN, MIN_ORDER, MIN_RETURN
 
     vs = VerdictSettings()
@@ -618,6 +618,7 @@ def _verdict_settings(_: Path) -> dict[str, str]:
         "windows_total": str(sum(windows)),
         "settle_budget": str(vs.settle_budget),
         "measure_fall": f"{math.exp(MEASURE_FALL):.6g}",
+        "measure_target": f"{math.exp(MEASURE_TARGET):.6g}",
         "confirm_periods": str(CONFIRM_PERIODS),
         "max_bands": str(vs.max_bands),
         "strides": f"{min(K01_STRIDES)}–{max(K01_STRIDES)}",

@@ -20,7 +20,7 @@ import gearchaos as gc
 from gearchaos.analysis.recurrence import distance_to_orbit
 from gearchaos.dynamics import periodic_orbit
 from gearchaos.dynamics.point import point_verdict
-from gearchaos.dynamics.verdict import VerdictSettings
+from gearchaos.dynamics.verdict import VerdictSettings, decide_motion
 from gearchaos.dynamics.verdict_rules import Window, decide_by_exponent
 from gearchaos.integrate.settings import SolverSettings
 from gearchaos.integrate.simulate import integrate
@@ -140,8 +140,6 @@ def test_a_measured_approach_shows_a_record_as_long_as_the_protocols() -> None:
     # protocol's 20 periods (a sweep stores that many), all on the orbit
     from scipy.linalg import expm
 
-    from gearchaos.dynamics.verdict import decide_motion
-
     zeta, force, omega, m = 0.005, 0.5, 1.3, 20
     system = gc.linear_oscillator(omega, zeta=zeta, force=force)
     settings = SolverSettings(transient_periods=0, periods=m)
@@ -165,3 +163,32 @@ def test_a_measured_approach_shows_a_record_as_long_as_the_protocols() -> None:
     assert v.max_multiplier == pytest.approx(math.exp(-zeta * T), rel=1e-6)
     assert v.record is not None and v.record.states.shape[0] >= m
     assert np.max(np.abs(v.record.states[-m:] - y_star)) <= reach
+
+
+def test_a_spiral_onto_a_1t_is_that_1t_not_a_torus() -> None:
+    # Ω = 1.2 from the symmetric state the response how-to's up sweep reaches at Ω = 1.18
+    # (in-phase planets, the sun at rest in the centre): the record spirals onto a stable 1T
+    # (a complex pair, |μ| ≈ 0.99). Measured over the shortest record that can show it, the
+    # spiral's wobbling envelope made the fall insignificant, the 1T was taken as coexisting,
+    # and the spiral's cyclic order on the section made a torus: QP
+    values = {"omega": 1.2}
+    system = resolve(V1, values)
+    names = list(system.state_names)
+    y0 = np.zeros(system.n_state)
+    for i in range(1, 6):
+        y0[names.index(f"p_{i}")] = 3.0483650912899516
+        y0[names.index(f"p_{i}_dot")] = 0.10916492070065517
+    y0[names.index("sigma")] = 6.575750905927513
+    y0[names.index("sigma_dot")] = 0.013631201417236567
+    cfg = SolverSettings(transient_periods=100, periods=50, perturbation=0.0)
+    ref = _reference(values, 1)
+    assert ref.minimal_period == 1 and ref.max_multiplier < 1 - 1e-3
+    # the truth: the motion from that state ends on the 1T
+    long = integrate(system, cfg.replace(transient_periods=2000, periods=8), y0=y0)
+    assert np.max(distance_to_orbit(long.states, ref.sections)) < 1e-8
+    tr = integrate(system, cfg, y0=y0)
+    v = decide_motion(V1, [values], [system], tr.states[None], tr.final_state[None], [tr.ok], cfg)
+    assert (v[0].label, v[0].evidence) == ("1T", "floquet"), v[0].reason
+    assert abs(v[0].max_multiplier - ref.max_multiplier) <= 1e-6
+    assert v[0].record is not None
+    assert np.max(distance_to_orbit(v[0].record.states[-50:], ref.sections)) < 1e-5

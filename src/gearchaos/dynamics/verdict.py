@@ -58,6 +58,7 @@ from .evidence import Verdict
 from .extension import VerdictRecord, extend
 from .lyapunov import exponent_estimate
 from .verdict_orbits import (
+    MEASURE_TARGET,
     Found,
     Settle,
     approach_rate,
@@ -212,14 +213,17 @@ def _judge(
     if how_close == "inconsistent":
         p.coexisting[f.period] = f.max_multiplier
         return False
-    # ln of the fall still needed, and the slowest rate the multipliers predict (it
-    # dominates in the end): the periods until the record lies within reach at that rate
-    fall, slowest = math.log(target / max(float(hist[-1]), target)), float(np.max(f.rates))
+    # ln of the fall still needed from the distances' envelope over the last record (a spiral
+    # wobbles under it), and the slowest rate the multipliers predict (it dominates in the
+    # end): the periods until the record lies within reach at that rate
+    top = float(np.max(hist[-p.shown :]))
+    fall, slowest = math.log(target / max(top, target)), float(np.max(f.rates))
     if how_close == "unmeasured":
-        have, need = p.history.shape[0], measure_periods(f.rates)
-        if have < need:  # too short a record for the slowest predicted rate: run on for it
-            # (at least a record's length: the run's last periods are a record, on the orbit
-            # or not)
+        have = p.history.shape[0]
+        if have < measure_periods(f.rates):  # too short for the slowest predicted rate: run
+            # on, to a record sized with a margin, and at least a record's length (the run's
+            # last periods are a record, on the orbit or not)
+            need = measure_periods(f.rates, MEASURE_TARGET)
             p.keep = max(p.keep, need)
             more = max(need - have, p.shown)
             p.settle = Settle(f, more, math.nan, p.shown, math.ceil(fall / slowest), measure=True)

@@ -50,6 +50,10 @@ __all__ = [
 #: Least fall of ln d over the half record an approach is measured on, at the slowest rate
 #: the multipliers predict, for :func:`approach_rate` to measure it (a fall by 1.25²).
 MEASURE_FALL = 2.0 * math.log(1.25)
+#: The fall a run that lengthens a record too short to measure its approach is sized for:
+#: twice the least, so that the scatter of the fit about its line (the envelope of a spiral
+#: wobbles) does not decide whether the record approaches.
+MEASURE_TARGET = 2.0 * MEASURE_FALL
 #: Fewest sections of the half record an approach is measured on.
 MEASURE_MIN = 16
 
@@ -103,7 +107,8 @@ def beyond_budget(s: Settle, p: Any, vs: Any) -> Verdict:
         what = (
             f"lies near {orbit}, but measuring its approach at the slowest rate the "
             f"multipliers predict ({float(np.max(f.rates)):.3g} per period) needs a record of "
-            f"{measure_periods(f.rates)} periods ({s.periods} more), and reaching it (every "
+            f"{measure_periods(f.rates, MEASURE_TARGET)} periods ({s.periods} more), and "
+            f"reaching it (every "
             f"section within the reach of its record) about {s.predicted}"
         )
     else:
@@ -123,16 +128,17 @@ def beyond_budget(s: Settle, p: Any, vs: Any) -> Verdict:
     )
 
 
-def measure_periods(rates: np.ndarray) -> int:
-    """Sections of record :func:`approach_rate` needs to measure an approach at the slowest
-    rate the multipliers predict, ``max(rates)`` (ln|μ_j|/d per section): twice the half
-    record over which that rate falls by :data:`MEASURE_FALL`, 2 · max(16,
-    ⌈MEASURE_FALL/|max rates|⌉) (|μ| = 0.9985 per period: 596; 0.9995: 1786). Undefined (a
+def measure_periods(rates: np.ndarray, fall: float = MEASURE_FALL) -> int:
+    """Sections of record over whose second half an approach at the slowest rate the
+    multipliers predict, ``max(rates)`` (ln|μ_j|/d per section), falls by ``fall`` in ln d:
+    2 · max(16, ⌈fall/|max rates|⌉). With :data:`MEASURE_FALL` the least record
+    :func:`approach_rate` measures (|μ| = 0.9985 per period: 596; 0.9995: 1786), with
+    :data:`MEASURE_TARGET` the record a measuring run lengthens it to. Undefined (a
     ParameterError) for rates that do not all fall."""
     slowest = float(np.max(rates)) if np.size(rates) else math.nan
     if not slowest < 0:
         raise ParameterError(f"rates must all be < 0 (a stable orbit): got max {slowest!r}")
-    return 2 * max(MEASURE_MIN, math.ceil(MEASURE_FALL / -slowest))
+    return 2 * max(MEASURE_MIN, math.ceil(fall / -slowest))
 
 
 def approach_rate(d: np.ndarray, floor: float, rates: np.ndarray) -> tuple[str, float]:
