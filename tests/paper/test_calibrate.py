@@ -391,6 +391,14 @@ def test_a_study_resumes_after_kill_9_without_losing_a_finished_trial(tmp_path: 
     assert len(done) == 6 and min(set(done) - set(before)) > 2  # the count continues
 
 
+def _default_sigint() -> None:
+    """In the child before exec: SIGINT's default action, as a shell gives a command. A SIGINT
+    left ignored in this pytest worker by an earlier test would be inherited, and Python then
+    never raises KeyboardInterrupt (the calibration hung until the test's bound in a full
+    run)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _running(pid: int) -> bool:
     try:
         with open(f"/proc/{pid}/stat") as f:
@@ -433,6 +441,7 @@ def test_an_interrupted_parallel_calibration_ends_its_workers(tmp_path: Path) ->
     proc = subprocess.Popen(
         [sys.executable, str(script), str(out), url], env=env, stdin=subprocess.DEVNULL,
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+        preexec_fn=_default_sigint,
     )  # fmt: skip
     lines: queue.Queue[str | None] = queue.Queue()
 
