@@ -23,6 +23,7 @@ from pathlib import Path
 
 import pytest
 
+import child_processes as child
 from gearchaos.integrate.threads import READY_ENV, READY_LINE
 
 GEARCHAOS = [sys.executable, "-m", "gearchaos"]
@@ -34,18 +35,6 @@ STOP_BOUND = 120.0
 def _children(pid: int) -> list[int]:
     out = subprocess.run(["pgrep", "-P", str(pid)], capture_output=True, text=True).stdout
     return [int(x) for x in out.split()]
-
-
-def _alive(pid: int) -> bool:
-    try:
-        with open(f"/proc/{pid}/stat") as f:
-            return f.read().split()[2] != "Z"
-    except OSError:
-        return False
-
-
-def _default_sigint() -> None:
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 class Command:
@@ -69,7 +58,7 @@ class Command:
             # the command starts with Ctrl-C's default action whatever an earlier test left in
             # this worker (an ignored SIGINT is inherited, and Python then never raises
             # KeyboardInterrupt)
-            preexec_fn=_default_sigint,
+            preexec_fn=child.default_sigint,
         )
         self.lines: queue.Queue[str | None] = queue.Queue()
         self.seen: list[str] = []
@@ -138,7 +127,7 @@ def _quiet(lines: list[str]) -> list[str]:
 
 def _all_gone(pids: list[int], bound: float = STOP_BOUND) -> list[int]:
     deadline = time.monotonic() + bound
-    while (left := [p for p in pids if _alive(p)]) and time.monotonic() < deadline:
+    while (left := [p for p in pids if child.running(p)]) and time.monotonic() < deadline:
         time.sleep(0.05)
     return left
 
@@ -260,7 +249,7 @@ def test_an_interrupted_pool_is_ended_before_the_interrupt_goes_on() -> None:
             raise KeyboardInterrupt
         assert not manager.is_alive()
         assert wakeup._closed
-        assert pids and not [p for p in pids if _alive(p)]
+        assert pids and not [p for p in pids if child.running(p)]
     finally:  # the old way left the worker running
         for p in pids:
             with contextlib.suppress(OSError):

@@ -28,6 +28,7 @@ import pytest
 import xarray as xr
 from hypothesis import given, settings, strategies as st
 
+import child_processes as child
 from gearchaos.gearset import GearSet, preset
 from gearchaos.paper import calibrate as cal
 from gearchaos.paper.calibrate import (
@@ -391,22 +392,6 @@ def test_a_study_resumes_after_kill_9_without_losing_a_finished_trial(tmp_path: 
     assert len(done) == 6 and min(set(done) - set(before)) > 2  # the count continues
 
 
-def _default_sigint() -> None:
-    """In the child before exec: SIGINT's default action, as a shell gives a command. A SIGINT
-    left ignored in this pytest worker by an earlier test would be inherited, and Python then
-    never raises KeyboardInterrupt (the calibration hung until the test's bound in a full
-    run)."""
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
-
-
-def _running(pid: int) -> bool:
-    try:
-        with open(f"/proc/{pid}/stat") as f:
-            return f.read().split()[2] != "Z"
-    except OSError:
-        return False
-
-
 PARALLEL = textwrap.dedent(
     """
     import os, sys, threading
@@ -441,7 +426,7 @@ def test_an_interrupted_parallel_calibration_ends_its_workers(tmp_path: Path) ->
     proc = subprocess.Popen(
         [sys.executable, str(script), str(out), url], env=env, stdin=subprocess.DEVNULL,
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
-        preexec_fn=_default_sigint,
+        preexec_fn=child.default_sigint,
     )  # fmt: skip
     lines: queue.Queue[str | None] = queue.Queue()
 
@@ -475,7 +460,7 @@ def test_an_interrupted_parallel_calibration_ends_its_workers(tmp_path: Path) ->
     assert proc.returncode == 0 and stdout.split() == ["interrupted"], (stdout, seen)
     assert not [x for x in seen if "Traceback" in x or "Exception ignored" in x], seen
     deadline = time.monotonic() + 120.0  # the children end with it (a bound on a hang only)
-    while (left := [p for p in workers if _running(p)]) and time.monotonic() < deadline:
+    while (left := [p for p in workers if child.running(p)]) and time.monotonic() < deadline:
         time.sleep(0.05)
     assert workers and not left, left
     running = [t for t in _trials(url, cal.STUDY) if t.state.name == "RUNNING"]
