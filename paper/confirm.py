@@ -4,8 +4,11 @@
     .venv/bin/python paper/confirm.py --storage sqlite:///paper/calibration.db [--top 3]
 
 The calibration scores candidates on coarse sweeps (a few hundred points). Before a candidate
-becomes the default ``sheng2016`` (issue 34), each of the ``--top`` best plausible candidates —
-ranked by landmark score, then structure — gets a full ``gearchaos reproduce --all`` (every
+becomes the default ``sheng2016`` (issue 34), each of the ``--top`` best eligible candidates —
+physically plausible, and with clearances that act (every continued backlash branch changes its
+multipliers or has an event, and the backlash sweeps hold double-sided impact:
+:func:`gearchaos.paper.structure.clearance_problems`), ranked by landmark score, then
+structure — gets a full ``gearchaos reproduce --all`` (every
 figure at full resolution, the verdicts, the paper-protocol column), and so does today's
 default for comparison (``--preset``, default ``sheng2016-v1``; or its committed report,
 ``--previous-report docs/report/report.json``). The counts of every report
@@ -41,6 +44,7 @@ from gearchaos.paper.calibrate import (
 from gearchaos.paper.conclusions import VERDICTS as CONCLUSION_VERDICTS
 from gearchaos.paper.loads import load_factors
 from gearchaos.paper.search_space import build_gearset
+from gearchaos.paper.structure import clearance_problems
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "paper"))
@@ -73,6 +77,11 @@ def _reproduce(args: list[str], out: Path) -> dict:
     return json.loads(report.read_text(encoding="utf-8"))
 
 
+def _problems(record: dict) -> list[str]:
+    """Why a record cannot be the default: implausible, or its clearances do not act."""
+    return record_plausibility(record) + clearance_problems(record)
+
+
 def _key(row: dict) -> tuple[int, int, int]:
     lm = row["counts"]["landmarks"]
     return (-lm.get("holds", 0), lm.get("does not hold", 0), row["rank"])
@@ -98,9 +107,10 @@ def main() -> None:
     else:
         records = list(read_results(args.log).values())
     order = ranked(records)
-    # plausible candidates (ranges, tooth combination, loads where the study measured them);
-    # ``--any`` confirms the best ones whatever their loads (a study without the load check)
-    top = [(i + 1, r) for i, r in enumerate(order) if args.any or not record_plausibility(r)]
+    # eligible candidates: plausible (ranges, tooth combination, loads where the study measured
+    # them) and with clearances that act; ``--any`` confirms the best ones whatever their loads
+    # and structure (a study without those measurements)
+    top = [(i + 1, r) for i, r in enumerate(order) if args.any or not _problems(r)]
     if args.trial:
         top = [(rank, r) for rank, r in enumerate(order, start=1) if r["index"] in args.trial]
     top = top[: args.top]
@@ -119,8 +129,8 @@ def main() -> None:
             "score": rec["score"], "structure": rec.get("structure"),
             "variables": rec["variables"], "counts": counts(rep), "loads": load_factors(gs),
         })  # fmt: skip
-        why = record_plausibility({**rec, "parts": {"loads": rows[-1]["loads"]}})
-        rows[-1]["problems"] = why
+        parts = {**(rec.get("parts") or {}), "loads": rows[-1]["loads"]}
+        rows[-1]["problems"] = _problems({**rec, "parts": parts})
     if args.previous_report:
         base = json.loads(Path(args.previous_report).read_text(encoding="utf-8"))
     else:
@@ -130,9 +140,13 @@ def main() -> None:
     result = {
         "source": f"study {args.study} ({args.storage})" if args.storage else Path(args.log).name,
         "candidates": len(records),
-        "rule": "among the physically plausible ones (ranges, tooth combination, peak mesh force "
-        "within the teeth's strength), most landmarks holding with the parameter acting, then "
-        "fewest not holding, then the calibration's rank",
+        "rule": (
+            "among the physically plausible ones (ranges, tooth combination, peak mesh force "
+            "within the teeth's strength) whose clearances act (every continued backlash "
+            "branch changes its multipliers or has an event; double-sided impact in the "
+            "backlash sweeps), most landmarks holding with the parameter acting, then fewest "
+            "not holding, then the calibration's rank"
+        ),
         "winner": None if winner is None else winner["trial"],
         "confirmed": rows,
         "previous": {

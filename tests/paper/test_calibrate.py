@@ -43,7 +43,7 @@ from gearchaos.paper.calibrate import (
     sweep_plan,
 )
 from gearchaos.paper.search_space import candidate_of, nearest_teeth, suggest
-from gearchaos.paper.structure import branch_score, double_sided_share
+from gearchaos.paper.structure import branch_score, clearance_problems, double_sided_share
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -632,14 +632,16 @@ def test_v1_preset_is_the_first_calibrations_best_candidate() -> None:
 )
 def test_default_preset_is_the_confirmed_winner_of_the_study() -> None:
     """sheng2016 is the candidate of the study that won the confirmation: among the confirmed
-    candidates (the best plausible ones by landmark score, then structure), the most landmarks
+    candidates (the best plausible ones whose clearances act, by landmark score, then
+    structure), the most landmarks
     holding with their parameter acting, then the fewest not holding, then the rank."""
     rows = {r["index"]: r for r in _rows(LOG)}
     conf = json.loads(CONFIRMATION.read_text())
     ranked = cal.ranked(rows.values())
-    plausible = [r for r in ranked if not plausibility(cal.candidate_from_record(r))]
+    # eligible: plausible in ranges, teeth and loads, and with clearances that act
+    eligible = [r for r in ranked if not cal.record_plausibility(r) and not clearance_problems(r)]
     confirmed = conf["confirmed"]
-    assert [c["trial"] for c in confirmed] == [r["index"] for r in plausible[: len(confirmed)]]
+    assert [c["trial"] for c in confirmed] == [r["index"] for r in eligible[: len(confirmed)]]
     for c in confirmed:
         assert c["score"] == rows[c["trial"]]["score"]
         assert c["rank"] == ranked.index(rows[c["trial"]]) + 1

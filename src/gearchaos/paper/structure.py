@@ -40,6 +40,7 @@ __all__ = [
     "BRANCHES",
     "MU_CHANGE",
     "branch_score",
+    "clearance_problems",
     "double_sided_share",
     "multiplier_change",
     "structure_term",
@@ -177,3 +178,27 @@ def structure_term(
         "branches": branches,
     }
     return 0.5 * (share + mean), parts
+
+
+def clearance_problems(record: Mapping[str, Any]) -> list[str]:
+    """Why the clearances of a calibration record's gear set do not act everywhere the seed
+    says they do (issue 34): a continued branch of :data:`BRANCHES` along which max|μ| changes
+    by less than :data:`MU_CHANGE` with no event, or no double-sided impact in the chaotic and
+    multi-periodic regions of the backlash sweeps. Empty when they act; a record without the
+    structural parts (a calibration before issue 34) gives one reason saying so."""
+    parts = record.get("parts")
+    if not isinstance(parts, Mapping) or not isinstance(parts.get("branches"), list):
+        return ["no structural measurements in the record (a calibration before issue 34)"]
+    why = []
+    for b in parts["branches"]:
+        if b.get("score", 0.0) < 1.0:
+            why.append(
+                f"{b.get('axis')} at Ω = {b.get('omega')}: max|μ| changes by "
+                f"{float(b.get('change', math.nan)):.2g} with no event"
+                + (f" ({b['reason']})" if b.get("reason") else "")
+            )
+    if not parts.get("double_sided_points"):
+        why.append(
+            "no double-sided impact in the backlash sweeps' chaotic and multi-periodic points"
+        )
+    return why
