@@ -25,7 +25,7 @@ from .planetary import (
     planetary_system,
 )
 from .system import Model, Observable, System
-from .target import DEFAULT_OMEGA, OMEGA, resolve
+from .target import DEFAULT_OMEGA, OMEGA, Target, resolve
 
 __all__ = [
     "DEFAULT_OMEGA",
@@ -38,6 +38,7 @@ __all__ = [
     "PlanetaryParameters",
     "Scales",
     "System",
+    "Target",
     "UserModel",
     "backlash_oscillator",
     "check_model",

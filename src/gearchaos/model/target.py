@@ -32,6 +32,7 @@ __all__ = [
     "DEFAULT_OMEGA",
     "OMEGA",
     "SPEEDS",
+    "Target",
     "check_names",
     "check_one_operating_point",
     "model_for",
@@ -44,6 +45,10 @@ __all__ = [
     "speeds_at",
     "split_omega",
 ]
+
+#: What a user simulates, sweeps or continues: a gear set (which builds a planetary model) or a
+#: :class:`System` of any model.
+Target = GearSet | System
 
 #: The name of the dimensionless forcing frequency Ω = ω/ω_n among the parameters.
 OMEGA = "omega"
