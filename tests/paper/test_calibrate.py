@@ -9,6 +9,7 @@ read from the code; the objectives of the driver tests are cheap stand-ins for t
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
@@ -471,6 +472,50 @@ def test_an_interrupted_parallel_calibration_ends_its_workers(tmp_path: Path) ->
     for t in running:  # each ended trial ran again with its parameters
         again = [u for u in trials if u.user_attrs.get("origin") == f"retry of #{t.number}"]
         assert len(again) == 1 and again[0].params == t.params
+
+
+@pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGTERM], ids=["SIGKILL", "SIGTERM"])
+def test_the_workers_of_a_killed_parallel_calibration_do_not_outlive_it(
+    tmp_path: Path, sig: signal.Signals
+) -> None:
+    # `kill` (or `kill -9`) of a calibration with --workers left its two worker processes
+    # running trials against the storage for minutes, adopted by init (no death signal, no
+    # watch of the parent in the calibration's pool); they end with their command now
+    out, url = tmp_path / "c.jsonl", f"sqlite:///{tmp_path / 'c.db'}"
+    script = tmp_path / "run.py"
+    script.write_text(PARALLEL)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    proc = subprocess.Popen(
+        [sys.executable, str(script), str(out), url], env=env, stdin=subprocess.DEVNULL,
+        stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, start_new_session=True,
+    )  # fmt: skip
+    workers: list[int] = []
+    try:
+        assert proc.stderr is not None
+        seen = 0
+        while seen < 2:  # readiness: both workers inside a trial
+            line = proc.stderr.readline()
+            assert line, "the calibration ended before both workers ran a trial"
+            seen += line.strip() == "trial running"
+        workers = [int(x) for x in subprocess.run(
+            ["pgrep", "-P", str(proc.pid)], capture_output=True, text=True
+        ).stdout.split()]  # fmt: skip
+        assert len(workers) >= 2, workers
+        proc.send_signal(sig)
+        proc.wait(timeout=60)
+        deadline = time.monotonic() + 60.0  # a bound on a hang only
+        while (left := [p for p in workers if child.running(p)]) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert not left, f"{len(left)} worker(s) of the killed calibration still run"
+    finally:
+        for p in workers:
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(p, signal.SIGKILL)
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait(timeout=30)
+        if proc.stderr:
+            proc.stderr.close()
 
 
 def test_a_trial_a_peer_finished_first_does_not_stop_the_worker(tmp_path: Path) -> None:

@@ -415,15 +415,20 @@ def _parallel(job: Job, where: Any, progress: Callable[[], None]) -> str:
     Interrupted, local worker processes are ended at once and completely
     (:func:`~gearchaos.sweep.execute.end_pool`; the trial each one ran is enqueued again by
     :func:`~gearchaos.paper.study.recover` when the study goes on): waiting for them would take
-    their whole run, and a pool left running fails in Python's exit hooks."""
+    their whole run, and a pool left running fails in Python's exit hooks. Killed, they end
+    with it (:func:`~gearchaos.sweep.execute.watch_parent`)."""
     import concurrent.futures as cf
     import multiprocessing
 
-    from ..sweep.execute import end_pool
+    from ..sweep.execute import end_pool, watch_parent
 
     if where.workers is not None:
         ctx = multiprocessing.get_context("spawn")
-        pool = cf.ProcessPoolExecutor(where.workers, mp_context=ctx)
+        # the workers end with this process, also when it is killed (SIGKILL, or SIGTERM's
+        # default action) and cannot end them: orphans would go on running trials
+        pool = cf.ProcessPoolExecutor(
+            where.workers, mp_context=ctx, initializer=watch_parent, initargs=(os.getpid(),)
+        )
         try:
             futures = [pool.submit(run_worker, job, i) for i in range(where.workers)]
             stopped = _wait(futures, progress)
