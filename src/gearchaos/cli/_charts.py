@@ -1,72 +1,9 @@
-"""The charts of ``gearchaos plot``: impact maps (``--impact MESH``) and amplitude–frequency
-figures (a response store with ``--branch``: amplitude or, with ``--quantity force_peak``, peak
-contact force)."""
+"""The table of ``gearchaos plot --contact --table``: the contact ranges of a 1-D sweep (its
+figures come from :func:`~gearchaos.plot.figure_for`)."""
 
 from __future__ import annotations
 
 from typing import Any
-
-from ..errors import ParameterError
-
-
-def check_quantity(quantity: str | None, applies: bool) -> None:
-    """``--quantity`` chooses what the amplitude–frequency figure draws (a response store with
-    ``--branch``); anywhere else it is refused instead of ignored."""
-    if quantity is not None and not applies:
-        raise ParameterError(
-            "--quantity applies to the amplitude–frequency figure of a response store drawn "
-            f"with --branch BRANCH.nc (without --sections, --impact or --boundaries): got "
-            f"--quantity {quantity}"
-        )
-
-
-def chart_figure(
-    res: Any,
-    impact: str | None,
-    branches: list[Any],
-    var: str | None,
-    planet: int | None,
-    sections: bool,
-    quantity: str | None = None,
-) -> Any:
-    """The impact map of ``res`` (``impact``: a mesh name) or its amplitude–frequency figure
-    with ``branches`` (``quantity``: amplitude or force_peak); options that do not apply are
-    refused by name."""
-    if impact is not None:
-        given = [
-            o for o, v in (("--branch", branches), ("--sections", sections), ("--var", var)) if v
-        ]
-        if given:
-            raise ParameterError(
-                f"--impact draws the contact regime of one mesh: {', '.join(given)} does not "
-                "apply to it"
-            )
-        from ..plot.impact import impact_figure
-
-        return impact_figure(res, mesh=impact, planet=1 if planet is None else planet)
-    from ..plot.amplitude import amplitude_figure
-
-    return amplitude_figure(
-        res,
-        branches,
-        var=var,
-        planet=1 if planet is None else planet,
-        quantity="amplitude" if quantity is None else quantity,
-    )
-
-
-def contact_chart(res: Any, given: dict[str, Any]) -> Any:
-    """The contact figure of a 1-D sweep or response store (``--contact``); the other
-    options of ``gearchaos plot`` that do not apply to it are refused by name."""
-    from ..plot.contact import contact_figure
-
-    wrong = [name for name, value in given.items() if value not in (None, False, [])]
-    if wrong:
-        raise ParameterError(
-            "--contact draws the contact regime of every mesh of a 1-D sweep: "
-            f"{', '.join(wrong)} does not apply to it"
-        )
-    return contact_figure(res)
 
 
 def contact_table(res: Any, *, title: str) -> Any:

@@ -339,6 +339,7 @@ def format_summary(summary: dict[str, Any], *, title: str | None = None) -> Any:
     :func:`~gearchaos.analysis.summary.summarize`."""
     if title is None:
         gs = summary.get("gearset")
+        # gear-set switch: a summary (analysis.summary) carries its gear set's name, no model
         title = f"gearchaos simulation{f' of {gs}' if gs else ''}"
     table = Table(title=escape(title), show_header=True, header_style="bold")
     table.add_column("quantity")
@@ -374,6 +375,7 @@ def format_summary(summary: dict[str, Any], *, title: str | None = None) -> Any:
     for key, label in labels.items():
         if key in summary:
             value = summary[key]
+            # gear-set switch: a summary (analysis.summary) says by its gear set which rows apply
             if value is None and key in optional and summary.get("gearset") is None:
                 continue  # quantities of a gear set, absent for other models
             recorded = summary.get("recorded_section_points")

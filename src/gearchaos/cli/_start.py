@@ -89,13 +89,15 @@ def load_start(path: str, at: str | None, model: str | None = None) -> Start:
         raise ParameterError(f"--from {escape_path(path)}: no such file or directory")
     start = _load(path, where)
     if named is not None:
-        target = start.gearset
-        own = getattr(target, "model", None) if not hasattr(target, "evolve") else None
+        from ..model.record import model_title
+        from ..model.target import model_for
+
+        own = model_for(start.gearset, {})  # the model of the file's target
         if type(own) is not named:
-            what = "a gear set" if own is None else f"the model {type(own).__qualname__}"
+            kind, name = model_title(own)
             raise ParameterError(
                 f"--model {escape_text(model)} does not apply: --from {escape_path(path)} is of "
-                f"{what}; drop --model"
+                f"the {kind} {escape_text(name)} ({type(own).__qualname__}); drop --model"
             )
     return start
 
@@ -289,14 +291,13 @@ def _state(values: Any, path: str, target: Any, params: dict[str, Any], what: st
 
 def _from_store(path: str, where: dict[str, str]) -> Start:
     from ..explore.compute import point_target
+    from ..model.record import recorded_target
     from ..sweep.result import SweepResult
 
     res = SweepResult.open(path)
     ds = res.ds
-    if res.base_gearset is None:  # a model the user has not named is refused, naming the file
-        from ..model.loading import rebuild_model
-
-        rebuild_model(ds.attrs, where=f"--from {escape_path(path)}")
+    # the store's target: a model the user has not named is refused, naming the file
+    recorded_target(ds.attrs, where=f"--from {escape_path(path)}")
     if "final_state" not in ds:
         raise StoreError(f"--from {path}: the store holds no final states to start from")
     index: dict[str, Any] = {}

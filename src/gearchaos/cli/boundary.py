@@ -262,6 +262,7 @@ def boundaries_figure(curves: list[Path], res: Any) -> Any:
     """The stability chart of ``plot MAP --boundaries CURVE.nc`` (``res`` the map's
     :class:`~gearchaos.sweep.SweepResult`) or of ``plot CURVE.nc`` alone (``res`` None)."""
     from ..dynamics.curve_file import open_curve
-    from ..plot.stability import stability_figure
+    from ..plot import figure_for
 
-    return stability_figure([open_curve(p) for p in curves], res)
+    opened = [open_curve(p) for p in curves]
+    return figure_for(opened) if res is None else figure_for(res, boundaries=opened)

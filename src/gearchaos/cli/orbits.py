@@ -290,9 +290,10 @@ def continue_(
         first = None
         if start is not None:  # the orbit at the file's point: the branch starts there
             from ..dynamics.orbits import periodic_orbit
+            from ..model.record import parameter_value
 
             if name not in values:  # the start's own value of the continued parameter
-                values[name] = gs[name] if hasattr(gs, "evolve") else getattr(gs.model, name)
+                values[name] = parameter_value(gs, name)
             settings = settings.replace(**start.section)
             with c.warnings_to_stderr():
                 first = periodic_orbit(

@@ -35,20 +35,13 @@ def _is_basin_store(path: Path) -> bool:
     return isinstance(attrs, dict) and attrs.get("kind") in KINDS
 
 
-def _plot_basins(store: Path, output: Path, **unused: Any) -> None:
-    """Draw a basin store (image, or fractions across the parameter)."""
-    from ..plot import savefig
-    from ..plot.basins import basins_figure
-    from ..sweep._basin_store import open_basins
-
-    given = [f"--{k}" for k, v in unused.items() if v not in (None, False, [])]
-    if given:
-        raise ParameterError(f"{', '.join(given)} do(es) not apply to the basin store {store}")
-    fig = basins_figure(open_basins(store))
-    if output.parent != Path(""):
-        output.parent.mkdir(parents=True, exist_ok=True)
-    savefig(fig, output)
-    c.wrote(output)
+#: How messages of :func:`~gearchaos.plot.figure_for` name its options: by this command's flags.
+OPTION_NAMES = {
+    "var": "--var", "planet": "--planet", "clearance_lines": "--clearance-lines",
+    "resonances": "--resonances", "branches": "--branch", "sections": "--sections",
+    "boundaries": "--boundaries", "impact": "--impact", "quantity": "--quantity",
+    "contact": "--contact",
+}  # fmt: skip
 
 
 @c.command()
@@ -189,100 +182,50 @@ def plot(
 
         matplotlib.use("Agg")
         from ..dynamics.cascade import open_cascade
-        from ..plot import savefig, sweep_figure
+        from ..dynamics.curve_file import open_curve
+        from ..plot import FigureOptions, figure_for, savefig
 
+        options = FigureOptions(
+            var=var, planet=planet, clearance_lines=clearance, resonances=resonances,
+            sections=sections, impact=impact, quantity=quantity, contact=contact,
+            names=OPTION_NAMES,
+        )  # fmt: skip
+        res = None
         if all(_is_branch(p) for p in stores):
-            if contact:
-                raise ParameterError(
-                    "--contact draws a sweep or response store, not branch or curve files"
-                )
-            from .boundary import boundaries_figure, is_curve_file
+            from .boundary import is_curve_file
 
-            if all(is_curve_file(p) for p in stores):  # a stability chart without a map
-                fig = boundaries_figure([*stores, *(boundaries or [])], None)
-                if figure.parent != Path(""):
-                    figure.parent.mkdir(parents=True, exist_ok=True)
-                savefig(fig, figure)
-                c.wrote(figure)
-                return
-            if sections or quantity:
-                raise ParameterError(
-                    f"{'--sections' if sections else '--quantity'} applies to response stores, "
-                    "not branch files"
-                )
-            from ..plot.branch import branch_figure
-
-            fig = branch_figure(
-                [br for b in [*stores, *(branch or [])] for br in open_cascade(b)],
-                var=var,
-                planet=1 if planet is None else planet,
-                clearance_lines=clearance,
-                resonances=resonances,
-            )
-            if figure.parent != Path(""):
-                figure.parent.mkdir(parents=True, exist_ok=True)
-            savefig(fig, figure)
-            c.wrote(figure)
-            return
-        if len(stores) > 1:
+            if not contact and all(is_curve_file(p) for p in stores):  # a chart without a map
+                source: Any = [open_curve(p) for p in stores]
+                boundaries_ = [open_curve(p) for p in boundaries or []]
+            else:
+                source = [br for b in [*stores, *(branch or [])] for br in open_cascade(b)]
+                boundaries_ = []
+            fig = figure_for(source, options, boundaries=boundaries_)
+        elif len(stores) > 1:
             raise ParameterError(
                 "STORE must be one sweep store, or branch files only: got "
                 f"{', '.join(str(p) for p in stores)}; draw branches over a sweep with "
                 "--branch BRANCH.nc"
             )
-        store = stores[0]
-        from ._charts import chart_figure, check_quantity, contact_chart, contact_table
+        elif _is_basin_store(stores[0]):
+            from ..sweep._basin_store import open_basins
 
-        if _is_basin_store(store):
-            check_quantity(quantity, False)
-            _plot_basins(
-                store, figure, var=var, planet=planet, branch=branch, sections=sections,
-                contact=contact,
-            )  # fmt: skip
-            return
-        res = open_store(store)
-        branches = [br for b in branch or [] for br in open_cascade(b)]
-        response = res.ds.attrs.get("kind") == "response"
-        if not contact:
-            check_quantity(
-                quantity, bool(branches and response) and not (sections or boundaries or impact)
+            fig = figure_for(
+                open_basins(stores[0]), options, where=str(stores[0]), branches=branch or []
             )
-        if contact:
-            fig = contact_chart(res, {
-                "--var": var, "--planet": planet, "--clearance-lines": clearance,
-                "--resonances": resonances, "--branch": branch, "--sections": sections,
-                "--boundaries": boundaries, "--impact": impact, "--quantity": quantity,
-            })  # fmt: skip
-        elif boundaries:
-            from .boundary import boundaries_figure
-
-            fig = boundaries_figure(list(boundaries), res)
-        elif impact is not None or (branches and response and not sections):
-            fig = chart_figure(res, impact, branches, var, planet, sections, quantity)
-        elif response and not sections:
-            from ..plot import response_figure
-
-            given = [o for o, v in (("--var", var), ("--planet", planet)) if v is not None]
-            if given:  # the response curves draw every mesh's contact force, no section
-                raise ParameterError(
-                    f"{' and '.join(given)} {'does' if len(given) == 1 else 'do'} not apply to "
-                    "the frequency-response figure of "
-                    f"{store}; add --sections to draw its bifurcation diagram of one variable"
-                )
-
-            fig = response_figure(res)
         else:
-            fig = sweep_figure(
-                res,
-                var="delta_sp" if var is None else var,
-                planet=1 if planet is None else planet,
-                clearance_lines=clearance,
-                resonances=resonances,
-                branches=branches,
+            store = stores[0]
+            res = open_store(store)
+            branches = [br for b in branch or [] for br in open_cascade(b)]
+            curves = [open_curve(p) for p in boundaries or []] if not contact else boundaries
+            fig = figure_for(
+                res, options, where=str(store), branches=branches, boundaries=curves or []
             )
         if figure.parent != Path(""):
             figure.parent.mkdir(parents=True, exist_ok=True)
         savefig(fig, figure)
     c.wrote(figure)
-    if table:
-        c.stdout().print(contact_table(res, title=f"contact regimes of {store}"))
+    if table and res is not None:
+        from ._charts import contact_table
+
+        c.stdout().print(contact_table(res, title=f"contact regimes of {stores[0]}"))

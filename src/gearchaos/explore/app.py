@@ -431,8 +431,15 @@ class Explorer(pn.viewable.Viewer):
         return ("point", self.model.store, values, point.direction, self.var, self.planet)
 
     def _request(self, point: Point) -> None:
-        if self.model.full.gearset is None:
-            self.computed.object = "*(this store holds no gear set: nothing to recompute)*"
+        try:  # what the store was computed on: a gear set or a model it can build again
+            target = self.model.full.base_target
+        except ParameterError as exc:  # a model of the user's own that was not named
+            self.computed.object = f"*(cannot recompute this point: {exc})*"
+            return
+        if target is None:
+            self.computed.object = (
+                "*(this store records no model to build again: nothing to recompute)*"
+            )
             return
         values = {k: v for k, v in point.values.items()}
         key = self._point_key(point)

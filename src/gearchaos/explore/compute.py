@@ -43,20 +43,21 @@ def point_target(res: Any, values: Mapping[str, float]) -> tuple[Any, dict[str, 
     and models from outside the package); else :class:`~gearchaos.errors.StoreError` (its
     points can be read, not recomputed).
     """
-    gs = res.gearset
-    if gs is None:
-        gs = res.base_target
-        if gs is None:
-            raise StoreError(
-                "this store's model is neither a gear set (no gearset_toml) nor a model it can "
-                "build again (no model_class): its stored sections can be explored, but points "
-                "cannot be recomputed from it"
-            )
-        fixed = {k: v for k, v in res.fixed.items() if k != OMEGA}
-        if fixed:
-            from ..model.target import resolve
+    target = res.base_target
+    if target is None:
+        raise StoreError(
+            "this store's model is neither a gear set (no gearset_toml) nor a model it can "
+            "build again (no model_class): its stored sections can be explored, but points "
+            "cannot be recomputed from it"
+        )
+    fixed = {k: v for k, v in res.fixed.items() if k != OMEGA}
+    if fixed:
+        from ..model.record import with_values
 
-            gs = resolve(gs, fixed)
+        try:
+            target = with_values(target, fixed)
+        except ParameterError as exc:
+            raise StoreError(f"the store's fixed values do not apply to its model: {exc}") from None
     out = {str(k): float(v) for k, v in values.items()}
     if OMEGA not in out:
         omega = res.fixed_value(OMEGA)
@@ -66,7 +67,7 @@ def point_target(res: Any, values: Mapping[str, float]) -> tuple[Any, dict[str, 
         if omega is None:
             raise StoreError("the store neither sweeps omega nor records a fixed value of it")
         out[OMEGA] = omega
-    return gs, out
+    return target, out
 
 
 def compute_point(
@@ -181,36 +182,12 @@ def _plain(obj: Any) -> Any:
 
 
 def _figure_png(result: Any, var: str | None, planet: int, periods: float) -> bytes:
-    """Phase portrait, the variable and its mesh's contact force against time, and spectrum,
-    as PNG bytes."""
-    from matplotlib.figure import Figure
+    """The figure of one point (:func:`~gearchaos.plot.sources.figure_for`, ``panels="point"``:
+    phase portrait, the variable and its mesh's contact force against time, spectrum), as PNG
+    bytes."""
+    from ..plot.sources import figure_for
 
-    from ..plot import phase_portrait, spectrum, time_history
-
-    groups = result.system.force_groups
-    force = next((f for _, f, d in groups if d == var), groups[0][1] if groups else "")
-    fig = Figure(figsize=(11.0, 7.2), dpi=90, layout="constrained")
-    axs = fig.subplots(2, 2)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        phase_portrait(result, var, planet, ax=axs[0, 0], periods=periods)
-        axs[0, 0].set_title("phase portrait")
-        time_history(result, var, planet, ax=axs[0, 1], periods=periods)
-        axs[0, 1].set_title("time history")
-        if force:
-            time_history(result, force, planet, ax=axs[1, 0], periods=periods)
-            axs[1, 0].set_title("contact force of the mesh")
-        else:
-            axs[1, 0].set_axis_off()
-            axs[1, 0].text(
-                0.5, 0.5, f"{result.system.name} tracks no contact forces", ha="center",
-                va="center", transform=axs[1, 0].transAxes, color="0.4",
-            )  # fmt: skip
-        spectrum(result, var, planet, ax=axs[1, 1])
-        mesh = result.system.capabilities.period_name == "mesh"
-        axs[1, 1].set_title(
-            f"amplitude spectrum ({'mesh' if mesh else 'forcing'} harmonics labelled)"
-        )
+    fig = figure_for(result, var=var, planet=planet, history_periods=periods, panels="point")
     buf = io.BytesIO()
     fig.savefig(buf, format="png")
     return buf.getvalue()

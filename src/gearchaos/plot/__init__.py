@@ -8,6 +8,8 @@ Every plotting function takes ``ax=None`` (a new figure when not given) and retu
 :func:`poincare_gallery` several (Poincaré maps titled with value, motion and LLE),
 :func:`bifurcation_figure` and :func:`sweep_figure` a sweep (one panel per family value),
 :func:`contact_figure` the contact regime of every mesh along a 1-D sweep (rattle against speed);
+:func:`figure_for` gives the figure of whatever was loaded (a result, a store, branch or
+curve files, a basin store), as ``gearchaos plot`` and the explorer draw it;
 :func:`savefig` writes PNG, PDF or SVG by suffix. Symbols follow the seed:
 X̄_sp1 = δ_sp1/b_c, time in mesh periods τΩ/2π.
 """
@@ -27,10 +29,12 @@ from .regimes import (
     regime_map,
 )
 from .response import response_figure
+from .sources import FigureOptions, figure_for
 from .timeseries import amplitude_spectrum, spectrum, time_history
 
 __all__ = [
     "REGIME_COLOURS",
+    "FigureOptions",
     "amplitude_spectrum",
     "axis_label",
     "axis_symbol",
@@ -39,6 +43,7 @@ __all__ = [
     "contact_figure",
     "distinct_counts",
     "distinct_map",
+    "figure_for",
     "phase_portrait",
     "poincare_gallery",
     "poincare_map",

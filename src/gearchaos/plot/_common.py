@@ -94,15 +94,17 @@ _SPEED_UNITS = ("rpm", "Hz")
 
 
 def subject(attrs: Any, gearset: Any = None) -> str:
-    """What a figure of a store or file is of, as its title names it: the gear set's name
-    (``sheng2016``; ``gearset``, else the one of the attribute ``gearset_toml``; see
-    :func:`gearset_title`), else the
-    model's (``backlash_oscillator``) — not the record's ``planetary[sheng2016]``."""
-    if gearset is None:
-        gearset = stored_gearset(attrs)
-    if gearset is not None:
-        return figure_text(gearset_title(gearset))
-    return figure_text(attrs.get("model", "") or "")
+    """What a figure of a store or file is of, as its title names it: the model's title
+    (:func:`~gearchaos.model.record.model_title`: the gear set's name, ``sheng2016``, for a
+    model built from one — ``gearset`` when given, else the one the attributes record — else
+    the model's, ``backlash_oscillator``), not the record's ``planetary[sheng2016]``; the
+    recorded name when the model cannot be built again."""
+    model = stored_model(attrs, gearset)
+    if model is None:
+        return figure_text(attrs.get("model", "") or "")
+    from ..model.record import model_title
+
+    return figure_text(model_title(model)[1])
 
 
 def gearset_title(gearset: Any) -> str:
@@ -110,14 +112,9 @@ def gearset_title(gearset: Any) -> str:
     named after a built-in preset whose values are another preset's is named by those
     (a store written with the default before issue 34 says ``sheng2016-v1``, not
     ``sheng2016``)."""
-    from ..gearset import list_presets, preset_of
+    from ..model.record import model_title
 
-    name = str(gearset.name)
-    if name in {n for n, _ in list_presets()}:
-        shown = preset_of(gearset)
-        if shown is not None:
-            return shown
-    return name
+    return model_title(PlanetaryModel.from_gearset(gearset))[1]
 
 
 def figure_text(text: Any) -> str:
@@ -167,13 +164,15 @@ def given_values(
     and stability charts."""
     shown = {str(n) for n in leave_out}
     out: list[str] = []
-    symbols = parameter_symbols(attrs) if gearset is None else {}
+    symbols = parameter_symbols(attrs)  # a gear set's model has none: the registry's
     metres = clearances_in_metres(gearset)
+    model = stored_model(attrs, gearset)
     for k, v in fixed.items():
         number = isinstance(v, int | float | np.number) and not isinstance(v, bool)
         if number and k not in shown and k not in metres:  # those: b̄ and µm from the gear set
-            out.append(given(k, v, symbols) + (speed_text(v, gearset) if k == OMEGA else ""))
+            out.append(given(k, v, symbols) + (speed_text(v, model) if k == OMEGA else ""))
             shown.add(k)
+    # gear-set switch: a gear set's fixed values are its registry's clearances (b̄ and µm) and ξ
     if gearset is None:  # a reference system or a user model: its parameters with a symbol
         text = str(attrs.get("model_parameters", "") or "")
         for k, v in re.findall(r"(\w+)=([-+0-9.eE]+)[,)]", text):
@@ -196,17 +195,20 @@ def given_values(
     return out
 
 
-def speed_text(omega: Any, gearset: Any) -> str:
-    """`` (7589 rpm)``: the sun speed that ``gearset`` (with its fixed values applied) turns Ω
-    into, written beside Ω in titles; ``""`` without a gear set."""
-    if gearset is None:
-        return ""
-    return f" ({fmt(gearset.sun_speed_rpm(float(omega)), '.5g')} rpm)"
+def speed_text(omega: Any, model: Any) -> str:
+    """`` (7589 rpm)``: the sun speed at Ω of ``model`` (built from a gear set with its fixed
+    values applied: :func:`~gearchaos.model.target.speeds_at`), written beside Ω in titles;
+    ``""`` for a model without speeds (or ``None``)."""
+    from ..model.target import speeds_at
+
+    rpm = None if model is None else speeds_at(model, float(omega)).get("sun_rpm")
+    return "" if rpm is None else f" ({fmt(rpm, '.5g')} rpm)"
 
 
 def clearances_in_metres(gearset: Any) -> dict[str, float]:
     """The clearances that ``gearset`` gives in metres (their ``units`` field ``m``), by
     name, in metres; ``{}`` without a gear set."""
+    # gear-set switch: clearances in metres are a gear set's input setting (backlash.units)
     if gearset is None:
         return {}
     from ..gearset.mapping import get_value
@@ -238,12 +240,10 @@ def at_line(values: list[str], width: int = 80) -> str:
 
 def model_symbols(attrs: Any) -> Mapping[str, Any]:
     """The figure symbols of the variables of what a store or branch file records (its
-    attributes): the planetary model's for a gear set; else the model's own ``symbols`` (the
-    optional member of the model contract), the model built again from ``model_class`` and
-    ``model_fields`` (:func:`stored_model`); none when it has none or can no longer be built
-    (its file moved)."""
-    if attrs.get("gearset_toml") or attrs.get("model") == "planetary":
-        return PlanetaryModel.symbols
+    attributes): the ``symbols`` (the optional member of the model contract) of its model
+    (:func:`stored_model`: the planetary model of its gear set, or the model built again
+    from ``model_class`` and ``model_fields``); none when it has none or can no longer be
+    built (its file moved)."""
     model = stored_model(attrs)
     return {} if model is None else dict(Capabilities.of(model).symbols)
 
@@ -251,42 +251,52 @@ def model_symbols(attrs: Any) -> Mapping[str, Any]:
 def parameter_symbols(attrs: Any) -> Mapping[str, str]:
     """The figure symbols of the parameters of the model a store, branch or curve file
     records (its attributes): the model's own ``parameter_symbols`` (the optional member of
-    the model contract; field name → mathtext without ``$``), the model built again by
+    the model contract; field name → mathtext without ``$``), the model of
     :func:`stored_model`; none for a gear set (the registry names its parameters), a model
     without them or one that can no longer be built. For ``symbols=`` of
     :func:`axis_label`, :func:`axis_symbol` and :func:`given`."""
-    if attrs.get("gearset_toml") or attrs.get("model") == "planetary":
-        return {}
     model = stored_model(attrs)
     table = {} if model is None else Capabilities.of(model).parameter_symbols
     return {str(k): str(v) for k, v in table.items()}
 
 
-def stored_model(attrs: Any) -> Any:
-    """The model a store's, branch file's or curve file's ``model_class``/``model_fields``
-    attributes describe, built again once per pair
-    (:func:`~gearchaos.model.loading.rebuild_model`); ``None`` when they are absent, when it is
-    the user's own model and the user has not named it (``--model``: a file's record never
-    imports anything) or when it cannot be built."""
-    spec, fields = attrs.get("model_class"), attrs.get("model_fields")
-    if not spec or fields is None:
-        return None
-    key = (str(spec), str(fields))
-    if key not in _REBUILT:
-        from ..model.loading import rebuild_model
+def stored_target(attrs: Any, gearset: Any = None) -> Any:
+    """What a store's, branch file's or curve file's attributes record as computed on
+    (:func:`~gearchaos.model.record.recorded_target`: ``gearset`` when given, else the gear
+    set of ``gearset_toml``, else a :class:`~gearchaos.model.System` of the model of
+    ``model_class``/``model_fields``), built once per record; ``None`` when they record
+    neither, when it is the user's own model and the user has not named it (``--model``: a
+    file's record never imports anything) or when it cannot be built."""
+    from ..model.record import recorded_target
 
-        try:  # only a model the user named or gearchaos's own: never an import by the record
-            model = rebuild_model({"model_class": key[0], "model_fields": key[1]})
-        except ParameterError:
-            return None  # not named (yet): the figure draws names, not symbols
-        if len(_REBUILT) >= 16:
-            _REBUILT.pop(next(iter(_REBUILT)))
-        _REBUILT[key] = model
-    return _REBUILT[key]
+    key = (*(str(attrs.get(k, "") or "") for k in _RECORD_KEYS), str(id(gearset)))
+    hit = _REBUILT.get(key)
+    if hit is not None and hit[0] is gearset:
+        return hit[1]
+    try:  # only a model the user named or gearchaos's own: never an import by the record
+        target = recorded_target(attrs, gearset)
+    except ParameterError:
+        return None  # not named (yet): the figure draws names, not symbols
+    if len(_REBUILT) >= 16:
+        _REBUILT.pop(next(iter(_REBUILT)))
+    _REBUILT[key] = (gearset, target)
+    return target
 
 
-#: Models built again for figures, by (model_class, model_fields): at most 16.
-_REBUILT: dict[tuple[str, str], Any] = {}
+def stored_model(attrs: Any, gearset: Any = None) -> Any:
+    """The model of :func:`stored_target` (``gearset`` when given, else what the attributes
+    record), or ``None``."""
+    from ..model.target import model_for
+
+    target = stored_target(attrs, gearset)
+    return None if target is None else model_for(target, {})
+
+
+#: The attributes that record what a file was computed on.
+_RECORD_KEYS = ("gearset_toml", "model_class", "model_fields")
+#: Targets built again for figures, by (gearset_toml, model_class, model_fields, the given
+#: gear set's id), with the given gear set: at most 16.
+_REBUILT: dict[tuple[str, ...], tuple[Any, Any]] = {}
 
 
 def var_symbol(var: str, planet: int | None, symbols: Mapping[str, Any] | None = None) -> str:
@@ -338,6 +348,7 @@ _HARMONIC_STYLES = {1: "-", 2: "--", 3: ":"}
 def resonance_lines(ax: Any, gearset: Any, lo: float, hi: float) -> int:
     """Vertical lines at Ω = ω_k/(h ω_n) inside [lo, hi], where the h-th mesh harmonic meets a
     natural frequency ω_k of the linear model; returns how many were drawn."""
+    # gear-set switch: natural frequencies come from a gear set's linear model (gearset_info)
     if gearset is None:
         raise ParameterError(
             "resonances need the gear set of the sweep (attribute gearset_toml); "

@@ -33,7 +33,7 @@ from .branch import BRANCH_COLOURS, branch_labels, mark_event
 from .placement import place_event_labels
 from .regimes import regime_band, regime_categories, regime_legend_below
 from .response import MESH_LABEL, periodic_mask
-from .units import PhysicalScales, fit_to_data, linear_axis, var_quantity
+from .units import PhysicalScales, fit_to_data, linear_axis
 
 __all__ = [
     "AMPLITUDE_GID",
@@ -285,7 +285,7 @@ def amplitude_figure(
         per = "planet" in sd[f"{var}_max"].dims or "planet_all" in sd[f"{var}_max"].dims
         sym = var_symbol(var, planet if per else None, model_symbols(sd.attrs))
         ax.set_ylabel(f"amplitude $\\max {sym} - \\min {sym}$")
-        kind = var_quantity(var)
+        kind = scales.quantity(var)
         found = scales.factor(kind) if kind is not None else None
         right = f"amplitude {found[1]}" if found else ""
     ax.grid(alpha=0.3, lw=0.5)

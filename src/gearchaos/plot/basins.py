@@ -32,12 +32,13 @@ from ._common import (
     model_symbols,
     parameter_symbols,
     speed_text,
-    stored_gearset,
+    stored_model,
+    stored_target,
     subject,
     var_symbol,
 )
 from .regimes import regime_colour
-from .units import PhysicalScales, physical_axis, var_quantity
+from .units import PhysicalScales, physical_axis
 
 __all__ = ["attractor_colours", "basin_image", "basins_figure", "fraction_curves"]
 
@@ -74,25 +75,33 @@ def _symbol(name: str, attrs: Any) -> str:
 
 
 def _scales(attrs: Any) -> PhysicalScales:
+    """The store's scales (``characteristic_length_m``, ``omega_n_rad_s``) with the sun speed
+    per unit Ω and the quantities of its model (:func:`stored_model`), where it has them."""
+    from ..model.contract import Capabilities
+    from ..model.target import speeds_at
+
     length, omega_n = attrs.get("characteristic_length_m"), attrs.get("omega_n_rad_s")
-    rpm = None
-    if attrs.get("gearset_toml"):
-        from ..gearset import GearSet
+    model = stored_model(attrs)
+    rpm = None if model is None else speeds_at(model, 1.0).get("sun_rpm")
+    quantities = None if model is None else Capabilities.of(model).quantities
+    return PhysicalScales(
+        length_m=length, omega_n=omega_n, rpm_per_omega=rpm, quantities=quantities
+    )
 
-        rpm = GearSet.from_toml_string(attrs["gearset_toml"]).sun_speed_rpm(1.0)
-    return PhysicalScales(length_m=length, omega_n=omega_n, rpm_per_omega=rpm)
 
+def _point_model(attrs: Any, values: Mapping[str, Any]) -> Any:
+    """The stored model with the basin point's other values applied (the stored model when
+    they are none of its parameters; ``None`` when it cannot be built): it turns Ω into the
+    sun speed where it has speeds."""
+    from ..model.target import model_for
 
-def _point_gearset(attrs: Any, values: Mapping[str, Any]) -> Any:
-    """The stored gear set with the basin point's other values applied (``None`` for a
-    model's store, or when they are no gear-set values): it turns Ω into the sun speed."""
-    gs = stored_gearset(attrs)
-    if gs is None:
+    target = stored_target(attrs)
+    if target is None:
         return None
     try:
-        return gs.evolve({k: v for k, v in values.items() if k != "omega"})
+        return model_for(target, {k: v for k, v in values.items() if k != "omega"})
     except (ParameterError, TypeError):
-        return gs
+        return model_for(target, {})
 
 
 def _physical(ax: Any, axis: str, name: str, attrs: Any) -> None:
@@ -201,8 +210,9 @@ def basin_image(ds: Any, ax: Any = None, *, points: bool = True) -> Any:
 
 
 def _has_right_axis(ds: Any, yname: str) -> bool:
-    q = var_quantity(yname)
-    return q is not None and _scales(ds.attrs).factor(q) is not None
+    scales = _scales(ds.attrs)
+    q = scales.quantity(yname)
+    return q is not None and scales.factor(q) is not None
 
 
 def fraction_curves(ds: Any, ax: Any = None, *, confidence: float = 0.95) -> Any:
@@ -271,9 +281,9 @@ def basins_figure(ds: Any) -> Any:
     if "omega" not in spec["values"] and "omega" in ds.attrs and ds.attrs["dims"][0] != "omega":
         spec["values"] = {"omega": float(ds.attrs["omega"]), **spec["values"]}
     psym = parameter_symbols(ds.attrs)
-    gs = _point_gearset(ds.attrs, spec["values"])
+    model = _point_model(ds.attrs, spec["values"])
     point = ", ".join(
-        given(k, v, psym) + (speed_text(v, gs) if k == "omega" else "")
+        given(k, v, psym) + (speed_text(v, model) if k == "omega" else "")
         for k, v in spec["values"].items()
     )
     if kind == "basins":

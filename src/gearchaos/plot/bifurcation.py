@@ -54,7 +54,6 @@ from .units import (
     notes_clear_of,
     physical_axis,
     secondary_axis,
-    var_quantity,
 )
 
 __all__ = ["bifurcation", "bifurcation_figure", "resolve_var", "suptitle"]
@@ -338,7 +337,7 @@ def bifurcation(
     no_offset(ax.yaxis)
     if physical:
         scales = PhysicalScales.of_sweep(res)
-        secondary_axis(ax, "y", var_quantity(var), scales)
+        secondary_axis(ax, "y", scales.quantity(var), scales)
         # rpm opposite Ω, µm opposite a clearance in b_c (a clearance in metres read in µm)
         physical_axis(ax, "x", x_name, scales, res.gearset)
     if lay.directions or (

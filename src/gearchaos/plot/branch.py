@@ -34,6 +34,7 @@ from ._common import (
     resonance_lines,
     stored_fixed,
     stored_gearset,
+    stored_model,
     subject,
     var_symbol,
 )
@@ -44,7 +45,6 @@ from .units import (
     fit_to_data,
     physical_axis,
     secondary_axis,
-    var_quantity,
 )
 
 __all__ = [
@@ -98,6 +98,7 @@ def branch_clearance(branch: Any, var: str) -> np.ndarray | None:
     if var in CLEARANCES:
         parameter, _, key = CLEARANCES[var]
         gs = stored_gearset(branch.attrs)
+        # gear-set switch: this variable's clearance is a gear-set parameter (b̄ or metres)
         if gs is None:
             return None
         if name == parameter:
@@ -412,11 +413,10 @@ def branch_figure(
     per = "planet" in branches[0][var].dims
     ylabel = var_symbol(var, planet if per else None, model_symbols(branches[0].attrs))
     ax.set_ylabel(f"${ylabel} - {sym}$" if relative else f"${ylabel}$")
-    if physical and gs is not None:
-        from ..model.planetary import PlanetaryModel
-
-        scales = PhysicalScales.of_model(PlanetaryModel.from_gearset(gs))
-        secondary_axis(ax, "y", var_quantity(var), scales)
+    model = stored_model(branches[0].attrs) if physical else None
+    if model is not None:  # the model's scales and quantities: none without scales
+        scales = PhysicalScales.of_model(model)
+        secondary_axis(ax, "y", scales.quantity(var), scales)
         # rpm opposite Ω, µm opposite a clearance in b_c (a clearance in metres read in µm)
         physical_axis(ax, "x", name, scales, gs)
     ax.legend(loc="best", fontsize="small")

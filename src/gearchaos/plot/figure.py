@@ -14,11 +14,12 @@ from .._output import check_replaceable, file_has_mark, staged_file
 from .._version import __version__
 from ..analysis.summary import motion_text
 from ..errors import ParameterError
+from ..model.record import model_title
 from ._common import message, variable
 from .phase import phase_portrait, poincare_map, sun_orbit
 from .timeseries import mesh_force_history, spectrum, time_history
 
-__all__ = ["SAVE_FORMATS", "savefig", "summary_figure"]
+__all__ = ["SAVE_FORMATS", "point_figure", "savefig", "summary_figure"]
 
 #: File suffixes :func:`savefig` writes.
 SAVE_FORMATS = (".png", ".pdf", ".svg")
@@ -35,9 +36,17 @@ def _fmt(v: Any, spec: str = ".4g") -> str:
     return "—" if v is None else format(v, spec)
 
 
+def _contact_groups(names: list[str]) -> list[str]:
+    """The group of each contact, by its name: ``sun_planet_2`` → ``sun_planet`` where
+    another contact shares the stem before the member's number, else the name itself
+    (``stage_1`` alone, ``c1``, ``mesh``)."""
+    stems = [n.rpartition("_")[0] if n.rpartition("_")[2].isdigit() else "" for n in names]
+    return [s if s and stems.count(s) > 1 else n for s, n in zip(stems, names, strict=True)]
+
+
 def _text_lines(result: Any, summary: dict[str, Any]) -> list[str]:
-    gs = summary.get("gearset")
-    owner = f"gear set: {gs}" if gs else f"model: {result.system.name}"
+    what, name = model_title(result.system.model)
+    owner = f"{what}: {name}"
     n = summary["distinct_section_points"]
     motion = motion_text(summary)
     recorded = summary.get("recorded_section_points")
@@ -46,14 +55,17 @@ def _text_lines(result: Any, summary: dict[str, Any]) -> list[str]:
         owner,
         rf"$\Omega = \omega/\omega_n$ = {_fmt(summary['omega'])}",
     ]
-    if not gs:  # a model of one's own: what its variables are called in the panels
+    if variable(result).definition is None:  # the panels do not say what the variables are
         shown = [n for n in result.system.state_names if not n.endswith("_dot")]
         names = ", ".join(f"${variable(result, n).symbol}$" for n in shown[:6])
         lines.append(f"variables: {names}" + (" …" if len(shown) > 6 else "") + " (and rates)")
     if summary.get("omega_n_rad_s") is not None:
         lines.append(rf"$\omega_n$ = {_fmt(summary['omega_n_rad_s'], '.5g')} rad/s")
-    if summary.get("mesh_frequency_hz") is not None:
-        lines.append(rf"mesh frequency $f_m$ = {_fmt(summary['mesh_frequency_hz'], '.5g')} Hz")
+    if summary.get("mesh_frequency_hz") is not None:  # the frequency of the model's period
+        name = result.system.capabilities.period_name
+        symbol = "f_m" if name == "mesh" else "f"
+        hz = _fmt(summary["mesh_frequency_hz"], ".5g")
+        lines.append(f"{name} frequency ${symbol}$ = {hz} Hz")
     if summary.get("sun_speed_rpm") is not None:
         lines.append(f"sun speed = {_fmt(summary['sun_speed_rpm'], '.5g')} rpm")
     lines.append(f"distinct section points: {points} (motion: {motion})")
@@ -73,9 +85,7 @@ def _text_lines(result: Any, summary: dict[str, Any]) -> list[str]:
         per = f" ({member}s 1…N)" if result.system.group_size else ""
         lines.append(f"contact regimes{per}:")
         groups: dict[str, list[str]] = {}
-        for c in contact:
-            mesh = c["mesh"]
-            group = mesh.rpartition("_")[0] if mesh[-1].isdigit() else mesh
+        for group, c in zip(_contact_groups([c["mesh"] for c in contact]), contact, strict=True):
             groups.setdefault(group, []).append(_REGIME_SHORT.get(c["regime"], c["regime"]))
         for group, regimes in groups.items():
             name = group.replace("sun_planet", "sun–planet").replace("planet_ring", "planet–ring")
@@ -207,13 +217,49 @@ def summary_figure(
     )
     tx.set_title("summary")
 
-    gs = summary.get("gearset") or result.system.name
+    name = model_title(result.system.model)[1]
     rpm = summary.get("sun_speed_rpm")
-    title = f"{gs}: Ω = {result.system.omega:g}"
+    title = f"{name}: Ω = {result.system.omega:g}"
     if rpm is not None:
         title += f" (sun {rpm:.0f} rpm)"
     title += f" — motion {motion_text(summary)}, status {summary['status']}"
     fig.suptitle(title, fontsize=14)
+    return fig
+
+
+def point_figure(result: Any, var: str | None, planet: int = 1, periods: float = 10.0) -> Any:
+    """The explorer's figure of one point: phase portrait, the variable and its mesh's
+    contact force against time (a note where the model tracks no contact forces), and the
+    amplitude spectrum (harmonics of the model's forcing period labelled), 2×2. Warnings of
+    the plots are silenced (the explorer shows the figure, not a log)."""
+    import warnings
+
+    from matplotlib.figure import Figure
+
+    groups = result.system.force_groups
+    force = next((f for _, f, d in groups if d == var), groups[0][1] if groups else "")
+    fig = Figure(figsize=(11.0, 7.2), dpi=90, layout="constrained")
+    axs = fig.subplots(2, 2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        phase_portrait(result, var, planet, ax=axs[0, 0], periods=periods)
+        axs[0, 0].set_title("phase portrait")
+        time_history(result, var, planet, ax=axs[0, 1], periods=periods)
+        axs[0, 1].set_title("time history")
+        if force:
+            time_history(result, force, planet, ax=axs[1, 0], periods=periods)
+            axs[1, 0].set_title("contact force of the mesh")
+        else:
+            axs[1, 0].set_axis_off()
+            axs[1, 0].text(
+                0.5, 0.5, f"{result.system.name} tracks no contact forces", ha="center",
+                va="center", transform=axs[1, 0].transAxes, color="0.4",
+            )  # fmt: skip
+        spectrum(result, var, planet, ax=axs[1, 1])
+        mesh = result.system.capabilities.period_name == "mesh"
+        axs[1, 1].set_title(
+            f"amplitude spectrum ({'mesh' if mesh else 'forcing'} harmonics labelled)"
+        )
     return fig
 
 

@@ -22,7 +22,6 @@ from .units import (
     secondary_axis,
     section_points,
     section_style,
-    var_quantity,
 )
 
 __all__ = ["phase_portrait", "poincare_map", "sun_orbit"]
@@ -110,8 +109,8 @@ def _finish(
         clearance_notes(ax, "x", (-info.clearance, info.clearance), info.clearance_symbol or "b")
     if physical:
         scales = PhysicalScales.of_result(result)
-        secondary_axis(ax, "x", var_quantity(info.name), scales)
-        secondary_axis(ax, "y", var_quantity(info.dot or ""), scales)
+        secondary_axis(ax, "x", scales.quantity(info.name), scales)
+        secondary_axis(ax, "y", scales.quantity(info.dot or ""), scales)
 
 
 def poincare_map(

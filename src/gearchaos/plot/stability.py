@@ -26,6 +26,7 @@ from ._common import (
     parameter_symbols,
     stored_fixed,
     stored_gearset,
+    stored_target,
     subject,
 )
 from .units import PhysicalScales, physical_axis
@@ -191,17 +192,21 @@ def stability_chart(
 
 
 def _scales(curve: Any, regimes: Any) -> tuple[PhysicalScales, Any]:
-    """Physical scales and gear set from the sweep, else from the curve's gear set."""
+    """Physical scales and gear set from the sweep, else from what the curve file records
+    (its target over the two parameters' ranges; none when it records no model that can be
+    built again)."""
     if regimes is not None:
         from ..sweep.result import SweepResult
 
         res = SweepResult.of(regimes)
         return PhysicalScales.of_sweep(res), res.gearset
-    gs = stored_gearset(curve.attrs)
-    if gs is None:
+    target = stored_target(curve.attrs)
+    if target is None:
         return PhysicalScales(), None
     names = (str(curve.attrs["parameter"]), str(curve.attrs["parameter2"]))
-    return PhysicalScales.over(gs, {n: curve[n].values for n in names}), gs
+    return PhysicalScales.over(target, {n: curve[n].values for n in names}), stored_gearset(
+        curve.attrs
+    )
 
 
 def stability_figure(

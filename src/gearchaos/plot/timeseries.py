@@ -25,7 +25,6 @@ from .units import (
     linear_axis,
     secondary_axis,
     section_points,
-    var_quantity,
 )
 
 #: ``gid`` of the mesh-harmonic labels and sideband lines of a spectrum.
@@ -88,7 +87,7 @@ def time_history(
         clearance_notes(ax, "y", (-info.clearance, info.clearance), info.clearance_symbol or "b")
     if physical:
         scales = PhysicalScales.of_result(result)
-        secondary_axis(ax, "y", var_quantity(info.name), scales)
+        secondary_axis(ax, "y", scales.quantity(info.name), scales)
         ms = scales.period_ms(result.system.omega)
         if ms is not None:
             linear_axis(ax, "x", ms, "t [ms]")
@@ -300,6 +299,7 @@ def spectrum(
             gid=HARMONIC_GID,
         )
     gs = result.system.capabilities.gearset
+    # gear-set switch: eccentricity sidebands come from a gear set's tooth numbers
     if gs is not None and gs.has_eccentricity:
         # eccentricities modulate the meshes at the sun's speed relative to the carrier,
         # f_s = f_m / z_s: sidebands h f_m ± f_s

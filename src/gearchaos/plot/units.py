@@ -55,18 +55,28 @@ class PhysicalScales:
     omega_n: float | None = None  # rad/s
     force_n: float | None = None  # k_m,sp b_c
     rpm_per_omega: float | None = None  # sun speed [rpm] per unit Ω
+    #: The model's ``quantities`` (variable or group → ``length``, ``velocity``, ``force``),
+    #: which :meth:`quantity` reads; ``None``: the planetary model's.
+    quantities: Mapping[str, str] | None = dataclasses.field(
+        default=None, compare=False, hash=False, repr=False
+    )
 
     @classmethod
     def of_model(cls, model: Any) -> PhysicalScales:
-        """The scales of a planetary model (none for reference systems)."""
+        """The scales of a model that gives them (its ``scales``: ω_n, the length and the
+        scale of each quantity it uses), with the sun speed per unit Ω where it has speeds
+        (:func:`~gearchaos.model.target.speeds_at`); none for a model without scales."""
         from ..model.contract import Capabilities
+        from ..model.target import speeds_at
 
         caps = Capabilities.of(model)
-        sc, gs = caps.scales, caps.gearset
+        sc = caps.scales
         if sc is None:
             return cls()
-        rpm = gs.sun_speed_rpm(1.0) if gs is not None else None
-        return cls(float(sc.length), float(sc.omega_n), float(sc.force), rpm)
+        used = set(caps.quantities.values())
+        force = float(sc.force) if "force" in used else None
+        rpm = speeds_at(model, 1.0).get("sun_rpm")
+        return cls(float(sc.length), float(sc.omega_n), force, rpm, caps.quantities)
 
     @classmethod
     def of_result(cls, result: Any) -> PhysicalScales:
@@ -74,35 +84,52 @@ class PhysicalScales:
 
     @classmethod
     def of_sweep(cls, res: Any) -> PhysicalScales:
-        """From a :class:`~gearchaos.sweep.SweepResult`: its gear set with the fixed values,
-        over the ranges of its swept parameters (:meth:`over`)."""
-        if res.gearset is None:
+        """From a :class:`~gearchaos.sweep.SweepResult`: its target (gear set or model) with
+        the fixed values, over the ranges of its swept parameters (:meth:`over`); none when
+        the store's model cannot be built again."""
+        from ..errors import ParameterError
+
+        try:
+            target = res.base_target
+        except ParameterError:  # a model the user has not named: no scales to read
             return cls()
+        if target is None:
+            return cls()
+        fixed = {k: v for k, v in res.fixed.items() if k != OMEGA}
         ranges = {
             name: np.asarray(res.ds[name].values, dtype=np.float64)
             for name in res.swept_names
             if name in res.ds.coords
         }
-        return cls.over(res.gearset, ranges)
+        return cls.over(target, ranges, fixed)
 
     @classmethod
-    def over(cls, gs: Any, ranges: Mapping[str, Any]) -> PhysicalScales:
-        """The scales of gear set ``gs`` where parameters take the values ``ranges`` (name →
-        values): a scale that one of them changes (ω_n along a stiffness or a mass, b_c along
-        the characteristic length …) is left undefined, since a physical axis linear in the
+    def over(
+        cls, target: Any, ranges: Mapping[str, Any], fixed: Mapping[str, Any] | None = None
+    ) -> PhysicalScales:
+        """The scales of ``target`` (a gear set or a :class:`~gearchaos.model.System`) with
+        the ``fixed`` values, where parameters take the values ``ranges`` (name → values): a
+        scale that one of them changes (ω_n along a stiffness or a mass, b_c along the
+        characteristic length …) is left undefined, since a physical axis linear in the
         dimensionless one would be wrong along it (checked at both ends of each range)."""
-        from ..model.planetary import PlanetaryModel
+        from ..model.target import model_for
 
-        base = cls.of_model(PlanetaryModel.from_gearset(gs))
+        fixed = dict(fixed or {})
+        base = cls.of_model(model_for(target, fixed))
         varying: set[str] = set()
         for name, values in ranges.items():
             if name == OMEGA:
                 continue
             values = np.asarray(values, dtype=np.float64)
             for v in (float(np.nanmin(values)), float(np.nanmax(values))):
-                end = cls.of_model(PlanetaryModel.from_gearset(gs.evolve({name: v})))
+                end = cls.of_model(model_for(target, {**fixed, name: v}))
                 varying |= {f for f in SCALE_FIELDS if not _same(getattr(base, f), getattr(end, f))}
         return dataclasses.replace(base, **dict.fromkeys(varying))
+
+    def quantity(self, var: str) -> str | None:
+        """The physical quantity of the variable ``var`` in the model these scales are of
+        (:func:`var_quantity` of its ``quantities``)."""
+        return var_quantity(var, self.quantities)
 
     def factor(self, quantity: str) -> tuple[float, str] | None:
         """(factor, axis label) of a quantity: ``length`` (µm), ``velocity`` (mm/s),
@@ -125,8 +152,8 @@ class PhysicalScales:
         return 2e3 * math.pi / (omega * self.omega_n) if self.omega_n else None
 
 
-#: The fields of :class:`PhysicalScales`.
-SCALE_FIELDS = tuple(f.name for f in dataclasses.fields(PhysicalScales))
+#: The scale fields of :class:`PhysicalScales` (not the quantities table).
+SCALE_FIELDS = tuple(f.name for f in dataclasses.fields(PhysicalScales) if f.compare)
 
 
 def _same(a: float | None, b: float | None) -> bool:
@@ -191,7 +218,7 @@ def physical_axis(
             return None
         sym = symbol or _unbarred(name)
         return secondary_axis(ax, axis, "length", scales, symbol=sym)
-    return secondary_axis(ax, axis, var_quantity(name), scales, symbol=symbol or "")
+    return secondary_axis(ax, axis, scales.quantity(name), scales, symbol=symbol or "")
 
 
 def _unbarred(name: str) -> str:
@@ -202,6 +229,7 @@ def _unbarred(name: str) -> str:
 def _units(gearset: Any, name: str) -> str | None:
     """The units (``dimensionless`` or ``m``) in which ``gearset`` gives the clearance
     ``name``; None without a gear set."""
+    # gear-set switch: clearances in metres are a gear set's input setting (backlash.units)
     if gearset is None:
         return None
     from ..gearset.mapping import get_value

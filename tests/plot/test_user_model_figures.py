@@ -1,0 +1,193 @@
+"""A model of one's own gets its own words, units and physical axes in the figures (issue 36,
+item 2): the figures ask the model's capabilities (its quantities and scales, its symbols,
+its contacts' names, the name of its period), never whether it is a gear set.
+
+The model here is a two-stage train written outside the package: two backlash oscillators,
+stage 1 and stage 2, whose deflections ``x_1``, ``x_2`` are lengths in units of b_0 = 20 µm
+with ω_0 = 5000 rad/s (so a velocity unit is b_0 ω_0 = 0.1 m/s), contacts named ``stage1``
+and ``stage2``, and a period called the tooth period. The expected axis factors are these
+scales, written here, not read from the code.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numba
+import numpy as np
+import pytest
+from figure_checks import draw
+
+import gearchaos as gc
+from gearchaos.model import System
+from gearchaos.model.contract import Contact, UserModel
+from gearchaos.plot import figure_for, summary_figure
+from gearchaos.sweep.result import SweepResult
+
+LENGTH, OMEGA_0 = 20e-6, 5000.0
+#: Words, symbols and names of the planetary model that a figure of this model must not show.
+PLANETARY = re.compile(r"planet|sun|_\{sp|_\{rp|sp1|\\bar\{X\}|mesh|b_c|gear set")
+
+
+@numba.njit(cache=True)
+def _stages_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
+    """Two backlash oscillators driven at Ω: x'' + 2ζx' + f(x; b_k) = 0.1 + 0.2 cos Ωτ."""
+    for s in range(2):
+        x, v = y[s], y[2 + s]
+        b = p[2 + s]
+        f = x - b if x > b else (x + b if x < -b else 0.0)
+        dydt[s] = v
+        dydt[2 + s] = -2.0 * p[1] * v - f + 0.1 + 0.2 * math.cos(p[0] * t)
+        obs[s] = x
+        obs[2 + s] = v
+
+
+@dataclass(frozen=True)
+class StageScales:
+    length: float = LENGTH
+    omega_n: float = OMEGA_0
+    stiffness: float = 1e8
+
+    @property
+    def velocity(self) -> float:
+        return self.length * self.omega_n
+
+    @property
+    def force(self) -> float:
+        return self.stiffness * self.length
+
+
+@dataclass(frozen=True)
+class TwoStageTrain(UserModel):
+    zeta: float = 0.05
+    b_1: float = 1.0
+    b_2: float = 0.5
+
+    name = "two_stage_train"
+    state_names = ("x_1", "x_2", "x_1_dot", "x_2_dot")
+    obs_names = ("x_1", "x_2", "x_1_dot", "x_2_dot")
+    n_track = 2
+    rhs = _stages_rhs
+    quantities: ClassVar[dict[str, str]] = {"x": "length", "x_dot": "velocity"}
+    symbols: ClassVar[dict[str, Any]] = {"x": (r"\bar{q}_{%d}", r"q_{%d}/b_0", None, None)}
+    parameter_symbols: ClassVar[dict[str, str]] = {"zeta": r"\zeta", "b_1": r"\bar{b}_1"}
+    period_name = "tooth"
+    member_name = "stage"
+    default_observables = ("x", "x_dot")  # the group: x_1 first
+    scales = StageScales()
+
+    @property
+    def contacts(self) -> tuple[Contact, ...]:
+        return (Contact("stage1", 0, self.b_1), Contact("stage2", 1, self.b_2))
+
+    @property
+    def switch_widths(self) -> np.ndarray:
+        return np.array([self.b_1, self.b_2])
+
+    def pack(self, omega: float) -> np.ndarray:
+        return np.array([omega, self.zeta, self.b_1, self.b_2])
+
+
+def _axes(fig: Any) -> list[Any]:
+    """Every Axes of ``fig`` with the secondary (physical) axes they carry."""
+    out = []
+    for ax in fig.axes:
+        out += [ax, *ax.child_axes]
+    return out
+
+
+def _texts(fig: Any) -> list[str]:
+    """Every text of ``fig``: titles, axis labels, texts and legend entries."""
+    out = [t.get_text() for t in fig.texts]
+    if fig._suptitle is not None:
+        out.append(fig._suptitle.get_text())
+    for ax in _axes(fig):
+        out += [ax.title.get_text(), ax.xaxis.get_label_text(), ax.yaxis.get_label_text()]
+        out += [t.get_text() for t in ax.texts]
+        legend = ax.get_legend()
+        if legend is not None:
+            out += [t.get_text() for t in legend.get_texts()]
+    return [t for t in out if t]
+
+
+def _secondaries(ax: Any) -> dict[str, float]:
+    """The secondary (physical) axes of ``ax``: label → physical value per unit of the
+    primary axis."""
+    out = {}
+    for sec in ax.child_axes:
+        axis = sec.yaxis if sec._orientation == "y" else sec.xaxis
+        forward = sec._functions[0]
+        out[axis.get_label_text()] = float(
+            forward(np.array([1.0]))[0] - forward(np.array([0.0]))[0]
+        )
+    return out
+
+
+@pytest.fixture(scope="module")
+def result() -> gc.SimulationResult:
+    return gc.simulate(
+        System(TwoStageTrain(), 1.2), transient_periods=20, periods=20, samples_per_period=32
+    )
+
+
+def test_summary_figure_names_the_model_its_stages_and_its_units(result) -> None:
+    fig = summary_figure(result)
+    draw(fig)
+    texts = _texts(fig)
+    panel = next(t for t in texts if t.startswith("model: "))
+    lines = panel.splitlines()
+    assert lines[0] == "model: two_stage_train"
+    # the contact regimes named by the model's contacts (not ": single, single")
+    regimes = [ln.strip() for ln in lines if ln.startswith("   ")]
+    assert [r.split(":")[0] for r in regimes] == ["stage1", "stage2"], panel
+    assert all(r.split(": ")[1] in ("none", "single", "double", "?") for r in regimes)
+    # the variable's symbol and definition are the model's
+    assert any(r"\bar{q}_{1} = q_{1}/b_0" in t for t in texts), texts
+    assert any("tooth periods" in t for t in texts), texts
+    # physical axes from the model's quantities and scales: x̄ in µm, x̄' in mm/s
+    history = next(ax for ax in fig.axes if ax.get_title().startswith("time history"))
+    period_ms = 2e3 * math.pi / (1.2 * OMEGA_0)  # one forcing period at Ω = 1.2
+    assert _secondaries(history) == pytest.approx({"[µm]": LENGTH * 1e6, "t [ms]": period_ms})
+    phase = next(ax for ax in fig.axes if ax.get_title().startswith("phase portrait"))
+    assert _secondaries(phase) == pytest.approx({"[µm]": LENGTH * 1e6, "[mm/s]": 0.1 * 1e3})
+    for text in texts:
+        assert not PLANETARY.search(text), text
+
+
+@pytest.fixture(scope="module")
+def store(tmp_path_factory) -> SweepResult:
+    path = tmp_path_factory.mktemp("two_stage") / "sweep.zarr"
+    gc.bifurcation(
+        System(TwoStageTrain(), 1.0), "omega=0.8:1.2:5", transient_periods=30, periods=8,
+        progress=False, store=path,
+    )  # fmt: skip
+    return SweepResult.open(path)
+
+
+def test_a_sweep_of_the_model_gets_its_symbols_and_physical_axes(store) -> None:
+    fig = figure_for(store)
+    draw(fig)
+    texts = _texts(fig)
+    assert any(t.startswith("two_stage_train") for t in texts), texts
+    panel = next(ax for ax in fig.axes if ax.child_axes)
+    assert _secondaries(panel) == pytest.approx({"[µm]": LENGTH * 1e6})
+    assert any(r"\zeta" in t for t in texts), texts  # the fixed ζ by the model's symbol
+    for text in texts:
+        assert not PLANETARY.search(text), text
+
+
+def test_a_branch_of_the_model_gets_its_physical_axes(tmp_path) -> None:
+    path = tmp_path / "branch.nc"
+    gc.continuation(System(TwoStageTrain(), 0.8), "omega=0.8:1.0", store=path)
+    from gearchaos.dynamics.cascade import open_cascade
+
+    fig = figure_for(list(open_cascade(path)))
+    draw(fig)
+    (ax,) = [a for a in fig.axes if a.get_xlabel()]
+    assert _secondaries(ax) == pytest.approx({"[µm]": LENGTH * 1e6})
+    assert fig._suptitle.get_text().startswith("two_stage_train: ")
+    for text in _texts(fig):
+        assert not PLANETARY.search(text), text
