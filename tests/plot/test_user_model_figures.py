@@ -153,6 +153,11 @@ def test_summary_figure_names_the_model_its_stages_and_its_units(result) -> None
     assert _secondaries(history) == pytest.approx({"[µm]": LENGTH * 1e6, "t [ms]": period_ms})
     phase = next(ax for ax in fig.axes if ax.get_title().startswith("phase portrait"))
     assert _secondaries(phase) == pytest.approx({"[µm]": LENGTH * 1e6, "[mm/s]": 0.1 * 1e3})
+    # the spectrum in multiples of the model's period's frequency, in Hz opposite
+    spec = next(ax for ax in fig.axes if ax.get_title().startswith("amplitude spectrum"))
+    assert "multiples of the tooth frequency" in spec.get_xlabel()
+    hz = 1.2 * OMEGA_0 / (2 * math.pi)  # f = Ω ω_0/2π
+    assert _secondaries(spec) == pytest.approx({"frequency [Hz]": hz})
     for text in texts:
         assert not PLANETARY.search(text), text
 

@@ -310,9 +310,9 @@ def spectrum(
                     ax.axvline(r, color="0.85", lw=0.5, ls=":", zorder=0, gid=HARMONIC_GID)
     if period_name(result) == "mesh":
         ax.set_xlabel(r"$\omega/\omega_m$ (multiples of the mesh frequency $f_m$)")
-        if f_m is not None:
-            linear_axis(ax, "x", f_m, "frequency [Hz]")
     else:
-        ax.set_xlabel(r"$\omega/\Omega$ (multiples of the forcing frequency)")
+        ax.set_xlabel(rf"$\omega/\Omega$ (multiples of the {period_name(result)} frequency)")
+    if f_m is not None:  # a model with scales: the frequency in Hz opposite
+        linear_axis(ax, "x", f_m, "frequency [Hz]")
     ax.set_ylabel(f"amplitude of ${info.symbol}$")
     return ax
