@@ -40,9 +40,9 @@ from .._version import provenance
 from ..analysis.contact import contact_regime
 from ..errors import IntegrationError, ParameterError, Status
 from ..integrate.settings import SolverSettings, split_keywords
-from ..model.loading import model_reference
+from ..model.record import model_record
 from ..model.system import System
-from ..model.target import resolve, scale_attrs
+from ..model.target import Target, resolve, scale_attrs
 from .shooting import Problem, Solution, correct, section_time
 from .stability import STABILITY_MARGIN, stability_of, structural_multipliers
 
@@ -324,16 +324,7 @@ def minimal_period(sections: np.ndarray, tol: float) -> int:
 def model_attrs(system: System) -> dict[str, Any]:
     """The model's provenance: ``model``, ``gearset_toml``, ``model_parameters``, scales and
     clearances (the attributes sweeps and simulations carry)."""
-    model = system.model
-    gs = system.capabilities.gearset
-    a: dict[str, Any] = {
-        "model": "planetary" if gs is not None else system.name,
-        "gearset_toml": gs.to_toml() if gs is not None else "",
-        "model_parameters": "" if gs is not None else repr(model),
-        **model_reference(model),
-    }
-    a.update(scale_attrs(model))
-    return a
+    return {**model_record(system), **scale_attrs(system.model)}
 
 
 # ------------------------------------------------------------------------------ front door
@@ -382,7 +373,7 @@ def initial_guess(
 
 
 def periodic_orbit(
-    target: Any,
+    target: Target,
     *,
     period: int = 1,
     guess: Any = None,

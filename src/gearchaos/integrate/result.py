@@ -30,6 +30,7 @@ from .._output import check_replaceable, write_file
 from .._version import provenance
 from ..errors import ParameterError, StoreError
 from ..model.loading import model_reference
+from ..model.record import model_record
 from .trajectory import Trajectory
 
 __all__ = ["SimulationResult", "open_simulation"]
@@ -77,8 +78,7 @@ class SimulationResult(Trajectory):
             ),
             **provenance(),
         }
-        gs = self.gearset
-        attrs["gearset_toml"] = gs.to_toml() if gs is not None else ""
+        attrs["gearset_toml"] = model_record(self.system)["gearset_toml"]
         caps = self.system.capabilities
         sc = caps.scales
         if sc is not None:

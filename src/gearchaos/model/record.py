@@ -1,21 +1,132 @@
-"""What a file records about its model, and what figures and tables call a model.
+"""What a file records about its model, written, checked and read in one place, and what
+figures and tables call a model.
 
-A store, branch file or curve file records what it was computed on: a gear set (its TOML,
-``gearset_toml``) or a model reference (``model_class``/``model_fields``,
-:func:`~gearchaos.model.loading.model_reference`). :func:`recorded_target` turns either into a
-target (:mod:`gearchaos.model.target`), from which :func:`~gearchaos.model.target.model_for`
-builds the model; the layers above then ask the model's
-:class:`~gearchaos.model.capabilities.Capabilities` (its symbols, quantities, scales, names),
-never which kind of record it was. :func:`model_title` is how a title names a model.
+Every store, simulation result, branch and curve file carries the same attributes to say
+which model it ran and how to build that model again:
+
+``model``
+    ``planetary`` for a gear set (or a model built from one), else the model's name;
+``gearset_toml``
+    the gear set's TOML text, empty for any other model;
+``model_parameters``
+    the model's ``repr`` (empty for a gear set, whose TOML says it all);
+``model_class``, ``model_fields``
+    what :func:`~gearchaos.model.loading.rebuild_model` needs to build a model that is no gear
+    set again (:func:`~gearchaos.model.loading.model_reference`; absent where it cannot).
+
+:func:`target_record` writes them for what a sweep or basin scan ran on, :func:`model_record`
+for the model a :class:`~gearchaos.model.System` runs, :func:`record_problem` says what is
+wrong with a stored record, and :func:`recorded_target` turns a record back into a target
+(:mod:`gearchaos.model.target`), from which :func:`~gearchaos.model.target.model_for` builds
+the model; the layers above then ask the model's
+:class:`~gearchaos.model.capabilities.Capabilities` (its contacts, symbols, quantities,
+scales, names), never which kind of record it was. :func:`model_title` is how a title names a
+model.
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
+from ..errors import ParameterError
+from ..gearset import GearSet
 from .contract import Capabilities
+from .loading import model_reference, rebuild_model
+from .system import System
+from .target import Target
 
-__all__ = ["model_title", "parameter_value", "recorded_target", "with_values"]
+__all__ = [
+    "PLANETARY",
+    "model_record",
+    "model_title",
+    "parameter_value",
+    "record_problem",
+    "recorded_target",
+    "stored_target",
+    "target_record",
+    "with_values",
+]
+
+#: The ``model`` attribute of a file of a gear set.
+PLANETARY = "planetary"
+
+
+def _gearset_record(gs: GearSet) -> dict[str, str]:
+    return {"model": PLANETARY, "gearset_toml": gs.to_toml(), "model_parameters": ""}
+
+
+def target_record(target: Target) -> dict[str, str]:
+    """The record of what a sweep or basin scan ran on: a gear set records its TOML (the
+    store's fixed values apply to it); a :class:`System` records its model by name,
+    ``repr`` and, where it can, the reference that builds it again (the store's fixed values
+    are fields of that model)."""
+    if isinstance(target, GearSet):
+        return _gearset_record(target)
+    model = target.model
+    return {
+        "model": str(model.name),
+        "gearset_toml": "",
+        "model_parameters": repr(model),
+        **model_reference(model),
+    }
+
+
+def model_record(system: System) -> dict[str, str]:
+    """The record of the model ``system`` runs, as built: a model built from a gear set
+    records that gear set (its TOML, every value applied), any other model itself
+    (:func:`target_record`)."""
+    gs = system.capabilities.gearset
+    return _gearset_record(gs) if gs is not None else target_record(system)
+
+
+def record_problem(attrs: Mapping[str, Any]) -> str | None:
+    """What is wrong with the record in a file's attributes ``attrs``, in words, or ``None``:
+    ``model`` must name the model, ``gearset_toml`` be text, a valid gear set for a
+    ``planetary`` file and empty for any other."""
+    model, gtext = attrs.get("model"), attrs.get("gearset_toml")
+    if not isinstance(model, str) or not model:
+        return f"the attribute model must name the model: got {_short(model)}"
+    if not isinstance(gtext, str):
+        return f"the attribute gearset_toml must be text: got {_short(gtext)}"
+    if model == PLANETARY:
+        if not gtext.strip():
+            return "the attribute gearset_toml (the gear set) is empty"
+        try:
+            GearSet.from_toml_string(gtext)
+        except ParameterError as exc:
+            return f"the stored gear set (gearset_toml) is invalid: {exc}"
+    elif gtext:
+        return f"a {model} store carries a gear set (gearset_toml)"
+    return None
+
+
+def stored_target(attrs: Mapping[str, Any], *, where: str = "the file") -> Target | None:
+    """What a file's record says it ran on (what :func:`target_record` wrote): its gear set,
+    or a :class:`System` at Ω = 1 of the model it records how to build
+    (:func:`~gearchaos.model.loading.rebuild_model`), or ``None`` when it records neither.
+
+    Raises
+    ------
+    ParameterError
+        The stored gear set is invalid, or the model cannot be built again (``where`` names
+        the file).
+    """
+    gtext = attrs.get("gearset_toml")
+    if isinstance(gtext, str) and gtext.strip():
+        try:
+            return GearSet.from_toml_string(gtext)
+        except ParameterError as exc:
+            raise ParameterError(
+                f"{where}: its gear set (gearset_toml) is invalid: {exc}"
+            ) from None
+    model = rebuild_model(attrs, where=where)
+    return None if model is None else System(model, 1.0)
+
+
+def _short(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else f"{text[:57]}..."
 
 
 def recorded_target(attrs: Any, given: Any = None, *, where: str = "the file") -> Any:

@@ -42,8 +42,8 @@ from ..errors import ParameterError, Status, StoreError
 from ..integrate._chains import ChainRun
 from ..integrate.interface import Info
 from ..integrate.settings import SolverSettings, split_keywords
-from ..model.loading import model_reference
-from ..model.target import resolve, scale_attrs
+from ..model.record import target_record
+from ..model.target import Target, resolve, scale_attrs
 from ._basin_store import BasinStore, open_basins
 from .execute import EXECUTION_OPTIONS, Execution, InProcess, executor
 from .integrity import StoreLock
@@ -71,7 +71,7 @@ class _Job:
 
     def __init__(
         self,
-        target: Any,
+        target: Target,
         kind: str,
         dims: tuple[str, str],
         coords: dict[str, Any],
@@ -142,17 +142,11 @@ class _Job:
         return var, chunks
 
     def attrs(self) -> dict[str, Any]:
-        from ..gearset import GearSet
-
-        t, ref = self.target, self.ref
-        planetary = isinstance(t, GearSet)
+        ref = self.ref
         return {
             "title": f"gearchaos {self.kind.replace('_', ' ')} of {ref.name}",
             "kind": self.kind,
-            "model": "planetary" if planetary else ref.model.name,
-            "gearset_toml": t.to_toml() if planetary else "",
-            "model_parameters": "" if planetary else repr(t.model),
-            **({} if planetary else model_reference(t.model)),
+            **target_record(self.target),
             "basin_spec": json.dumps(self.spec, sort_keys=True),
             "confirm_periods": int(self.spec["confirm_periods"]),
             **self.cfg.to_record(),
@@ -437,7 +431,7 @@ def _varied_base(base_state: Any, axes: tuple[Axis, Axis]) -> None:
 
 
 def _split(
-    kwargs: dict[str, Any], settings: Any, params: Any, door: Any, target: Any
+    kwargs: dict[str, Any], settings: Any, params: Any, door: Any, target: Target
 ) -> tuple[dict[str, Any], SolverSettings, Execution]:
     where = Execution(**{k: kwargs.pop(k) for k in EXECUTION_OPTIONS if k in kwargs})
     values, cfg = split_keywords(
@@ -472,7 +466,7 @@ def _match_options(tol: float, spread_fraction: float, confirm_periods: int) -> 
 
 
 def basins(
-    target: Any,
+    target: Target,
     x: Any,
     y: Any,
     *,

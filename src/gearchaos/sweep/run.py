@@ -25,8 +25,8 @@ from ..integrate._chains import ChainOutput, ChainRun
 from ..integrate.interface import Info
 from ..integrate.settings import SolverSettings, check_params, renamed_keyword
 from ..integrate.threads import abandon, resume
-from ..model.loading import model_reference
-from ..model.target import scale_attrs
+from ..model.record import target_record
+from ..model.target import Target, scale_attrs
 from ._response_store import response_extract, response_variables
 from .execute import EXECUTION_OPTIONS, Execution, InProcess, executor
 from .grid import Grid, Task
@@ -213,16 +213,11 @@ def _coords(grid: Grid, layout: _Layout) -> dict[str, tuple[tuple[str, ...], np.
     return c
 
 
-def _attrs(target: Any, grid: Grid) -> dict[str, Any]:
-    from ..gearset import GearSet
-
+def _attrs(target: Target, grid: Grid) -> dict[str, Any]:
     spec, ref = grid.spec, grid.reference
     a: dict[str, Any] = {
         "title": f"gearchaos sweep of {ref.name}",
-        "model": ref.model.name if not isinstance(target, GearSet) else "planetary",
-        "gearset_toml": target.to_toml() if isinstance(target, GearSet) else "",
-        "model_parameters": "" if isinstance(target, GearSet) else repr(target.model),
-        **({} if isinstance(target, GearSet) else model_reference(target.model)),
+        **target_record(target),
         "sweep_toml": spec.to_toml(),
         **spec.solver.to_record(),
         "initial_conditions": spec.initial_conditions,
@@ -257,7 +252,7 @@ def _sigterm_as_interrupt() -> Iterator[None]:
 
 
 def run_sweep(
-    target: Any,
+    target: Target,
     spec: SweepSpec,
     *,
     store: str | os.PathLike[str] | None = None,
@@ -490,7 +485,7 @@ def _run_pool(
             fut.cancel()
 
 
-def _default_observe(target: Any) -> tuple[str, ...]:
+def _default_observe(target: Target) -> tuple[str, ...]:
     """X̄_sp and X̄'_sp for gear sets; a reference system's first tracked observable and its
     derivative."""
     from ..model.system import System
@@ -502,7 +497,7 @@ def _default_observe(target: Any) -> tuple[str, ...]:
 
 
 def bifurcation(
-    target: Any,
+    target: Target,
     vary: Any,
     *,
     family: Any = None,

@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ParameterError, StoreError
+from ..errors import StoreError
 from .integrity import read_json, verify_chunks
 
 __all__ = ["verify_attributes", "verify_metadata", "verify_progress"]
@@ -274,23 +274,12 @@ def _verify_element_types(root: str, ds: Any, spec: Any) -> None:
 
 
 def _verify_target(root: str, attrs: Any) -> None:
-    """``model`` names the model; a planetary store's ``gearset_toml`` is a valid gear set."""
-    model, gtext = attrs.get("model"), attrs.get("gearset_toml")
-    if not isinstance(model, str) or not model:
-        raise _damaged(root, f"the attribute model must name the model: got {_short(model)}")
-    if not isinstance(gtext, str):
-        raise _damaged(root, f"the attribute gearset_toml must be text: got {_short(gtext)}")
-    if model == "planetary":
-        from ..gearset import GearSet
+    """The model's record is whole (:func:`~gearchaos.model.record.record_problem`)."""
+    from ..model.record import record_problem
 
-        if not gtext.strip():
-            raise _damaged(root, "the attribute gearset_toml (the gear set) is empty")
-        try:
-            GearSet.from_toml_string(gtext)
-        except ParameterError as exc:
-            raise _damaged(root, f"the stored gear set (gearset_toml) is invalid: {exc}") from None
-    elif gtext:
-        raise _damaged(root, f"a {model} store carries a gear set (gearset_toml)")
+    problem = record_problem(attrs)
+    if problem is not None:
+        raise _damaged(root, problem)
 
 
 def verify_progress(root: str, progress_dir: str) -> None:
