@@ -5,7 +5,8 @@ first observed planet — X̄_sp1 and X̄'_sp1 by default) and, when present, th
 exponents, labels every point with :func:`gearchaos.analysis.classify.classify_sections`
 (1T … nT, QP, chaos, unresolved; ``failed`` where the integration failed) and writes the
 variables ``motion``, ``period`` (0: none found), ``k01`` (0–1 test), ``indicators_agree``,
-``contact_sp`` and ``contact_rp`` (contact regime of every mesh, MODEL.md §8: 0 none, 1
+``contact_KEY`` for each kind of mesh among the model's contacts (``contact_sp`` and
+``contact_rp`` of a planetary train; contact regime of every mesh, MODEL.md §8: 0 none, 1
 single-sided, 2 double-sided impact) and the attribute ``regime_table`` (JSON: fraction of
 the swept points in each regime, per family value when there is a family). It needs no
 re-simulation, so ``gearchaos classify run.zarr`` can re-label a stored sweep with other
@@ -18,6 +19,7 @@ import json
 import os
 import shutil
 import tempfile
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -172,20 +174,57 @@ def label_periods(
     return out
 
 
+@dataclass(frozen=True)
+class _Mesh:
+    """A kind of mesh of the store's model whose regime a sweep stores as ``contact_KEY``: the
+    tracked ``group`` of its deflections (per member: one column each), the ``key`` (the
+    label of its force group, else the group's name) and the ``words`` naming it."""
+
+    key: str
+    group: str
+    per_member: bool
+    words: str
+
+
+def _meshes(res: SweepResult) -> list[_Mesh]:
+    """The kinds of mesh of the store's model (its capabilities): each tracked group whose
+    observables are all mesh contacts (bearings are judged on both extrema, which a sweep does
+    not turn into regimes), and whose minimum the store holds."""
+    try:
+        reference = res.reference
+    except (ParameterError, StoreError):
+        return []
+    if reference is None:
+        return []
+    caps = reference.capabilities
+    meshes = {c.column: c for c in caps.contacts if c.kind == "mesh"}
+    labels = {deflection: label for label, _, deflection in caps.force_groups}
+    out = []
+    for group, cols, per in reference.tracked_groups():
+        if f"{group}_min" not in res.ds.data_vars or not all(int(j) in meshes for j in cols):
+            continue
+        name = meshes[int(cols[0])].name
+        words = (name.rpartition("_")[0] if per else name).replace("_", "–")
+        out.append(_Mesh(labels.get(group, group), group, bool(per), words))
+    return out
+
+
 def _contact(res: SweepResult) -> dict[str, Any]:
-    """Contact regime codes per mesh (MODEL.md §8) from the stored minimum deflections."""
+    """Contact regime codes of each kind of mesh (MODEL.md §8) from the stored minimum
+    deflections against the clearance at every point: 0 where the drive flanks never part
+    (min δ̄ > b̄), 1 single-sided (min δ̄ ≥ −b̄), 2 double-sided, −1 unknown (no value)."""
     out: dict[str, Any] = {}
     ds = res.ds
-    if res.base_gearset is None or "delta_sp_min" not in ds.data_vars:
-        return out
-    for mesh in ("sp", "rp"):
-        dmin = np.asarray(ds[f"delta_{mesh}_min"].transpose(*res.lead_dims, "planet_all").values)
-        found = res.clearance(f"delta_{mesh}")
-        assert found is not None  # a gear-set store always has its backlashes
-        b = found[0][..., None]
+    for mesh in _meshes(res):
+        found = res.clearance(mesh.group)
+        if found is None:
+            continue
+        tail = ("planet_all",) if mesh.per_member else ()
+        dmin = np.asarray(ds[f"{mesh.group}_min"].transpose(*res.lead_dims, *tail).values)
+        b = found[0][..., None] if mesh.per_member else found[0]
         code = np.where(dmin > b, 0, np.where(dmin >= -b, 1, 2)).astype(np.int8)
         code[np.isnan(dmin)] = -1
-        out[f"contact_{mesh}"] = code
+        out[f"contact_{mesh.key}"] = code
     return out
 
 
@@ -260,10 +299,11 @@ def classify_store(
             else zarr.open_group(zstore, mode="a", use_consolidated=False)
         )
         dims = list(res["dims"])
-        for mesh, label in (("sp", "sun–planet"), ("rp", "planet–ring")):
-            name = f"contact_{mesh}"
+        for mesh in _meshes(SweepResult(ds)):
+            name = f"contact_{mesh.key}"
             if name not in res:
                 continue
+            which = f"each {mesh.words} mesh" if mesh.per_member else f"the {mesh.words} mesh"
             arr = g.create_array(
                 name,
                 shape=res[name].shape,
@@ -271,10 +311,10 @@ def classify_store(
                 dtype="int8",
                 fill_value=None,
                 attributes={
-                    "long_name": f"contact regime of each {label} mesh over the recorded window",
+                    "long_name": f"contact regime of {which} over the recorded window",
                     "flag_values": [-1, 0, 1, 2],
                     "flag_meanings": "unknown none single_sided double_sided",
-                    "_ARRAY_DIMENSIONS": [*dims, "planet_all"],
+                    "_ARRAY_DIMENSIONS": [*dims, *(["planet_all"] if mesh.per_member else [])],
                 },
                 overwrite=True,
             )

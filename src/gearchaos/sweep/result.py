@@ -23,6 +23,8 @@ from .._files import check_path
 from ..errors import ParameterError, Status, StoreError
 from ..gearset.schema import CLEARANCES, FIELDS, OMEGA
 from ..model.contract import Capabilities
+from ..model.system import System
+from ..model.target import Target
 from .store import open_sweep
 
 __all__ = ["NON_SWEEP_DIMS", "SweepLayout", "SweepResult", "open_result"]
@@ -67,7 +69,8 @@ class SweepResult:
 
     spec: Any
     base_gearset: Any
-    _gearset: Any
+    _reference: Any
+    _target: Any
     _model: Any
 
     def __init__(self, ds: Any, *, _parsed: SweepResult | None = None):
@@ -82,7 +85,8 @@ class SweepResult:
         if _parsed is not None:
             self.spec = _parsed.spec
             self.base_gearset = _parsed.base_gearset
-            self._gearset = _parsed._gearset
+            self._reference = _parsed._reference
+            self._target = _parsed._target
             self._model = _parsed._model
             return
         from .spec import SweepSpec
@@ -103,7 +107,8 @@ class SweepResult:
                 self.base_gearset = GearSet.from_toml_string(gtext)
             except ParameterError as exc:
                 raise StoreError(f"the store's gear set (gearset_toml) is invalid: {exc}") from None
-        self._gearset = _UNSET
+        self._reference = _UNSET
+        self._target = _UNSET
         self._model = _UNSET
 
     @classmethod
@@ -135,54 +140,62 @@ class SweepResult:
         for a reference system): a store written with the default before issue 34 records a
         gear set named ``sheng2016`` and says ``"sheng2016-v1"``
         (:func:`~gearchaos.gearset.preset_of`)."""
-        if self.base_gearset is None:
-            return None
         from ..gearset import preset_of
 
-        return preset_of(self.base_gearset)
+        gs = self.base_gearset
+        if gs is None:  # gear-set switch: only a gear set can have a preset's values
+            return None
+        return preset_of(gs)
+
+    @property
+    def reference(self) -> System | None:
+        """The model the store was swept on with its fixed values applied, as a
+        :class:`~gearchaos.model.System` (at the fixed Ω, else Ω = 1): its capabilities
+        (contacts, clearances, groups, names, its gear set) say what the store's variables
+        are. ``None`` when the store records no model."""
+        if self._reference is _UNSET:
+            from ..model.target import resolve
+
+            target = self.base_target
+            system = None
+            if target is not None:
+                try:
+                    system = resolve(target, self.fixed, default_omega=1.0)
+                except ParameterError as exc:
+                    raise StoreError(
+                        f"the store's fixed values do not apply to {target.name}: {exc}"
+                    ) from None
+            self._reference = system
+        return self._reference
 
     @property
     def gearset(self) -> Any:
-        """The stored gear set with the fixed (non-Ω) values applied, or ``None``."""
-        if self._gearset is _UNSET:
-            gs = self.base_gearset
-            if gs is not None:
-                changes = {k: v for k, v in self.fixed.items() if k != OMEGA}
-                if changes:
-                    try:
-                        gs = gs.evolve(changes)
-                    except ParameterError as exc:
-                        raise StoreError(
-                            f"the store's fixed values do not apply to its gear set: {exc}"
-                        ) from None
-            self._gearset = gs
-        return self._gearset
+        """The stored gear set with the fixed (non-Ω) values applied (the gear set
+        :attr:`reference` is built from), or ``None``."""
+        reference = self.reference
+        return None if reference is None else reference.capabilities.gearset
 
     @property
     def base_model(self) -> Any:
-        """The model of a store that is not of a gear set, built again from what the store
-        records (``model_class``, ``model_fields``;
-        :func:`~gearchaos.model.loading.rebuild_model`), or ``None``."""
+        """The model a store that is not of a gear set records how to build again
+        (``model_class``, ``model_fields``; :func:`~gearchaos.model.loading.rebuild_model`),
+        or ``None``."""
         if self._model is _UNSET:
             from ..model.loading import rebuild_model
 
-            self._model = (
-                None
-                if self.base_gearset is not None
-                else rebuild_model(self.ds.attrs, where="the sweep store")
-            )
+            self._model = rebuild_model(self.ds.attrs, where="the sweep store")
         return self._model
 
     @property
-    def base_target(self) -> Any:
+    def base_target(self) -> Target | None:
         """What the store was swept on, without its fixed values: its gear set, or a
         :class:`~gearchaos.model.System` of its model at Ω = 1; ``None`` when it records
-        neither."""
-        if self.base_gearset is not None:
-            return self.base_gearset
-        from ..model import System
+        neither (:func:`~gearchaos.model.record.stored_target`)."""
+        if self._target is _UNSET:
+            from ..model.record import stored_target
 
-        return None if self.base_model is None else System(self.base_model, 1.0)
+            self._target = stored_target(self.ds.attrs, where="the sweep store")
+        return self._target
 
     @property
     def swept_names(self) -> tuple[str, ...]:
@@ -355,12 +368,9 @@ class SweepResult:
                 return self._to_bar(parameter, np.full(shape, fixed)), sym
             if f"clearance_{key}" in attrs:
                 return np.full(shape, float(attrs[f"clearance_{key}"])), sym
-            gs = self.gearset
-            if gs is None:
-                return None
-            bsp, brp = gs.backlash_bar()
-            b = {"sun_planet": bsp, "planet_ring": brp}.get(key, gs.sun_bearing_clearance_bar())
-            return np.full(shape, b), sym
+            reference = self.reference
+            b = None if reference is None else reference.capabilities.clearances.get(key)
+            return None if b is None else (np.full(shape, float(b)), sym)
         if f"clearance_{var}" in attrs:  # reference systems: x of the backlash oscillator
             try:
                 return np.array(self.values("b")), "b"
@@ -396,7 +406,7 @@ class SweepResult:
 
     def _to_bar(self, parameter: str, value: np.ndarray) -> np.ndarray:
         gs = self.base_gearset
-        if gs is None:
+        if gs is None:  # gear-set switch: only a gear set gives clearances in metres
             return np.asarray(value, dtype=np.float64)
         units = gs.backlash.units if parameter.startswith("backlash.") else gs.clearance.units
         v = np.asarray(value, dtype=np.float64)
