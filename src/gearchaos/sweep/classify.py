@@ -178,7 +178,8 @@ def label_periods(
 class _Mesh:
     """A kind of mesh of the store's model whose regime a sweep stores as ``contact_KEY``: the
     tracked ``group`` of its deflections (per member: one column each), the ``key`` (the
-    label of its force group, else the group's name) and the ``words`` naming it."""
+    label of its force group, else the name of its contact, without the member's number) and
+    the ``words`` naming it."""
 
     key: str
     group: str
@@ -204,8 +205,8 @@ def _meshes(res: SweepResult) -> list[_Mesh]:
         if f"{group}_min" not in res.ds.data_vars or not all(int(j) in meshes for j in cols):
             continue
         name = meshes[int(cols[0])].name
-        words = (name.rpartition("_")[0] if per else name).replace("_", "–")
-        out.append(_Mesh(labels.get(group, group), group, bool(per), words))
+        stem = name.rpartition("_")[0] if per else name  # sun_planet_1 → sun_planet
+        out.append(_Mesh(labels.get(group, stem), group, bool(per), stem.replace("_", "–")))
     return out
 
 
@@ -303,7 +304,9 @@ def classify_store(
             name = f"contact_{mesh.key}"
             if name not in res:
                 continue
-            which = f"each {mesh.words} mesh" if mesh.per_member else f"the {mesh.words} mesh"
+            which = (
+                f"each {mesh.words} mesh" if mesh.per_member else f"the mesh contact {mesh.words}"
+            )
             arr = g.create_array(
                 name,
                 shape=res[name].shape,
