@@ -179,7 +179,7 @@ class _Mesh:
     """A kind of mesh of the store's model whose regime a sweep stores as ``contact_KEY``: the
     tracked ``group`` of its deflections (per member: one column each), the ``key`` (the
     label of its force group, else the name of its contact, without the member's number) and
-    the ``words`` naming it."""
+    the ``words`` naming it in a long name (``each sun–planet mesh``, ``the mesh 'mesh'``)."""
 
     key: str
     group: str
@@ -190,10 +190,12 @@ class _Mesh:
 def _meshes(res: SweepResult) -> list[_Mesh]:
     """The kinds of mesh of the store's model (its capabilities): each tracked group whose
     observables are all mesh contacts (bearings are judged on both extrema, which a sweep does
-    not turn into regimes), and whose minimum the store holds."""
+    not turn into regimes), and whose minimum the store holds. None for a model the store
+    records but that cannot be built here (a model's file the user has not named): its
+    labels need no model."""
     try:
         reference = res.reference
-    except (ParameterError, StoreError):
+    except ParameterError:
         return []
     if reference is None:
         return []
@@ -205,8 +207,12 @@ def _meshes(res: SweepResult) -> list[_Mesh]:
         if f"{group}_min" not in res.ds.data_vars or not all(int(j) in meshes for j in cols):
             continue
         name = meshes[int(cols[0])].name
-        stem = name.rpartition("_")[0] if per else name  # sun_planet_1 → sun_planet
-        out.append(_Mesh(labels.get(group, stem), group, bool(per), stem.replace("_", "–")))
+        if per:  # sun_planet_1 … → each sun–planet mesh
+            stem = name.rpartition("_")[0]
+            words = f"each {stem.replace('_', '–')} mesh"
+        else:
+            stem, words = name, f"the mesh {name!r}"
+        out.append(_Mesh(labels.get(group, stem), group, bool(per), words))
     return out
 
 
@@ -304,9 +310,6 @@ def classify_store(
             name = f"contact_{mesh.key}"
             if name not in res:
                 continue
-            which = (
-                f"each {mesh.words} mesh" if mesh.per_member else f"the mesh contact {mesh.words}"
-            )
             arr = g.create_array(
                 name,
                 shape=res[name].shape,
@@ -314,7 +317,7 @@ def classify_store(
                 dtype="int8",
                 fill_value=None,
                 attributes={
-                    "long_name": f"contact regime of {which} over the recorded window",
+                    "long_name": f"contact regime of {mesh.words} over the recorded window",
                     "flag_values": [-1, 0, 1, 2],
                     "flag_meanings": "unknown none single_sided double_sided",
                     "_ARRAY_DIMENSIONS": [*dims, *(["planet_all"] if mesh.per_member else [])],
