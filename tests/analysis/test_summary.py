@@ -82,6 +82,26 @@ def test_reference_system_summary() -> None:
     assert s["contact"] == []
 
 
+def test_a_model_with_force_groups_gets_its_load_factor() -> None:
+    """Issue 36: the load factor and the transmission error come from the model's force groups
+    and static load, not from whether it is a planetary train. The backlash oscillator declares
+    one group (``mesh``: the contact force on x) and its static load F̄_m. Unforced (ε = 0,
+    F̄_a = 0) it comes to rest on its drive flank, x = b + F̄_m: the peak contact force is the
+    static load (load factor 1) and the transmission error has no RMS; forced at resonance the
+    peak exceeds it."""
+    rest = gc.backlash_oscillator(1.0, zeta=0.1, eps=0.0, b=1.0, f_mean=0.5, f_alt=0.0)
+    s = summarize(gc.simulate(rest, transient_periods=60, periods=10, samples_per_period=8))
+    assert s["load_factor_mesh_max"] == pytest.approx(1.0, rel=1e-6)
+    assert s["dte_mesh1_rms"] == pytest.approx(0.0, abs=1e-6)
+    # the planetary train's keys stay, empty: this model has no sun–planet mesh
+    assert s["load_factor_sp_max"] is None and s["load_factor_rp_max"] is None
+    assert s["dte_sp1_rms"] is None
+    json.dumps(s, allow_nan=False)
+    forced = gc.backlash_oscillator(1.0, zeta=0.1, b=1.0, f_mean=0.5, f_alt=0.3, omega_power=0)
+    s = summarize(gc.simulate(forced, transient_periods=60, periods=10, samples_per_period=8))
+    assert s["load_factor_mesh_max"] > 1.0 and s["dte_mesh1_rms"] > 0.0
+
+
 def test_motion_name() -> None:
     assert motion_name(1) == "1T"
     assert motion_name(3) == "3T"

@@ -15,6 +15,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..model.response import response_quantities
+from ..model.target import speeds_at
 from .classify import classify_motion
 from .contact import contact_regimes, separation_fraction
 from .motion import Motion
@@ -139,7 +140,7 @@ def summarize(
     out: dict[str, Any] = {
         "omega": omega,
         "omega_n_rad_s": _num(scales.omega_n) if scales is not None else None,
-        "sun_speed_rpm": _num(gs.sun_speed_rpm(omega)) if gs is not None else None,
+        "sun_speed_rpm": _num(speeds_at(system.model, omega).get("sun_rpm")),
         "distinct_section_points": int(n),
         # the motion is the verdict's; the record alone gives only a record label
         "motion": None,
@@ -183,20 +184,23 @@ def summarize(
         out["coexisting"] = []
         out["indicators_agree"] = bool(mc.agree)
         out["motion_note"] = mc.note
-    out["gearset"] = gs.name if gs is not None else None
+    out["gearset"] = gs.name if gs is not None else None  # gear-set switch: names its gear set
     out["mesh_frequency_hz"] = (
         _num(omega * scales.omega_n / (2.0 * math.pi)) if scales is not None else None
     )
+    # every summary has the keys of a planetary train's two kinds of mesh (None without them)
     out["load_factor_sp_max"] = None
     out["load_factor_rp_max"] = None
     out["dte_sp1_rms"] = None
-    labels = [label for label, _, _ in system.force_groups]
-    if labels == ["sp", "rp"]:  # a planetary train: the keys above
+    labels = [label for label, _, _ in caps.force_groups]
+    if labels and caps.static_mesh_force is not None:
+        # each kind of mesh whose contact forces the model tracks, against its static load:
         # peak contact forces from the extrema tracked inside every step (not from samples)
         rq = response_quantities(system, result.obs_min, result.obs_max, result.observables)
         for mesh in labels:
             out[f"load_factor_{mesh}_max"] = _num(rq[f"load_factor_{mesh}"])
-        out["dte_sp1_rms"] = _num(np.ravel(rq["dte_rms_sp"])[0])
+        first = labels[0]  # the transmission error of its first mesh (planet 1 of a train)
+        out[f"dte_{first}1_rms"] = _num(np.ravel(rq[f"dte_rms_{first}"])[0])
     s = result.solver
     out["transient_periods"] = _num(s.transient_periods)
     out["periods"] = int(s.periods)
