@@ -27,11 +27,10 @@ import numpy as np
 from .._checks import check_int
 from ..analysis.summary import format_exponent
 from ..errors import ParameterError, Status
-from ..gearset import GearSet
 from ..integrate.settings import MAX_SAMPLES_PER_PERIOD, SolverSettings, split_keywords
 from ..integrate.simulate import integrate
 from ..model.system import System
-from ..model.target import resolve
+from ..model.target import Target, resolve
 
 __all__ = [
     "LYAPUNOV_BLOCKS",
@@ -125,7 +124,7 @@ LYAPUNOV_SETTINGS = SolverSettings(periods=500)
 
 
 def lyapunov_spectrum(
-    system: Any,
+    system: Target,
     settings: SolverSettings | None = None,
     *,
     n_exponents: int | None = None,
@@ -176,7 +175,7 @@ def lyapunov_spectrum(
         values_and_settings, settings, params, LYAPUNOV_SETTINGS, door=lyapunov_spectrum,
         target=system,
     )  # fmt: skip
-    if not isinstance(system, System | GearSet):
+    if not isinstance(system, Target):
         raise ParameterError(
             f"system must be a System or a GearSet (with omega=): got {type(system).__name__}"
         )
@@ -224,7 +223,7 @@ def lyapunov_spectrum(
     )
 
 
-def max_lyapunov(system: Any, **kwargs: object) -> float:
+def max_lyapunov(system: Target, **kwargs: object) -> float:
     """Largest Lyapunov exponent (per unit τ) of a gear set at ``omega=`` or of any system;
     see :func:`lyapunov_spectrum` (``gc.max_lyapunov(gs, omega=1.7)``)."""
     return lyapunov_spectrum(system, n_exponents=1, **kwargs).largest  # type: ignore[arg-type]
