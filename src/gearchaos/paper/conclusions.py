@@ -201,7 +201,14 @@ def conclusion_2(stores: Stores) -> Verdict:
     """Every model ingredient is present in the gear set and excited in the runs."""
     from ..sweep.result import SweepResult
 
-    ds = next((d for d in stores.values() if d.attrs.get("gearset_toml")), None)
+    ds = next(
+        (
+            d
+            for d in stores.values()
+            if d.attrs.get("gearset_toml")  # gear-set switch: a seed's conclusion on gear sets
+        ),
+        None,
+    )
     if ds is None:
         return _missing(2, ["any figure with its gear set"])
     gs = SweepResult.of(ds).base_gearset

@@ -41,9 +41,10 @@ from typing import Any
 from .._checks import check_bool, check_int, check_real
 from .._output import staged_file, write_file
 from ..errors import ParameterError
+from ..gearset import GearSet
 from ..gearset.schema import display_symbol, tex
 from ..integrate.settings import SolverSettings, check_params, renamed_keyword, split_keywords
-from .recipes import load_figures, lookup_figure
+from .recipes import load_figures, lookup_figure, seed_gearset
 
 __all__ = [
     "GALLERIES",
@@ -380,7 +381,7 @@ def reproduce_gallery(
     *,
     quick: bool = False,
     progress: bool = True,
-    gearset: Any = None,
+    gearset: GearSet | None = None,
 ) -> dict[str, Any]:
     """Draw the seed's Poincaré gallery ``name`` with the default gear set (or ``gearset``).
 
@@ -395,7 +396,6 @@ def reproduce_gallery(
         ``{"figure", "json", "table" (the CSV), "points", "failed", "seconds", "rows"}``.
     """
     from .._version import __version__
-    from ..gearset import preset
     from ..plot import savefig
 
     g = get_gallery(name)
@@ -404,7 +404,7 @@ def reproduce_gallery(
     out.mkdir(parents=True, exist_ok=True)
     stem = g.name + ("-quick" if quick else "")
     tr, rec = QUICK_PERIODS if quick else (g.transient_periods, g.periods)
-    gs = preset(PRESET) if gearset is None else gearset
+    gs = seed_gearset(gearset)
     fig, rows = run_gallery(
         gs,
         g.param,

@@ -46,6 +46,7 @@ from typing import Any, TypeVar
 import numpy as np
 
 from ..errors import ParameterError
+from ..gearset import GearSet
 from ..gearset.schema import tex
 
 __all__ = [
@@ -57,10 +58,23 @@ __all__ = [
     "Recipe",
     "VaryAxis",
     "reproduce",
+    "seed_gearset",
 ]
 
 #: Gear set every recipe runs on.
 PRESET = "sheng2016"
+
+
+def seed_gearset(gearset: GearSet | None = None) -> GearSet:
+    """The gear set a figure of the paper is made for: ``gearset``, by default the
+    :data:`PRESET` preset."""
+    from ..gearset import preset
+
+    if gearset is None:  # gear-set switch: the paper's figures are of the seed's gear set
+        return preset(PRESET)
+    return gearset
+
+
 #: (transient, recorded) mesh periods of the full sweeps: the seed's protocol.
 FULL_PERIODS = (100, 100)
 #: (transient, recorded) mesh periods of the ``quick`` sweeps.
@@ -259,7 +273,7 @@ def reproduce(
     progress: bool = True,
     workers: int | None = None,
     overwrite: bool = False,
-    gearset: Any = None,
+    gearset: GearSet | None = None,
     paper_protocol: bool = False,
 ) -> dict[str, Any]:
     """Run the sweep of the seed's figure ``name`` and draw it in the seed's layout.
@@ -307,7 +321,6 @@ def reproduce(
         ``name`` is not a recipe.
     """
     recipe = get_recipe(name)
-    from ..gearset import preset
     from ..plot import savefig
     from ..plot.bifurcation import bifurcation_figure
     from ..sweep import bifurcation
@@ -319,7 +332,7 @@ def reproduce(
     store = out / f"{stem}.zarr"
     png = out / f"{stem}.png"
     ds = bifurcation(
-        preset(PRESET) if gearset is None else gearset,
+        seed_gearset(gearset),
         **recipe.sweep_kwargs(quick, paper_protocol),
         store=str(store),
         overwrite=overwrite,

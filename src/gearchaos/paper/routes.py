@@ -34,6 +34,8 @@ from typing import Any
 
 import numpy as np
 
+from ..gearset import GearSet
+
 __all__ = [
     "BRANCH_ROW",
     "ROUTE_OF_EVENT",
@@ -420,7 +422,7 @@ def report_branches(
     outdir: str | os.PathLike[str],
     *,
     quick: bool = False,
-    gearset: Any = None,
+    gearset: GearSet | None = None,
 ) -> tuple[dict[str, list[dict[str, Any]]], dict[str, Any]]:
     """Continue the branches of the route figures' panels (:func:`follow_branches`, saved
     under ``outdir/branches`` and read back on a second run) and return their event rows by
@@ -430,11 +432,10 @@ def report_branches(
     import concurrent.futures as cf
     import time
 
-    from ..gearset import preset
     from .evidence import panels
-    from .recipes import PRESET, RECIPES
+    from .recipes import RECIPES, seed_gearset
 
-    target = preset(PRESET) if gearset is None else gearset
+    target = seed_gearset(gearset)
     steps, max_points, max_period, max_branches = BRANCH_STEPS[bool(quick)]
     rows: dict[str, list[dict[str, Any]]] = {}
     done: dict[str, Any] = {}

@@ -42,7 +42,7 @@ from .._files import open_regular_nofollow, read_nofollow
 from .._marks import MARK_KEY, MAX_MARKED_BYTES, file_is_marked, fill_mark, placeholder
 from .._output import check_replaceable, write_file
 from .._version import __version__
-from ..gearset import preset_of
+from ..gearset import GearSet, preset_of
 from .export_table import Column, ExportTables
 
 __all__ = ["MARK", "sections_path", "sidecar_path", "write_csv_export"]
@@ -198,7 +198,16 @@ def _attr(attrs: dict[str, Any], key: str) -> Any:
     return _jsonable(value)
 
 
-def _provenance(attrs: dict[str, Any], source: str | None, gearset: Any) -> dict[str, Any]:
+def _gearset_names(gearset: GearSet | None) -> dict[str, str | None]:
+    """The ``gearset`` and ``preset`` a sidecar names (``None`` for a model's result)."""
+    if gearset is None:  # gear-set switch: a sidecar names only a gear set and its preset
+        return {"gearset": None, "preset": None}
+    return {"gearset": gearset.name, "preset": preset_of(gearset)}
+
+
+def _provenance(
+    attrs: dict[str, Any], source: str | None, gearset: GearSet | None
+) -> dict[str, Any]:
     attrs = dict(attrs)
     placed: set[str] = set()
 
@@ -210,8 +219,7 @@ def _provenance(attrs: dict[str, Any], source: str | None, gearset: Any) -> dict
     out: dict[str, Any] = {
         "source": source,
         "title": _attr(attrs, "title") if "title" in attrs else None,
-        "gearset": None if gearset is None else gearset.name,
-        "preset": None if gearset is None else preset_of(gearset),
+        **_gearset_names(gearset),
     }
     placed.add("title")
     out["specification"] = group(_SPECIFICATION)

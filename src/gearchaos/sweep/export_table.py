@@ -171,7 +171,7 @@ class _Physics:
         self.gearset = gs
         self.n = n
         self.rows: list[Any] = []
-        if gs is None:
+        if gs is None:  # gear-set switch: an export never imports a model's code for scales
             return
         from ..model.planetary import nondimensionalise
 
@@ -185,7 +185,7 @@ class _Physics:
             self.rows.append(cache[key])
 
     def __bool__(self) -> bool:
-        return self.gearset is not None
+        return self.gearset is not None  # gear-set switch: as above, physics of gear sets
 
     def each(self, fn: Any) -> np.ndarray:
         return np.array([fn(gs, sc) for gs, sc in self.rows], dtype=np.float64)
