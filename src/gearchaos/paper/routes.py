@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 
 from ..gearset import GearSet
+from ..model.target import Target
 
 __all__ = [
     "BRANCH_ROW",
@@ -197,7 +198,7 @@ def _stretch_starts(x: np.ndarray, labels: np.ndarray, label: str) -> list[float
 
 
 def follow_branches(
-    target: Any,
+    target: Target,
     name: str,
     x: np.ndarray,
     labels: np.ndarray,

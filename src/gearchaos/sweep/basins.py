@@ -43,6 +43,7 @@ from ..integrate._chains import ChainRun
 from ..integrate.interface import Info
 from ..integrate.settings import SolverSettings, split_keywords
 from ..model.record import target_record
+from ..model.system import System
 from ..model.target import Target, resolve, scale_attrs
 from ._basin_store import BasinStore, open_basins
 from .execute import EXECUTION_OPTIONS, Execution, InProcess, executor
@@ -336,7 +337,7 @@ def _identify_task(
     }
 
 
-def _base_state(system: Any, base_state: Any) -> np.ndarray:
+def _base_state(system: System, base_state: Any) -> np.ndarray:
     """The state of the coordinates not varied: zeros, a mapping by state name or an array."""
     names, n = list(system.state_names), system.n_state
     y = np.zeros(n)
@@ -362,7 +363,7 @@ def _base_state(system: Any, base_state: Any) -> np.ndarray:
     return arr
 
 
-def _state_axis(system: Any, item: Any, which: str) -> Axis:
+def _state_axis(system: System, item: Any, which: str) -> Axis:
     try:
         ax = parse_axis(item)
     except ParameterError as exc:

@@ -26,14 +26,14 @@ from ..integrate.interface import Info
 from ..integrate.settings import SolverSettings, check_params, renamed_keyword
 from ..integrate.threads import abandon, resume
 from ..model.record import target_record
-from ..model.target import Target, scale_attrs
+from ..model.target import Target, resolve, scale_attrs
 from ._response_store import response_extract, response_variables
 from .execute import EXECUTION_OPTIONS, Execution, InProcess, executor
 from .grid import Grid, Task
 from .integrity import StoreLock
 from .orbits import task_orbits
 from .progress import _Bar
-from .spec import DEFAULT_OBSERVE, SweepSpec, sweep_keywords
+from .spec import SweepSpec, sweep_keywords
 from .speeds import given_speed, omega_spec, speed_coords
 from .store import SweepStore
 from .variables import ORBIT_VARIABLES, SKIPPED, STEP_COUNTS, status_attrs
@@ -486,13 +486,9 @@ def _run_pool(
 
 
 def _default_observe(target: Target) -> tuple[str, ...]:
-    """X̄_sp and X̄'_sp for gear sets; a reference system's first tracked observable and its
-    derivative."""
-    from ..model.system import System
-
-    if not isinstance(target, System):
-        return DEFAULT_OBSERVE
-    var, dot = target.default_observables
+    """The model's default pair (variable, derivative): X̄_sp and X̄'_sp of a gear set's
+    planetary model, a reference system's first tracked observable and its derivative."""
+    var, dot = resolve(target, {}, default_omega=1.0).default_observables
     return (var, dot) if dot != var else (var,)
 
 
