@@ -32,7 +32,7 @@ from typing import Any
 from ..errors import ParameterError
 from ..gearset import GearSet
 from .contract import Capabilities
-from .loading import model_reference, rebuild_model
+from .loading import model_reference
 from .system import System
 from .target import Target
 
@@ -43,7 +43,6 @@ __all__ = [
     "parameter_value",
     "record_problem",
     "recorded_target",
-    "stored_target",
     "target_record",
     "with_values",
 ]
@@ -99,29 +98,6 @@ def record_problem(attrs: Mapping[str, Any]) -> str | None:
     elif gtext:
         return f"a {model} store carries a gear set (gearset_toml)"
     return None
-
-
-def stored_target(attrs: Mapping[str, Any], *, where: str = "the file") -> Target | None:
-    """What a file's record says it ran on (what :func:`target_record` wrote): its gear set,
-    or a :class:`System` at Ω = 1 of the model it records how to build
-    (:func:`~gearchaos.model.loading.rebuild_model`), or ``None`` when it records neither.
-
-    Raises
-    ------
-    ParameterError
-        The stored gear set is invalid, or the model cannot be built again (``where`` names
-        the file).
-    """
-    gtext = attrs.get("gearset_toml")
-    if isinstance(gtext, str) and gtext.strip():
-        try:
-            return GearSet.from_toml_string(gtext)
-        except ParameterError as exc:
-            raise ParameterError(
-                f"{where}: its gear set (gearset_toml) is invalid: {exc}"
-            ) from None
-    model = rebuild_model(attrs, where=where)
-    return None if model is None else System(model, 1.0)
 
 
 def _short(value: Any) -> str:

@@ -190,11 +190,11 @@ class SweepResult:
     def base_target(self) -> Target | None:
         """What the store was swept on, without its fixed values: its gear set, or a
         :class:`~gearchaos.model.System` of its model at Ω = 1; ``None`` when it records
-        neither (:func:`~gearchaos.model.record.stored_target`)."""
+        neither (:func:`~gearchaos.model.record.recorded_target`)."""
         if self._target is _UNSET:
-            from ..model.record import stored_target
+            from ..model.record import recorded_target
 
-            self._target = stored_target(self.ds.attrs, where="the sweep store")
+            self._target = recorded_target(self.ds.attrs, where="the sweep store")
         return self._target
 
     @property
