@@ -129,7 +129,8 @@ class Capabilities:
         default=(),
         metadata=_doc(
             "`Contact(name, column, clearance, kind)` for each mesh and bearing whose contact "
-            "regime (no impact, single-sided, double-sided) analyses report",
+            "regime (no impact, single-sided, double-sided) analyses report; a sweep stores a "
+            "mesh's as `contact_NAME` (the meshes of a force group as `contact_LABEL`)",
             "none",
         ),
     )

@@ -106,7 +106,8 @@ class UserModel:
       clearance b_k of the dead zone on each tracked observable (``inf``: smooth): the integrator
       lands a step where a tracked observable crosses ±b_k, where the vector field has a kink.
     * ``contacts`` (otherwise: none): ``Contact(name, column, clearance, kind)`` for each mesh and
-      bearing whose contact regime (no impact, single-sided, double-sided) analyses report.
+      bearing whose contact regime (no impact, single-sided, double-sided) analyses report; a sweep
+      stores a mesh's as ``contact_NAME`` (the meshes of a force group as ``contact_LABEL``).
     * ``clearances`` (otherwise: the contacts' half clearances by their names): half clearances by
       name: store attributes ``clearance_NAME``, clearance lines in figures (``symbols`` name them).
     * ``n_contact_forces`` (otherwise: 0): how many tracked observables, at the end of the tracked
