@@ -42,6 +42,7 @@ from .._marks import fill_mark, placeholder
 from .._output import check_replaceable, file_has_mark, write_file
 from ..analysis.motion import Motion
 from ..errors import ParameterError
+from ..gearset import GearSet
 from ..sweep.result import SweepResult
 from .accounting import count_text, landmark_rows as accounting_rows, verdict_counts
 
@@ -139,7 +140,7 @@ def _e(text: Any) -> str:
 
 
 def _run_paper_protocol(
-    outdir: Path, quick: bool, progress: bool, workers: int | None, gearset: Any = None
+    outdir: Path, quick: bool, progress: bool, workers: int | None, gearset: GearSet | None = None
 ) -> dict[str, dict[str, Any]]:
     """Every recipe's sweep on the seed's own protocol (``paper_protocol``): figure name →
     what :func:`~gearchaos.paper.recipes.reproduce` returned, or ``{"error": …}``."""
@@ -165,7 +166,7 @@ def _run_paper_protocol(
 
 
 def _run_figures(
-    outdir: Path, quick: bool, progress: bool, workers: int | None, gearset: Any = None
+    outdir: Path, quick: bool, progress: bool, workers: int | None, gearset: GearSet | None = None
 ) -> dict[str, dict[str, Any]]:
     from .galleries import GALLERIES, reproduce_gallery
     from .recipes import reproduce
@@ -499,7 +500,7 @@ def build_report(
     quick: bool = False,
     progress: bool = True,
     workers: int | None = None,
-    gearset: Any = None,
+    gearset: GearSet | None = None,
     gearset_label: str | None = None,
     paper_protocol: bool = True,
 ) -> Path:
@@ -525,6 +526,7 @@ def build_report(
     from .recipes import PRESET as DEFAULT_PRESET
 
     label = gearset_label or (
+        # gear-set switch: the report names the seed's gear set, or the preset it defaults to
         f"gear set {gearset.name}" if gearset is not None else f"preset {DEFAULT_PRESET}"
     )
     out = Path(os.fspath(outdir))
@@ -536,16 +538,15 @@ def build_report(
     paper_stores = _open_stores(paper)
     for name, res in paper.items():
         results.setdefault(name, {})["paper_protocol"] = res
-    from ..gearset import preset
     from .action import landmark_actions
     from .landmarks import load_landmarks
-    from .recipes import PRESET
+    from .recipes import seed_gearset
     from .routes import report_branches
 
     branches, followed = report_branches(stores, out, quick=quick, gearset=gearset)
     verdicts = evaluate_conclusions(stores, branches=branches)
     marks = load_landmarks()
-    target = preset(PRESET) if gearset is None else gearset
+    target = seed_gearset(gearset)
     t_act = time.perf_counter()
     actions = landmark_actions(target, marks, stores, branches=branches, quick=quick)
     acted = {"seconds": time.perf_counter() - t_act}
