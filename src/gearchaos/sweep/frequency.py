@@ -26,13 +26,14 @@ import numpy as np
 from .._checks import check_real
 from ..errors import ParameterError
 from ..integrate.settings import SolverSettings, check_params, renamed_keyword
+from ..model.target import Target, resolve
 from .run import bifurcation
 
 __all__ = ["find_jumps", "response"]
 
 
 def response(
-    target: Any,
+    target: Target,
     vary: Any,
     *,
     direction: str = "both",
@@ -84,12 +85,11 @@ def response(
         )
     if solver is not None:
         settings = renamed_keyword("response", "solver", "settings", solver, settings)
-    from ..model.system import System
-
-    if isinstance(target, System) and not target.force_groups:
+    model = resolve(target, {}, default_omega=1.0)  # what the target's model tracks
+    if not model.force_groups:
         raise ParameterError(
             f"response needs a model that tracks mesh contact forces (its force_groups and "
-            f"n_contact_forces): {target.name} tracks none; its section values' hysteresis "
+            f"n_contact_forces): {model.name} tracks none; its section values' hysteresis "
             "is drawn by bifurcation with --initial-conditions continuation --direction both"
         )
     return bifurcation(
