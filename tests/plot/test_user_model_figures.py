@@ -196,3 +196,26 @@ def test_a_branch_of_the_model_gets_its_physical_axes(tmp_path) -> None:
     assert fig._suptitle.get_text().startswith("two_stage_train: ")
     for text in _texts(fig):
         assert not PLANETARY.search(text), text
+
+
+def test_spectrum_sidebands_come_from_the_model() -> None:
+    """A gear set with eccentricities gets sidebands h ± 1/z_s around the mesh harmonics
+    (the sun's speed relative to the carrier is f_m/z_s); the two-stage train, whose forcing
+    has no such modulation, gets none."""
+    from gearchaos.plot.timeseries import HARMONIC_GID
+
+    gs = gc.preset("hindawi2021").evolve({"eccentricity.sun": 3e-6})
+    side = 1.0 / gs.teeth.sun  # z_s, from the gear set's numbers
+    with pytest.warns(UserWarning, match="non-zero eccentricity"):
+        eccentric = gc.simulate(gs, omega=0.5, transient_periods=5, periods=8)
+    ax = gc.plot.spectrum(eccentric, max_harmonic=3.0)
+    lines = sorted(
+        float(line.get_xdata()[0])
+        for line in ax.lines
+        if line.get_gid() == HARMONIC_GID and line.get_linestyle() == ":"
+    )
+    expected = sorted(r for h in (1, 2, 3) for r in (h - side, h + side) if r <= 3.0)
+    assert lines == pytest.approx(expected)
+    plain = gc.simulate(System(TwoStageTrain(), 1.2), transient_periods=5, periods=8)
+    ax = gc.plot.spectrum(plain, max_harmonic=3.0)
+    assert not [ln for ln in ax.lines if ln.get_linestyle() == ":"]

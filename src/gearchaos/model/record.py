@@ -21,7 +21,7 @@ wrong with a stored record, and :func:`recorded_target` turns a record back into
 the model; the layers above then ask the model's
 :class:`~gearchaos.model.capabilities.Capabilities` (its contacts, symbols, quantities,
 scales, names), never which kind of record it was. :func:`model_title` is how a title names a
-model.
+model, and :func:`sidebands` where a spectrum marks the sidebands of its forcing.
 """
 
 from __future__ import annotations
@@ -43,6 +43,7 @@ __all__ = [
     "parameter_value",
     "record_problem",
     "recorded_target",
+    "sidebands",
     "target_record",
     "with_values",
 ]
@@ -171,3 +172,14 @@ def with_values(target: Any, changes: Any) -> Any:
     if isinstance(target, GearSet):
         return target.evolve(dict(changes))
     return System(model_for(target, dict(changes)), target.omega)
+
+
+def sidebands(model: Any) -> tuple[float, ...]:
+    """The offsets s of the sidebands h ± s around each harmonic h of ``model``'s forcing
+    frequency, in multiples of it, that its spectrum marks: a model built from a gear set with
+    eccentricities has s = f_s/f_m = 1/z_s (the eccentricities modulate the meshes at the
+    sun's speed relative to the carrier, f_s = f_m/z_s); other models have none."""
+    gearset = Capabilities.of(model).gearset
+    if gearset is None or not gearset.has_eccentricity:
+        return ()
+    return (1.0 / float(gearset.teeth.sun),)

@@ -298,12 +298,9 @@ def spectrum(
             color="0.35",
             gid=HARMONIC_GID,
         )
-    gs = result.system.capabilities.gearset
-    # gear-set switch: eccentricity sidebands come from a gear set's tooth numbers
-    if gs is not None and gs.has_eccentricity:
-        # eccentricities modulate the meshes at the sun's speed relative to the carrier,
-        # f_s = f_m / z_s: sidebands h f_m ± f_s
-        side = 1.0 / float(gs.teeth.sun)
+    from ..model.record import sidebands
+
+    for side in sidebands(result.system.model):  # h ± side, in multiples of the frequency
         for h in range(1, math.floor(hi) + 1):
             for r in (h - side, h + side):
                 if 0.0 < r <= hi:
