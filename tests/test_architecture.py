@@ -347,7 +347,7 @@ def test_each_test_module_uses_the_package_its_folder_mirrors() -> None:
 #: 29 modules (sweep 21, plot 20, cli 7, paper 6, dynamics 4, analysis 3, explore 3, integrate 1).
 #: Issue 36's target is zero: the upper layers ask the model (its contacts, quantities,
 #: names), never whether it is a gear set. Each reduction lowers this number; it never grows.
-#: After plot/, cli/ and explore/ asked the model (figures, figure_for): 43, of which the 8
+#: After plot/, cli/ and explore/ asked the model (figures, figure_for): 42, of which the 7
 #: left in those layers carry a ``# gear-set switch:`` reason. A switch that carries one
 #: (:data:`REASON`) is not counted: after sweep, analysis, dynamics, integrate and paper asked
 #: the model too, none is left unexplained.
