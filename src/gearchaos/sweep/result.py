@@ -171,8 +171,14 @@ class SweepResult:
     @property
     def gearset(self) -> Any:
         """The stored gear set with the fixed (non-Ω) values applied (the gear set
-        :attr:`reference` is built from), or ``None``."""
-        reference = self.reference
+        :attr:`reference` is built from), or ``None``: also for a store of a model of the
+        user's own that the user has not named (no gear set needs that consent)."""
+        from ..model.loading import ModelConsentError
+
+        try:
+            reference = self.reference
+        except ModelConsentError:
+            return None
         return None if reference is None else reference.capabilities.gearset
 
     @property
