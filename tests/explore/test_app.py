@@ -63,3 +63,21 @@ def test_a_zoom_writes_and_shows_a_finer_sibling_store(gear_store: Path) -> None
         assert xr.open_zarr(expected).attrs["complete"] is True
     finally:
         app.workers.shutdown()
+
+
+def test_a_point_of_a_reference_systems_store_is_computed_too(linear_map_store: Path) -> None:
+    """The explorer asks whether the store records a model it can build, not whether it holds
+    a gear set: a point of a Duffing store is recomputed and drawn (before, the explorer said
+    the store held no gear set and computed nothing)."""
+    ds = xr.open_zarr(linear_map_store)
+    app = gc.explore(linear_map_store)
+    try:
+        values = {d: float(ds[d].values[1]) for d in ds["status"].dims if d != "direction"}
+        point = app.model.nearest(*values.values())
+        app.select(point)
+        _wait(app, lambda: app.computed.object.startswith(("**computed at", "**could not")))
+        assert app.computed.object.startswith("**computed at"), app.computed.object
+        png = app.figure_png.object
+        assert isinstance(png, bytes) and png[:8] == b"\x89PNG\r\n\x1a\n"
+    finally:
+        app.workers.shutdown()
