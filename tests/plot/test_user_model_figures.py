@@ -172,6 +172,18 @@ def store(tmp_path_factory) -> SweepResult:
     return SweepResult.open(path)
 
 
+def test_the_explorers_point_figure_speaks_the_models_words(result) -> None:
+    fig = figure_for(result, panels="point")
+    draw(fig)
+    texts = _texts(fig)
+    assert "amplitude spectrum (tooth harmonics labelled)" in texts
+    assert "two_stage_train tracks no contact forces" in texts
+    history = next(ax for ax in fig.axes if ax.get_title() == "time history")
+    assert _secondaries(history)["[µm]"] == pytest.approx(LENGTH * 1e6)
+    for text in texts:
+        assert not PLANETARY.search(text), text
+
+
 def test_a_sweep_of_the_model_gets_its_symbols_and_physical_axes(store) -> None:
     fig = figure_for(store)
     draw(fig)

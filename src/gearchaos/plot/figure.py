@@ -256,10 +256,8 @@ def point_figure(result: Any, var: str | None, planet: int = 1, periods: float =
                 va="center", transform=axs[1, 0].transAxes, color="0.4",
             )  # fmt: skip
         spectrum(result, var, planet, ax=axs[1, 1])
-        mesh = result.system.capabilities.period_name == "mesh"
-        axs[1, 1].set_title(
-            f"amplitude spectrum ({'mesh' if mesh else 'forcing'} harmonics labelled)"
-        )
+        name = result.system.capabilities.period_name  # mesh: a gear train's
+        axs[1, 1].set_title(f"amplitude spectrum ({name} harmonics labelled)")
     return fig
 
 
