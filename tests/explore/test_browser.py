@@ -143,8 +143,10 @@ def server(gear_store: Path) -> Iterator[dict[str, Any]]:
     _stop(srv)
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture
 def page(server: dict[str, Any], browser: Any) -> Iterator[Any]:
+    """A page of its own for each test (its own Bokeh session, no point selected), so that no
+    test sees the point another one left selected."""
     pg = _open(browser, server["url"])
     yield pg
     pg.close()
