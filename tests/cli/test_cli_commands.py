@@ -45,12 +45,30 @@ def test_presets_lists_sheng2016(runner: CliRunner) -> None:
     assert "sheng2016" in result.stdout
 
 
+def test_init_gearset_writes_the_values_of_preset(runner: CliRunner, tmp_path) -> None:
+    """``--preset NAME`` writes that preset's values (the how-tos pin the previous default)."""
+    f = tmp_path / "v1.toml"
+    result = runner.invoke(app, ["init-gearset", str(f), "--preset", "sheng2016-v1"])
+    assert result.exit_code == 0, result.output
+    gs = GearSet.from_toml(f)
+    ref = preset("sheng2016-v1")
+    assert gs.evolve({"name": ref.name, "description": ref.description}) == ref
+    assert gs.teeth != preset("sheng2016").teeth  # not the default's values
+    assert "the sheng2016-v1 preset" in f.read_text(encoding="utf-8")
+    # an unknown preset is refused by name, and no file is written
+    g = tmp_path / "none.toml"
+    result = runner.invoke(app, ["init-gearset", str(g), "--preset", "nope"])
+    assert result.exit_code == 2
+    assert "unknown preset 'nope'" in result.stderr and "sheng2016-v1" in result.stderr
+    assert not g.exists()
+
+
 def test_init_gearset_round_trip(runner: CliRunner, tmp_path) -> None:
     f = tmp_path / "my.toml"
     result = runner.invoke(app, ["init-gearset", str(f)])
     assert result.exit_code == 0, result.output
     gs = GearSet.from_toml(f)
-    ref = preset("sheng2016-v1")
+    ref = preset("sheng2016")  # the default gear set of every command
     assert gs.evolve({"name": ref.name, "description": ref.description}) == ref
 
     # refuses to overwrite without --force, and leaves the file alone

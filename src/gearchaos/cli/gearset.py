@@ -77,9 +77,10 @@ def init_gearset(
             "edited since (never another file).",
         ),
     ] = False,
+    target: c.Target = c.Target().offering("preset"),
 ) -> None:
-    """Write a commented gear-set file to start from (the sheng2016 values, every line
-    explained); edit it, then run **gearchaos simulate --gearset FILE**."""
+    """Write a commented gear-set file to start from (the values of --preset, default
+    sheng2016, every line explained); edit it, then run **gearchaos simulate --gearset FILE**."""
     from .._marks import fill_mark, placeholder
     from .._output import check_replaceable, file_has_mark, write_file
     from .._text import escape_path
@@ -99,7 +100,8 @@ def init_gearset(
         check_replaceable(str(file), what="gear-set file", ours=file_has_mark)
         # gearchaos's mark: the digest of the file (an edited file is the user's)
         head = f"# {placeholder()} (written by gearchaos init-gearset)\n"
-        text = fill_mark((head + template_toml()).encode("utf-8"))
+        template = template_toml(target.preset or c.DEFAULT_PRESET)
+        text = fill_mark((head + template).encode("utf-8"))
         # complete or not at all: a full disk leaves the old file (or none), never a part
         write_file(str(file), text, what="gear-set file")
     c.wrote(file)

@@ -154,20 +154,25 @@ def to_toml(gs: GearSet) -> str:
     return _check_gearset(gs, "to_toml").to_toml()
 
 
-def template_toml() -> str:
-    """A commented gear-set file to start from: the values of the default preset ``sheng2016``
-    (the calibrated stand-in for the seed's Table 1), every line explained.
+def template_toml(name: str = "sheng2016") -> str:
+    """A commented gear-set file to start from: the values of a preset (by default
+    ``sheng2016``, the calibrated stand-in for the seed's Table 1), every line explained.
+
+    Parameters
+    ----------
+    name : str
+        The preset whose values the file holds (:func:`list_presets`).
 
     Returns
     -------
     str
-        TOML that :func:`from_toml_string` reads back to the ``sheng2016`` preset (except for
-        ``name`` and ``description``); each parameter line carries its symbol, units and meaning.
+        TOML that :func:`from_toml_string` reads back to that preset (except for ``name`` and
+        ``description``); each parameter line carries its symbol, units and meaning.
     """
-    gs = preset("sheng2016").evolve(
+    gs = preset(name).evolve(
         {
             "name": "my_gearset",
-            "description": "describe the gear set here (values: the sheng2016 preset)",
+            "description": f"describe the gear set here (values: the {name} preset)",
         }
     )
     return template_text(gs)
