@@ -167,7 +167,9 @@ QUICKSTART_ROWS = (
     "motion",
     "X̄_sp1 section min",
     "X̄_sp1 section max",
+    "load factor sun–planet (max)",
     "contact sun_planet_1",
+    "contact planet_ring_1",
 )
 LYAPUNOV_ROWS = (
     "motion",
@@ -178,16 +180,49 @@ LYAPUNOV_ROWS = (
     "indicators agree",
     "motion note",
 )
+#: The README's quick start: the period of the orbit it shows, shot and continued in Ω.
+QUICKSTART_PERIOD = 2
+ORBIT_COMMAND = "gearchaos orbit --set omega=1.5 --period 2 -o orbit.nc"
 
 
 def _quickstart(work: Path) -> dict[str, str]:
+    """The README's quick start (and the tutorial's step 2): a 2T orbit, found stable by its
+    multipliers, on which every mesh hits its back flank each period (X̄_sp1 swings across the
+    whole dead zone ±b̄_sp) while the sun stays inside its bearing clearance."""
+    import gearchaos as gc
+
     rows = table_rows(run(SOURCES["quickstart"].command or "", work))
-    note = cell(rows, "motion note")
-    if cell(rows, "motion") != "1T" or "until its record lay on it" not in note:
+    if cell(rows, "motion") != f"{QUICKSTART_PERIOD}T" or cell(rows, "decided by") != "floquet":
         raise ProseOutOfDate(
-            "the quick start is no longer a 1T orbit that the run from rest reaches only when "
-            "the verdict continues it (README 'Quick start', tutorial step 2)"
+            f"the quick start is no longer a {QUICKSTART_PERIOD}T orbit confirmed by its Floquet "
+            f"multipliers: {cell(rows, 'motion')} by {cell(rows, 'decided by')} (README "
+            "'Quick start', tutorial step 2)"
         )
+    contacts = {name: cell(rows, name) for name in rows if name.startswith("contact ")}
+    if not contacts or set(contacts.values()) != {"double_sided"}:
+        raise ProseOutOfDate(
+            f"the quick start says every mesh hits its back flank (double-sided impact): {contacts}"
+        )
+    ds = gc.open_simulation(work / "out" / "simulation.nc")
+    b_sp, b_s = float(ds.attrs["clearance_sun_planet"]), float(ds.attrs["clearance_sun_bearing"])
+    lo = float(ds["delta_sp_min"].sel(planet=1))
+    hi = float(ds["delta_sp_max"].sel(planet=1))
+    section = ds["delta_sp"].sel(planet=1)
+    if not (lo < -b_sp and hi > b_sp and float(section.max()) < -b_sp):
+        raise ProseOutOfDate(
+            f"the quick start says X̄_sp1 swings across the dead zone ±{b_sp:g} every period and "
+            f"its section points lie beyond the back flank: it spans {lo:.2f} … {hi:.2f}, the "
+            f"section {float(section.min()):.2f} … {float(section.max()):.2f}"
+        )
+    sun = max(abs(float(ds[k])) for k in ("x_s_min", "x_s_max", "y_s_min", "y_s_max"))
+    if not sun < 0.1 * b_s:
+        raise ProseOutOfDate(
+            f"the quick start says the sun hardly moves, well inside its bearing clearance "
+            f"{b_s:g}: it reaches {sun:.3g}"
+        )
+    load = float(cell(rows, "load factor sun–planet (max)"))
+    if not load > 1:
+        raise ProseOutOfDate(f"the quick start's peak load is not above the static: {load}")
     shown, recorded = cell(rows, "distinct section points").split(" of ")
     return {
         "excerpt": excerpt(rows, QUICKSTART_ROWS),
@@ -195,31 +230,59 @@ def _quickstart(work: Path) -> dict[str, str]:
         "recorded": recorded,
         "mu": f"{float(cell(rows, 'max |μ| (Floquet)')):.3f}",
         "added": cell(rows, "periods added to finish the transient"),
+        "swing.lo": f"{lo:.1f}",
+        "swing.hi": f"{hi:.1f}",
+        "b_sp": f"{b_sp:g}",
+        "b_s": f"{b_s:g}",
+        "load": f"{load:.0f}",
     }
 
 
+_LAMBDA = re.compile(r"^(-?[\d.]+(?:e-?\d+)?) ± ([\d.]+(?:e-?\d+)?)$")
+
+
 def _lyapunov(work: Path) -> dict[str, str]:
+    """The tutorial's step 6: chaos, decided by λ₁, whose interval λ₁ ± 2σ excludes zero and
+    lies above the bias bound in the last window and the one before."""
     rows = table_rows(run(SOURCES["chaos-point"].command or "", work))
-    if cell(rows, "motion") != "chaos":
-        raise ProseOutOfDate("Ω = 2.0 (xi = 0.03) is no longer chaos (tutorial step 6)")
+    if cell(rows, "motion") != "chaos" or cell(rows, "decided by") != "lyapunov":
+        raise ProseOutOfDate("Ω = 2.0 (xi = 0.03) is no longer chaos by λ₁ (tutorial step 6)")
+    m = _LAMBDA.match(cell(rows, "λ₁ [1/τ]"))
+    if m is None or not float(m.group(1)) - 2 * float(m.group(2)) > 0:
+        raise ProseOutOfDate(
+            f"tutorial step 6 says λ₁ ± 2σ excludes zero: λ₁ = {cell(rows, 'λ₁ [1/τ]')}"
+        )
+    if "and so in the" not in cell(rows, "motion note"):
+        raise ProseOutOfDate("tutorial step 6 says λ₁ was above the bound in two windows")
     return {"excerpt": excerpt(rows, LYAPUNOV_ROWS)}
+
+
+#: The tutorial's gallery (step 5): Ω → the label its prose describes.
+GALLERY = {"0.88": "1T", "2": "chaos", "2.27": "QP", "3.02": "3T"}
 
 
 def _gallery(work: Path) -> dict[str, str]:
     out = run(SOURCES["gallery"].command or "", work)
     table = printed_table(out)
-    labels: dict[str, tuple[str, str]] = {}
+    labels: dict[str, tuple[str, ...]] = {}
     for line in table.splitlines():
         if line.startswith("│"):
             cells = [c.strip() for c in line.strip("│").split("│")]
-            labels[cells[0]] = (cells[1].lstrip("■ "), cells[3])
-    expected = {"0.5": "1T", "1.1": "2T", "2": "chaos", "3.5": "2T"}
-    if {k: v[0] for k, v in labels.items()} != expected:
+            labels[cells[0]] = (cells[1].lstrip("■ "), *cells[2:])
+    if {k: v[0] for k, v in labels.items()} != GALLERY:
         raise ProseOutOfDate(
-            f"the tutorial's gallery (step 5) describes {expected}; the command now labels "
+            f"the tutorial's gallery (step 5) describes {GALLERY}; the command now labels "
             f"{ {k: v[0] for k, v in labels.items()} }"
         )
-    return {"table": table, "mu-3.5": f"{float(labels['3.5'][1]):.2f}"}
+    # columns after the label: decided by, max |μ|, λ₁, K, agree, distinct points
+    distinct = {k: int(v[6]) for k, v in labels.items()}
+    if distinct["0.88"] != 1 or distinct["3.02"] != 3:
+        raise ProseOutOfDate(f"step 5 says one section point at 0.88, three at 3.02: {distinct}")
+    return {
+        "table": table,
+        "mu-0.88": f"{float(labels['0.88'][2]):.2f}",
+        "mu-3.02": f"{float(labels['3.02'][2]):.2f}",
+    }
 
 
 _SEGMENT = re.compile(r"│ (stable|unstable) ([\d.]+) … ([\d.]+)")
@@ -227,23 +290,35 @@ _EVENT = re.compile(r"│ (\w+) +│ ([\d.]+) ±")
 
 
 def _continuation(work: Path) -> dict[str, str]:
+    """The README's continuation of the quick start's 2T orbit up in Ω: stable from Ω = 1.5
+    up to a fold, where it ends (the branch turns back, unstable)."""
+    run(ORBIT_COMMAND, work)
     out = run(SOURCES["continue"].command or "", work)
-    stable = [(float(a), float(b)) for kind, a, b in _SEGMENT.findall(out) if kind == "stable"]
-    events = [(kind, float(v)) for kind, v in _EVENT.findall(out)]
-    kinds = [k for k, _ in events]
-    if len(stable) != 1 or kinds != ["neimark_sacker", "period_doubling"]:
+    segments = [(kind, float(a), float(b)) for kind, a, b in _SEGMENT.findall(out)]
+    folds = [float(v) for kind, v in _EVENT.findall(out) if kind == "fold"]
+    if (
+        len(segments) < 2
+        or segments[0][0] != "stable"
+        or segments[0][1] != 1.5
+        or segments[1][0] != "unstable"
+        or not folds
+    ):
         raise ProseOutOfDate(
-            "the README says the 1T branch near Ω = 1.5 is stable on one stretch between a "
-            f"Neimark–Sacker bifurcation and a period doubling; now: stable {stable}, "
-            f"events {kinds}"
+            "the README says the 2T orbit of the quick start, continued up from Ω = 1.5, stays "
+            f"stable up to a fold where the branch turns back unstable; now: {segments}, "
+            f"folds {folds}"
         )
-    (lo, hi), (ns, pd) = stable[0], (events[0][1], events[1][1])
-    if not ns <= lo <= hi <= pd:
-        raise ProseOutOfDate(f"the stable stretch {lo}–{hi} is not between {ns} and {pd}")
-    return {"ns": f"{ns:.3f}", "pd": f"{pd:.3f}"}
+    fold = min(folds, key=lambda v: abs(v - segments[0][2]))
+    if not abs(fold - segments[0][2]) < 1e-3:
+        raise ProseOutOfDate(
+            f"the stable stretch 1.5–{segments[0][2]} does not end at a fold ({folds})"
+        )
+    return {"fold": f"{fold:.3f}"}
 
 
 def _attractors(work: Path) -> dict[str, str]:
+    """The README: every one of the eight starts at Ω = 1.5 ends on the quick start's 2T orbit,
+    which is stable."""
     out = run(SOURCES["attractors"].command or "", work)
     found = []
     for line in out.splitlines():
@@ -251,14 +326,14 @@ def _attractors(work: Path) -> dict[str, str]:
             cells = [c.strip() for c in line.strip("│").split("│")]
             found.append((cells[0], cells[2], cells[4]))
     shape = [(label, starts) for label, starts, _ in found]
-    if shape != [("1T", "0"), ("chaos", "1, 2, 3, 4, 5, 6, 7")]:
+    if shape != [(f"{QUICKSTART_PERIOD}T", "0, 1, 2, 3, 4, 5, 6, 7")]:
         raise ProseOutOfDate(
-            "the README says 'gearchaos attractors --set omega=1.5' finds the 1T orbit from "
-            f"rest and chaos from the seven other starts; it now finds {shape}"
+            "the README says 'gearchaos attractors --set omega=1.5' finds one attractor, the 2T "
+            f"orbit, from all eight starts; it now finds {shape}"
         )
     mu = re.search(r"max \|μ\| = ([\d.]+), stable", found[0][2])
     if mu is None:
-        raise ProseOutOfDate(f"the 1T attractor's orbit is no longer stable: {found[0][2]!r}")
+        raise ProseOutOfDate(f"the 2T attractor's orbit is no longer stable: {found[0][2]!r}")
     return {"mu": f"{float(mu.group(1)):.3f}"}
 
 
@@ -292,7 +367,66 @@ def _fig4a(work: Path) -> dict[str, str]:
     for key in [k for k in values if k.endswith(".1T.lo")]:
         lo, hi = float(values[key]), float(values[key.replace(".lo", ".hi")])
         values[key.replace(".lo", ".mean")] = repr(float(x.sel(omega=slice(lo, hi)).mean()))
+    _fig4a_claims(ds, values)
     return values
+
+
+#: What the tutorial's step 4 says of the Full sweep's windows (numbered as the page's block
+#: lists them): window → (label, the contact regime of every mesh of every planet there).
+FIG4A_WINDOWS = {1: ("1T", "none"), 9: ("1T", "double_sided"), 11: ("2T", "double_sided"),
+                 23: ("1T", "single_sided")}  # fmt: skip
+#: … and the stretches it calls mostly chaos (from window to window).
+FIG4A_CHAOS = ((2, 10), (12, 21))
+
+
+def _fig4a_claims(ds: Any, values: dict[str, str]) -> None:
+    """Raise :class:`ProseOutOfDate` unless the Full sweep still shows what step 4 says: the
+    contact regimes of its 1T and 2T windows, the quick start's Ω = 1.5 inside the 2T window,
+    the last window up to the sweep's end, and chaos on most points of the two chaotic stretches,
+    whose section points reach beyond the back flank (and, in the second, both flanks)."""
+    import numpy as np
+
+    def window(n: int, label: str) -> tuple[float, float]:
+        key = f"w{n}.{label}.lo"
+        if key not in values:
+            raise ProseOutOfDate(f"tutorial step 4: window {n} of the listing is no longer {label}")
+        return float(values[key]), float(values[key.replace(".lo", ".hi")])
+
+    flags = dict(enumerate(str(ds["contact_sp"].attrs["flag_meanings"]).split(), start=-1))
+    for n, (label, regime) in FIG4A_WINDOWS.items():
+        lo, hi = window(n, label)
+        for var in ("contact_sp", "contact_rp"):
+            found = {flags[int(v)] for v in np.unique(ds[var].sel(omega=slice(lo, hi)).values)}
+            if found != {regime}:
+                raise ProseOutOfDate(
+                    f"tutorial step 4 says {label} at Ω = {lo:.3f} … {hi:.3f} has {regime} on "
+                    f"every mesh: {var} there is {sorted(found)}"
+                )
+    lo, hi = window(11, "2T")
+    if not lo <= 1.5 <= hi:
+        raise ProseOutOfDate(f"step 4 says the 2T window {lo}–{hi} holds the quick start's Ω = 1.5")
+    step = float(ds["omega"].values[1] - ds["omega"].values[0])
+    if not window(12, "chaos")[0] - hi < 1.5 * step:
+        raise ProseOutOfDate("step 4 says the runs from rest go from the 2T window into chaos")
+    last = float(ds["omega"].values[-1])
+    if not window(23, "1T")[1] == round(last, 3) or f"w24.{'1T'}.lo" in values:
+        raise ProseOutOfDate("step 4 says the 1T of window 23 holds up to the sweep's end")
+    b_sp = float(ds.attrs["clearance_sun_planet"])
+    x = ds["delta_sp"].sel(planet=1)
+    for first, end in FIG4A_CHAOS:
+        lo, hi = window(first, "chaos")[0], window(end, "chaos")[1]
+        stretch = ds["motion"].sel(omega=slice(lo, hi)).values.astype(str)
+        xs = x.sel(omega=slice(lo, hi))
+        if not (stretch == "chaos").mean() > 0.5 or not float(xs.min()) < -b_sp:
+            raise ProseOutOfDate(
+                f"step 4 says Ω = {lo} … {hi} is mostly chaos reaching below −b̄_sp: "
+                f"{100 * (stretch == 'chaos').mean():.0f} % chaos, min X̄ {float(xs.min()):.2f}"
+            )
+    lo, hi = window(FIG4A_CHAOS[1][0], "chaos")[0], window(FIG4A_CHAOS[1][1], "chaos")[1]
+    if not float(x.sel(omega=slice(lo, hi)).max()) > b_sp:
+        raise ProseOutOfDate(f"step 4 says Ω = {lo} … {hi} spreads over both sides of ±b̄_sp")
+    if not float(values["w9.1T.mean"]) < -b_sp:
+        raise ProseOutOfDate("step 4 says window 9's 1T section point is beyond the back flank")
 
 
 def _slug(verdict: str) -> str:
@@ -678,10 +812,13 @@ SOURCES: dict[str, Source] = {
     ),
     "chaos-point": Source("gearchaos simulate --set xi=0.03 --set omega=2.0", _lyapunov),
     "gallery": Source(
-        "gearchaos poincare --set xi=0.03 --vary omega=0.5,1.1,2.0,3.5 --with phase -o gallery.png",
+        "gearchaos poincare --set xi=0.03 --vary omega=0.88,2.0,2.27,3.02 --with phase "
+        "-o gallery.png",
         _gallery,
     ),
-    "continue": Source("gearchaos continue --vary omega=1.45:1.56 -o branch.nc", _continuation),
+    "continue": Source(
+        "gearchaos continue --from orbit.nc --vary omega=1.5:1.8 -o branch.nc", _continuation
+    ),
     "attractors": Source("gearchaos attractors --set omega=1.5", _attractors),
     "fig4a": Source(
         "gearchaos bifurcation --vary omega=0.05:4:800 --set xi=0.03 -o fig4a.zarr",
@@ -695,13 +832,14 @@ SOURCES: dict[str, Source] = {
         "gearchaos plot rattle.zarr --contact --table -o rattle.png", _rattle, slow=True
     ),
     "map": Source(
-        "gearchaos bifurcation --vary omega=0.5:3.5:31 --vary xi=0.03:0.11:5 -o map.zarr",
+        "gearchaos bifurcation --preset sheng2016-v1 --vary omega=0.5:3.5:31 --vary xi=0.03:0.11:5 "
+        "-o map.zarr",
         _maps,
         slow=True,
     ),
     "quick": Source(None, _quick),
     "period-doubling": Source(
-        "gearchaos continue --preset sheng2016 --vary omega=3.3:3.45 -o branch.nc",
+        "gearchaos continue --preset sheng2016-v1 --vary omega=3.3:3.45 -o branch.nc",
         _period_doubling,
         slow=True,
     ),
