@@ -144,9 +144,10 @@ def _check_outputs(work: Path, variant: str) -> None:
     assert sweep.sizes["section"] == 100
     assert np.all(sweep["status"].values == 0)
     assert all(LABEL.match(str(x)) for x in sweep["motion"].values)
-    # physics: at Ω ≤ 0.1 the response is quasi-static, one section point at the static
-    # deflection computed by hand from the gear set
-    slow = sweep.sel(omega=slice(None, 0.1))
+    # physics: at Ω ≤ 0.06 the response is quasi-static, one section point at the static
+    # deflection computed by hand from the gear set (the inertial correction grows as Ω²: with
+    # the default's transmission error of 2.75 b_c it is 1.2e-4 at Ω = 0.05, 5e-4 at Ω = 0.1)
+    slow = sweep.sel(omega=slice(None, 0.06))
     assert slow.sizes["omega"] >= 1
     x = slow["delta_sp"].sel(planet=1).values
     assert np.all(slow["motion"].values == "1T")
