@@ -138,3 +138,101 @@ def test_pages_state_no_unmeasured_run_times() -> None:
         for m in _WALL_CLOCK.finditer(page.read_text(encoding="utf-8"))
     ]
     assert not found, found
+
+
+_BRANCH = """period-2 branch of sheng2016 in omega
+│ stable 1.5 … 1.56944 (8588.4 … 8986 rpm)    │                         49 points │
+│ unstable 1.5694 … 1.5 (8985.7 … 8588.4 rpm) │                         54 points │
+┃ kind           ┃ omega ± uncertainty ┃ sun speed [rpm] ┃ multiplier              ┃ detail ┃
+│ {kind:<14} │ 1.569437771 ± 6e-09 │ 8986            │ 1+0i (|μ| 1)            │        │
+│ neimark_sacker │ 1.52924668 ± 6e-08  │ 8755.9          │ -0.8876+0.4606i (|μ| 1) │        │
+"""
+_ATTRACTORS = "│ 2T     │ -0.01332 │ {starts} │ -16.312, -14.391     │ max |μ| = 0.8944, {kind} │\n"
+
+
+def test_the_readmes_continuation_claim_is_checked(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The README says the 2T orbit is stable from Ω = 1.5 up to a fold where its branch turns
+    back: a branch that ends its stable stretch otherwise is prose out of date."""
+    printed = {"text": _BRANCH.format(kind="fold")}
+    monkeypatch.setattr(gen, "run", lambda command, cwd: printed["text"])
+    assert gen._continuation(Path(".")) == {"fold": "1.569"}
+    printed["text"] = _BRANCH.format(kind="period_doubling")  # no fold ends it
+    with pytest.raises(gen.ProseOutOfDate, match="fold"):
+        gen._continuation(Path("."))
+    printed["text"] = _BRANCH.format(kind="fold").replace("│ stable", "│ unstable")
+    with pytest.raises(gen.ProseOutOfDate, match="stable"):
+        gen._continuation(Path("."))
+
+
+def test_the_readmes_attractor_claim_is_checked(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The README says all eight starts at Ω = 1.5 end on one stable 2T orbit."""
+    every = "0, 1, 2, 3, 4, 5, 6, 7"
+    printed = {"text": _ATTRACTORS.format(starts=every, kind="stable")}
+    monkeypatch.setattr(gen, "run", lambda command, cwd: printed["text"])
+    assert gen._attractors(Path(".")) == {"mu": "0.894"}
+    two = _ATTRACTORS.format(starts="0, 1, 2, 3", kind="stable")
+    printed["text"] = two + two.replace("0, 1, 2, 3", "4, 5, 6, 7").replace("2T", "chaos", 1)
+    with pytest.raises(gen.ProseOutOfDate, match="eight starts"):
+        gen._attractors(Path("."))
+    printed["text"] = _ATTRACTORS.format(starts=every, kind="unstable")
+    with pytest.raises(gen.ProseOutOfDate, match="no longer stable"):
+        gen._attractors(Path("."))
+
+
+#: A made-up Full sweep in the shape step 4 describes: (lo, hi, label, contact regime, X̄).
+_WINDOWS = [
+    (0.05, 0.38, "1T", 0, 3.6), (0.42, 0.52, "chaos", 2, -5.0), (0.53, 0.55, "chaos", 2, -5.0),
+    (0.56, 0.64, "chaos", 2, -5.0), (0.66, 0.69, "chaos", 2, -5.0), (0.71, 0.74, "chaos", 2, -5.0),
+    (0.75, 0.79, "5T", 2, -5.0), (0.79, 0.82, "QP", 2, -5.0), (0.83, 0.93, "1T", 2, -9.0),
+    (0.94, 1.40, "chaos", 2, -5.0), (1.44, 1.54, "2T", 2, -15.0), (1.541, 1.57, "chaos", 2, 5.0),
+    (1.59, 1.92, "chaos", 2, 5.0), (1.97, 2.12, "chaos", 1, 5.0), (2.13, 2.24, "chaos", 1, 5.0),
+    (2.25, 2.29, "QP", 1, 5.0), (2.32, 2.35, "2T", 1, 5.0), (2.41, 2.44, "chaos", 2, -5.0),
+    (2.52, 2.55, "QP", 1, 5.0), (2.56, 2.89, "chaos", 1, 5.0), (2.90, 2.93, "chaos", 1, 5.0),
+    (3.00, 3.04, "3T", 1, 2.0), (3.10, 4.0, "1T", 1, 2.6),
+]  # fmt: skip
+
+
+def _made_up_sweep(change: dict[int, tuple[str, int]] | None = None) -> tuple[object, dict]:
+    import numpy as np
+    import xarray as xr
+
+    omega = np.round(np.linspace(0.05, 4.0, 800), 6)
+    motion = np.full(omega.size, "chaos", dtype=object)
+    contact = np.full(omega.size, 2)
+    x = np.zeros(omega.size)
+    values: dict[str, str] = {}
+    for n, (lo, hi, label, regime, level) in enumerate(_WINDOWS, start=1):
+        label, regime = (change or {}).get(n, (label, regime))
+        inside = (omega >= lo) & (omega <= hi)
+        motion[inside], contact[inside], x[inside] = label, regime, level
+        first, last = omega[inside][0], omega[inside][-1]
+        values[f"w{n}.{label}.lo"], values[f"w{n}.{label}.hi"] = f"{first:.3f}", f"{last:.3f}"
+        values[f"w{n}.{label}.mean"] = repr(level)
+    planets = np.broadcast_to(contact[:, None], (omega.size, 5))
+    ds = xr.Dataset(
+        {
+            "motion": ("omega", motion.astype(str)),
+            "contact_sp": (("omega", "planet_all"), planets.copy()),
+            "contact_rp": (("omega", "planet_all"), planets.copy()),
+            "delta_sp": (("omega", "planet"), np.stack([x, x], axis=1)),
+        },
+        coords={"omega": omega, "planet": [1, 2]},
+        attrs={"clearance_sun_planet": 3.0},
+    )
+    ds["contact_sp"].attrs["flag_meanings"] = "unknown none single_sided double_sided"
+    return ds, values
+
+
+def test_the_tutorials_sweep_claims_are_checked() -> None:
+    """Step 4's claims about the Full sweep: the contact regime of its 1T and 2T windows, the
+    window order and the chaotic stretches. A sweep that differs is prose out of date."""
+    gen._fig4a_claims(*_made_up_sweep())  # the sweep the page describes passes
+    for change, words in (
+        ({9: ("1T", 1)}, "double_sided on every mesh"),  # its 1T without back-flank impact
+        ({23: ("1T", 2)}, "single_sided on every mesh"),
+        ({1: ("1T", 1)}, "none on every mesh"),  # the quasi-static 1T rattling
+        ({11: ("3T", 2)}, "window 11 of the listing is no longer 2T"),
+        ({10: ("QP", 2)}, "no longer chaos"),
+    ):
+        with pytest.raises(gen.ProseOutOfDate, match=words):
+            gen._fig4a_claims(*_made_up_sweep(change))
