@@ -100,7 +100,7 @@ def test_info_json(runner: CliRunner) -> None:
     result = runner.invoke(app, ["info", "--json"])
     assert result.exit_code == 0, result.output
     data = json.loads(result.stdout)
-    gs = preset("sheng2016-v1")
+    gs = preset("sheng2016")  # the default gear set
     assert data["omega_n_rad_s"] == pytest.approx(gs.omega_n, rel=1e-12)
     freqs = data["natural_frequencies"]
     hz = [f["hz"] for f in freqs]
@@ -115,7 +115,7 @@ def test_info_with_set_and_omega(runner: CliRunner) -> None:
     )
     assert result.exit_code == 0, result.output
     data = json.loads(result.stdout)
-    gs = preset("sheng2016-v1").evolve({"stiffness.sun_planet_mean": 7e8})
+    gs = preset("sheng2016").evolve({"stiffness.sun_planet_mean": 7e8})  # the default's
     assert data["omega_n_rad_s"] == pytest.approx(gs.omega_n, rel=1e-12)
     assert data["operating_point"]["omega"] == 2.0
     assert data["operating_point"]["sun_speed_rpm"] == pytest.approx(gs.sun_speed_rpm(2.0))
