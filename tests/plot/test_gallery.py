@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -204,3 +205,24 @@ def test_gallery_recipes_draw_the_values_the_seed_names(name: str) -> None:
     if name in RANGES:
         lo, hi = RANGES[name]
         assert min(g.values) == lo and max(g.values) == hi
+
+
+def test_titles_of_a_row_of_four_do_not_overlap(planetary: gc.SimulationResult) -> None:
+    """Four panels in a row, each titled with the sun speed and λ₁ ± its error (the tutorial's
+    gallery): no title reaches into its neighbour's, and the last stays inside the figure."""
+    long = {"sun_speed_rpm": 4637.7, "lle_error": 0.00066, "motion": "QP", "lle": -0.0001769}
+    sums = [{**summary("QP", -0.0001769), **long}] * 4
+    fig = poincare_gallery(
+        [planetary] * 4, sums, param="omega", values=[0.81, 0.88, 2.7, 3.02], with_="phase"
+    )
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    renderer = canvas.get_renderer()
+    titles = [ax._left_title for ax in map_axes(fig)]  # the artist of ax.set_title(loc="left")
+    extents = [t.get_window_extent(renderer) for t in titles]
+    assert len(extents) == 4
+    for left, right in itertools.pairwise(extents):
+        assert left.x1 < right.x0, (left, right)
+    assert extents[-1].x1 <= fig.bbox.x1

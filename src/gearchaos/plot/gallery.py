@@ -66,6 +66,12 @@ def parse_extras(with_: Iterable[str] | str | None) -> tuple[str, ...]:
     return tuple(n for n in GALLERY_EXTRAS if n in names)
 
 
+#: From this many panels per row on, a panel's title takes two lines (value; label and λ₁):
+#: on one line ``(a) Ω = 0.81 (4637.7 rpm) · QP · λ₁ = −0.00018 ± 0.0007`` runs into the next
+#: panel's title.
+WRAP_COLUMNS = 4
+
+
 def _ncols(n: int) -> int:
     if n <= 4:
         return max(n, 1)
@@ -171,7 +177,10 @@ def poincare_gallery(
             ax.set_xlabel(f"${info.symbol}$")
             ax.set_ylabel(f"${info.dot_symbol}$")
         letter = f"({string.ascii_lowercase[k % 26]}) " if n > 1 else ""
-        ax.set_title(letter + gallery_title(param, value, shown), fontsize="small", loc="left")
+        text = letter + gallery_title(param, value, shown)
+        if cols >= WRAP_COLUMNS:  # narrow panels: the label and λ₁ under the value
+            text = text.replace(" · ", "\n", 1)
+        ax.set_title(text, fontsize="small", loc="left")
         colour = regime_colour(label)
         for spine in ax.spines.values():
             spine.set_edgecolor(colour)
