@@ -246,7 +246,7 @@ def _lyapunov(work: Path) -> dict[str, str]:
     lies above the bias bound in the last window and the one before."""
     rows = table_rows(run(SOURCES["chaos-point"].command or "", work))
     if cell(rows, "motion") != "chaos" or cell(rows, "decided by") != "lyapunov":
-        raise ProseOutOfDate("Ω = 2.0 (xi = 0.03) is no longer chaos by λ₁ (tutorial step 6)")
+        raise ProseOutOfDate("Ω = 2.7 (xi = 0.03) is no longer chaos by λ₁ (tutorial step 6)")
     m = _LAMBDA.match(cell(rows, "λ₁ [1/τ]"))
     if m is None or not float(m.group(1)) - 2 * float(m.group(2)) > 0:
         raise ProseOutOfDate(
@@ -254,11 +254,16 @@ def _lyapunov(work: Path) -> dict[str, str]:
         )
     if "and so in the" not in cell(rows, "motion note"):
         raise ProseOutOfDate("tutorial step 6 says λ₁ was above the bound in two windows")
-    return {"excerpt": excerpt(rows, LYAPUNOV_ROWS)}
+    from gearchaos.analysis.classify import K_CHAOS
+
+    k = float(cell(rows, "0–1 test K"))
+    if not k > K_CHAOS or cell(rows, "indicators agree") != "yes":
+        raise ProseOutOfDate(f"tutorial step 6 says the 0–1 test agrees (K near 1): K = {k}")
+    return {"excerpt": excerpt(rows, LYAPUNOV_ROWS), "K": f"{k:.2f}", "K_chaos": f"{K_CHAOS:g}"}
 
 
 #: The tutorial's gallery (step 5): Ω → the label its prose describes.
-GALLERY = {"0.88": "1T", "2": "chaos", "2.27": "QP", "3.02": "3T"}
+GALLERY = {"0.81": "QP", "0.88": "1T", "2.7": "chaos", "3.02": "3T"}
 
 
 def _gallery(work: Path) -> dict[str, str]:
@@ -402,6 +407,10 @@ def _fig4a_claims(ds: Any, values: dict[str, str]) -> None:
                     f"tutorial step 4 says {label} at Ω = {lo:.3f} … {hi:.3f} has {regime} on "
                     f"every mesh: {var} there is {sorted(found)}"
                 )
+    window(7, "5T")
+    lo, hi = window(8, "QP")
+    if not lo <= 0.81 <= hi:
+        raise ProseOutOfDate(f"step 5 says its QP point Ω = 0.81 lies in the QP window {lo}–{hi}")
     lo, hi = window(11, "2T")
     if not lo <= 1.5 <= hi:
         raise ProseOutOfDate(f"step 4 says the 2T window {lo}–{hi} holds the quick start's Ω = 1.5")
@@ -810,9 +819,9 @@ SOURCES: dict[str, Source] = {
     "quickstart": Source(
         "gearchaos simulate --preset sheng2016 --set omega=1.5 -o out/", _quickstart
     ),
-    "chaos-point": Source("gearchaos simulate --set xi=0.03 --set omega=2.0", _lyapunov),
+    "chaos-point": Source("gearchaos simulate --set xi=0.03 --set omega=2.7", _lyapunov),
     "gallery": Source(
-        "gearchaos poincare --set xi=0.03 --vary omega=0.88,2.0,2.27,3.02 --with phase "
+        "gearchaos poincare --set xi=0.03 --vary omega=0.81,0.88,2.7,3.02 --with phase "
         "-o gallery.png",
         _gallery,
     ),
