@@ -1,7 +1,8 @@
 """The numbers and tables of docs/reproduction.md that the calibration wrote: read from the
 committed exports of the studies (``paper/calibration-study1.jsonl``, the first study of issue
 34, without the load check; ``paper/calibration.jsonl``, the study with it), the confirmation of
-the first study's best candidate (``paper/confirmation-study1.json``, by ``paper/confirm.py``)
+the first study's best candidate (``paper/confirmation-study1.json``, by ``paper/confirm.py``),
+the confirmation of the load-checked study's best eligible candidates (``paper/confirmation.json``)
 and the presets themselves. The peak mesh loads of the first study's best candidates, which it
 did not measure, are computed here (:func:`gearchaos.paper.loads.load_factors`, about a second
 a gear set). Used by ``docs/make_doc_numbers.py`` as its ``calibration`` source."""
@@ -16,6 +17,7 @@ ROOT = Path(__file__).resolve().parents[1]
 STUDY1 = ROOT / "paper" / "calibration-study1.jsonl"
 STUDY2 = ROOT / "paper" / "calibration.jsonl"
 CONFIRMATION1 = ROOT / "paper" / "confirmation-study1.json"
+CONFIRMATION = ROOT / "paper" / "confirmation.json"
 
 
 class Markdown(str):
@@ -109,8 +111,9 @@ def calibration_values() -> dict[str, str]:
     the first study's best)."""
     from gearchaos.gearset import preset
     from gearchaos.model.derived import gearset_info
-    from gearchaos.paper.calibrate import load_problems, ranked
+    from gearchaos.paper.calibrate import load_problems, ranked, record_plausibility
     from gearchaos.paper.search_space import build_gearset, candidate_from_record
+    from gearchaos.paper.structure import clearance_problems
 
     out: dict[str, str] = {}
     s1 = ranked(_rows(STUDY1))
@@ -157,9 +160,45 @@ def calibration_values() -> dict[str, str]:
         out["study2.best.score"] = f"{b2['score']:.2f}"
         out["study2.best.structure"] = f"{b2.get('structure', 0.0):.2f}"
 
+    # eligible: plausible in ranges, teeth and loads, and with clearances that act
+    eligible = [r for r in s2 if not record_plausibility(r) and not clearance_problems(r)]
+    out["study2.eligible"] = str(len(eligible))
+    out["study2.enqueued"] = str(sum(1 for r in s2 if r["origin"] != "tpe"))
+    out["study2.minutes"] = f"{sum(float(r['seconds']) for r in s2) / 60:.0f}"
+    out["study2.eligible-top"] = _study_table(eligible, 6)
+
+    conf2 = json.loads(CONFIRMATION.read_text(encoding="utf-8"))
+    rows = []
+    for r in conf2["confirmed"]:
+        tag = f"trial {r['trial']}" + (" (adopted)" if r["trial"] == conf2["winner"] else "")
+        rows.append([tag, *_counts_cells(r["counts"]), *_load_cells(r["loads"])])
+    p2 = conf2["previous"]
+    rows.append([p2["preset"], *_counts_cells(p2["counts"]), *_load_cells(p2["loads"])])
+    out["confirm2"] = _table(["gear set", *COUNT_HEAD, *LOAD_HEAD], rows)
+    out["confirm2.count"] = str(len(conf2["confirmed"]))
+    win = next(r for r in conf2["confirmed"] if r["trial"] == conf2["winner"])
+    wl, pl = win["counts"]["landmarks"], p2["counts"]["landmarks"]
+    out["confirm2.winner"] = str(win["trial"])
+    out["confirm2.holds"] = str(wl.get("holds", 0))
+    out["confirm2.constant"] = str(wl.get("holds (constant)", 0))
+    out["confirm2.partly"] = str(wl.get("partly", 0))
+    out["confirm2.not"] = str(wl.get("does not hold", 0))
+    out["confirm2.previous-holds"] = str(pl.get("holds", 0))
+    out["confirm2.previous-constant"] = str(pl.get("holds (constant)", 0))
+    out["confirm2.force"] = f"{win['loads']['peak_force_N'] / 1e3:.3g}"
+    out["confirm2.minutes"] = f"{win['counts']['seconds'] / 60:.0f}"
+    for tag, name in (("new", "sheng2016"), ("old", "sheng2016-v1")):
+        g = preset(name)
+        out[f"{tag}.torque"] = f"{g.torque.input:.0f}"
+        out[f"{tag}.te"] = f"{g.transmission_error.sun_planet * 1e6:.3g}"
+        out[f"{tag}.bc"] = f"{g.clearance.characteristic_length * 1e6:.3g}"
+        out[f"{tag}.teeth"] = f"{g.teeth.sun}/{g.teeth.planet}/{g.teeth.ring}"
+        out[f"{tag}.planets"] = str(g.n_planets)
+
     for tag, gs in (
         ("old", preset("sheng2016-v1")),
         ("study1", build_gearset(candidate_from_record(best))),
+        ("new", preset("sheng2016")),
     ):
         dim = gearset_info(gs)["dimensionless"]
         out[f"abar.{tag}"] = f"{dim['te_sp']:.3g}"
