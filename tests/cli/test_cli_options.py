@@ -131,10 +131,12 @@ def test_every_command_takes_the_shared_options_from_their_group() -> None:
             for field in fields:
                 declared = type(record).declarations()[field].__metadata__[0].help
                 assert params[field].help == own.get(field, declared), (name, field)
-    # the target options: on every command that simulates or reads a recorded model
+    # the target options: on every command that simulates or reads a recorded model, and on
+    # init-gearset, whose --preset names the gear set whose values it writes
     assert sorted(takers["Target"]) == sorted(
         ["simulate", "info", "bifurcation", "response", "poincare", "orbit", "continue",
-         "attractors", "basins", "basin-fractions", "reproduce", "plot", "explore", "boundary"]
+         "attractors", "basins", "basin-fractions", "reproduce", "plot", "explore", "boundary",
+         "init-gearset"]
     )  # fmt: skip
     assert sorted(takers["Solver"]) == sorted(
         ["simulate", "bifurcation", "response", "poincare", "orbit", "continue", "attractors",
