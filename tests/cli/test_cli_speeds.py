@@ -15,6 +15,7 @@ from typer.testing import CliRunner
 
 import gearchaos as gc
 from gearchaos.cli import app
+from gearchaos.cli._options import DEFAULT_PRESET
 from gearchaos.gearset import GearSet
 
 SHORT = ["--transient", "2", "--periods", "2"]
@@ -35,7 +36,7 @@ def _omega_at_rpm(gs: GearSet, rpm: float) -> float:
 
 
 def test_info_and_simulate_take_the_sun_speed(runner: CliRunner) -> None:
-    gs = gc.preset("sheng2016-v1")
+    gs = gc.preset(DEFAULT_PRESET)  # the gear set the commands run without --preset
     result = runner.invoke(app, ["info", "--set", "sun_rpm=7500", "--json"])
     assert result.exit_code == 0, result.output
     point = json.loads(result.stdout)["operating_point"]
@@ -57,7 +58,7 @@ def test_info_and_simulate_take_the_sun_speed(runner: CliRunner) -> None:
 
 def test_info_tables_show_the_sun_speed_of_every_resonance(runner: CliRunner) -> None:
     result = runner.invoke(app, ["info", "--json"])
-    gs = gc.preset("sheng2016-v1")
+    gs = gc.preset(DEFAULT_PRESET)  # the gear set the commands run without --preset
     for row in json.loads(result.stdout)["omega_at_resonances"]:
         rpm = row["sun_speed_rpm"]
         assert _omega_at_rpm(gs, rpm) == pytest.approx(row["omega"], rel=1e-12)
@@ -103,7 +104,7 @@ def test_bifurcation_over_sun_rpm_stores_omega_and_prints_both(
          str(store)],
     )  # fmt: skip
     assert result.exit_code == 0, result.output
-    gs = gc.preset("sheng2016-v1")
+    gs = gc.preset(DEFAULT_PRESET)  # the gear set the commands run without --preset
     ds = xr.open_zarr(store)
     expected = [_omega_at_rpm(gs, r) for r in (2000.0, 5000.0, 8000.0)]
     np.testing.assert_allclose(ds["omega"].values, expected, rtol=1e-12)
