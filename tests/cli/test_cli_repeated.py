@@ -37,12 +37,14 @@ def test_a_single_valued_option_given_twice_is_refused(
 
 
 def test_options_that_may_repeat_still_do(tmp_path: Path) -> None:
-    # --set and a 2-D map's two --vary are lists
+    # --set and a 2-D map's two --vary are lists (teeth.sun = 33 is sheng2016-v1's own, so the
+    # gear set stays consistent: z_r = z_s + 2 z_p)
     out = tmp_path / "m.zarr"
     r = CliRunner().invoke(
         app,
         [
-            "bifurcation", "-v", "omega=1:1.2:2", "-v", "xi=0.03,0.05", "--set", "teeth.sun=33",
+            "bifurcation", "--preset", "sheng2016-v1", "-v", "omega=1:1.2:2", "-v", "xi=0.03,0.05",
+            "--set", "teeth.sun=33",
             "--set", "backlash.sun_planet=3", "--transient", "2", "--periods", "2", "-o", str(out),
         ],
     )  # fmt: skip
