@@ -19,6 +19,10 @@ from typer.testing import CliRunner
 import gearchaos as gc
 from gearchaos.cli import app
 
+#: the gear set these tests were written against: its stable 1T orbit at Ω = 1.5 and its 2T
+#: orbit at Ω = 3.5 (the recalibrated default has a 2T orbit at 1.5 and a 1T at 3.5)
+V1 = ["--preset", "sheng2016-v1"]
+
 
 @pytest.fixture(scope="module")
 def runner() -> CliRunner:
@@ -43,13 +47,13 @@ def _refused(runner: CliRunner, args: list[str], *needles: str) -> str:
 def store(tmp_path_factory: pytest.TempPathFactory, runner: CliRunner) -> Path:
     """A three-point Ω sweep whose middle point (Ω = 1.5) ends on the stable 1T orbit."""
     path = tmp_path_factory.mktemp("start") / "w.zarr"
-    _ok(runner, ["bifurcation", "--vary", "omega=1.4:1.6:3", "-o", str(path), "--quiet"])
+    _ok(runner, ["bifurcation", *V1, "--vary", "omega=1.4:1.6:3", "-o", str(path), "--quiet"])
     return path
 
 
 # ------------------------------------------------------------------ a longer settle
 def test_orbit_period_two_at_3_5_settles_to_the_stable_2t_orbit(runner: CliRunner) -> None:
-    out = json.loads(_ok(runner, ["orbit", "--period", "2", "--set", "omega=3.5", "--json"]))
+    out = json.loads(_ok(runner, ["orbit", *V1, "--period", "2", "--set", "omega=3.5", "--json"]))
     assert out["converged"] and out["stable"], out["message"]
     assert out["minimal_period"] == 2
     # the attractor a long simulation from rest ends on is this orbit: its section points
@@ -86,7 +90,7 @@ def test_continue_in_backlash_at_1_5_starts_without_a_given_start(
     runner: CliRunner, tmp_path: Path
 ) -> None:
     path = tmp_path / "b.nc"
-    args = ["continue", "--vary", "backlash.sun_planet=1:6", "--set", "omega=1.5"]
+    args = ["continue", *V1, "--vary", "backlash.sun_planet=1:6", "--set", "omega=1.5"]
     out = json.loads(_ok(runner, [*args, "-o", str(path), "--json"]))
     ds = gc.open_branch(path)
     lam = ds["backlash.sun_planet"].values
@@ -110,7 +114,7 @@ def test_orbit_from_a_store_point_is_the_orbit_at_that_point(
     runner: CliRunner, store: Path
 ) -> None:
     here = json.loads(_ok(runner, ["orbit", "--from", str(store), "--at", "omega=1.5", "--json"]))
-    rest = json.loads(_ok(runner, ["orbit", "--set", "omega=1.5", "--json"]))
+    rest = json.loads(_ok(runner, ["orbit", *V1, "--set", "omega=1.5", "--json"]))
     assert here["converged"] and rest["converged"]
     # the same orbit, reached from two different guesses
     np.testing.assert_allclose(here["x_sp1"], rest["x_sp1"], atol=1e-8)
