@@ -193,8 +193,8 @@ def test_a_simulation_file_says_where_its_record_starts(runner: CliRunner, tmp_p
     for omega, words in (("1.5", "continuation of the run reached from rest"),
                          ("0.5", "rest, perturbed")):  # fmt: skip
         out = tmp_path / f"sim{omega}"
-        result = runner.invoke(app, ["simulate", "--set", f"omega={omega}", "-o", str(out),
-                                     "--no-plot"])  # fmt: skip
+        result = runner.invoke(app, ["simulate", "--preset", "sheng2016-v1", "--set",
+                                     f"omega={omega}", "-o", str(out), "--no-plot"])  # fmt: skip
         assert result.exit_code == 0, result.output
         ds = gc.open_simulation(out / "simulation.nc")
         assert words in ds.attrs["initial_state"]
