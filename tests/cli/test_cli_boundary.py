@@ -24,7 +24,9 @@ runner = CliRunner()
 def curve_file(tmp_path_factory):
     where = tmp_path_factory.mktemp("boundary")
     branch = where / "branch.nc"
-    got = runner.invoke(app, ["continue", "--vary", "omega=3.3:3.45", "-o", str(branch)])
+    # sheng2016-v1's period doubling near Ω = 3.4 (the recalibrated default is 1T there)
+    args = ["continue", "--preset", "sheng2016-v1", "--vary", "omega=3.3:3.45", "-o", str(branch)]
+    got = runner.invoke(app, args)
     assert got.exit_code == 0, got.output
     pd = next(e for e in events(gc.open_branch(branch)) if e.kind == "period_doubling")
     curve = where / "pd.nc"
@@ -41,7 +43,7 @@ def test_boundary_command_writes_the_curve_with_provenance(curve_file) -> None:
     assert summary["kind"] == "period_doubling" and summary["parameter2"] == "xi"
     # the gear set of the first point (at its ξ), as branch files record it
     stored = gc.GearSet.from_toml_string(ds.attrs["gearset_toml"])
-    assert stored.name == gc.preset("sheng2016").name  # the default
+    assert stored.name == gc.preset("sheng2016-v1").name  # the branch's gear set
     assert "version" in ds.attrs and "rtol" in ds.attrs
     # it starts at the branch's event (ξ = 0.03) and lands on ξ = 0.025 on both sides
     assert np.isclose(ds.omega.values[ds.direction.values == 0][0], pd.value, atol=1e-7)
