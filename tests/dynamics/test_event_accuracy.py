@@ -81,13 +81,14 @@ def test_files_without_uncertainty_still_read(tmp_path) -> None:
 
 
 def test_cli_continue_reports_each_event_with_its_uncertainty(tmp_path: Path) -> None:
-    """The Neimark–Sacker bifurcation of the seed's gear set near Ω = 1.496 (README): the
+    """The Neimark–Sacker bifurcation of sheng2016-v1 near Ω = 1.496 (README): the
     text table and the JSON give its uncertainty, and a run with rtol 1e-11 lands inside it."""
     runner = CliRunner()
+    V1 = ["--preset", "sheng2016-v1"]  # the recalibrated default has no NS point near 1.5
 
     def run(*extra: str) -> dict:
         out = tmp_path / f"b{len(list(tmp_path.iterdir()))}.nc"
-        args = ["continue", "--vary", "omega=1.49:1.50", "-o", str(out), *extra]
+        args = ["continue", *V1, "--vary", "omega=1.49:1.50", "-o", str(out), *extra]
         result = runner.invoke(app, [*args, "--json"])
         assert result.exit_code == 0, result.output
         return json.loads(result.stdout)
@@ -106,7 +107,7 @@ def test_cli_continue_reports_each_event_with_its_uncertainty(tmp_path: Path) ->
     # cells on a narrow one rather than cutting them)
     text = runner.invoke(
         app,
-        ["continue", "--vary", "omega=1.49:1.50", "-o", str(tmp_path / "t.nc")],
+        ["continue", *V1, "--vary", "omega=1.49:1.50", "-o", str(tmp_path / "t.nc")],
         env={"COLUMNS": "200"},
     )
     assert text.exit_code == 0, text.output
