@@ -139,7 +139,8 @@ def test_python_summary_is_the_command_line_summary(tmp_path) -> None:
     for omega in (1.5, 3.5):
         res = gc.simulate(SHENG, omega=omega)
         py = gc.summarize(res)
-        cli = CliRunner().invoke(app, ["simulate", "--set", f"omega={omega}", "--json"])
+        args = ["simulate", "--preset", SHENG.name, "--set", f"omega={omega}", "--json"]
+        cli = CliRunner().invoke(app, args)
         assert cli.exit_code == 0, cli.output
         out = json.loads(cli.stdout)
         assert py["motion"] == out["motion"] and py["evidence"] == out["evidence"] == "floquet"
