@@ -31,6 +31,7 @@ from gearchaos.model.contract import (
     check_model,
 )
 from gearchaos.model.target import parameter_names, scale_attrs, speeds_at
+from stage_scales import StageScales
 
 
 @numba.njit(cache=True)
@@ -64,23 +65,6 @@ class Minimal(UserModel):
 
     def pack(self, omega: float) -> np.ndarray:
         return np.array([omega, self.zeta, self.b_1, self.b_2])
-
-
-@dataclass(frozen=True)
-class StageScales:
-    """Physical scales of the two-stage train: b_c = 20 µm, ω_n = 5000 rad/s, k = 1e8 N/m."""
-
-    length: float = 20e-6
-    omega_n: float = 5000.0
-    stiffness: float = 1e8
-
-    @property
-    def velocity(self) -> float:
-        return self.length * self.omega_n
-
-    @property
-    def force(self) -> float:
-        return self.stiffness * self.length
 
 
 @dataclass(frozen=True)

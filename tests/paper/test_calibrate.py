@@ -413,6 +413,19 @@ PARALLEL = textwrap.dedent(
 )
 
 
+def _start_parallel(out: Path, url: str, stdout: int = subprocess.DEVNULL) -> subprocess.Popen:
+    """Start :data:`PARALLEL` (two workers whose every trial blocks) in its own session, with
+    SIGINT's default action, text stderr piped (each worker writes "trial running")."""
+    script = out.with_name("run.py")
+    script.write_text(PARALLEL)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    return subprocess.Popen(
+        [sys.executable, str(script), str(out), url], env=env, stdin=subprocess.DEVNULL,
+        stdout=stdout, stderr=subprocess.PIPE, text=True, start_new_session=True,
+        preexec_fn=child.default_sigint,
+    )  # fmt: skip
+
+
 def test_an_interrupted_parallel_calibration_ends_its_workers(tmp_path: Path) -> None:
     # Ctrl-C to a calibration with --workers waited for the whole run of every worker (the
     # pool's `with` shut it down waiting); its workers are ended at once, and their trials run
@@ -421,14 +434,7 @@ def test_an_interrupted_parallel_calibration_ends_its_workers(tmp_path: Path) ->
     import threading
 
     out, url = tmp_path / "c.jsonl", f"sqlite:///{tmp_path / 'c.db'}"
-    script = tmp_path / "run.py"
-    script.write_text(PARALLEL)
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
-    proc = subprocess.Popen(
-        [sys.executable, str(script), str(out), url], env=env, stdin=subprocess.DEVNULL,
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
-        preexec_fn=child.default_sigint,
-    )  # fmt: skip
+    proc = _start_parallel(out, url, stdout=subprocess.PIPE)
     lines: queue.Queue[str | None] = queue.Queue()
 
     def read() -> None:
@@ -481,14 +487,7 @@ def test_the_workers_of_a_killed_parallel_calibration_do_not_outlive_it(
     # `kill` (or `kill -9`) of a calibration with --workers left its two worker processes
     # running trials against the storage for minutes, adopted by init (no death signal, no
     # watch of the parent in the calibration's pool); they end with their command now
-    out, url = tmp_path / "c.jsonl", f"sqlite:///{tmp_path / 'c.db'}"
-    script = tmp_path / "run.py"
-    script.write_text(PARALLEL)
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
-    proc = subprocess.Popen(
-        [sys.executable, str(script), str(out), url], env=env, stdin=subprocess.DEVNULL,
-        stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, start_new_session=True,
-    )  # fmt: skip
+    proc = _start_parallel(tmp_path / "c.jsonl", f"sqlite:///{tmp_path / 'c.db'}")
     workers: list[int] = []
     try:
         assert proc.stderr is not None

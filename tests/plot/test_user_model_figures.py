@@ -26,8 +26,9 @@ from gearchaos.model import System
 from gearchaos.model.contract import Contact, UserModel
 from gearchaos.plot import figure_for, summary_figure
 from gearchaos.sweep.result import SweepResult
+from stage_scales import StageScales
 
-LENGTH, OMEGA_0 = 20e-6, 5000.0
+LENGTH, OMEGA_0 = StageScales.length, StageScales.omega_n
 #: Words, symbols and names of the planetary model that a figure of this model must not show.
 PLANETARY = re.compile(r"planet|sun|_\{sp|_\{rp|sp1|\\bar\{X\}|mesh|b_c|gear set")
 
@@ -43,21 +44,6 @@ def _stages_rhs(t, y, p, dydt, obs, level):  # pragma: no cover - compiled
         dydt[2 + s] = -2.0 * p[1] * v - f + 0.1 + 0.2 * math.cos(p[0] * t)
         obs[s] = x
         obs[2 + s] = v
-
-
-@dataclass(frozen=True)
-class StageScales:
-    length: float = LENGTH
-    omega_n: float = OMEGA_0
-    stiffness: float = 1e8
-
-    @property
-    def velocity(self) -> float:
-        return self.length * self.omega_n
-
-    @property
-    def force(self) -> float:
-        return self.stiffness * self.length
 
 
 @dataclass(frozen=True)
