@@ -19,11 +19,12 @@ import numpy as np
 from .._checks import check_bool, check_int, check_real
 from ..errors import IntegrationError, ParameterError, StoreError
 from ..integrate.settings import SolverSettings, split_keywords
+from ..model.record import parameter_value
 from . import branch_events as ev
 from .arclength import parse_vary
 from .curve_file import RESUMABLE, curve_dataset, open_curve
 from .curve_tests import CURVE_KINDS, TestFunction, grazing_contact
-from .curves import Curve, CurvePoint, CurveSteps, parameter_value
+from .curves import Curve, CurvePoint, CurveSteps
 from .orbits import ORBIT_SETTINGS, check_tol, contact_levels
 from .shooting import multipliers_of
 

@@ -54,13 +54,13 @@ import numpy as np
 from ..errors import ParameterError
 from ..integrate.settings import SolverSettings
 from ..model.system import System
-from ..model.target import OMEGA, resolve
+from ..model.target import resolve
 from . import branch_events as ev
 from .curve_tests import TestFunction, changes
 from .orbits import contact_levels
 from .shooting import Shot, multipliers_of, newton_step, residual_of, shoot
 
-__all__ = ["Curve", "CurvePoint", "CurveSteps", "parameter_value"]
+__all__ = ["Curve", "CurvePoint", "CurveSteps"]
 
 #: Forward-difference step of the Jacobian, relative to each unknown's scale.
 FD_STEP = 1e-5
@@ -459,24 +459,3 @@ def _projected(curve: Curve, p: CurvePoint) -> np.ndarray:
     """The tangent's parameter components, in units of the ranges."""
     assert p.tangent is not None
     return np.asarray(p.tangent[-2:] / curve.scale[-2:])
-
-
-# ------------------------------------------------------------------------------ front door
-def parameter_value(target: Any, name: str) -> float:
-    """The current value of parameter ``name`` of a gear set or system (Ω: the system's)."""
-    if isinstance(target, System):
-        if name == OMEGA:
-            return float(target.omega)
-        if hasattr(target.model, name):
-            value = getattr(target.model, name)
-            if isinstance(value, int | float) and not isinstance(value, bool):
-                return float(value)
-        raise ParameterError(f"{name} is no numeric field of the model {target.name}")
-    if name == OMEGA:
-        raise ParameterError("omega has no value of its own in a gear set: fix it (omega=1.5)")
-    from ..gearset.mapping import get_value
-
-    value = get_value(target, name)
-    if not isinstance(value, int | float) or isinstance(value, bool):
-        raise ParameterError(f"{name} must be a numeric parameter to vary: got {value!r}")
-    return float(value)

@@ -149,15 +149,28 @@ def model_title(model: Any) -> tuple[str, str]:
     return ("gear set", name)
 
 
-def parameter_value(target: Any, name: str) -> Any:
-    """The value of the parameter ``name`` on ``target``: a gear set's by its dotted name
-    (``gs["backlash.sun_planet"]``), a :class:`~gearchaos.model.System`'s the field of its
-    model."""
-    from ..gearset import GearSet
+def parameter_value(target: Any, name: str) -> float:
+    """The current value of the numeric parameter ``name`` of ``target``: a gear set's by its
+    dotted name (``gs["backlash.sun_planet"]``), a :class:`~gearchaos.model.System`'s the field
+    of its model, or its Ω. A gear set has no Ω of its own, and a parameter that is not a
+    number cannot be varied: both are refused (:class:`~gearchaos.errors.ParameterError`)."""
+    from ..gearset.mapping import get_value
+    from .target import OMEGA
 
-    if isinstance(target, GearSet):
-        return target[name]
-    return getattr(target.model, name)
+    if isinstance(target, System):
+        if name == OMEGA:
+            return float(target.omega)
+        if hasattr(target.model, name):
+            value = getattr(target.model, name)
+            if isinstance(value, int | float) and not isinstance(value, bool):
+                return float(value)
+        raise ParameterError(f"{name} is no numeric field of the model {target.name}")
+    if name == OMEGA:
+        raise ParameterError("omega has no value of its own in a gear set: fix it (omega=1.5)")
+    value = get_value(target, name)
+    if not isinstance(value, int | float) or isinstance(value, bool):
+        raise ParameterError(f"{name} must be a numeric parameter to vary: got {value!r}")
+    return float(value)
 
 
 def with_values(target: Any, changes: Any) -> Any:
