@@ -102,18 +102,32 @@ def _counts_cells(c: dict[str, Any]) -> list[str]:
 COUNT_HEAD = ["holds", "holds (constant)", "partly", "not", "conclusions h/p/n"]
 
 
+def _confirmation_table(conf: dict[str, Any]) -> Markdown:
+    """The counts and loads of a ``paper/confirm.py`` summary: each confirmed candidate (the
+    winner marked "adopted" where one was adopted from it), then the previous default."""
+    rows = []
+    for r in conf["confirmed"]:
+        tag = f"trial {r['trial']}" + (" (adopted)" if r["trial"] == conf.get("winner") else "")
+        rows.append([tag, *_counts_cells(r["counts"]), *_load_cells(r["loads"])])
+    p = conf["previous"]
+    rows.append([p["preset"], *_counts_cells(p["counts"]), *_load_cells(p["loads"])])
+    return _table(["gear set", *COUNT_HEAD, *LOAD_HEAD], rows)
+
+
 def calibration_values() -> dict[str, str]:
     """Keys ``study1.*`` (the first study: ``trials``, ``enqueued``, ``best.*``, ``top``,
     ``structured`` — trials whose clearances act —, ``broken`` — of those, how many break their
     teeth among the ``top``), ``confirm1`` (the confirmed candidate against the previous
     default), ``study2.*`` (the load-checked study: ``trials``, ``feasible``, ``best.*``,
-    ``top``), ``abar.*`` and ``tdbar.*`` (Ā = A/b_c and T̄_D of the previous default and of
-    the first study's best)."""
+    ``top``, ``eligible`` and ``eligible-top`` — plausible, with clearances that act),
+    ``confirm2.*`` (its confirmation: the table, the winner and its counts against the previous
+    default's), ``new.*`` and ``old.*`` (the calibrated values of ``sheng2016`` and
+    ``sheng2016-v1``), ``abar.*`` and ``tdbar.*`` (Ā = A/b_c and T̄_D of the previous default,
+    the first study's best and the new default)."""
     from gearchaos.gearset import preset
     from gearchaos.model.derived import gearset_info
-    from gearchaos.paper.calibrate import load_problems, ranked, record_plausibility
+    from gearchaos.paper.calibrate import adoption_problems, load_problems, ranked
     from gearchaos.paper.search_space import build_gearset, candidate_from_record
-    from gearchaos.paper.structure import clearance_problems
 
     out: dict[str, str] = {}
     s1 = ranked(_rows(STUDY1))
@@ -135,12 +149,8 @@ def calibration_values() -> dict[str, str]:
     out["study1.top-count"] = str(len(top))
 
     conf = json.loads(CONFIRMATION1.read_text(encoding="utf-8"))
-    rows = []
-    for r in conf["confirmed"]:
-        rows.append([f"trial {r['trial']}", *_counts_cells(r["counts"]), *_load_cells(r["loads"])])
     p = conf["previous"]
-    rows.append([p["preset"], *_counts_cells(p["counts"]), *_load_cells(p["loads"])])
-    out["confirm1"] = _table(["gear set", *COUNT_HEAD, *LOAD_HEAD], rows)
+    out["confirm1"] = _confirmation_table(conf)
     c = conf["confirmed"][0]
     out["confirm1.trial"] = str(c["trial"])
     out["confirm1.holds"] = str(c["counts"]["landmarks"].get("holds", 0))
@@ -161,20 +171,15 @@ def calibration_values() -> dict[str, str]:
         out["study2.best.structure"] = f"{b2.get('structure', 0.0):.2f}"
 
     # eligible: plausible in ranges, teeth and loads, and with clearances that act
-    eligible = [r for r in s2 if not record_plausibility(r) and not clearance_problems(r)]
+    eligible = [r for r in s2 if not adoption_problems(r)]
     out["study2.eligible"] = str(len(eligible))
     out["study2.enqueued"] = str(sum(1 for r in s2 if r["origin"] != "tpe"))
     out["study2.minutes"] = f"{sum(float(r['seconds']) for r in s2) / 60:.0f}"
     out["study2.eligible-top"] = _study_table(eligible, 6)
 
     conf2 = json.loads(CONFIRMATION.read_text(encoding="utf-8"))
-    rows = []
-    for r in conf2["confirmed"]:
-        tag = f"trial {r['trial']}" + (" (adopted)" if r["trial"] == conf2["winner"] else "")
-        rows.append([tag, *_counts_cells(r["counts"]), *_load_cells(r["loads"])])
     p2 = conf2["previous"]
-    rows.append([p2["preset"], *_counts_cells(p2["counts"]), *_load_cells(p2["loads"])])
-    out["confirm2"] = _table(["gear set", *COUNT_HEAD, *LOAD_HEAD], rows)
+    out["confirm2"] = _confirmation_table(conf2)
     out["confirm2.count"] = str(len(conf2["confirmed"]))
     win = next(r for r in conf2["confirmed"] if r["trial"] == conf2["winner"])
     wl, pl = win["counts"]["landmarks"], p2["counts"]["landmarks"]

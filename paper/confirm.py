@@ -7,7 +7,7 @@ The calibration scores candidates on coarse sweeps (a few hundred points). Befor
 becomes the default ``sheng2016`` (issue 34), each of the ``--top`` best eligible candidates —
 physically plausible, and with clearances that act (every continued backlash branch changes its
 multipliers or has an event, and the backlash sweeps hold double-sided impact:
-:func:`gearchaos.paper.structure.clearance_problems`), ranked by landmark score, then
+:func:`gearchaos.paper.calibrate.adoption_problems`), ranked by landmark score, then
 structure — gets a full ``gearchaos reproduce --all`` (every
 figure at full resolution, the verdicts, the paper-protocol column), and so does today's
 default for comparison (``--preset``, default ``sheng2016-v1``; or its committed report,
@@ -35,16 +35,15 @@ from gearchaos.gearset import preset
 from gearchaos.paper.accounting import verdict_counts
 from gearchaos.paper.calibrate import (
     STUDY,
+    adoption_problems,
     candidate_from_record,
     ranked,
     read_results,
-    record_plausibility,
     study_records,
 )
 from gearchaos.paper.conclusions import VERDICTS as CONCLUSION_VERDICTS
 from gearchaos.paper.loads import load_factors
 from gearchaos.paper.search_space import build_gearset
-from gearchaos.paper.structure import clearance_problems
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "paper"))
@@ -77,11 +76,6 @@ def _reproduce(args: list[str], out: Path) -> dict:
     return json.loads(report.read_text(encoding="utf-8"))
 
 
-def _problems(record: dict) -> list[str]:
-    """Why a record cannot be the default: implausible, or its clearances do not act."""
-    return record_plausibility(record) + clearance_problems(record)
-
-
 def _key(row: dict) -> tuple[int, int, int]:
     lm = row["counts"]["landmarks"]
     return (-lm.get("holds", 0), lm.get("does not hold", 0), row["rank"])
@@ -110,7 +104,7 @@ def main() -> None:
     # eligible candidates: plausible (ranges, tooth combination, loads where the study measured
     # them) and with clearances that act; ``--any`` confirms the best ones whatever their loads
     # and structure (a study without those measurements)
-    top = [(i + 1, r) for i, r in enumerate(order) if args.any or not _problems(r)]
+    top = [(i + 1, r) for i, r in enumerate(order) if args.any or not adoption_problems(r)]
     if args.trial:
         top = [(rank, r) for rank, r in enumerate(order, start=1) if r["index"] in args.trial]
     top = top[: args.top]
@@ -130,7 +124,7 @@ def main() -> None:
             "variables": rec["variables"], "counts": counts(rep), "loads": load_factors(gs),
         })  # fmt: skip
         parts = {**(rec.get("parts") or {}), "loads": rows[-1]["loads"]}
-        rows[-1]["problems"] = _problems({**rec, "parts": parts})
+        rows[-1]["problems"] = adoption_problems({**rec, "parts": parts})
     if args.previous_report:
         base = json.loads(Path(args.previous_report).read_text(encoding="utf-8"))
     else:

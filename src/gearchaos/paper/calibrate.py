@@ -101,6 +101,7 @@ __all__ = [
     "SearchSpace",
     "SweepSettings",
     "TeethChoice",
+    "adoption_problems",
     "base_candidate",
     "best_record",
     "build_gearset",
@@ -185,6 +186,15 @@ def record_plausibility(record: Mapping[str, Any], space: SearchSpace = DEFAULT_
     """Reasons a calibration record is not physically plausible: its candidate's
     (:func:`plausibility`) and its loads' (:func:`load_problems`)."""
     return plausibility(candidate_from_record(record, space), space) + load_problems(record)
+
+
+def adoption_problems(record: Mapping[str, Any], space: SearchSpace = DEFAULT_SPACE) -> list[str]:
+    """Why a calibration record cannot become the default gear set (issue 34): it is not
+    physically plausible (:func:`record_plausibility`), or its clearances do not act
+    (:func:`gearchaos.paper.structure.clearance_problems`). Empty for an eligible record."""
+    from .structure import clearance_problems
+
+    return record_plausibility(record, space) + clearance_problems(record)
 
 
 def _rank_key(record: Mapping[str, Any]) -> tuple[bool, float, float, int]:
