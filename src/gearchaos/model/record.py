@@ -122,9 +122,7 @@ def recorded_target(attrs: Any, given: Any = None, *, where: str = "the file") -
         return given
     text = str(attrs.get("gearset_toml", "") or "")
     if text:
-        from ..gearset.io import from_toml_string
-
-        return from_toml_string(text)
+        return GearSet.from_toml_string(text)
     from .loading import rebuild_model
     from .system import System
 
