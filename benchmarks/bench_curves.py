@@ -20,7 +20,7 @@ import argparse
 import time
 
 import gearchaos as gc
-from gearchaos.dynamics.branch_events import events
+from gearchaos.dynamics.continuation.events import events
 
 MAP = {"transient_periods": 150, "periods": 16, "progress": False}
 

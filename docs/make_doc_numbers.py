@@ -22,7 +22,7 @@ verbatim in a code block or in inline code of every page that quotes it (checked
 directory with ``COLUMNS=100`` (the width of the excerpts), and reads its output; the
 ``report`` source reads ``docs/report/report.json`` instead, which ``gearchaos reproduce --all
 -o docs/report`` wrote, and the ``verdict`` source the defaults of
-:class:`~gearchaos.dynamics.verdict.VerdictSettings` and the constants of the verdict's rules
+:class:`~gearchaos.dynamics.verdict.decide.VerdictSettings` and the constants of the verdict's rules
 (tolerances, window lengths, budgets). Window keys of the tutorial's Full sweep are
 ``fig4a.wN.LABEL.lo|hi`` (the N-th window the page's Python block prints, which must carry
 LABEL, so that the prose around it stays true) with an optional format after ``|``.
@@ -495,7 +495,7 @@ def _quick(_: Path) -> dict[str, str]:
 def _cascade(work: Path) -> dict[str, str]:
     """The period doublings of the cascade how-to's branches (its first block, as the page
     shows it): the one each branch of the cascade ends at, in the order of the cascade."""
-    from gearchaos.dynamics.cascade import open_cascade
+    from gearchaos.dynamics.continuation.cascade import open_cascade
 
     if not (work / "cascade.nc").exists():
         run_howto(CASCADE, work, ("cascade.png",))
@@ -732,14 +732,14 @@ def power_text(value: float) -> str:
 
 def _verdict_settings(_: Path) -> dict[str, str]:
     """The verdict's tolerances, windows and budgets as the docs state them: the defaults of
-    :class:`~gearchaos.dynamics.verdict.VerdictSettings` and the constants its rules use."""
+    :class:`~gearchaos.dynamics.verdict.decide.VerdictSettings` and the constants its rules use."""
     from gearchaos.analysis.bands import MIN_BAND_POINTS
     from gearchaos.analysis.chaos01 import MIN_LENGTH
     from gearchaos.analysis.classify import K_CHAOS, K_REGULAR
-    from gearchaos.dynamics.stability import FREE_TOL, STRUCTURAL_TOL
-    from gearchaos.dynamics.verdict import CONFIRM_PERIODS, VerdictSettings
-    from gearchaos.dynamics.verdict_orbits import MEASURE_FALL, MEASURE_TARGET
-    from gearchaos.dynamics.verdict_rules import K01_STRIDES, MAX_RETURN, MIN_ORDER, MIN_RETURN
+    from gearchaos.dynamics.orbits.stability import FREE_TOL, STRUCTURAL_TOL
+    from gearchaos.dynamics.verdict.decide import CONFIRM_PERIODS, VerdictSettings
+    from gearchaos.dynamics.verdict.periodic import MEASURE_FALL, MEASURE_TARGET
+    from gearchaos.dynamics.verdict.rules import K01_STRIDES, MAX_RETURN, MIN_ORDER, MIN_RETURN
 
     vs = VerdictSettings()
     windows = [vs.min_extension]  # a record of min_extension periods (a sweep's)

@@ -135,8 +135,9 @@ def test_analysis_is_pure_and_the_integrator_is_driven_from_dynamics() -> None:
         if _layer(module) == "analysis":
             assert not any(d.startswith("gearchaos.integrate") for d in deps), (module, deps)
             assert "rich" not in mods[module].read_text(encoding="utf-8"), module
-    for name in ("lyapunov", "orbits", "shooting", "arclength", "branch", "branch_events",
-                 "coexistence", "verdict", "orbit_batch"):  # fmt: skip
+    for name in ("lyapunov", "orbits.orbit", "orbits.shooting", "continuation.arclength",
+                 "continuation.branch", "continuation.events", "attractors.coexistence",
+                 "verdict.decide", "orbits.batch"):  # fmt: skip
         assert f"gearchaos.dynamics.{name}" in graph, name
         assert f"gearchaos.analysis.{name}" not in graph, name
     assert "gearchaos.model.modal" in graph and "gearchaos.model.derived" in graph
@@ -191,7 +192,10 @@ MEMBERS = frozenset(f.name for f in dataclasses.fields(Capabilities))
 #: ``getattr``/``hasattr`` calls naming a member of the model contract that remain outside
 #: ``gearset/`` and ``model/``, by (file, member), each with the reason it stays.
 MEMBER_PROBES_KEPT = {
-    ("dynamics/branch.py", "kind"): "hasattr(start, 'kind') asks whether a branch's start is "
+    (
+        "dynamics/continuation/branch.py",
+        "kind",
+    ): "hasattr(start, 'kind') asks whether a branch's start is "
     "a continuation event (kind, value) or an orbit: no model is probed",
 }
 
@@ -271,6 +275,39 @@ def _facade() -> dict[str, str]:
     return out
 
 
+def _uses_module(path: Path, prefix: str) -> bool:
+    """Whether the test module ``path`` uses the module or subpackage ``prefix``
+    (``gearchaos.dynamics.orbits``): imports from it, or imports a name of a package above it
+    (``from gearchaos.dynamics import periodic_orbit``, ``gc.periodic_orbit``) defined in it."""
+    import importlib
+
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    aliases = {"gearchaos"}
+    for node in ast.walk(tree):
+        names: list[tuple[str, str | None]] = []
+        if isinstance(node, ast.Import):
+            names = [(alias.name, None) for alias in node.names]
+            aliases.update(a.asname for a in node.names if a.name == "gearchaos" and a.asname)
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            names = [(node.module, alias.name) for alias in node.names]
+        for module, name in names:
+            if module == prefix or module.startswith(prefix + "."):
+                return True
+            if name and prefix.startswith(module + ".") and module.startswith("gearchaos"):
+                obj = getattr(importlib.import_module(module), name, None)
+                if str(getattr(obj, "__module__", "")).startswith(prefix):
+                    return True
+    import gearchaos
+
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name):
+            if node.value.id in aliases:
+                obj = getattr(gearchaos, node.attr, None)
+                if str(getattr(obj, "__module__", "")).startswith(prefix):
+                    return True
+    return False
+
+
 def _packages_used(path: Path, facade: dict[str, str]) -> set[str]:
     """Packages of gearchaos a test module uses: ``gearchaos.<pkg>`` imports, and the package
     of each top-level name it imports or reads as ``gc.<name>``."""
@@ -328,11 +365,16 @@ def test_each_test_module_uses_the_package_its_folder_mirrors() -> None:
     for folder in _test_folders():
         if folder.name in CROSS_CUTTING:
             continue
-        for path in sorted(folder.glob("test_*.py")):
-            key = f"{folder.name}/{path.name}"
+        for path in sorted(folder.rglob("test_*.py")):
+            key = path.relative_to(TESTS).as_posix()
             used = _packages_used(path, facade)
             if folder.name not in used and key not in NO_IMPORT:
                 misplaced.append(f"tests/{key} uses {sorted(used)}, not gearchaos.{folder.name}")
+            sub = path.parent.relative_to(folder).parts
+            if sub and not (ROOT / folder.name / Path(*sub) / "__init__.py").is_file():
+                misplaced.append(f"tests/{key} is in a folder no package src/gearchaos/ has")
+            elif sub and not _uses_module(path, ".".join(("gearchaos", folder.name, *sub))):
+                misplaced.append(f"tests/{key} does not use gearchaos.{folder.name}.{sub[0]}")
     stale = [key for key in NO_IMPORT if not (TESTS / key).is_file()]
     assert not stale, f"NO_IMPORT names test modules that are gone: {stale}"
     assert not misplaced, "test modules in the folder of a package they do not use:\n" + (
@@ -517,4 +559,44 @@ def test_gear_set_switches_outside_gearset_and_model_do_not_grow() -> None:
         f'{total} lines outside gearset/ and model/ ask "is it a gear set?" (at most '
         f"{GEAR_SET_SWITCHES}: ask the model for its contacts, quantities and names instead):\n"
         f"{table}"
+    )
+
+
+#: The subpackages of ``dynamics`` by concept (issue 36, item 5) and what each may import:
+#: ``lyapunov → orbits → continuation → curves`` and ``orbits → verdict → attractors``.
+DYNAMICS_ROOMS = {
+    "lyapunov": set(),
+    "orbits": {"lyapunov"},
+    "continuation": {"lyapunov", "orbits"},
+    "curves": {"lyapunov", "orbits", "continuation"},
+    "verdict": {"lyapunov", "orbits"},
+    "attractors": {"lyapunov", "orbits", "verdict"},
+}
+
+
+def _room(module: str) -> str | None:
+    parts = module.split(".")
+    return parts[2] if len(parts) > 2 and parts[1] == "dynamics" else None
+
+
+def test_dynamics_is_split_by_concept_and_its_rooms_import_one_way() -> None:
+    """``dynamics/`` holds only its rooms (and its facade), and a room imports only the rooms
+    below it."""
+    top = sorted(p.name for p in (ROOT / "dynamics").iterdir() if not p.name.startswith("_"))
+    assert top == sorted([*(r for r in DYNAMICS_ROOMS if r != "lyapunov"), "lyapunov.py"]), top
+    graph = _graph()
+    bad = []
+    seen = set()
+    for module, deps in graph.items():
+        room = _room(module)
+        if room is None:
+            continue
+        seen.add(room)
+        for dep in deps:
+            other = _room(dep)
+            if other is not None and other != room and other not in DYNAMICS_ROOMS[room]:
+                bad.append(f"{module} ({room}) imports {dep} ({other})")
+    assert seen == set(DYNAMICS_ROOMS), seen
+    assert not bad, "imports between the rooms of dynamics against their order:\n" + "\n".join(
+        sorted(bad)
     )

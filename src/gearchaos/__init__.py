@@ -72,16 +72,16 @@ __all__ = [
 ]
 
 if TYPE_CHECKING:
-    from .dynamics.arclength import continuation
-    from .dynamics.boundary import boundary_curve
-    from .dynamics.branch import open_branch, save_branch
-    from .dynamics.branch_events import Event
-    from .dynamics.coexistence import attractors
-    from .dynamics.curve_file import open_curve
+    from .dynamics.attractors.coexistence import attractors
+    from .dynamics.continuation.arclength import continuation
+    from .dynamics.continuation.branch import open_branch, save_branch
+    from .dynamics.continuation.events import Event
+    from .dynamics.curves.boundary import boundary_curve
+    from .dynamics.curves.file import open_curve
     from .dynamics.lyapunov import lyapunov_spectrum, max_lyapunov
-    from .dynamics.orbit_batch import periodic_orbits
-    from .dynamics.orbits import PeriodicOrbit, periodic_orbit
-    from .dynamics.point import summarize
+    from .dynamics.orbits.batch import periodic_orbits
+    from .dynamics.orbits.orbit import PeriodicOrbit, periodic_orbit
+    from .dynamics.verdict.point import summarize
     from .explore import explore
     from .sweep.basin_fractions import basin_fractions
     from .sweep.basins import basins
@@ -89,19 +89,19 @@ if TYPE_CHECKING:
 _LAZY_SUBPACKAGES = ("analysis", "dynamics", "plot", "paper", "explore")
 #: Functions of the lazy subpackages exported here, by the module that defines them.
 _LAZY_ATTRIBUTES = {
-    "PeriodicOrbit": "dynamics.orbits",
-    "periodic_orbit": "dynamics.orbits",
-    "continuation": "dynamics.arclength",
-    "boundary_curve": "dynamics.boundary",
-    "open_curve": "dynamics.curve_file",
-    "Event": "dynamics.branch_events",
-    "open_branch": "dynamics.branch",
-    "save_branch": "dynamics.branch",
+    "PeriodicOrbit": "dynamics.orbits.orbit",
+    "periodic_orbit": "dynamics.orbits.orbit",
+    "continuation": "dynamics.continuation.arclength",
+    "boundary_curve": "dynamics.curves.boundary",
+    "open_curve": "dynamics.curves.file",
+    "Event": "dynamics.continuation.events",
+    "open_branch": "dynamics.continuation.branch",
+    "save_branch": "dynamics.continuation.branch",
     "lyapunov_spectrum": "dynamics.lyapunov",
     "max_lyapunov": "dynamics.lyapunov",
-    "periodic_orbits": "dynamics.orbit_batch",
-    "attractors": "dynamics.coexistence",
-    "summarize": "dynamics.point",
+    "periodic_orbits": "dynamics.orbits.batch",
+    "attractors": "dynamics.attractors.coexistence",
+    "summarize": "dynamics.verdict.point",
     "basins": "sweep.basins",
     "basin_fractions": "sweep.basin_fractions",
 }

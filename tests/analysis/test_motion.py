@@ -20,7 +20,7 @@ from hypothesis import given, settings, strategies as st
 
 from gearchaos.analysis.classify import MotionClass, classify_motion, sort_labels
 from gearchaos.analysis.motion import LABEL_DTYPE, UNSET_TEXT, Motion, MotionKind
-from gearchaos.dynamics.evidence import Verdict
+from gearchaos.dynamics.verdict.evidence import Verdict
 from gearchaos.errors import ParameterError
 
 SRC = Path(__file__).resolve().parents[2] / "src" / "gearchaos"

@@ -147,7 +147,7 @@ def test_summary_carries_the_verdicts_window_and_coexisting_orbits(
     """The README's summary contract: ``simulate --json`` (a summary with the verdict) has the
     window λ₁ was measured over and the stable orbits beside the motion; a record-only summary
     says that no window ran and names none."""
-    from gearchaos.dynamics.evidence import Verdict
+    from gearchaos.dynamics.verdict.evidence import Verdict
 
     v = Verdict(
         "QP",

@@ -49,7 +49,7 @@ def test_basin_fractions_command(tmp_path):
 
 
 #: Twin-well Duffing with chaotic transients of hundreds of periods onto its one stable 1T
-#: (tests/dynamics/test_basins.py checks that against scipy).
+#: (tests/dynamics/attractors/test_basins.py checks that against scipy).
 TRANSIENT = [*MODEL[:4], "--set", "delta=0.15", "--set", "omega=1"]
 
 

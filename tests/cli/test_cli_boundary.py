@@ -15,7 +15,7 @@ from typer.testing import CliRunner
 
 import gearchaos as gc
 from gearchaos.cli import app
-from gearchaos.dynamics.branch_events import events
+from gearchaos.dynamics.continuation.events import events
 
 runner = CliRunner()
 

@@ -8,7 +8,7 @@ import pytest
 from typer.testing import CliRunner
 
 from gearchaos.cli import app
-from gearchaos.dynamics.cascade import open_cascade
+from gearchaos.dynamics.continuation.cascade import open_cascade
 
 MODEL = ["--model", "gearchaos.model.library:BacklashOscillator", "--set", "b=1",
          "--set", "zeta=0.05", "--set", "f_alt=0.1", "--set", "f_mean=0.1"]  # fmt: skip

@@ -119,7 +119,7 @@ def test_sweep_store_rebuilds_the_model_for_starts_and_the_explorer(
     from gearchaos.explore.compute import compute_point
 
     point = compute_point(str(store), {"omega": 1.2})
-    from gearchaos.dynamics.point import analyse_point
+    from gearchaos.dynamics.verdict.point import analyse_point
     from gearchaos.sweep.result import SweepResult
 
     settings = SweepResult.open(store).spec.solver.replace(samples_per_period=64)

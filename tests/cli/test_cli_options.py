@@ -18,7 +18,7 @@ from typer.testing import CliRunner
 
 import gearchaos as gc
 from gearchaos.cli import EXIT_INVALID, _options as o, app
-from gearchaos.dynamics.boundary import ASSESS
+from gearchaos.dynamics.curves.boundary import ASSESS
 from gearchaos.integrate.settings import SETTLE_CHOICES
 from gearchaos.plot.amplitude import QUANTITIES
 from gearchaos.sweep.exports import FORMATS
@@ -178,7 +178,7 @@ def test_both_spellings_of_the_verdict_switch_reach_the_library(
 ) -> None:
     """What reaches the library's keyword (``verdict=`` of a point, ``verdicts=`` of a sweep)
     is the switch as given, in either spelling."""
-    import gearchaos.dynamics.point
+    import gearchaos.dynamics.verdict.point
     import gearchaos.sweep
 
     seen: dict[str, Any] = {}
@@ -190,7 +190,7 @@ def test_both_spellings_of_the_verdict_switch_reach_the_library(
         seen.update(kwargs)
         raise Reached
 
-    monkeypatch.setattr(gearchaos.dynamics.point, "analyse_point", catch)
+    monkeypatch.setattr(gearchaos.dynamics.verdict.point, "analyse_point", catch)
     monkeypatch.setattr(gearchaos.sweep, "bifurcation", catch)
     args = {
         "simulate": ["simulate", "--set", "omega=1.5"],

@@ -13,7 +13,7 @@ from typer.testing import CliRunner
 
 import gearchaos as gc
 from gearchaos.cli import app
-from gearchaos.dynamics.point import analyse_point
+from gearchaos.dynamics.verdict.point import analyse_point
 from gearchaos.errors import IntegrationError
 from gearchaos.gearset import GearSet, preset
 from gearchaos.integrate.settings import SolverSettings
@@ -192,9 +192,11 @@ def test_integration_failure_exits_1(runner: CliRunner, monkeypatch) -> None:
     def fail(*args: object, **kwargs: object) -> None:
         raise IntegrationError("simulation at omega=1.5 stopped at tau=3: NON_FINITE: diverged")
 
-    # the CLI simulates through gearchaos.dynamics.point.analyse_point, which runs the
+    # the CLI simulates through gearchaos.dynamics.verdict.point.analyse_point, which runs the
     # integration with run_simulation
-    monkeypatch.setattr(importlib.import_module("gearchaos.dynamics.point"), "run_simulation", fail)
+    monkeypatch.setattr(
+        importlib.import_module("gearchaos.dynamics.verdict.point"), "run_simulation", fail
+    )
     result = runner.invoke(app, ["simulate", "--json"])
     assert result.exit_code == 1
     assert "NON_FINITE" in result.stderr

@@ -131,7 +131,7 @@ def test_orbit_file_round_trip_starts_a_branch_on_that_orbit(
             ["orbit", "--from", str(store), "--at", "omega=1.5", "-o", str(orbit_file), "--json"],
         )
     )
-    saved = gc.dynamics.orbit_file.open_orbit(orbit_file)
+    saved = gc.dynamics.orbits.file.open_orbit(orbit_file)
     assert saved.attrs["omega"] == 1.5 and saved.attrs["period"] == 1
     branch = tmp_path / "c.nc"
     _ok(runner, ["continue", "--from", str(orbit_file), "--vary", "omega=1.5:1.55",

@@ -127,7 +127,7 @@ def _check_reference_tables(site: Path) -> None:
 #: :data:`EVENT_KINDS`.`` (issue 24): the sentence in the Type column, the role escaped.
 _BROKEN_ROWS = """<table><thead><tr><th>Name</th><th>Type</th><th>Description</th></tr></thead>
 <tbody><tr class="doc-section-item"><td><code>kind</code></td>
-<td><code>one of &lt;autoref identifier=&#34;gearchaos.dynamics.branch_events.EVENT_KINDS&#34;
+<td><code>one of &lt;autoref identifier=&#34;gearchaos.dynamics.continuation.events.EVENT_KINDS&#34;
 optional&gt;&lt;code&gt;EVENT_KINDS&lt;/code&gt;&lt;/autoref&gt;.</code></td><td></td></tr>
 <tr><td><code>arclength</code></td><td><code>the branch&#39;s arclength at the event.</code></td>
 <td></td></tr><tr><td><code>value</code></td><td><code>float</code></td><td>The value.</td></tr>

@@ -35,7 +35,7 @@ from test_fuzz_gearset import BASE, culprits, invalid_values
 
 import gearchaos as gc
 from gearchaos.dynamics.lyapunov import lyapunov_spectrum, max_lyapunov
-from gearchaos.dynamics.point import analyse_point
+from gearchaos.dynamics.verdict.point import analyse_point
 from gearchaos.gearset.schema import ALIASES, FIELDS
 from gearchaos.integrate import integrate, integrate_batch
 from gearchaos.integrate.settings import SolverSettings

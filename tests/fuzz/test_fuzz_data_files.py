@@ -22,7 +22,7 @@ from fuzz_helpers import cli_refused, hsettings, refused
 from hypothesis import strategies as st
 
 import gearchaos as gc
-from gearchaos.dynamics.orbit_file import save_orbit
+from gearchaos.dynamics.orbits.file import save_orbit
 
 DUFFING = gc.duffing(1.2)
 TINY = {"transient_periods": 2}
@@ -422,7 +422,7 @@ def _writers(results: dict[str, Any], files: dict[str, Path]) -> dict[str, Any]:
     from typer.testing import CliRunner
 
     from gearchaos.cli import app
-    from gearchaos.dynamics.cascade import save_cascade
+    from gearchaos.dynamics.continuation.cascade import save_cascade
     from gearchaos.plot import savefig
     from gearchaos.sweep.exports import export
 
@@ -570,7 +570,7 @@ def test_escaped_a_gear_set_name_from_a_file_never_reaches_the_terminal_raw(
 
 
 def open_orbit_attrs(path: Path) -> dict[str, Any]:
-    from gearchaos.dynamics.orbit_file import open_orbit
+    from gearchaos.dynamics.orbits.file import open_orbit
 
     return dict(open_orbit(path).attrs)
 

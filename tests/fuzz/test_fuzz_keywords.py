@@ -36,7 +36,7 @@ from hypothesis import given, strategies as st
 
 import gearchaos as gc
 from gearchaos.dynamics.lyapunov import lyapunov_spectrum, max_lyapunov
-from gearchaos.dynamics.point import analyse_point
+from gearchaos.dynamics.verdict.point import analyse_point
 from gearchaos.integrate import integrate, integrate_batch
 from gearchaos.integrate.settings import SolverSettings
 from gearchaos.model.target import parameter_names

@@ -31,8 +31,8 @@ from typer.testing import CliRunner
 import gearchaos as gc
 from gearchaos.cli import app
 from gearchaos.cli._start import load_start
-from gearchaos.dynamics.branch import save_branch
-from gearchaos.dynamics.orbit_file import save_orbit
+from gearchaos.dynamics.continuation.branch import save_branch
+from gearchaos.dynamics.orbits.file import save_orbit
 from gearchaos.model import load_model_class
 
 _SERIAL = itertools.count()

@@ -53,7 +53,7 @@ from test_fuzz_keywords import (
 )
 
 import gearchaos as gc
-from gearchaos.dynamics.branch import MANIFEST, open_branch, save_branch
+from gearchaos.dynamics.continuation.branch import MANIFEST, open_branch, save_branch
 
 PROFILES = profiles({"rows": 6, "options": 5, "files": 1, "damage": 3})
 DUFFING = gc.duffing(1.0)

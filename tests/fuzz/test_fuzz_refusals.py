@@ -20,12 +20,12 @@ import pytest
 from fuzz_helpers import cli_refused, inside, refused
 
 import gearchaos as gc
-from gearchaos.dynamics.boundary import boundary_curve
-from gearchaos.dynamics.branch import save_branch
-from gearchaos.dynamics.branch_events import events
+from gearchaos.dynamics.continuation.branch import save_branch
+from gearchaos.dynamics.continuation.events import events
+from gearchaos.dynamics.curves.boundary import boundary_curve
 
 #: The single-mesh backlash oscillator with constant stiffness (ε = 0): its branch over
-#: Ω = 0.6 … 0.72 grazes once (the closed form of tests/dynamics/test_curves.py).
+#: Ω = 0.6 … 0.72 grazes once (the closed form of tests/dynamics/curves/test_curves.py).
 OSCILLATOR = {"zeta": 0.05, "f_alt": 0.1, "f_mean": 0.1}
 
 

@@ -86,13 +86,13 @@ def test_no_switch_predicted_ahead_of_an_observable_sitting_on_its_level() -> No
 
 def test_an_orbit_grazing_its_clearance_is_integrated_with_its_tangents() -> None:
     """A period-1 orbit of the backlash oscillator that grazes the clearance (it dips 1e-9
-    into the dead zone: a point of the grazing curve of tests/dynamics/test_curves.py),
+    into the dead zone: a point of the grazing curve of tests/dynamics/curves/test_curves.py),
     integrated over one period with its variational equations at rtol 1e-10, once stalled at
     the exit of the dead zone (x landed exactly on b̄, each step then aimed at a crossing 1e-13
     ahead) until the step budget ran out. It must finish, and its end state must be the plain
     run's (the tangents change the step sizes, not the solution beyond the tolerance)."""
     import gearchaos as gc
-    from gearchaos.dynamics.shooting import shoot
+    from gearchaos.dynamics.orbits.shooting import shoot
     from gearchaos.integrate.settings import SolverSettings
 
     y = np.array([1.1989473899282392, 0.01025968298815881])

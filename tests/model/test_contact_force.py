@@ -19,7 +19,7 @@ from typer.testing import CliRunner
 
 import gearchaos as gc
 from gearchaos.cli import app
-from gearchaos.dynamics.point import analyse_point
+from gearchaos.dynamics.verdict.point import analyse_point
 from gearchaos.integrate.settings import SolverSettings
 from gearchaos.model.response import response_quantities
 

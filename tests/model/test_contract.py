@@ -25,7 +25,7 @@ import numpy as np
 import pytest
 
 import gearchaos as gc
-from gearchaos.dynamics.shooting import shoot
+from gearchaos.dynamics.orbits.shooting import shoot
 from gearchaos.integrate.settings import SolverSettings
 from gearchaos.integrate.simulate import integrate
 from gearchaos.model import System

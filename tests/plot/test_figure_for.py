@@ -20,9 +20,9 @@ from typer.testing import CliRunner
 
 import gearchaos as gc
 from gearchaos.cli import app
-from gearchaos.dynamics.branch_events import events
-from gearchaos.dynamics.cascade import open_cascade
-from gearchaos.dynamics.curve_file import open_curve
+from gearchaos.dynamics.continuation.cascade import open_cascade
+from gearchaos.dynamics.continuation.events import events
+from gearchaos.dynamics.curves.file import open_curve
 from gearchaos.plot import FigureOptions, figure_for
 from gearchaos.sweep._basin_store import open_basins
 from gearchaos.sweep.result import SweepResult

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 import gearchaos as gc
-from gearchaos.dynamics.basins import BasinAttractor
+from gearchaos.dynamics.attractors.basins import BasinAttractor
 from gearchaos.plot._common import fmt, given, given_values, parameter_symbols
 from gearchaos.plot.gallery import gallery_title
 

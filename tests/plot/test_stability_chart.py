@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 import gearchaos as gc
-from gearchaos.dynamics.branch_events import events
+from gearchaos.dynamics.continuation.events import events
 from gearchaos.plot.regimes import REGIME_COLOURS, REGIME_GID
 from gearchaos.plot.stability import boundary_label, stability_chart, stability_figure
 

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import gearchaos as gc
-from gearchaos.dynamics.point import analyse_point
+from gearchaos.dynamics.verdict.point import analyse_point
 from gearchaos.integrate.settings import SolverSettings
 from gearchaos.plot import summary_figure
 

@@ -185,7 +185,7 @@ def test_a_sweep_of_the_model_gets_its_symbols_and_physical_axes(store) -> None:
 def test_a_branch_of_the_model_gets_its_physical_axes(tmp_path) -> None:
     path = tmp_path / "branch.nc"
     gc.continuation(System(TwoStageTrain(), 0.8), "omega=0.8:1.0", store=path)
-    from gearchaos.dynamics.cascade import open_cascade
+    from gearchaos.dynamics.continuation.cascade import open_cascade
 
     fig = figure_for(list(open_cascade(path)))
     draw(fig)

@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 
 import gearchaos as gc
-from gearchaos.dynamics.arclength import continuation
+from gearchaos.dynamics.continuation.arclength import continuation
 
 FIG8 = {"xi": 0.11, "backlash.planet_ring": 3.5, "clearance.sun_bearing": 2.0}
 AXIS = "backlash.sun_planet"

@@ -1,6 +1,6 @@
 """The verdict's store variables come from one table of the verdict's fields.
 
-Every field of :class:`~gearchaos.dynamics.evidence.Verdict` is either held by a variable of
+Every field of :class:`~gearchaos.dynamics.verdict.evidence.Verdict` is either held by a variable of
 :data:`~gearchaos.sweep.verdicts.VERDICT_COLUMNS` or named in
 :data:`~gearchaos.sweep.verdicts.NOT_STORED` with a reason, so a new field cannot be
 forgotten; the variables keep the names, element types and fill values of the stores written
@@ -15,8 +15,8 @@ import math
 import numpy as np
 
 from gearchaos.analysis.motion import Motion
-from gearchaos.dynamics.evidence import EVIDENCE, Verdict
-from gearchaos.dynamics.extension import RECORD_SOURCES, VerdictRecord
+from gearchaos.dynamics.verdict.evidence import EVIDENCE, Verdict
+from gearchaos.dynamics.verdict.extension import RECORD_SOURCES, VerdictRecord
 from gearchaos.sweep.verdicts import (
     NOT_STORED,
     VERDICT_COLUMNS,

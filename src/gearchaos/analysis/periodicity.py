@@ -62,7 +62,7 @@ def periods_of(
         The noise floor ε of the section points (a scalar, or one per sequence), in their
         units: a sequence whose spread S is at most ε is one point (period 1), whatever its
         magnitude. The motion verdict passes ε = 10³ (atol + rtol·max|x|) of the integration
-        (:mod:`gearchaos.dynamics.verdict`). None keeps :func:`detect_period`'s rule
+        (:mod:`gearchaos.dynamics.verdict.decide`). None keeps :func:`detect_period`'s rule
         S ≤ rtol·max|x|.
 
     Returns

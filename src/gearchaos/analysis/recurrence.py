@@ -2,7 +2,7 @@
 periodic orbit or lingers near one, and its distance from an orbit's section points.
 
 Pure functions of recorded arrays, used by the motion verdict
-(:mod:`gearchaos.dynamics.verdict`) to pick the period to shoot.
+(:mod:`gearchaos.dynamics.verdict.decide`) to pick the period to shoot.
 """
 
 from __future__ import annotations

@@ -78,7 +78,7 @@ def summarize(
         (:func:`~gearchaos.dynamics.lyapunov.max_lyapunov`); it decides quasi-periodic vs
         chaotic motion, confirmed by the 0–1 test and the spectrum. Ignored with ``verdict``.
     verdict
-        The motion verdict's fields (:meth:`gearchaos.dynamics.verdict.Verdict.to_dict`):
+        The motion verdict's fields (:meth:`gearchaos.dynamics.verdict.decide.Verdict.to_dict`):
         then ``motion`` is its label, ``lle``/``lle_error`` its λ₁ and error, and
         ``evidence``, ``max_multiplier``, ``extra_periods``, ``window_start`` and
         ``window_periods`` (the window λ₁ was measured over), ``coexisting`` (stable orbits

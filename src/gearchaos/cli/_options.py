@@ -50,8 +50,8 @@ from typing import (
 
 import typer
 
-from ..dynamics.boundary import ASSESS
-from ..dynamics.verdict_settings import CONFIRM_PERIODS
+from ..dynamics.curves.boundary import ASSESS
+from ..dynamics.verdict.settings import CONFIRM_PERIODS
 from ..errors import ParameterError
 from ..integrate.settings import SETTLE_CHOICES, SolverSettings
 from ..plot.amplitude import QUANTITIES
@@ -84,7 +84,7 @@ else:
     InitialConditions = choices("InitialConditions", INITIAL_CONDITIONS)
     #: ``--settle``: :data:`gearchaos.integrate.settings.SETTLE_CHOICES`.
     Settle = choices("Settle", SETTLE_CHOICES)
-    #: ``boundary --assess``: :data:`gearchaos.dynamics.boundary.ASSESS`.
+    #: ``boundary --assess``: :data:`gearchaos.dynamics.curves.boundary.ASSESS`.
     Assess = choices("Assess", ASSESS)
     #: ``export --to``: :data:`gearchaos.sweep.exports.FORMATS`.
     ExportFormat = choices("ExportFormat", FORMATS)
@@ -470,7 +470,7 @@ class Verdict(OptionGroup):
 class Confirm(OptionGroup):
     """How the attractor tools (``attractors``, ``basins``, ``basin-fractions``) confirm a
     chaotic or quasi-periodic attractor: by a last window of at least ``--confirm-periods``
-    periods (:func:`~gearchaos.dynamics.verdict.confirmed_settings`)."""
+    periods (:func:`~gearchaos.dynamics.verdict.decide.confirmed_settings`)."""
 
     confirm_periods: Annotated[
         int,

@@ -87,7 +87,7 @@ def speed_range(target: Any, vary: str, values: Mapping[str, Any]) -> str:
     converted through ``target`` with the fixed ``values`` (Ω among them dropped), so the
     branch, its file and its figure are in Ω like every other one; tables write the speeds
     beside it."""
-    from ..dynamics.arclength import parse_vary
+    from ..dynamics.continuation.arclength import parse_vary
     from ..model.target import operating_omega
 
     name, a, b = parse_vary(vary)

@@ -118,7 +118,7 @@ def _names_a_sweep(path: str) -> bool:
 def _load(path: str, where: dict[str, str]) -> Start:
     if os.path.isdir(path) and _names_a_sweep(path):
         return _from_store(path, where)
-    from ..dynamics.branch import open_branch
+    from ..dynamics.continuation.branch import open_branch
 
     try:
         branch = open_branch(path)
@@ -126,7 +126,7 @@ def _load(path: str, where: dict[str, str]) -> Start:
         branch, reason = None, str(exc)
     if branch is not None:  # a branch file: what is wrong with it is said, not tried as another
         return _from_branch(path, branch, where)
-    from ..dynamics.orbit_file import open_orbit
+    from ..dynamics.orbits.file import open_orbit
 
     try:
         ds = open_orbit(path)

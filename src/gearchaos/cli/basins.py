@@ -90,7 +90,7 @@ def _legend_table(
 ) -> Table:
     import numpy as np
 
-    from ..dynamics.basins import BasinAttractor
+    from ..dynamics.attractors.basins import BasinAttractor
 
     table = Table(title=title, title_justify="left")
     for col in ("code", "attractor", "evidence", "share of starts"):
@@ -263,7 +263,7 @@ def basin_fractions(
             )
         seconds = time.perf_counter() - t0
     path = output.required_path()
-    from ..dynamics.basins import BasinAttractor
+    from ..dynamics.attractors.basins import BasinAttractor
 
     param = ds.attrs["dims"][0]
     cats, tracks = json.loads(ds.attrs["attractors"]), json.loads(ds.attrs["tracks"])

@@ -128,9 +128,9 @@ def boundary(
 
     Example: **gearchaos boundary --from branch.nc --event pd1 --vary xi=0.01:0.05 -o pd.nc**
     """
-    from ..dynamics.boundary import boundary_curve
-    from ..dynamics.branch import open_branch
-    from ..dynamics.branch_events import events
+    from ..dynamics.continuation.branch import open_branch
+    from ..dynamics.continuation.events import events
+    from ..dynamics.curves.boundary import boundary_curve
     from ..integrate.settings import SolverSettings
     from ._start import _gearset, name_model
 
@@ -250,7 +250,7 @@ def _uncertainty(ds: Any) -> dict[str, Any]:
 
 def is_curve_file(path: Path) -> bool:
     """Whether ``path`` is a boundary-curve file (a branch file of two parameters)."""
-    from ..dynamics.branch import open_branch
+    from ..dynamics.continuation.branch import open_branch
 
     try:
         return bool(open_branch(path).attrs.get("kind") == "boundary_curve")
@@ -261,7 +261,7 @@ def is_curve_file(path: Path) -> bool:
 def boundaries_figure(curves: list[Path], res: Any) -> Any:
     """The stability chart of ``plot MAP --boundaries CURVE.nc`` (``res`` the map's
     :class:`~gearchaos.sweep.SweepResult`) or of ``plot CURVE.nc`` alone (``res`` None)."""
-    from ..dynamics.curve_file import open_curve
+    from ..dynamics.curves.file import open_curve
     from ..plot import figure_for
 
     opened = [open_curve(p) for p in curves]

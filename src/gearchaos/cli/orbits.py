@@ -14,9 +14,9 @@ from rich.markup import escape
 from rich.table import Table
 from rich.text import Text
 
-from ..dynamics.coexistence import ATTRACTOR_SETTINGS
-from ..dynamics.orbits import ORBIT_SETTINGS
-from ..dynamics.stability import STABILITY_MARGIN
+from ..dynamics.attractors.coexistence import ATTRACTOR_SETTINGS
+from ..dynamics.orbits.orbit import ORBIT_SETTINGS
+from ..dynamics.orbits.stability import STABILITY_MARGIN
 from ..errors import IntegrationError, ParameterError
 from ..gearset.schema import OMEGA, SPEEDS
 from . import _common as c
@@ -140,7 +140,7 @@ def orbit(
 
     Example: **gearchaos orbit --set omega=1.5 --period 1**
     """
-    from ..dynamics.orbits import periodic_orbit
+    from ..dynamics.orbits.orbit import periodic_orbit
 
     with c.reported_errors():
         gs, values, start = _start_values(from_, at, target)
@@ -256,8 +256,8 @@ def continue_(
 
     Example: **gearchaos continue --vary omega=0.2:4 --set xi=0.03 -o branch.nc**
     """
-    from ..dynamics.arclength import continuation
-    from ..dynamics.branch import branch_summary
+    from ..dynamics.continuation.arclength import continuation
+    from ..dynamics.continuation.branch import branch_summary
 
     with c.reported_errors():
         if not vary or "=" not in vary:
@@ -289,7 +289,7 @@ def continue_(
         period = _period(period, start)
         first = None
         if start is not None:  # the orbit at the file's point: the branch starts there
-            from ..dynamics.orbits import periodic_orbit
+            from ..dynamics.orbits.orbit import periodic_orbit
             from ..model.record import parameter_value
 
             if name not in values:  # the start's own value of the continued parameter
@@ -364,7 +364,7 @@ def continue_(
 
 def _cascade_entry(branch: Any) -> dict[str, Any]:
     """The summary of one period-2n branch of a cascade, naming where it was born."""
-    from ..dynamics.branch import branch_summary
+    from ..dynamics.continuation.branch import branch_summary
 
     a = branch.attrs
     return {
@@ -450,7 +450,7 @@ def attractors(
     Example (a stable 1T orbit beside a chaotic attractor): **gearchaos attractors --set
     omega=1.5**
     """
-    from ..dynamics.coexistence import attractors as find
+    from ..dynamics.attractors.coexistence import attractors as find
 
     with c.reported_errors():
         gs, omega = c.point_target(target, output.json)

@@ -16,7 +16,7 @@ from .sweep import open_store
 def _is_branch(path: Path) -> bool:
     """Whether ``path`` names a branch file of `gearchaos continue` (netCDF, or a Zarr branch
     with its chunk manifest) rather than a sweep store."""
-    from ..dynamics.branch import MANIFEST
+    from ..dynamics.continuation.branch import MANIFEST
 
     if path.suffix.lower() in (".nc", ".nc4", ".h5"):
         return True
@@ -181,8 +181,8 @@ def plot(
         import matplotlib
 
         matplotlib.use("Agg")
-        from ..dynamics.cascade import open_cascade
-        from ..dynamics.curve_file import open_curve
+        from ..dynamics.continuation.cascade import open_cascade
+        from ..dynamics.curves.file import open_curve
         from ..plot import FigureOptions, figure_for, savefig
 
         options = FigureOptions(

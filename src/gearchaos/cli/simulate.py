@@ -74,7 +74,7 @@ def simulate(
         decided = verdict.decided()
         if directory is not None:
             directory.mkdir(parents=True, exist_ok=True)
-        from ..dynamics.point import analyse_point
+        from ..dynamics.verdict.point import analyse_point
 
         err = c.stderr()
         spinner: contextlib.AbstractContextManager[Any] = contextlib.nullcontext()

@@ -1,33 +1,35 @@
-"""What drives the integrator to decide a question about the motion.
+"""What drives the integrator to decide a question about the motion, by concept.
 
-:mod:`.lyapunov` (exponents from the variational equations), :mod:`.orbits` (periodic orbits
-by shooting, Floquet multipliers; :mod:`.shooting` the map evaluations and the Newton
-corrector, :mod:`.orbit_batch` many orbits in one Newton iteration, :mod:`.orbit_file` orbit
-files), :mod:`.arclength` (pseudo-arclength continuation of branches; :mod:`.branch_events`
-their folds, period doublings, Neimark–Sacker and grazing events, located by
-:mod:`.branch_locate`; :mod:`.branch` their datasets and files; :mod:`.boundary`
-two-parameter boundary curves of their events (:mod:`.curves` the method,
-:mod:`.curve_tests` test functions and codimension-2 points, :mod:`.curve_file` curve files).
+:mod:`.lyapunov` (exponents from the variational equations); :mod:`.orbits` (periodic orbits by
+shooting, Floquet multipliers, many orbits at once, orbit files); :mod:`.continuation`
+(pseudo-arclength continuation of branches, their events, cascades and branch files);
+:mod:`.curves` (two-parameter boundary curves of those events); :mod:`.verdict` (the one motion
+verdict — nT confirmed by shooting and Floquet multipliers, chaos and quasi-periodicity by a
+Lyapunov exponent with its error, transients finished by extending the run — used by
+``simulate``, sweeps, ``classify``, galleries, ``attractors``, the explorer, ``response`` and the
+reproduction report, and one operating point end to end); :mod:`.attractors` (coexisting
+attractors from several starts, and basins).
 
-:mod:`.verdict` — the one motion verdict (nT confirmed by shooting and Floquet multipliers,
-chaos and quasi-periodicity by a Lyapunov exponent with its error, transients finished by
-extending the run) used by ``simulate``, sweeps, ``classify``, galleries, ``attractors``, the
-explorer, ``response`` and the reproduction report; :mod:`.point` (one operating point end
-to end) and :mod:`.coexistence` (coexisting attractors from several starts) use it.
+The front doors :func:`gearchaos.continuation` and :func:`gearchaos.attractors` are the
+package's (``gearchaos.dynamics.continuation`` and ``gearchaos.dynamics.attractors`` are the
+subpackages that define them).
+
+The subpackages depend on each other in one direction: ``lyapunov → orbits → continuation →
+curves`` and ``orbits → verdict → attractors``.
 """
 
-from .arclength import continuation
-from .boundary import boundary_curve
-from .branch import branch_multipliers, branch_summary, open_branch, save_branch
-from .branch_events import Event, events
-from .coexistence import Attractor, attractors
-from .curve_file import open_curve
-from .evidence import EVIDENCE, Verdict
+from .attractors.coexistence import Attractor
+from .continuation.branch import branch_multipliers, branch_summary, open_branch, save_branch
+from .continuation.events import Event, events
+from .curves.boundary import boundary_curve
+from .curves.file import open_curve
 from .lyapunov import LyapunovResult, lyapunov_spectrum, max_lyapunov
-from .orbit_batch import periodic_orbits
-from .orbits import PeriodicOrbit, periodic_orbit
-from .point import PointAnalysis, analyse_point
-from .verdict import VerdictSettings, decide_motion
+from .orbits.batch import periodic_orbits
+from .orbits.orbit import PeriodicOrbit, periodic_orbit
+from .verdict.decide import decide_motion
+from .verdict.evidence import EVIDENCE, Verdict
+from .verdict.point import PointAnalysis, analyse_point
+from .verdict.settings import VerdictSettings
 
 __all__ = [
     "EVIDENCE",
@@ -39,11 +41,9 @@ __all__ = [
     "Verdict",
     "VerdictSettings",
     "analyse_point",
-    "attractors",
     "boundary_curve",
     "branch_multipliers",
     "branch_summary",
-    "continuation",
     "decide_motion",
     "events",
     "lyapunov_spectrum",

@@ -143,7 +143,7 @@ def lyapunov_spectrum(
         :class:`~gearchaos.model.System`; its forcing period T = 2π/Ω sets the
         renormalisation interval T / ``renormalizations_per_period``.
     settings, params, **values_and_settings
-        Parameter values by name, as for :func:`~gearchaos.dynamics.orbits.periodic_orbit`
+        Parameter values by name, as for :func:`~gearchaos.dynamics.orbits.orbit.periodic_orbit`
         (``omega=1.7``, ``xi=0.05``; dotted names in ``params={"backlash.sun_planet": 2}``),
         and :class:`~gearchaos.integrate.settings.SolverSettings` (default: 100 transient
         periods, 500 periods averaged over) and/or its fields by name: ``transient_periods``,

@@ -29,7 +29,7 @@ from bokeh.models.annotations import Span
 from bokeh.plotting import figure
 
 from ..analysis.summary import format_exponent
-from ..dynamics.curve_file import open_curve
+from ..dynamics.curves.file import open_curve
 from ..errors import ParameterError
 from ..model.loading import named_models
 from ..plot.regimes import REGIME_COLOURS

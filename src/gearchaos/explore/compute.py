@@ -2,8 +2,9 @@
 
 Both functions run in a worker process (the compiled kernels hold the GIL, so a thread would
 stall the web server) and return plain, picklable values: numbers, text and PNG bytes. They
-reuse the library's front doors — :func:`~gearchaos.dynamics.point.analyse_point` (simulation,
-λ₁ and the motion label), :func:`~gearchaos.dynamics.orbits.periodic_orbit` (Floquet
+reuse the library's front doors — :func:`~gearchaos.dynamics.verdict.point.analyse_point`
+(simulation,
+λ₁ and the motion label), :func:`~gearchaos.dynamics.orbits.orbit.periodic_orbit` (Floquet
 multipliers of an nT orbit), the plots of :mod:`gearchaos.plot` (phase portrait, time
 histories, spectrum with the mesh harmonics labelled) and :func:`~gearchaos.sweep.run_sweep`
 (a resumable sweep into a store).
@@ -83,7 +84,8 @@ def compute_point(
     The point is simulated from rest with the store's protocol (its transient, recorded
     periods and tolerances; :data:`POINT_SAMPLES` samples per forcing period T = 2π/Ω instead
     of one), as ``gearchaos simulate`` would, and its largest Lyapunov exponent λ₁ is
-    integrated with the same settings (:func:`~gearchaos.dynamics.point.analyse_point`). When
+    integrated with the same settings (:func:`~gearchaos.dynamics.verdict.point.analyse_point`).
+    When
     the motion is nT with n ≤ 8, the period-n orbit is found by shooting from the simulation
     and its Floquet multipliers μ (eigenvalues of the monodromy matrix) are returned.
 
@@ -114,7 +116,7 @@ def compute_point(
         ``(re, im)``, largest modulus first, or ``None``), ``orbit_note`` and ``png``
         (a 2×2 figure: phase portrait, X̄ and contact force against time, spectrum).
     """
-    from ..dynamics.point import analyse_point
+    from ..dynamics.verdict.point import analyse_point
     from ..model.loading import name_models
     from ..sweep.result import open_result
 
@@ -152,7 +154,7 @@ def _period(motion: Any) -> int | None:
 def _multipliers(
     target: Any, values: dict[str, float], settings: Any, n: int, guess: Any
 ) -> tuple[list[tuple[float, float]] | None, str]:
-    from ..dynamics.orbits import periodic_orbit
+    from ..dynamics.orbits.orbit import periodic_orbit
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

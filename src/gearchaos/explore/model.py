@@ -302,7 +302,7 @@ class ExploreModel:
     def evidence(self, point: Point) -> str:
         """What decided the stored label (the verdict's flag and max |μ|), or ``""`` for a
         store labelled from its records alone."""
-        from ..dynamics.evidence import EVIDENCE
+        from ..dynamics.verdict.evidence import EVIDENCE
 
         if "verdict" not in self.full.ds.data_vars:
             return ""

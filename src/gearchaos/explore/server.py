@@ -22,7 +22,7 @@ from typing import Any
 
 import panel as pn
 
-from ..dynamics.curve_file import open_curve
+from ..dynamics.curves.file import open_curve
 from ..sweep.result import open_result
 from .app import Explorer, Workers
 from .model import ExploreModel

@@ -395,7 +395,7 @@ _KINDS: dict[str, Any] = {
 
 
 #: The defaults of one simulation, the same from Python (:func:`gearchaos.simulate`,
-#: :func:`~gearchaos.dynamics.point.analyse_point`) and from ``gearchaos simulate``: the
+#: :func:`~gearchaos.dynamics.verdict.point.analyse_point`) and from ``gearchaos simulate``: the
 #: seed's protocol with 64 samples per mesh period (time histories, spectra, RMS values).
 SIMULATION = SolverSettings(samples_per_period=64)
 

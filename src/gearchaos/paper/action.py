@@ -95,7 +95,7 @@ def branch_action(
     ``{"change": max − min of max|μ| over both halves, "mu": [min, max], "events": count,
     "kinds": [...], "reached": [min, max] of the parameter, "reason": why none started, or
     ""}``."""
-    from ..dynamics.arclength import continuation
+    from ..dynamics.continuation.arclength import continuation
     from ..errors import IntegrationError, ParameterError
 
     steps, points = BRANCH_STEPS[bool(quick)]

@@ -173,7 +173,7 @@ def run_gallery(
         anything runs), ``param`` also among the fixed parameters, a parameter given twice, no
         Ω, or invalid ``with_``.
     """
-    from ..dynamics.point import analyse_point
+    from ..dynamics.verdict.point import analyse_point
     from ..model.target import resolve
     from ..plot import axis_symbol
     from ..plot.gallery import parse_extras, poincare_gallery

@@ -5,7 +5,7 @@ names (a figure's recipe at one family value, e.g. Fig. 4 at ξ = 0.03), one swe
 recipe's swept parameter (:func:`gearchaos.bifurcation`) with the report's protocol: the recipe's
 fixed values, the start at rest perturbed by the default 10⁻⁶ (:class:`SolverSettings`), 100
 transient and 100 recorded periods, the default tolerances, λ₁ on and every point decided by
-the motion verdict (:mod:`gearchaos.dynamics.verdict`). Every landmark is checked with
+the motion verdict (:mod:`gearchaos.dynamics.verdict.decide`). Every landmark is checked with
 :func:`gearchaos.paper.landmarks.evaluate` (the report's tolerances); the landmarks that name a
 bifurcation are then scored from the events of continued branches of their panel
 (:func:`~gearchaos.paper.routes.follow_branches`,

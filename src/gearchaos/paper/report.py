@@ -15,7 +15,7 @@ Every landmark row also says whether the swept parameter acts on its panel
 seed's own protocol says (:mod:`.accounting`: the same sweep from the exact zero start with
 labels from the record alone, ``paper_protocol``).
 
-Motion labels are the motion verdict of every point (:mod:`gearchaos.dynamics.verdict`):
+Motion labels are the motion verdict of every point (:mod:`gearchaos.dynamics.verdict.decide`):
 periodic labels confirmed by shooting with their Floquet multipliers, chaos and QP from λ₁ with
 its standard error over an extension of the run, transients finished.
 

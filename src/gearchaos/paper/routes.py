@@ -214,7 +214,8 @@ def follow_branches(
     """Continue the branches of one panel: from the middle of every 1T (and 3T) stretch of the
     sweep's labels, in both directions to the ends of the swept range, each with its
     period-doubling cascade (``continuation(..., cascade=depth)``,
-    :mod:`gearchaos.dynamics.cascade`: at every period doubling of a branch that is stable on
+    :mod:`gearchaos.dynamics.continuation.cascade`: at every period doubling of a branch that is
+    stable on
     one side of it — the attractor doubles — the period-2n branch, over the whole swept range)
     up to period ``max_period``, at most ``max_branches`` branches in all (breadth first within
     a cascade), each of at most ``max_points`` points. ``steps`` sets the largest step
@@ -224,8 +225,8 @@ def follow_branches(
 
     Returns the branch datasets (:func:`gearchaos.continuation`).
     """
-    from ..dynamics.arclength import continuation
-    from ..dynamics.cascade import open_cascade
+    from ..dynamics.continuation.arclength import continuation
+    from ..dynamics.continuation.cascade import open_cascade
     from ..errors import IntegrationError, ParameterError
 
     xs = np.asarray(x, dtype=float)

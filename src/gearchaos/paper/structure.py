@@ -106,7 +106,7 @@ def multiplier_change(
     ``hi`` when no orbit starts there): ``{"change": max − min of max|μ|, "events": count,
     "kinds": [...], "from": start, "reached": [min, max] of the parameter, "reason": why it
     failed, or ""}``."""
-    from ..dynamics.arclength import continuation
+    from ..dynamics.continuation.arclength import continuation
     from ..errors import IntegrationError, ParameterError
 
     span = hi - lo

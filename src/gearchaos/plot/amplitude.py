@@ -176,7 +176,7 @@ def amplitude_figure(
         bifurcation sweep) with the extrema of ``var``.
     branches
         Continued branches of the swept parameter (:func:`gearchaos.continuation`,
-        :func:`gearchaos.dynamics.cascade.open_cascade`).
+        :func:`gearchaos.dynamics.continuation.cascade.open_cascade`).
     var, planet
         The deflection (default ``delta_sp``; ``x`` for the backlash oscillator) and planet;
         with ``quantity="force_peak"``, the deflection of the mesh whose force is drawn

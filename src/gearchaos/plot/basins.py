@@ -120,7 +120,7 @@ def _catalogue(ds: Any, group: int = 0) -> list[dict[str, Any]]:
 
 
 def _legend_text(e: dict[str, Any], name: str, column: int) -> str:
-    from ..dynamics.basins import BasinAttractor
+    from ..dynamics.attractors.basins import BasinAttractor
 
     return BasinAttractor.from_record(e).legend(name, column, fmt)
 

@@ -4,7 +4,8 @@ At every value of one parameter, ``starts`` random initial states (the same seed
 draws at every value: common random numbers, so differences between values are not sampling
 noise of different draws) are labelled by the attractor they reach exactly as the starts of a
 basin image are (:mod:`gearchaos.sweep.basins`); attractors of neighbouring values are linked
-into tracks (:func:`~gearchaos.dynamics.basins.link_tracks`), and :func:`fractions` gives the
+into tracks (:func:`~gearchaos.dynamics.attractors.basins.link_tracks`), and :func:`fractions`
+gives the
 share of starts on each track with its Wilson confidence interval
 (:func:`~gearchaos.analysis.fractions.wilson_interval`): "how likely is rattle at this speed".
 """
@@ -20,8 +21,8 @@ from typing import Any
 import numpy as np
 
 from .._checks import check_bool, check_int, check_real
-from ..dynamics.basins import FAILED
-from ..dynamics.verdict import CONFIRM_PERIODS
+from ..dynamics.attractors.basins import FAILED
+from ..dynamics.verdict.decide import CONFIRM_PERIODS
 from ..errors import ParameterError
 from ..integrate.settings import SolverSettings
 from ..model.target import resolve
@@ -117,7 +118,8 @@ def basin_fractions(
     ``base_state``; None: every state in mid ± 2·range of the motion from rest there), with
     the same seeded draws at every value. Each start is labelled as in :func:`basins`;
     attractors of neighbouring values are linked into tracks
-    (:func:`~gearchaos.dynamics.basins.link_tracks`). Other arguments as for :func:`basins`
+    (:func:`~gearchaos.dynamics.attractors.basins.link_tracks`). Other arguments as for
+    :func:`basins`
     (``confirm_periods``: the last window that confirms a chaotic or QP attractor, default
     2000, stored in the ``confirm_periods`` attribute).
 
@@ -222,7 +224,7 @@ def fractions(ds: Any, *, confidence: float = 0.95) -> Any:
         for c, t in enumerate(row):
             present[p, col[t]] = True
             if t not in found:
-                from ..dynamics.basins import BasinAttractor
+                from ..dynamics.attractors.basins import BasinAttractor
 
                 e = BasinAttractor.from_record(cats[str(p)]["entries"][c])
                 where = e.section_states[0, 0] if e.period else np.median(e.section_states[:, 0])

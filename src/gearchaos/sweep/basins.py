@@ -8,9 +8,10 @@ starts in a box of initial states at every value of a parameter and estimates th
 ending on each attractor with its Wilson confidence interval
 (:mod:`gearchaos.sweep.basin_fractions`).
 
-How a start is labelled (:mod:`gearchaos.dynamics.basins`): an attractor catalogue is built
+How a start is labelled (:mod:`gearchaos.dynamics.attractors.basins`): an attractor catalogue is
+built
 from a seeded sample of ``sample`` starts of the operating point by
-:func:`~gearchaos.dynamics.coexistence.attractors` (each attractor decided by the motion
+:func:`~gearchaos.dynamics.attractors.coexistence.attractors` (each attractor decided by the motion
 verdict: orbits confirmed by shooting with their multipliers, chaos by λ₁ ± its error); every
 start's record is matched against it, and only the starts that match nothing get the verdict
 (the catalogue grows by the attractors they find).
@@ -36,8 +37,14 @@ import numpy as np
 
 from .._checks import check_bool, check_int, check_memory, check_real
 from .._version import provenance
-from ..dynamics.basins import FAILED, Catalogue, catalogue_from_sample, identify, link_tracks
-from ..dynamics.verdict import CONFIRM_PERIODS, confirmed_settings
+from ..dynamics.attractors.basins import (
+    FAILED,
+    Catalogue,
+    catalogue_from_sample,
+    identify,
+    link_tracks,
+)
+from ..dynamics.verdict.decide import CONFIRM_PERIODS, confirmed_settings
 from ..errors import ParameterError, Status, StoreError
 from ..integrate._chains import ChainRun
 from ..integrate.interface import Info
@@ -508,11 +515,12 @@ def basins(
         Starts (drawn with ``seed`` from the image) from which the attractor catalogue is
         built before the image is matched against it.
     tol, spread_fraction
-        The matching rules (:mod:`gearchaos.dynamics.basins`).
+        The matching rules (:mod:`gearchaos.dynamics.attractors.basins`).
     confirm_periods
         A chaotic or quasi-periodic attractor is catalogued only after a last window of at
         least this many periods confirms it (default 2000, as for
-        :func:`~gearchaos.dynamics.coexistence.attractors`): a chaotic transient that ends on
+        :func:`~gearchaos.dynamics.attractors.coexistence.attractors`): a chaotic transient that
+        ends on
         an orbit within it is that orbit's start. Stored in the ``confirm_periods`` attribute
         (and ``basin_spec``).
     chunk_points

@@ -67,7 +67,7 @@ def _refuse(path: str, what: str, hint: str) -> StoreError:
 def result_kind(ds: Any) -> str:
     """The kind of a result dataset (a key of :data:`KINDS`); a branch, a boundary curve, an
     orbit or anything else raises :class:`~gearchaos.errors.StoreError` saying what it is."""
-    from ..dynamics.orbit_file import ORBIT_TITLE
+    from ..dynamics.orbits.file import ORBIT_TITLE
     from ..integrate.result import SIMULATION_TITLE
     from ._basin_store import KINDS as BASIN_KINDS
 
@@ -132,7 +132,7 @@ def _open_store(path: str) -> Any:
 
 
 def _open_file(path: str) -> Any:
-    from ..dynamics.orbit_file import ORBIT_TITLE
+    from ..dynamics.orbits.file import ORBIT_TITLE
     from ..integrate.result import SIMULATION_TITLE
 
     name, ds = load_netcdf(path, what="result file")

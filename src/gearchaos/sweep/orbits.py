@@ -77,7 +77,7 @@ def orbit_checks(
     dict of numpy.ndarray
         ``orbit_residual``, ``orbit_max_multiplier``, ``orbit_period``, ``orbit_status`` (K,).
     """
-    from ..dynamics.orbit_batch import periodic_orbits
+    from ..dynamics.orbits.batch import periodic_orbits
 
     K = len(points)
     out = empty((K,))

@@ -289,7 +289,7 @@ class SweepSpec:
         final state, and store its residual, largest multiplier modulus and a status flag
         (:mod:`gearchaos.sweep.orbits`).
     verdicts
-        Decide every point's motion with the verdict (:mod:`gearchaos.dynamics.verdict`):
+        Decide every point's motion with the verdict (:mod:`gearchaos.dynamics.verdict.decide`):
         nT confirmed by shooting, chaos and QP by λ₁ ± its error, transients finished by
         extending the run (the stored section record is then the finished one). False
         labels the points from their records alone (faster, heuristic).

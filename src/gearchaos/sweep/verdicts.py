@@ -1,10 +1,11 @@
 """The motion verdict of every sweep point (``verdicts=True``, the default).
 
-Each task decides its points with :func:`gearchaos.dynamics.verdict.decide_motion` right after
+Each task decides its points with :func:`gearchaos.dynamics.verdict.decide.decide_motion` right
+after
 integrating them (in the worker, all points of a period together), and writes per point
 
 * ``motion`` — the label (1T … nT, QP, chaos, unresolved, failed);
-* ``verdict`` — what decided it, a flag (:data:`~gearchaos.dynamics.verdict.EVIDENCE`);
+* ``verdict`` — what decided it, a flag (:data:`~gearchaos.dynamics.verdict.decide.EVIDENCE`);
 * ``max_multiplier`` — max |μ| of the orbit that confirmed an nT label, or of the unstable
   orbit the motion stayed near (NaN otherwise);
 * ``lle`` and ``lle_error`` — λ₁ per unit τ and its standard error (exact, error 0, for a
@@ -18,7 +19,8 @@ integrating them (in the worker, all points of a period together), and writes pe
   record brought onto the orbit it approached); ``orbit`` marks stores of earlier versions,
   which showed a confirmed orbit's own points.
 
-Each variable holds one attribute of the point's :class:`~gearchaos.dynamics.evidence.Verdict`;
+Each variable holds one attribute of the point's
+:class:`~gearchaos.dynamics.verdict.evidence.Verdict`;
 :data:`VERDICT_COLUMNS` is the one table of them (attribute, long name, element type, fill
 value, flag legend), and :data:`NOT_STORED` names the verdict's fields no variable holds and
 why, so a new field of the verdict is either stored or said not to be.
@@ -40,9 +42,9 @@ from typing import Any
 import numpy as np
 
 from ..analysis.motion import LABEL_DTYPE, UNSET_TEXT
-from ..dynamics.evidence import EVIDENCE
-from ..dynamics.extension import RECORD_SOURCES
-from ..dynamics.verdict import VerdictSettings, decide_motion
+from ..dynamics.verdict.decide import VerdictSettings, decide_motion
+from ..dynamics.verdict.evidence import EVIDENCE
+from ..dynamics.verdict.extension import RECORD_SOURCES
 
 __all__ = [
     "NOT_STORED",
@@ -62,7 +64,7 @@ class VerdictColumn:
     Attributes
     ----------
     source
-        The :class:`~gearchaos.dynamics.evidence.Verdict` attribute (a field, or a property
+        The :class:`~gearchaos.dynamics.verdict.evidence.Verdict` attribute (a field, or a property
         of its fields) the variable holds.
     long_name, dtype, fill
         The variable's ``long_name``, element type and fill value (the value of a point not

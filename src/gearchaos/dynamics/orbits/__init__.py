@@ -1,0 +1,12 @@
+"""Periodic orbits: shooting on the stroboscopic map and their Floquet multipliers.
+
+:mod:`.shooting` (map evaluations, sample times and the one Newton corrector), :mod:`.orbit`
+(:func:`periodic_orbit` and :class:`PeriodicOrbit`), :mod:`.batch` (many orbits in one compiled
+call per Newton iteration), :mod:`.stability` (one stability criterion) and :mod:`.file` (orbit
+files).
+"""
+
+from .batch import periodic_orbits
+from .orbit import PeriodicOrbit, periodic_orbit
+
+__all__ = ["PeriodicOrbit", "periodic_orbit", "periodic_orbits"]
