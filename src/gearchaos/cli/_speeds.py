@@ -10,7 +10,7 @@ from typing import Any
 
 from ..errors import ParameterError
 from ..gearset.schema import SPEEDS
-from ..model.target import OMEGA
+from ..model.target import OMEGA, Target
 
 __all__ = [
     "one_point",
@@ -46,7 +46,7 @@ def without_speeds(changes: Mapping[str, object]) -> dict[str, object]:
 
 
 def point_omega(
-    target: Any,
+    target: Target,
     omega: float | None,
     changes: Mapping[str, object],
     pending: Mapping[str, Any] | None = None,
@@ -64,7 +64,7 @@ def point_omega(
     return operating_omega(target, {**rest, **speeds})[0]
 
 
-def speeds_per_omega(target: Any, values: Mapping[str, Any] | None = None) -> dict[str, float]:
+def speeds_per_omega(target: Target, values: Mapping[str, Any] | None = None) -> dict[str, float]:
     """The speeds (``sun_rpm``, ``mesh_hz``) per unit Ω of ``target`` with the parameter
     ``values`` (Ω and speeds among them ignored); ``{}`` for a model without a gear set."""
     from ..model.target import model_for, speeds_at
@@ -73,7 +73,7 @@ def speeds_per_omega(target: Any, values: Mapping[str, Any] | None = None) -> di
     return speeds_at(model_for(target, rest), 1.0)
 
 
-def speed_note(target: Any, omega: float, values: Mapping[str, Any] | None = None) -> str:
+def speed_note(target: Target, omega: float, values: Mapping[str, Any] | None = None) -> str:
     """`` (n_s = 7500 rpm, f_m = 3078 Hz)`` at Ω for a model built from a gear set (with the
     parameter ``values``), else ``""``: the speeds that a line showing Ω writes beside it."""
     per = speeds_per_omega(target, values)
@@ -82,7 +82,7 @@ def speed_note(target: Any, omega: float, values: Mapping[str, Any] | None = Non
     return f" (n_s = {omega * per['sun_rpm']:.5g} rpm, f_m = {omega * per['mesh_hz']:.5g} Hz)"
 
 
-def speed_range(target: Any, vary: str, values: Mapping[str, Any]) -> str:
+def speed_range(target: Target, vary: str, values: Mapping[str, Any]) -> str:
     """``omega=A:B`` for a continuation over a speed (``sun_rpm=2000:9000``): its ends
     converted through ``target`` with the fixed ``values`` (Ω among them dropped), so the
     branch, its file and its figure are in Ω like every other one; tables write the speeds

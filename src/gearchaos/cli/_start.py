@@ -20,6 +20,7 @@ from .._checks import check_int, check_real
 from .._text import escape_path, escape_text
 from ..analysis.motion import Motion
 from ..errors import ParameterError, StoreError
+from ..model.target import Target
 
 OMEGA = "omega"
 DIRECTION = "direction"
@@ -258,7 +259,7 @@ def _fixed(attrs: Any, path: str) -> dict[str, Any]:
     return values
 
 
-def _state(values: Any, path: str, target: Any, params: dict[str, Any], what: str) -> np.ndarray:
+def _state(values: Any, path: str, target: Target, params: dict[str, Any], what: str) -> np.ndarray:
     """The state ``values`` (the file's ``what``) as a vector of the states of the model at the
     recorded parameter values ``params``: the values, the state's length and its finiteness
     are the file's, checked before any shooting starts from it."""

@@ -25,6 +25,7 @@ import numpy as np
 from ..analysis.motion import Motion
 from ..errors import ParameterError, StoreError
 from ..gearset.schema import OMEGA
+from ..model.target import Target
 
 __all__ = ["POINT_SAMPLES", "compute_point", "point_target", "run_zoom"]
 
@@ -152,7 +153,7 @@ def _period(motion: Any) -> int | None:
 
 
 def _multipliers(
-    target: Any, values: dict[str, float], settings: Any, n: int, guess: Any
+    target: Target, values: dict[str, float], settings: Any, n: int, guess: Any
 ) -> tuple[list[tuple[float, float]] | None, str]:
     from ..dynamics.orbits.orbit import periodic_orbit
 

@@ -21,6 +21,7 @@ import numpy as np
 
 from .._checks import check_choice, check_int, check_memory, check_real
 from ..errors import ParameterError
+from ..model.target import Target
 
 __all__ = [
     "PERTURBATION",
@@ -408,7 +409,7 @@ def split_keywords(
     default: SolverSettings,
     *,
     door: Any = "",
-    target: Any = None,
+    target: Target | None = None,
     options: Iterable[str] = (),
 ) -> tuple[dict[str, Any], SolverSettings]:
     """The one keyword vocabulary of the front doors (``simulate``, ``bifurcation``,
@@ -461,7 +462,7 @@ def check_params(keyword: str, params: Any) -> Any:
     return params
 
 
-def check_keyword(door: str, target: Any, key: str, options: Iterable[str]) -> None:
+def check_keyword(door: str, target: Target, key: str, options: Iterable[str]) -> None:
     """Refuse ``key``, given to ``door`` by name, unless it is a parameter of ``target``: the
     refusal names the closest of ``options`` (the door's other keywords) and the target's
     parameters whose names are Python identifiers."""

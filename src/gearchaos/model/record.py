@@ -147,7 +147,7 @@ def model_title(model: Any) -> tuple[str, str]:
     return ("gear set", name)
 
 
-def parameter_value(target: Any, name: str) -> float:
+def parameter_value(target: Target, name: str) -> float:
     """The current value of the numeric parameter ``name`` of ``target``: a gear set's by its
     dotted name (``gs["backlash.sun_planet"]``), a :class:`~gearchaos.model.System`'s the field
     of its model, or its Ω. A gear set has no Ω of its own, and a parameter that is not a
@@ -171,7 +171,7 @@ def parameter_value(target: Any, name: str) -> float:
     return float(value)
 
 
-def with_values(target: Any, changes: Any) -> Any:
+def with_values(target: Target, changes: Any) -> Any:
     """``target`` with the parameter ``changes`` (no Ω) applied, of the same kind: a gear set
     evolved by dotted name, a :class:`~gearchaos.model.System` whose model has the changed
     fields (at the same Ω). Unknown names are refused

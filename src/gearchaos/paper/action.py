@@ -43,6 +43,7 @@ from typing import Any
 
 import numpy as np
 
+from ..model.target import Target
 from .evidence import clearance_reach, panels
 from .landmark_data import AxisAction, Landmark, LandmarkResult, recipe_for
 from .structure import MU_CHANGE
@@ -81,7 +82,7 @@ _CLEARANCES = (*_BACKLASHES, "clearance.sun_bearing")
 
 
 def branch_action(
-    target: Any,
+    target: Target,
     axis: str,
     lo: float,
     hi: float,
@@ -185,7 +186,7 @@ def _event_text(rows: Sequence[Mapping[str, Any]]) -> str:
 
 
 def panel_action(
-    target: Any,
+    target: Target,
     recipe: str,
     family_value: float | None,
     ds: Any = None,
@@ -217,7 +218,7 @@ def panel_action(
 
 
 def axis_action(
-    target: Any,
+    target: Target,
     axis: str,
     lo: float,
     hi: float,
@@ -299,7 +300,7 @@ def _panel_key(mark: Landmark) -> tuple[str, float | None]:
 
 
 def landmark_actions(
-    target: Any,
+    target: Target,
     landmarks: Iterable[Landmark],
     stores: Mapping[str, Any],
     *,

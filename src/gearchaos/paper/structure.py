@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from ..analysis.motion import Motion, MotionKind
+from ..model.target import Target
 
 __all__ = [
     "BACKLASH_AXES",
@@ -100,7 +101,7 @@ def branch_score(change: float, events: int) -> float:
 
 
 def multiplier_change(
-    target: Any, axis: str, lo: float, hi: float, fixed: Mapping[str, Any], settings: Any = None
+    target: Target, axis: str, lo: float, hi: float, fixed: Mapping[str, Any], settings: Any = None
 ) -> dict[str, Any]:
     """The period-1 branch over ``axis`` ∈ [lo, hi] at ``fixed``, continued from ``lo`` (from
     ``hi`` when no orbit starts there): ``{"change": max − min of max|μ|, "events": count,
@@ -151,7 +152,7 @@ def multiplier_change(
 
 
 def structure_term(
-    target: Any, stores: Mapping[str, Any], settings: Any = None
+    target: Target, stores: Mapping[str, Any], settings: Any = None
 ) -> tuple[float, dict[str, Any]]:
     """(structure in [0, 1], its parts) of gear set ``target`` whose objective sweeps are
     ``stores`` (see the module docstring)."""

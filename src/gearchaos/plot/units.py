@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from ..gearset.schema import MODULE_BOUNDED, OMEGA
+from ..model.target import Target
 from ._common import axis_symbol, fmt
 
 __all__ = [
@@ -105,7 +106,7 @@ class PhysicalScales:
 
     @classmethod
     def over(
-        cls, target: Any, ranges: Mapping[str, Any], fixed: Mapping[str, Any] | None = None
+        cls, target: Target, ranges: Mapping[str, Any], fixed: Mapping[str, Any] | None = None
     ) -> PhysicalScales:
         """The scales of ``target`` (a gear set or a :class:`~gearchaos.model.System`) with
         the ``fixed`` values, where parameters take the values ``ranges`` (name → values): a

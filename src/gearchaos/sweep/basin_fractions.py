@@ -25,7 +25,7 @@ from ..dynamics.attractors.basins import FAILED
 from ..dynamics.verdict.decide import CONFIRM_PERIODS
 from ..errors import ParameterError
 from ..integrate.settings import SolverSettings
-from ..model.target import resolve
+from ..model.target import Target, resolve
 from .basins import (
     _base_state,
     _Job,
@@ -41,7 +41,7 @@ __all__ = ["basin_fractions", "fractions"]
 
 
 def _box_starts(
-    target: Any,
+    target: Target,
     values: list[dict[str, Any]],
     box: Any,
     base_state: Any,
@@ -91,7 +91,7 @@ def _box_starts(
 
 
 def basin_fractions(
-    target: Any,
+    target: Target,
     vary: Any,
     *,
     starts: int = 200,

@@ -27,7 +27,7 @@ from ..dynamics.lyapunov import random_tangents
 from ..errors import ParameterError
 from ..integrate._chains import ChainRun
 from ..model.system import System
-from ..model.target import OMEGA, check_names, model_for, split_omega
+from ..model.target import OMEGA, Target, check_names, model_for, split_omega
 from .spec import SweepSpec
 
 __all__ = ["Grid", "Task"]
@@ -64,7 +64,7 @@ class Task:
 class Grid:
     """Maps grid indices to systems and lays out tasks for a spec and a target."""
 
-    def __init__(self, target: Any, spec: SweepSpec, *, chunk_points: int | None = None):
+    def __init__(self, target: Target, spec: SweepSpec, *, chunk_points: int | None = None):
         self.spec = spec
         self.target = target
         self.fixed = dict(spec.fixed)

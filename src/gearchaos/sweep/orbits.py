@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from ..integrate.settings import SolverSettings
+from ..model.target import Target
 from .classify import label_periods
 from .variables import ORBIT_STATUS, ORBIT_VARIABLES
 
@@ -46,7 +47,7 @@ def empty(shape: tuple[int, ...]) -> dict[str, np.ndarray]:
 
 
 def orbit_checks(
-    target: Any,
+    target: Target,
     points: Sequence[Mapping[str, Any]],
     periods: Sequence[int] | np.ndarray,
     final_states: np.ndarray,

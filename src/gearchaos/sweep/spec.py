@@ -33,7 +33,7 @@ import numpy as np
 from .._checks import check_bool, check_choice, check_int
 from ..errors import ParameterError, StoreError
 from ..integrate.settings import SolverSettings, check_keyword, check_params, renamed_keyword
-from ..model.target import OMEGA, check_omega
+from ..model.target import OMEGA, Target, check_omega
 from .execute import EXECUTION_OPTIONS
 
 __all__ = ["Axis", "SweepSpec", "parse_axis", "parse_values"]
@@ -220,7 +220,7 @@ SPEC_OPTIONS = (
 
 
 def sweep_keywords(
-    door: str, target: Any, keywords: Mapping[str, Any], params: Any
+    door: str, target: Target, keywords: Mapping[str, Any], params: Any
 ) -> tuple[dict[str, Any], dict[str, Any]]:
     """A sweep door's keywords in the front doors' vocabulary
     (:func:`~gearchaos.integrate.settings.split_keywords`): the parameter values — ``params``

@@ -29,6 +29,7 @@ from ..errors import ParameterError
 from ..gearset.schema import SPEEDS
 from ..model.target import (
     OMEGA,
+    Target,
     check_one_operating_point,
     model_for,
     resolve,
@@ -45,7 +46,7 @@ __all__ = ["given_speed", "omega_spec", "speed_coords"]
 _SAME = 1e-12
 
 
-def _moving(target: Any, spec: SweepSpec, changes: dict[str, Any]) -> str | None:
+def _moving(target: Target, spec: SweepSpec, changes: dict[str, Any]) -> str | None:
     """The first swept parameter along which the speeds per unit Ω change (ω_n along a mesh
     stiffness, a tooth number …), or None; every value of every axis is checked."""
     base = speeds_at(model_for(target, changes), 1.0)
@@ -59,7 +60,7 @@ def _moving(target: Any, spec: SweepSpec, changes: dict[str, Any]) -> str | None
     return None
 
 
-def given_speed(target: Any, spec: SweepSpec) -> str | None:
+def given_speed(target: Target, spec: SweepSpec) -> str | None:
     """The speed (``sun_rpm`` or ``mesh_hz``) by which ``spec`` gives its operating point,
     swept or fixed; ``None`` when it gives Ω (or nothing). Ω given twice is refused."""
     names = [a.name for a in spec.axes] + [k for k, _ in spec.fixed]
@@ -68,7 +69,7 @@ def given_speed(target: Any, spec: SweepSpec) -> str | None:
     return speeds[0] if speeds else None
 
 
-def omega_spec(target: Any, spec: SweepSpec) -> SweepSpec:
+def omega_spec(target: Target, spec: SweepSpec) -> SweepSpec:
     """``spec`` with its speed (a ``sun_rpm`` or ``mesh_hz`` axis or fixed value) replaced by
     Ω, converted through the gear set with the fixed values applied; ``spec`` itself when it
     gives Ω. Refused: Ω and a speed together, a target without a gear set, a swept parameter
@@ -107,7 +108,7 @@ def omega_spec(target: Any, spec: SweepSpec) -> SweepSpec:
 
 
 def speed_coords(
-    target: Any, spec: SweepSpec, speed: str | None, omega: float | None = None
+    target: Target, spec: SweepSpec, speed: str | None, omega: float | None = None
 ) -> tuple[dict[str, tuple[tuple[str, ...], np.ndarray]], dict[str, float]]:
     """The speeds the store of a sweep given by the speed ``speed`` (:func:`given_speed`)
     records beside Ω (``spec`` gives Ω: :func:`omega_spec`): coordinates ``sun_rpm`` and

@@ -46,6 +46,7 @@ from ..._checks import check_int, check_real
 from ...analysis.motion import Motion
 from ...errors import ParameterError
 from ...integrate.settings import SolverSettings
+from ...model.target import Target
 from ..verdict.decide import CONFIRM_PERIODS, VerdictSettings, confirmed_settings, decide_motion
 
 __all__ = [
@@ -309,7 +310,7 @@ class Catalogue:
 
 
 def catalogue_from_sample(
-    target: Any,
+    target: Target,
     values: Mapping[str, Any],
     starts: np.ndarray,
     settings: SolverSettings,
@@ -374,7 +375,7 @@ def catalogue_from_sample(
 
 def identify(
     catalogue: Catalogue,
-    target: Any,
+    target: Target,
     values: Mapping[str, Any],
     system: Any,
     settings: SolverSettings,

@@ -38,7 +38,7 @@ from ...analysis.motion import Motion
 from ...errors import ParameterError
 from ...integrate._chains import ChainRun, run_chains
 from ...integrate.settings import SolverSettings, split_keywords
-from ...model.target import resolve
+from ...model.target import Target, resolve
 from ..orbits.orbit import PeriodicOrbit
 from ..verdict.decide import CONFIRM_PERIODS, confirmed_settings, decide_motion
 from ..verdict.evidence import Verdict
@@ -198,7 +198,7 @@ def _same_set(a: np.ndarray, b: np.ndarray, fraction: float) -> bool:
 
 
 def attractors(
-    target: Any,
+    target: Target,
     *,
     starts: int = 8,
     seed: int = 0,

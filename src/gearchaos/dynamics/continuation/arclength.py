@@ -46,7 +46,7 @@ from ..._checks import check_bool, check_int, check_real, got
 from ...errors import IntegrationError, ParameterError
 from ...integrate.settings import SolverSettings, split_keywords
 from ...model.system import System
-from ...model.target import OMEGA, resolve
+from ...model.target import OMEGA, Target, resolve
 from ..orbits.orbit import (
     ORBIT_SETTINGS,
     PeriodicOrbit,
@@ -134,7 +134,7 @@ class _Branch:
 
     def __init__(
         self,
-        target: Any,
+        target: Target,
         name: str,
         fixed: dict[str, Any],
         cfg: SolverSettings,
@@ -336,7 +336,7 @@ class _Branch:
 
 # ------------------------------------------------------------------------------ front door
 def continuation(
-    target: Any,
+    target: Target,
     vary: Any,
     *,
     period: int | None = None,

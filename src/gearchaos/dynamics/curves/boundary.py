@@ -21,6 +21,7 @@ from ..._checks import check_bool, check_int, check_real
 from ...errors import IntegrationError, ParameterError, StoreError
 from ...integrate.settings import SolverSettings, split_keywords
 from ...model.record import parameter_value
+from ...model.target import Target
 from ..continuation import events as ev
 from ..continuation.arclength import parse_vary
 from ..orbits.orbit import ORBIT_SETTINGS, check_tol, contact_levels
@@ -33,7 +34,7 @@ __all__ = ["boundary_curve"]
 
 
 def boundary_curve(
-    target: Any,
+    target: Target,
     event: ev.Event,
     vary: Any,
     *,

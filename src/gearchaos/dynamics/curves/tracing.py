@@ -54,7 +54,7 @@ import numpy as np
 from ...errors import ParameterError
 from ...integrate.settings import SolverSettings
 from ...model.system import System
-from ...model.target import resolve
+from ...model.target import Target, resolve
 from ..continuation import events as ev
 from ..orbits.orbit import contact_levels
 from ..orbits.shooting import Shot, multipliers_of, newton_step, residual_of, shoot
@@ -111,7 +111,7 @@ class Curve:
 
     def __init__(
         self,
-        target: Any,
+        target: Target,
         names: tuple[str, str],
         fixed: dict[str, Any],
         cfg: SolverSettings,

@@ -22,7 +22,7 @@ from ..._checks import check_int, check_real
 from ...errors import ParameterError
 from ...integrate._chains import ChainRun, run_chains
 from ...integrate.settings import SolverSettings
-from ...model.target import resolve
+from ...model.target import Target, resolve
 from .orbit import ORBIT_SETTINGS, PeriodicOrbit, default_tol, orbit_from
 from .shooting import (
     TRUST_RADIUS,
@@ -52,7 +52,7 @@ def _guesses(systems: list[Any], n: int, cfg: SolverSettings) -> np.ndarray:
 
 
 def periodic_orbits(
-    target: Any,
+    target: Target,
     points: Sequence[Mapping[str, Any]],
     *,
     period: int = 1,

@@ -55,6 +55,7 @@ from ...analysis.recurrence import converging_period, near_period, noise_floor
 from ...errors import ParameterError
 from ...integrate.settings import SolverSettings
 from ...model.system import System
+from ...model.target import Target
 from ..lyapunov import exponent_estimate
 from .evidence import Verdict
 from .extension import VerdictRecord, extend
@@ -241,7 +242,7 @@ def _judge(
 
 
 def decide_motion(
-    target: Any,
+    target: Target,
     values: Sequence[Mapping[str, Any]],
     systems: Sequence[System],
     sections: np.ndarray,

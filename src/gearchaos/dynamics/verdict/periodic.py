@@ -34,6 +34,7 @@ from ...analysis.recurrence import distance_to_orbit
 from ...errors import ParameterError
 from ...integrate.settings import SolverSettings
 from ...model.system import System
+from ...model.target import Target
 from ..orbits.shooting import multipliers_of, shoot
 from ..orbits.stability import stability_of, structural_multipliers
 from .evidence import Verdict
@@ -220,7 +221,7 @@ def _found(
 
 
 def shoot_candidates(
-    target: Any,
+    target: Target,
     values: Sequence[Mapping[str, Any]],
     systems: Sequence[System],
     starts: Mapping[int, np.ndarray],

@@ -26,7 +26,7 @@ from ...errors import ParameterError, Status
 from ...integrate.result import SimulationResult
 from ...integrate.settings import SIMULATION, SolverSettings
 from ...integrate.simulate import run_simulation
-from ...model.target import resolve
+from ...model.target import Target, resolve
 from ..lyapunov import lyapunov_spectrum
 from ..orbits.shooting import section_fraction
 from .decide import VerdictSettings, decide_motion
@@ -68,7 +68,7 @@ class PointAnalysis:
 
 
 def analyse_point(
-    target: Any,
+    target: Target,
     values: Mapping[str, Any] | None = None,
     settings: SolverSettings | None = None,
     *,
@@ -207,7 +207,7 @@ def _verdict_settings(verdict: Any) -> VerdictSettings | None:
 
 
 def point_verdict(
-    target: Any,
+    target: Target,
     values: Mapping[str, Any] | None,
     result: SimulationResult,
     verdict: VerdictSettings | None = None,
