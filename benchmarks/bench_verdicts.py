@@ -1,16 +1,17 @@
 """Benchmark (issue 22): what the motion verdict costs, and what it changes, on the seed's
 Fig. 4(a) sweep.
 
-Run as ``python benchmarks/bench_verdicts.py [--points 1000] [--baseline SRC] [--reproduce]``.
+Run as ``python benchmarks/bench_verdicts.py [--points 1000] [--preset NAME] [--baseline SRC]
+[--reproduce]``.
 
 With ``--baseline SRC`` (the ``src/`` of an earlier checkout, e.g. a ``git worktree`` of the
 commit before a change to the verdict) the same verdict sweep also runs there, in a child
 process, and the table of label changes from those verdicts to these is printed (issue 32:
 against the verdicts of before).
 
-The sweep: Ω ∈ [0.05, 4] in ``--points`` values, the default gear set ``sheng2016`` at
-ξ = 0.03, 100 transient + 100 recorded periods, in memory on all cores. Three sweeps in this
-one process, after a 4-point warm-up of each kind (compilation left out):
+The sweep: Ω ∈ [0.05, 4] in ``--points`` values, the gear set ``--preset`` (default
+``sheng2016``) at ξ = 0.03, 100 transient + 100 recorded periods, in memory on all cores. Three
+sweeps in this one process, after a 4-point warm-up of each kind (compilation left out):
 
 1. plain — ``verdicts=False``: labels from the record alone (the heuristic of old);
 2. Lyapunov — ``verdicts=False, lyapunov=True``: λ₁ of every point from the recorded run;
@@ -50,7 +51,7 @@ import numpy as np
 import gearchaos as gc
 from gearchaos import sweep
 spec = json.loads(sys.argv[1])
-gs = gc.preset("sheng2016")
+gs = gc.preset(spec["preset"])
 sweep.bifurcation(gs, "omega=0.05:4:4", params={"xi": 0.03}, progress=False)
 t = time.perf_counter()
 ds = sweep.bifurcation(gs, f"omega=0.05:4:{spec['points']}", params={"xi": 0.03}, progress=False)
@@ -60,8 +61,8 @@ print("RESULT" + json.dumps(out))
 """
 
 
-def _sweep(points: int, **options: object) -> tuple[float, object]:
-    gs = gc.preset("sheng2016")
+def _sweep(points: int, preset: str, **options: object) -> tuple[float, object]:
+    gs = gc.preset(preset)
     t = time.perf_counter()
     ds = sweep.bifurcation(
         gs, f"omega=0.05:4:{points}", params={"xi": 0.03}, progress=False, **options
@@ -74,13 +75,21 @@ def main() -> None:
     ap.add_argument("--points", type=int, default=1000)
     ap.add_argument("--reproduce", action="store_true", help="also time reproduce --all")
     ap.add_argument("--baseline", type=Path, help="src/ of an earlier checkout to compare")
+    ap.add_argument(
+        "--preset",
+        default="sheng2016",
+        help="built-in gear set (one the baseline also has, to compare with an earlier checkout)",
+    )
     a = ap.parse_args()
     for kw in ({"verdicts": False}, {"verdicts": False, "lyapunov": True}, {}):
-        _sweep(4, **kw)  # compile / load the cache
-    t_plain, plain = _sweep(a.points, verdicts=False)
-    t_lyap, _ = _sweep(a.points, verdicts=False, lyapunov=True)
-    t_verd, verd = _sweep(a.points)
-    print(f"Fig. 4(a) sweep: {a.points} Ω in [0.05, 4], ξ = 0.03, 100 + 100 periods, all cores")
+        _sweep(4, a.preset, **kw)  # compile / load the cache
+    t_plain, plain = _sweep(a.points, a.preset, verdicts=False)
+    t_lyap, _ = _sweep(a.points, a.preset, verdicts=False, lyapunov=True)
+    t_verd, verd = _sweep(a.points, a.preset)
+    print(
+        f"Fig. 4(a) sweep of {a.preset}: {a.points} Ω in [0.05, 4], ξ = 0.03, 100 + 100 periods, "
+        "all cores"
+    )
     print(f"  plain (record labels)   {t_plain:7.2f} s   1.00×")
     print(f"  with Lyapunov exponents {t_lyap:7.2f} s   {t_lyap / t_plain:.2f}×")
     print(f"  with verdicts           {t_verd:7.2f} s   {t_verd / t_plain:.2f}×  (goal ≤ 3×)")
@@ -109,8 +118,11 @@ def main() -> None:
     extra = np.asarray(verd.extra_periods.values).ravel()  # type: ignore[attr-defined]
     print(f"periods added per point: mean {extra.mean():.1f}, max {int(extra.max())}")
     if a.baseline is not None:
-        base = run_child(_BASELINE, {"points": a.points}, a.baseline.resolve())
-        print(f"\nbaseline verdict sweep ({a.baseline}): {base['seconds']:.2f} s")
+        base = run_child(_BASELINE, {"points": a.points, "preset": a.preset}, a.baseline.resolve())
+        print(
+            f"\nbaseline verdict sweep ({a.baseline}): {base['seconds']:.2f} s, "
+            f"this one / baseline {t_verd / base['seconds']:.3f}"
+        )
         changes = collections.Counter(zip(base["motion"], new, strict=True))
         print("label changes (earlier verdict → this verdict), counts:")
         for (o, n), c in sorted(changes.items(), key=lambda kv: -kv[1]):
