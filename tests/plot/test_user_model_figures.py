@@ -217,3 +217,32 @@ def test_spectrum_sidebands_come_from_the_model() -> None:
     plain = gc.simulate(System(TwoStageTrain(), 1.2), transient_periods=5, periods=8)
     ax = gc.plot.spectrum(plain, max_harmonic=3.0)
     assert not [ln for ln in ax.lines if ln.get_linestyle() == ":"]
+
+
+def test_time_axes_count_the_models_declared_period() -> None:
+    """A model whose forcing repeats after T = 5·2π/Ω (stages at Ω and 3Ω/5) is drawn in its
+    own periods: the time axis is τ/T, the section points fall on whole periods, and one
+    period lasts T/ω_0 = 5·2π/(Ω ω_0) on the axis in ms (not 2π/(Ω ω_0))."""
+    from two_frequency_train import PERIOD_FACTOR, TwoFrequencyTrain
+
+    omega, s = 1.2, 16
+    res = gc.simulate(
+        System(TwoFrequencyTrain(), omega), transient_periods=6, periods=4, samples_per_period=s
+    )
+    period = PERIOD_FACTOR * 2 * math.pi / omega  # T in units of τ, from the model's forcing
+    ax = gc.plot.time_history(res, "x", periods=4)
+    (line,) = [ln for ln in ax.lines if ln.get_label() == r"$\bar{q}_{1}$"]
+    np.testing.assert_allclose(line.get_xdata(), res.tau / period, rtol=1e-12)
+    # the recorded window: 4 periods after a transient of 6, sampled s times per period
+    assert line.get_xdata()[0] == pytest.approx(6.0) and line.get_xdata()[-1] == pytest.approx(
+        10.0 - 1.0 / s
+    )
+    (points,) = [ln for ln in ax.lines if ln.get_label() == "section points"]
+    np.testing.assert_allclose(points.get_xdata(), [6.0, 7.0, 8.0, 9.0], rtol=1e-12)
+    ms = PERIOD_FACTOR * 2e3 * math.pi / (omega * OMEGA_0)  # one period T/ω_0 in ms
+    assert _secondaries(ax)["t [ms]"] == pytest.approx(ms)
+    assert "train periods" in ax.get_xlabel()
+    fig = summary_figure(res)
+    draw(fig)
+    for text in _texts(fig):
+        assert not PLANETARY.search(text), text

@@ -502,8 +502,9 @@ def period_axis_label(result: Any) -> str:
 
 
 def to_periods(result: Any, tau: np.ndarray) -> np.ndarray:
-    """τ in forcing (mesh) periods: τΩ/2π."""
-    return np.asarray(tau) * result.system.omega / (2.0 * math.pi)
+    """τ in the model's forcing periods: τ/T, T = :attr:`~gearchaos.model.System.period`
+    (τΩ/2π for a forcing of one frequency, τΩ/(2π·``period_factor``) for several)."""
+    return np.asarray(tau) / result.system.period
 
 
 def sample_window(result: Any, periods: float | None) -> slice:

@@ -56,6 +56,9 @@ class PhysicalScales:
     omega_n: float | None = None  # rad/s
     force_n: float | None = None  # k_m,sp b_c
     rpm_per_omega: float | None = None  # sun speed [rpm] per unit Ω
+    #: The model's forcing period T in units of 2π/Ω (its ``period_factor``): one period
+    #: lasts T/ω_n = period_factor·2π/(Ω ω_n) (:meth:`period_ms`).
+    period_factor: float = dataclasses.field(default=1.0, compare=False)
     #: The model's ``quantities`` (variable or group → ``length``, ``velocity``, ``force``),
     #: which :meth:`quantity` reads; ``None``: the planetary model's.
     quantities: Mapping[str, str] | None = dataclasses.field(
@@ -77,7 +80,9 @@ class PhysicalScales:
         used = set(caps.quantities.values())
         force = float(sc.force) if "force" in used else None
         rpm = speeds_at(model, 1.0).get("sun_rpm")
-        return cls(float(sc.length), float(sc.omega_n), force, rpm, caps.quantities)
+        return cls(
+            float(sc.length), float(sc.omega_n), force, rpm, caps.period_factor, caps.quantities
+        )
 
     @classmethod
     def of_result(cls, result: Any) -> PhysicalScales:
@@ -125,7 +130,8 @@ class PhysicalScales:
             for v in (float(np.nanmin(values)), float(np.nanmax(values))):
                 end = cls.of_model(model_for(target, {**fixed, name: v}))
                 varying |= {f for f in SCALE_FIELDS if not _same(getattr(base, f), getattr(end, f))}
-        return dataclasses.replace(base, **dict.fromkeys(varying))
+        cleared: dict[str, Any] = dict.fromkeys(varying)
+        return dataclasses.replace(base, **cleared)
 
     def quantity(self, var: str) -> str | None:
         """The physical quantity of the variable ``var`` in the model these scales are of
@@ -134,8 +140,8 @@ class PhysicalScales:
 
     def factor(self, quantity: str) -> tuple[float, str] | None:
         """(factor, axis label) of a quantity: ``length`` (µm), ``velocity`` (mm/s),
-        ``force`` (N), ``omega`` (sun speed, rpm), ``mesh_hz`` (Hz per Ω), ``time``
-        (ms per mesh period of Ω = 1 — use :meth:`period_ms` for a given Ω)."""
+        ``force`` (N), ``omega`` (sun speed, rpm), ``mesh_hz`` (Hz per Ω); the time of one
+        forcing period at a given Ω is :meth:`period_ms`."""
         if quantity == "length" and self.length_m:
             return self.length_m * 1e6, "[µm]"
         if quantity == "velocity" and self.length_m and self.omega_n:
@@ -149,8 +155,12 @@ class PhysicalScales:
         return None
 
     def period_ms(self, omega: float) -> float | None:
-        """One forcing (mesh) period at Ω in milliseconds: 2π/(Ω ω_n)."""
-        return 2e3 * math.pi / (omega * self.omega_n) if self.omega_n else None
+        """One forcing period T of the model at Ω in milliseconds: T/ω_n with
+        T = ``period_factor``·2π/Ω (:attr:`~gearchaos.model.System.period`: 2π/Ω unless the
+        model declares a forcing of several frequencies)."""
+        if not self.omega_n:
+            return None
+        return 2e3 * math.pi * self.period_factor / (omega * self.omega_n)
 
 
 #: The scale fields of :class:`PhysicalScales` (not the quantities table).
