@@ -167,7 +167,7 @@ QUICKSTART_ROWS = (
     "motion",
     "X̄_sp1 section min",
     "X̄_sp1 section max",
-    "load factor sun–planet (max)",
+    "load factor sun_planet (max)",
     "contact sun_planet_1",
     "contact planet_ring_1",
 )
@@ -220,7 +220,7 @@ def _quickstart(work: Path) -> dict[str, str]:
             f"the quick start says the sun hardly moves, well inside its bearing clearance "
             f"{b_s:g}: it reaches {sun:.3g}"
         )
-    load = float(cell(rows, "load factor sun–planet (max)"))
+    load = float(cell(rows, "load factor sun_planet (max)"))
     if not load > 1:
         raise ProseOutOfDate(f"the quick start's peak load is not above the static: {load}")
     shown, recorded = cell(rows, "distinct section points").split(" of ")

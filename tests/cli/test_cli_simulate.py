@@ -5,6 +5,7 @@ from __future__ import annotations
 import importlib
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -22,12 +23,11 @@ from gearchaos.integrate.settings import SolverSettings
 CONTRACT = [
     "omega",
     "omega_n_rad_s",
-    "sun_speed_rpm",
     "distinct_section_points",
     "motion",
     "record_label",
-    "x_sp1_section_min",
-    "x_sp1_section_max",
+    "section_min",
+    "section_max",
     "contact",
     "status",
     "steps_accepted",
@@ -62,8 +62,8 @@ def test_json_keys_and_values_match_the_python_api(runner: CliRunner) -> None:
     ds = res.to_dataset()
     x = ds.delta_sp.sel(planet=1).values
     assert out["omega"] == 1.5
-    assert out["x_sp1_section_min"] == pytest.approx(float(x.min()), rel=1e-12)
-    assert out["x_sp1_section_max"] == pytest.approx(float(x.max()), rel=1e-12)
+    assert out["section_min"] == pytest.approx(float(x.min()), rel=1e-12)
+    assert out["section_max"] == pytest.approx(float(x.max()), rel=1e-12)
     assert out["steps_accepted"] == res.steps_accepted
     assert out["steps_rejected"] == res.steps_rejected
     assert out["status"] == "ok"
@@ -82,9 +82,9 @@ def test_json_keys_and_values_match_the_python_api(runner: CliRunner) -> None:
     assert isinstance(out["motion"], str) and out["motion"]
     assert out["steps_accepted"] > 0 and out["steps_rejected"] >= 0
     # section values lie within the extrema tracked at every step
-    assert float(ds.delta_sp_min.sel(planet=1)) <= out["x_sp1_section_min"]
-    assert out["x_sp1_section_min"] <= out["x_sp1_section_max"]
-    assert out["x_sp1_section_max"] <= float(ds.delta_sp_max.sel(planet=1))
+    assert float(ds.delta_sp_min.sel(planet=1)) <= out["section_min"]
+    assert out["section_min"] <= out["section_max"]
+    assert out["section_max"] <= float(ds.delta_sp_max.sel(planet=1))
     n = gs.n_planets
     assert len(out["contact"]) == 2 * n
     assert all(set(c) == {"mesh", "regime", "separation_fraction"} for c in out["contact"])
@@ -209,3 +209,31 @@ def test_human_output_names_the_summary(runner: CliRunner) -> None:
     assert result.exit_code == 0, result.output
     for text in ("sheng2016", "Ω", "ω_n", "sun speed", "X̄_sp1", "contact", "status"):
         assert text in result.stdout
+
+
+def test_a_user_models_output_speaks_its_own_words(runner: CliRunner) -> None:
+    """Issue 36: ``simulate --model`` of a model of one's own (tests/two_frequency_train.py: two
+    stages meshing at Ω and 3Ω/5, T = 5·2π/Ω) prints its section variable by its symbol, its
+    contacts and its periods, and neither its JSON nor its table names the planetary model."""
+    from pathlib import Path
+
+    from gearchaos.model import System
+    from two_frequency_train import TwoFrequencyTrain
+
+    model = f"{Path(__file__).parents[1] / 'two_frequency_train.py'}:TwoFrequencyTrain"
+    args = ["--model", model, "--set", "omega=1.2", "--no-verdict"]
+    out = run_json(runner, *args)
+    old = {"x_sp1_section_min", "x_sp1_section_max", "sun_speed_rpm", "dte_sp1_rms"}
+    assert not old & set(out) and "load_factor_sp_max" not in out
+    assert out["section_variable"] == "x_1" and out["dte_contact"] == "stage1"
+    # the range of the model's own section points (one per T = 5·2π/Ω), from its record
+    ref = gc.simulate(System(TwoFrequencyTrain(), 1.2), transient_periods=20, periods=20)
+    x = ref.section("x_1")
+    assert (out["section_min"], out["section_max"]) == (float(x.min()), float(x.max()))
+    result = runner.invoke(app, ["simulate", *SHORT, *args])
+    assert result.exit_code == 0, result.output
+    text = result.stdout
+    assert "q̄_1 section min" in text and "contact stage2" in text
+    assert "20 recorded train periods" in text
+    words = re.compile(r"planet|sun|ring|sp1|X̄|mesh|b_c|gear set", re.IGNORECASE)
+    assert not words.search(text), text

@@ -1,9 +1,12 @@
 """A JSON-serialisable summary of one simulation, and its table for humans.
 
 :func:`summarize` condenses a :class:`~gearchaos.SimulationResult` into the numbers a reader
-wants first: where it ran (Ω, ω_n, sun speed), what motion it found (distinct Poincaré points of
-(X̄_sp1, X̄'_sp1), named 1T, 2T, … or ``many``), the contact regime of every mesh and whether the
-integration succeeded (the command line renders it as a table).
+wants first: where it ran (Ω, and ω_n with the speeds where the model has them), what motion it
+found (distinct Poincaré points of the model's section variables, X̄_sp1 and X̄'_sp1 for the
+planetary model, named 1T, 2T, … or ``many``), the contact regime of every contact and whether
+the integration succeeded (the command line renders it as a table). Every key is the same for
+every model, or named by the model's own words (its section variable, its mesh types, its
+contacts); none names the planetary model unless the model is one.
 """
 
 from __future__ import annotations
@@ -14,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from ..model.response import response_quantities
+from ..model.response import mesh_contacts, response_quantities, transmission_error
 from ..model.target import speeds_at
 from .classify import classify_motion
 from .contact import contact_regimes, separation_fraction
@@ -23,16 +26,15 @@ from .poincare import count_distinct, section_points, section_variables
 
 __all__ = ["SUMMARY_KEYS", "format_exponent", "motion_name", "motion_text", "summarize"]
 
-#: Keys every summary of a planetary result has (in this order); extras follow them.
+#: Keys every summary has, of any model (in this order); extras follow them.
 SUMMARY_KEYS = (
     "omega",
     "omega_n_rad_s",
-    "sun_speed_rpm",
     "distinct_section_points",
     "motion",
     "record_label",
-    "x_sp1_section_min",
-    "x_sp1_section_max",
+    "section_min",
+    "section_max",
     "contact",
     "status",
     "steps_accepted",
@@ -92,24 +94,30 @@ def summarize(
     Returns
     -------
     dict
-        ``omega`` (Ω), ``omega_n_rad_s`` (ω_n), ``sun_speed_rpm``, ``distinct_section_points``
-        (``max_count + 1`` means many), ``motion`` (the verdict's ``1T``, ``2T``, …, ``QP``,
-        ``chaos``, ``unresolved``; None without a verdict), ``record_label`` (the record-only
-        label of :func:`~gearchaos.analysis.classify.classify_motion`) with ``lle``,
-        ``k01`` (0–1 test), ``indicators_agree`` and ``motion_note``,
-        ``x_sp1_section_min``/``_max`` (range of the X̄_sp1 section values), ``contact`` (a list
-        of ``{"mesh": "sun_planet_1", "regime": "none|single_sided|double_sided"}``, sun–planet
-        meshes first, then planet–ring), ``status`` (lower-case :class:`~gearchaos.Status`
-        name), ``steps_accepted``, ``steps_rejected``; then the extras ``gearset``,
-        ``mesh_frequency_hz``, ``load_factor_sp_max``, ``load_factor_rp_max`` (dynamic load factor
+        ``omega`` (Ω), ``omega_n_rad_s`` (ω_n; None for a model without scales),
+        ``distinct_section_points`` (``max_count + 1`` means many), ``motion`` (the verdict's
+        ``1T``, ``2T``, …, ``QP``, ``chaos``, ``unresolved``; None without a verdict),
+        ``record_label`` (the record-only label of
+        :func:`~gearchaos.analysis.classify.classify_motion`) with ``lle``, ``k01`` (0–1 test),
+        ``indicators_agree`` and ``motion_note``, ``section_min``/``section_max`` (range of the
+        section values of ``section_variable``), ``contact`` (a list of
+        ``{"mesh": "sun_planet_1", "regime": "none|single_sided|double_sided"}``, one per
+        contact of the model in its order: sun–planet meshes first, then planet–ring, for the
+        planetary model), ``status`` (lower-case :class:`~gearchaos.Status` name),
+        ``steps_accepted``, ``steps_rejected``; then the extras ``section_variable`` (the
+        variable whose section ``section_min``/``section_max`` give: the first of the model's
+        default observables, ``delta_sp_1`` for the planetary model), ``gearset``,
+        ``omega_hz`` (Ω in Hz, Ω ω_n/2π: a gear train's mesh frequency; None without
+        scales), ``sun_speed_rpm`` (only for a model that has speeds: one built from a gear
+        set), ``load_factor_<m>_max`` for each mesh type ``m`` of the model's force groups
+        when it has a static load (``sp``, ``rp`` for the planetary model: dynamic load factor
         max |Fᶜ| / (T_D/(N r_bs)) over the planets, Fᶜ the mesh *contact* force, 0 while the
         teeth are apart, its extrema tracked inside every integration step so that it does not
-        depend on ``samples_per_period``), ``dte_sp1_rms`` (RMS dynamic transmission error
-        √⟨(X̄_sp1 − ⟨X̄_sp1⟩)²⟩ over the samples, in b_c), ``transient_periods``, ``periods``,
-        ``samples_per_period``, ``section_variable`` (the variable whose section the
-        ``x_sp1_*`` keys give: ``delta_sp_1``, or another model's default). Quantities that do
-        not apply (no gear set, a reference system)
-        are ``None``; for reference systems the ``x_sp1_*`` keys hold the first state.
+        depend on ``samples_per_period``), ``dte_rms`` (RMS dynamic transmission error
+        √⟨(δ̄ − ⟨δ̄⟩)²⟩ over the samples of the deflection δ̄ that the model's first mesh
+        contact is judged on, in the model's dimensionless length: b_c for the planetary
+        model) and ``dte_contact`` (that contact: ``sun_planet_1``; both None for a model
+        without mesh contacts), ``transient_periods``, ``periods``, ``samples_per_period``.
     """
     system = result.system
     x, xd = section_points(result)
@@ -140,13 +148,12 @@ def summarize(
     out: dict[str, Any] = {
         "omega": omega,
         "omega_n_rad_s": _num(scales.omega_n) if scales is not None else None,
-        "sun_speed_rpm": _num(speeds_at(system.model, omega).get("sun_rpm")),
         "distinct_section_points": int(n),
         # the motion is the verdict's; the record alone gives only a record label
         "motion": None,
         "record_label": mc.label,
-        "x_sp1_section_min": _num(finite.min()) if finite.size else None,
-        "x_sp1_section_max": _num(finite.max()) if finite.size else None,
+        "section_min": _num(finite.min()) if finite.size else None,
+        "section_max": _num(finite.max()) if finite.size else None,
         "contact": contact,
         "status": result.status.name.lower(),
         "steps_accepted": int(result.steps_accepted),
@@ -185,22 +192,25 @@ def summarize(
         out["indicators_agree"] = bool(mc.agree)
         out["motion_note"] = mc.note
     out["gearset"] = gs.name if gs is not None else None  # gear-set switch: names its gear set
-    out["mesh_frequency_hz"] = (
-        _num(omega * scales.omega_n / (2.0 * math.pi)) if scales is not None else None
-    )
-    # every summary has the keys of a planetary train's two kinds of mesh (None without them)
-    out["load_factor_sp_max"] = None
-    out["load_factor_rp_max"] = None
-    out["dte_sp1_rms"] = None
-    labels = [label for label, _, _ in caps.force_groups]
-    if labels and caps.static_mesh_force is not None:
-        # each kind of mesh whose contact forces the model tracks, against its static load:
+    out["omega_hz"] = _num(omega * scales.omega_n / (2.0 * math.pi)) if scales is not None else None
+    rpm = speeds_at(system.model, omega).get("sun_rpm")  # a model built from a gear set
+    if rpm is not None:
+        out["sun_speed_rpm"] = _num(rpm)
+    meshes = mesh_contacts(system)
+    if meshes and caps.static_mesh_force is not None:
+        # each mesh type whose contact forces the model tracks, against its static load:
         # peak contact forces from the extrema tracked inside every step (not from samples)
         rq = response_quantities(system, result.obs_min, result.obs_max, result.observables)
-        for mesh in labels:
+        for mesh in meshes:
             out[f"load_factor_{mesh}_max"] = _num(rq[f"load_factor_{mesh}"])
-        first = labels[0]  # the transmission error of its first mesh (planet 1 of a train)
-        out[f"dte_{first}1_rms"] = _num(np.ravel(rq[f"dte_rms_{first}"])[0])
+    # the transmission error of the model's first mesh contact (sun_planet_1 of a train),
+    # from the deflection it is judged on
+    first = next((c for c in caps.contacts if c.kind == "mesh"), None)
+    dte = None
+    if first is not None and result.observables.shape[0]:
+        dte = _num(transmission_error(result.observables[:, first.column]))
+    out["dte_rms"] = dte
+    out["dte_contact"] = first.name if first is not None else None
     s = result.solver
     out["transient_periods"] = _num(s.transient_periods)
     out["periods"] = int(s.periods)

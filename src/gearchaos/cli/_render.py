@@ -4,8 +4,9 @@ tables and gallery rows. Symbols come from the parameter registry
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from rich.columns import Columns
@@ -18,6 +19,10 @@ from ..analysis.motion import Motion
 from ..analysis.summary import format_exponent
 from ..gearset.mapping import flatten
 from ..gearset.schema import display_symbol as symbol
+from ..model.response import mesh_contacts
+
+if TYPE_CHECKING:
+    from ..model.system import System
 
 __all__ = [
     "add_motion_rows",
@@ -26,7 +31,9 @@ __all__ = [
     "gallery_rows_table",
     "info_renderables",
     "pairs_table",
+    "plain_symbol",
     "regime_table",
+    "summary_labels",
     "sweep_summary",
     "sweep_table",
 ]
@@ -334,20 +341,80 @@ def _fmt(v: Any) -> str:
     return str(v)
 
 
-def format_summary(summary: dict[str, Any], *, title: str | None = None) -> Any:
-    """A :class:`rich.table.Table` of a summary from
-    :func:`~gearchaos.analysis.summary.summarize`."""
-    if title is None:
-        gs = summary.get("gearset")
-        # gear-set switch: a summary (analysis.summary) carries its gear set's name, no model
-        title = f"gearchaos simulation{f' of {gs}' if gs else ''}"
-    table = Table(title=escape(title), show_header=True, header_style="bold")
-    table.add_column("quantity")
-    table.add_column("value", justify="right")
+#: Greek letters of mathtext symbols, as text.
+_GREEK = {
+    name: chr(code)
+    for name, code in (
+        ("alpha", 0x3B1), ("beta", 0x3B2), ("gamma", 0x3B3), ("delta", 0x3B4),
+        ("epsilon", 0x3B5), ("varepsilon", 0x3B5), ("zeta", 0x3B6), ("eta", 0x3B7),
+        ("theta", 0x3B8), ("kappa", 0x3BA), ("lambda", 0x3BB), ("mu", 0x3BC), ("nu", 0x3BD),
+        ("xi", 0x3BE), ("pi", 0x3C0), ("rho", 0x3C1), ("sigma", 0x3C3), ("tau", 0x3C4),
+        ("phi", 0x3C6), ("varphi", 0x3C6), ("chi", 0x3C7), ("psi", 0x3C8), ("omega", 0x3C9),
+        ("Gamma", 0x393), ("Delta", 0x394), ("Theta", 0x398), ("Lambda", 0x39B),
+        ("Xi", 0x39E), ("Pi", 0x3A0), ("Sigma", 0x3A3), ("Phi", 0x3A6), ("Psi", 0x3A8),
+        ("Omega", 0x3A9),
+    )
+}  # fmt: skip
+_ACCENTS = {"bar": "\u0304", "dot": "\u0307", "ddot": "\u0308", "hat": "\u0302", "tilde": "\u0303"}
+_MATH_COMMAND = re.compile(r"\\([A-Za-z]+)")
+
+
+def plain_symbol(mathtext: str) -> str | None:
+    r"""A model's mathtext symbol as plain text for a terminal: ``\bar{X}_{sp1}`` → ``X̄_sp1``,
+    ``\bar{\sigma}`` → ``σ̄``, ``\mathrm{x\_1}`` → ``x_1``; None for a symbol with a command
+    this does not know (the caller writes the variable's name instead)."""
+    text = mathtext.strip().strip("$")
+    text = re.sub(r"\\mathrm\{([^{}]*)\}", r"\1", text).replace(r"\_", "_")
+    text = re.sub(r"\\[,;:! ]", " ", text)
+
+    def accent(m: re.Match[str]) -> str:
+        inner = m.group(2)
+        inner = _GREEK.get(inner[1:], inner) if inner.startswith("\\") else inner
+        return inner + _ACCENTS[m.group(1)]
+
+    accents = "|".join(_ACCENTS)
+    text = re.sub(rf"\\({accents})\{{(\\?[A-Za-z]+|.)\}}", accent, text)
+    text = re.sub(rf"\\({accents})\s*(\\[A-Za-z]+|[A-Za-z])", accent, text)
+    text = _MATH_COMMAND.sub(lambda m: _GREEK.get(m.group(1), m.group(0)), text)
+    if "\\" in text:
+        return None
+    return text.replace("{", "").replace("}", "")
+
+
+def _group_name(label: str, contacts: Sequence[str]) -> str:
+    """A mesh type by its contacts: the stem they share before the member's number
+    (``sun_planet_1 … sun_planet_5`` → ``sun_planet``), a lone contact's name, else the
+    type's own label."""
+    if len(contacts) == 1:
+        return contacts[0]
+    parts = [c.rpartition("_") for c in contacts]
+    stems = {head for head, _, _ in parts}
+    numbered = all(head and tail.isdigit() for head, _, tail in parts)
+    return stems.pop() if numbered and len(stems) == 1 else label
+
+
+def summary_labels(summary: Mapping[str, Any], system: System | None = None) -> dict[str, str]:
+    """The row label of each key of ``summary`` that its table shows, in the table's order,
+    in the words of the model of ``system`` (a :class:`~gearchaos.model.System`: its
+    capabilities name the section variable by its symbol, the mesh types by their contacts
+    and the frequency by its period); without one, the summary's own names."""
+    section = str(summary.get("section_variable") or "section variable")
+    frequency = "Ω ω_n/2π [Hz]"
+    groups: dict[str, tuple[str, ...]] = {}
+    if system is not None:
+        caps = system.capabilities
+        entry = caps.symbols.get(caps.default_observables[0])
+        if entry is not None and system.section_pair(1)[0] == section:
+            sym = entry[0] % 1 if "%d" in entry[0] else entry[0]  # its first member's
+            section = plain_symbol(sym) or section
+        if caps.period_factor == 1.0:  # Ω is the frequency of its period
+            frequency = f"{caps.period_name} frequency [Hz]"
+        groups = mesh_contacts(system)
+    loads = [k for k in summary if k.startswith("load_factor_") and k.endswith("_max")]
     labels = {
         "omega": "Ω = ω/ω_n",
         "omega_n_rad_s": "ω_n [rad/s]",
-        "mesh_frequency_hz": "mesh frequency [Hz]",
+        "omega_hz": frequency,
         "sun_speed_rpm": "sun speed [rpm]",
         "distinct_section_points": "distinct section points",
         "motion": "motion",
@@ -355,29 +422,38 @@ def format_summary(summary: dict[str, Any], *, title: str | None = None) -> Any:
         "max_multiplier": "max |μ| (Floquet)",
         "lle": "λ₁ [1/τ]",
         "extra_periods": "periods added to finish the transient",
-        "x_sp1_section_min": "X̄_sp1 section min",
-        "x_sp1_section_max": "X̄_sp1 section max",
-        "load_factor_sp_max": "load factor sun–planet (max)",
-        "load_factor_rp_max": "load factor planet–ring (max)",
-        "dte_sp1_rms": "DTE RMS sun–planet 1 [b_c]",
-        "status": "status",
-        "steps_accepted": "steps accepted",
-        "steps_rejected": "steps rejected",
+        "section_min": f"{section} section min",
+        "section_max": f"{section} section max",
     }
-    var = summary.get("section_variable")
-    if var is not None and var != "delta_sp_1":  # another model: its own section variable
-        labels["x_sp1_section_min"] = f"{var} section min"
-        labels["x_sp1_section_max"] = f"{var} section max"
-    optional = {
-        "omega_n_rad_s", "mesh_frequency_hz", "sun_speed_rpm", "load_factor_sp_max",
-        "load_factor_rp_max", "dte_sp1_rms",
-    }  # fmt: skip
-    for key, label in labels.items():
+    for key in loads:
+        mesh = key[len("load_factor_") : -len("_max")]
+        labels[key] = f"load factor {_group_name(mesh, groups.get(mesh, ()))} (max)"
+    labels["dte_rms"] = f"DTE RMS {summary.get('dte_contact') or ''}".rstrip()
+    labels.update(status="status", steps_accepted="steps accepted", steps_rejected="steps rejected")
+    return labels
+
+
+def format_summary(
+    summary: dict[str, Any], system: System | None = None, *, title: str | None = None
+) -> Any:
+    """A :class:`rich.table.Table` of a summary from
+    :func:`~gearchaos.analysis.summary.summarize`, its rows labelled by
+    :func:`summary_labels` in the words of the model of ``system`` (the
+    :class:`~gearchaos.model.System` that ran)."""
+    if title is None:
+        gs = summary.get("gearset")
+        # gear-set switch: a summary (analysis.summary) carries its gear set's name, no model
+        title = f"gearchaos simulation{f' of {gs}' if gs else ''}"
+    table = Table(title=escape(title), show_header=True, header_style="bold")
+    table.add_column("quantity")
+    table.add_column("value", justify="right")
+    # None: the model has no scales (ω_n, Hz) or no mesh types (DTE)
+    optional = {"omega_n_rad_s", "omega_hz", "dte_rms"}
+    for key, label in summary_labels(summary, system).items():
         if key in summary:
             value = summary[key]
-            # gear-set switch: a summary (analysis.summary) says by its gear set which rows apply
-            if value is None and key in optional and summary.get("gearset") is None:
-                continue  # quantities of a gear set, absent for other models
+            if value is None and key in optional:
+                continue
             recorded = summary.get("recorded_section_points")
             if key == "distinct_section_points" and recorded:
                 value = f"{int(value)} of {int(recorded)}"

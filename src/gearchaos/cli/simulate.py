@@ -11,6 +11,8 @@ from rich.text import Text
 
 from .._text import escape_path
 from ..integrate.settings import SIMULATION
+from ..model.contract import Capabilities
+from ..model.target import model_for
 from . import _common as c
 from ._render import add_motion_rows
 from ._speeds import speed_note
@@ -81,8 +83,9 @@ def simulate(
         if not output.json and err.is_terminal:
             total = protocol.transient + protocol.periods
             what = " and the verdict" if decided else (" and λ₁" if lyapunov else "")
+            name = Capabilities.of(model_for(gs, {})).period_name
             spinner = err.status(
-                f"integrating {gs.name} at Ω = {omega:g}, {total:g} mesh periods{what}…"
+                f"integrating {gs.name} at Ω = {omega:g}, {total:g} {name} periods{what}…"
             )
         with spinner, c.warnings_to_stderr():
             point = analyse_point(
@@ -113,12 +116,13 @@ def simulate(
 
     out = c.stdout()
     title = f"gearchaos simulation of {gs.name} at Ω = {omega:g}{speed_note(gs, omega)}"
-    table = format_summary(summary, title=title)
+    table = format_summary(summary, result.system, title=title)
     add_motion_rows(table, summary)
     out.print(table)
+    name = result.system.capabilities.period_name
     out.print(
         Text(
-            f"{protocol.transient:g} transient + {protocol.periods} recorded mesh periods, "
+            f"{protocol.transient:g} transient + {protocol.periods} recorded {name} periods, "
             f"rtol {solver.rtol:g}, atol {solver.atol:g}",
             style="dim",
         )

@@ -38,10 +38,12 @@ from .system import Observable, System
 __all__ = [
     "MeshGroup",
     "compressive_contact_forces",
+    "mesh_contacts",
     "mesh_groups",
     "peak_contact_forces",
     "response_quantities",
     "static_mesh_force",
+    "transmission_error",
 ]
 
 #: Names of the response quantities per mesh type ``m`` (``sp``, ``rp`` or ``mesh``).
@@ -74,6 +76,25 @@ def mesh_groups(system: System) -> list[MeshGroup]:
             # beside its force (the same values)
             d = Observable(deflection, "obs", np.array([system.obs_names.index(deflection)]), False)
         out.append(MeshGroup(label, system.observable(force), d))
+    return out
+
+
+def mesh_contacts(system: System) -> dict[str, tuple[str, ...]]:
+    """The names of the contacts of each mesh type, by its label, in member order: the
+    model's :attr:`~gearchaos.model.contract.Capabilities.contacts` judged on the columns of
+    the type's deflection (``sp`` → ``sun_planet_1 … sun_planet_N``, the backlash
+    oscillator's ``mesh`` → ``mesh``). A member that no contact is judged on is named by its
+    deflection variable (``delta_sp_2``), so every mesh type names each of its members."""
+    caps = system.capabilities
+    by_column = {c.column: c.name for c in caps.contacts}
+    out: dict[str, tuple[str, ...]] = {}
+    for g in mesh_groups(system):
+        d = g.deflection
+        names = system.obs_names if d.source == "obs" else system.state_names
+        out[g.mesh] = tuple(
+            by_column.get(int(col), names[int(col)]) if d.source == "obs" else names[int(col)]
+            for col in d.columns
+        )
     return out
 
 
@@ -158,6 +179,13 @@ def peak_contact_forces(
     return out
 
 
+def transmission_error(deflection: np.ndarray) -> np.ndarray:
+    """The RMS dynamic transmission error √⟨(δ̄ − ⟨δ̄⟩)²⟩ of mesh deflections sampled along
+    the first axis (uniform over whole forcing periods): the RMS of their fluctuating part."""
+    d = np.asarray(deflection, dtype=np.float64)
+    return np.sqrt(np.mean((d - d.mean(axis=0)) ** 2, axis=0))
+
+
 def static_mesh_force(system: System) -> float:
     """F̄_static: T̄_D/N (planetary, MODEL.md §10.1, at this Ω) or F_m (oscillator); NaN when
     the model has no static load."""
@@ -204,7 +232,7 @@ def response_quantities(
         f = observables[:, cols]
         d = observables[:, g.deflection.columns]
         rms = np.sqrt(np.mean(f * f, axis=0))
-        dte = np.sqrt(np.mean((d - d.mean(axis=0)) ** 2, axis=0))
+        dte = transmission_error(d)
         shape: Any = slice(None) if g.force.per_planet else 0
         out[f"force_rms_{g.mesh}"] = rms[shape]
         out[f"force_peak_{g.mesh}"] = peak

@@ -15,6 +15,7 @@ from .._version import __version__
 from ..analysis.summary import motion_text
 from ..errors import ParameterError
 from ..model.record import model_title
+from ..model.response import mesh_contacts
 from ._common import message, variable
 from .phase import phase_portrait, poincare_map, sun_orbit
 from .timeseries import mesh_force_history, spectrum, time_history
@@ -44,6 +45,11 @@ def _contact_groups(names: list[str]) -> list[str]:
     return [s if s and stems.count(s) > 1 else n for s, n in zip(stems, names, strict=True)]
 
 
+def _words(group: str) -> str:
+    """A contact group as the text panel writes it (``sun_planet`` → ``sun–planet``)."""
+    return group.replace("sun_planet", "sun–planet").replace("planet_ring", "planet–ring")
+
+
 def _text_lines(result: Any, summary: dict[str, Any]) -> list[str]:
     what, name = model_title(result.system.model)
     owner = f"{what}: {name}"
@@ -61,35 +67,42 @@ def _text_lines(result: Any, summary: dict[str, Any]) -> list[str]:
         lines.append(f"variables: {names}" + (" …" if len(shown) > 6 else "") + " (and rates)")
     if summary.get("omega_n_rad_s") is not None:
         lines.append(rf"$\omega_n$ = {_fmt(summary['omega_n_rad_s'], '.5g')} rad/s")
-    if summary.get("mesh_frequency_hz") is not None:  # the frequency of the model's period
-        name = result.system.capabilities.period_name
-        symbol = "f_m" if name == "mesh" else "f"
-        hz = _fmt(summary["mesh_frequency_hz"], ".5g")
-        lines.append(f"{name} frequency ${symbol}$ = {hz} Hz")
+    caps = result.system.capabilities
+    if summary.get("omega_hz") is not None:
+        hz = _fmt(summary["omega_hz"], ".5g")
+        if caps.period_factor == 1.0:  # Ω is the frequency of the model's period
+            name = caps.period_name
+            symbol = "f_m" if name == "mesh" else "f"
+            lines.append(f"{name} frequency ${symbol}$ = {hz} Hz")
+        else:
+            lines.append(rf"$\Omega\omega_n/2\pi$ = {hz} Hz")
     if summary.get("sun_speed_rpm") is not None:
         lines.append(f"sun speed = {_fmt(summary['sun_speed_rpm'], '.5g')} rpm")
     lines.append(f"distinct section points: {points} (motion: {motion})")
-    lo, hi = summary.get("x_sp1_section_min"), summary.get("x_sp1_section_max")
+    lo, hi = summary.get("section_min"), summary.get("section_max")
     if lo is not None:
         sym = f"${variable(result).symbol}$"
         lines.append(f"{sym} on the section: {_fmt(lo)} … {_fmt(hi)}")
-    if summary.get("load_factor_sp_max") is not None:
-        lines.append(
-            "max load factor: sun–planet "
-            f"{_fmt(summary['load_factor_sp_max'], '.3g')}, planet–ring "
-            f"{_fmt(summary.get('load_factor_rp_max'), '.3g')}"
-        )
+    meshes = mesh_contacts(result.system)
+    loads = {m: summary.get(f"load_factor_{m}_max") for m in meshes}
+    if any(v is not None for v in loads.values()):
+        every = [c.name for c in caps.contacts]
+        group_of = dict(zip(every, _contact_groups(every), strict=True))
+        parts = []
+        for m, value in loads.items():  # a mesh type by the group of its contacts
+            found = {group_of.get(n, m) for n in meshes[m]}
+            parts.append(f"{_words(found.pop()) if len(found) == 1 else m} {_fmt(value, '.3g')}")
+        lines.append(f"max load factor: {', '.join(parts)}")
     contact = summary.get("contact", [])
     if contact:
-        member = result.system.capabilities.member_name
+        member = caps.member_name
         per = f" ({member}s 1…N)" if result.system.group_size else ""
         lines.append(f"contact regimes{per}:")
-        groups: dict[str, list[str]] = {}
+        regimes_of: dict[str, list[str]] = {}
         for group, c in zip(_contact_groups([c["mesh"] for c in contact]), contact, strict=True):
-            groups.setdefault(group, []).append(_REGIME_SHORT.get(c["regime"], c["regime"]))
-        for group, regimes in groups.items():
-            name = group.replace("sun_planet", "sun–planet").replace("planet_ring", "planet–ring")
-            lines.append(f"   {name}: {', '.join(regimes)}")
+            regimes_of.setdefault(group, []).append(_REGIME_SHORT.get(c["regime"], c["regime"]))
+        for group, regimes in regimes_of.items():
+            lines.append(f"   {_words(group)}: {', '.join(regimes)}")
     lines.append(
         f"status: {summary['status']}  (steps {summary['steps_accepted']} accepted, "
         f"{summary['steps_rejected']} rejected)"
