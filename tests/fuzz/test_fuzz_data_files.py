@@ -150,7 +150,6 @@ def test_refused_a_forged_model_class_never_runs_the_module_beside_the_file(
         ("os:system", {"command": "touch {marker}"}),
         ("builtins:exec", {"source": "open('{marker}', 'w')"}),
         ("gearchaos.model.library:Evil", {}),
-        ("gearchaos.model.planetary:PlanetaryModel", {}),
     ],
 )
 def test_refused_a_module_or_class_named_only_by_the_file(
@@ -169,6 +168,24 @@ def test_refused_a_module_or_class_named_only_by_the_file(
     out = cli_refused("orbit --from forged module", ["orbit", "--from", str(path)], CONSENT,
                       watch=tmp_path)  # fmt: skip
     assert spec in out
+    assert not marker.exists()
+
+
+@pytest.mark.parametrize("fields", [{}, {"command": "touch {marker}"}, {"gearset": "x = 1"}])
+def test_refused_a_forged_planetary_record_names_its_fields(
+    files: dict[str, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch, fields: dict[str, Any]
+) -> None:
+    """The planetary model is gearchaos's own (issue 36: a gear set's files record it, with the
+    gear set as its fields), so its record alone builds it: a forged one is refused as damaged,
+    naming the rule of its fields, rather than for want of the user's consent."""
+    monkeypatch.chdir(tmp_path)
+    marker = tmp_path / "OWNED"
+    spec = "gearchaos.model.planetary:PlanetaryModel"
+    text = json.dumps(fields).replace("{marker}", str(marker))
+    path = _forge_nc(files["orbit"], tmp_path / "forged.nc", model_class=spec, model_fields=text)
+    out = cli_refused("orbit --from forged planetary", ["orbit", "--from", str(path)],
+                      "model_fields", watch=tmp_path)  # fmt: skip
+    assert spec in out or "gear set" in out
     assert not marker.exists()
 
 
@@ -562,7 +579,11 @@ def test_escaped_a_gear_set_name_from_a_file_never_reaches_the_terminal_raw(
     hostile = json.dumps(HOSTILE_NAME)  # a TOML basic string with \\u escapes
     forged_toml = re.sub(r'(?m)^name = ".*"$', lambda m: f"name = {hostile}", toml, count=1)
     assert forged_toml != toml
-    path = _forge_nc(gearset_orbit, tmp_path / "named.nc", gearset_toml=forged_toml)
+    # both copies of the gear set (the model's fields and gearset_toml), as a forger would
+    fields = json.dumps({"gearset": forged_toml})
+    path = _forge_nc(
+        gearset_orbit, tmp_path / "named.nc", gearset_toml=forged_toml, model_fields=fields
+    )
     result = CliRunner().invoke(app, ["orbit", "--from", str(path)])
     assert "Traceback" not in result.output
     assert not _acting(result.stdout) and not _acting(result.stderr), result.output

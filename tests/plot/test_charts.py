@@ -224,7 +224,7 @@ def test_event_names_sit_beside_the_curve_not_on_it(oscillator_response) -> None
 def test_amplitude_figure_is_titled_by_the_shared_helper(oscillator_response) -> None:
     """The title names the model (or gear set) and the figure as the other sweep figures do
     (bifurcation.suptitle), not the store's "gearchaos … of …" record."""
-    from gearchaos.gearset.io import to_toml
+    from gearchaos.model.record import target_record
 
     _, res, branch = oscillator_response
     title = amplitude_figure(res, [branch]).get_suptitle().splitlines()
@@ -237,8 +237,8 @@ def test_amplitude_figure_is_titled_by_the_shared_helper(oscillator_response) ->
     assert branch_figure([branch]).get_suptitle().splitlines()[1] == given
     force = amplitude_figure(res, [branch], quantity="force_peak").get_suptitle()
     assert force.startswith(f"backlash_oscillator: peak contact force curves\n{given}\n")
-    geared = res.copy()
-    geared.attrs["gearset_toml"] = to_toml(gc.preset("sheng2016-v1"))
+    geared = res.copy()  # the record of a gear set: its model reference and its TOML
+    geared.attrs.update(target_record(gc.preset("sheng2016-v1")))
     title = amplitude_figure(geared, [branch]).get_suptitle().splitlines()
     assert title[0] == "sheng2016-v1: amplitude–frequency curves"
     assert title[1].startswith(r"at $\bar b_{sp}$ = ")

@@ -141,29 +141,22 @@ def _load(path: str, where: dict[str, str]) -> Start:
 
 def _gearset(attrs: Any, path: str) -> Any:
     """The gear set a file records, or a :class:`~gearchaos.model.System` of the model it
-    records (built only with the user's consent: ``--model``)."""
-    from ..gearset import GearSet
+    records (built only with the user's consent: ``--model``), read by the one reader of
+    records (:func:`~gearchaos.model.record.recorded_target`)."""
+    from ..model.record import recorded_gearset, recorded_target
 
-    text = str(attrs.get("gearset_toml", ""))
-    if not text:
-        from ..model import System
-        from ..model.loading import rebuild_model
-
-        model = rebuild_model(attrs, where=f"--from {escape_path(path)}")
-        if model is None:
-            raise StoreError(
-                f"--from {escape_path(path)}: its model is neither a gear set (no gearset_toml) "
-                "nor one it records how to build (no model_class); start it from Python "
-                "(periodic_orbit(system, guess=state))"
-            )
-        return System(model, 1.0)
-    try:
-        return GearSet.from_toml_string(text)
+    where = f"--from {escape_path(path)}"
+    try:  # a damaged gear set (or two that differ) is a damaged file
+        gearset = recorded_gearset(attrs, where=where)
     except ParameterError as exc:
+        raise StoreError(str(exc)) from None
+    target = recorded_target(attrs, gearset, where=where)
+    if target is None:
         raise StoreError(
-            f"--from {escape_path(path)}: its attribute gearset_toml is no valid gear set "
-            f"({escape_text(exc)}); the file is damaged"
-        ) from None
+            f"{where}: its model is neither a gear set nor one it records how to build (no "
+            "model_class); start it from Python (periodic_orbit(system, guess=state))"
+        )
+    return target
 
 
 # ------------------------------------------------------------------ a file's attributes

@@ -48,9 +48,8 @@ def point_target(res: Any, values: Mapping[str, float]) -> tuple[Any, dict[str, 
     target = res.base_target
     if target is None:
         raise StoreError(
-            "this store's model is neither a gear set (no gearset_toml) nor a model it can "
-            "build again (no model_class): its stored sections can be explored, but points "
-            "cannot be recomputed from it"
+            "this store records no model it can build again (no model_class, no gear set): "
+            "its stored sections can be explored, but points cannot be recomputed from it"
         )
     fixed = {k: v for k, v in res.fixed.items() if k != OMEGA}
     if fixed:

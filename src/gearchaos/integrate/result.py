@@ -9,11 +9,12 @@ mesh contact forces, 0 while the teeth are apart and where the mesh force would 
 :func:`gearchaos.model.response.compressive_contact_forces`) with their ``_min``/``_max``
 (planet) and
 ``load_factor_sp``, ``load_factor_rp`` (planet: max |F̄ᶜ| over T̄_D/N); attributes
-``gearset_toml``, ``omega``, ``rtol``, ``atol``, ``transient_periods`` (the protocol's),
-``extra_periods`` (periods a motion verdict added to that transient before the record),
-``periods``, ``status``, ``version``. With ``samples_per_period > 1``
-the full time history is added on dimension ``sample`` (coordinate ``tau_sample``) as
-``<name>_history``.
+``model_class`` and ``model_fields`` (the model reference: for a gear set, the gear set),
+``gearset_toml`` (the gear set again, for the previous release), ``omega``, ``rtol``,
+``atol``, ``transient_periods`` (the protocol's), ``extra_periods`` (periods a motion
+verdict added to that transient before the record), ``periods``, ``status``, ``version``.
+With ``samples_per_period > 1`` the full time history is added on dimension ``sample``
+(coordinate ``tau_sample``) as ``<name>_history``.
 """
 
 from __future__ import annotations

@@ -11,8 +11,9 @@ A model class is found by a name in two ways, with different trust:
   there (``evil/evilmod.py:Evil``, ``os:system``), so the record alone never imports
   anything. :func:`stored_model_class` matches it against what the user already trusts:
 
-  1. gearchaos's reference systems (:data:`REFERENCE_MODELS`, an allow-list of classes, not
-     of import paths), by their recorded name;
+  1. gearchaos's own models by their recorded name, an allow-list of classes, not of import
+     paths: the reference systems (:data:`REFERENCE_MODELS`) and the planetary model, whose
+     ``model_fields`` are the gear set it is built from (:mod:`.gearset_record`);
   2. the classes the user named in this process (:func:`load_model_class`), by the recorded
      reference, or by the class name when the file has moved;
   3. the :class:`~gearchaos.model.contract.UserModel` subclasses the user's own code has
@@ -35,10 +36,13 @@ from typing import Any
 from .._text import escape_text
 from ..errors import ParameterError
 from .contract import Capabilities, UserModel, check_model
+from .gearset_record import PLANETARY_MODEL, gearset_fields, recorded_gearset
 from .library import BacklashOscillator, Duffing, LinearSystem, Lorenz
+from .planetary import PlanetaryModel
 
 __all__ = [
     "ENTRY_POINT_GROUP",
+    "LAYOUT_FIELDS",
     "REFERENCE_MODELS",
     "ModelConsentError",
     "build_model",
@@ -64,7 +68,7 @@ REFERENCE_MODELS: dict[str, type] = {
 #: Fields of a reference system that are its layout, not parameters: a file's record must
 #: leave them at their defaults (another kernel kind or state size would make the compiled
 #: right-hand side read and write outside its arrays).
-_LAYOUT_FIELDS = ("kind", "name", "n_state", "n_track", "n_contact_forces", "state_names",
+LAYOUT_FIELDS = ("kind", "name", "n_state", "n_track", "n_contact_forces", "state_names",
                   "obs_names")  # fmt: skip
 
 #: The classes the user named in this process, by the name given (:func:`load_model_class`).
@@ -252,10 +256,15 @@ def model_spec(cls: type) -> str | None:
 
 def model_reference(model: Any) -> dict[str, str]:
     """What a store or branch file records to build ``model`` again (:func:`rebuild_model`):
-    ``model_class`` (:func:`model_spec`) and ``model_fields`` (JSON of its dataclass fields);
-    empty for a gear-set model (its gear set TOML says it all) or a model that is no dataclass
-    of JSON values."""
-    if not dataclasses.is_dataclass(model) or Capabilities.of(model).gearset is not None:
+    ``model_class`` (:func:`model_spec`) and ``model_fields`` (JSON of its dataclass fields).
+    A model built from a gear set records the planetary model and, as its fields, that gear
+    set (:data:`~gearchaos.model.gearset_record.PLANETARY_MODEL`,
+    :func:`~gearchaos.model.gearset_record.gearset_fields`); a model that is no dataclass of
+    JSON values records nothing."""
+    gearset = Capabilities.of(model).gearset
+    if gearset is not None:
+        return {"model_class": PLANETARY_MODEL, "model_fields": gearset_fields(gearset)}
+    if not dataclasses.is_dataclass(model):
         return {}
     fields = {f.name: getattr(model, f.name) for f in dataclasses.fields(model) if f.init}
     try:
@@ -312,6 +321,8 @@ def stored_model_class(spec: str, *, where: str) -> type:
     """
     spec = str(spec)
     name = spec.rpartition(":")[2]
+    if spec == PLANETARY_MODEL:
+        return PlanetaryModel
     found = REFERENCE_MODELS.get(spec)
     if found is not None:
         return found
@@ -342,18 +353,25 @@ def stored_model_class(spec: str, *, where: str) -> type:
 
 def rebuild_model(attrs: Any, *, where: str = "the file") -> Any:
     """The model a store's or file's ``model_class``/``model_fields`` attributes describe
-    (:func:`model_reference`), or ``None`` when they are absent. The class is found by
-    :func:`stored_model_class` (never imported by its recorded name); ``where`` names the file
-    in messages.
+    (:func:`model_reference`), or ``None`` when they are absent. A model built from a gear set
+    is the planetary model of the gear set the record holds
+    (:func:`~gearchaos.model.gearset_record.recorded_gearset`: its ``model_fields``, or
+    ``gearset_toml`` in a file written before gear sets recorded their model); any other class
+    is found by :func:`stored_model_class` (never imported by its recorded name). ``where``
+    names the file in messages.
 
     Raises
     ------
     ModelConsentError
         The file needs a model the user has not named.
     ParameterError
-        ``model_fields`` is no JSON object of the class's fields, a reference system's record
+        ``model_fields`` is no JSON object of the class's fields (for the planetary model: no
+        valid gear set, or another than ``gearset_toml``'s), a reference system's record
         changes its layout (kind, state names, sizes), or the values break the contract.
     """
+    gearset = recorded_gearset(attrs, where=where)
+    if gearset is not None:
+        return PlanetaryModel.from_gearset(gearset)
     spec, fields = attrs.get("model_class"), attrs.get("model_fields")
     if not spec or fields is None:
         return None
@@ -374,7 +392,7 @@ def rebuild_model(attrs: Any, *, where: str = "the file") -> Any:
     if cls in REFERENCE_MODELS.values():
         missing = dataclasses.MISSING
         defaults = {f.name: f.default for f in dataclasses.fields(cls) if f.default is not missing}
-        for key in _LAYOUT_FIELDS:
+        for key in LAYOUT_FIELDS:
             if key in values and key in defaults and values[key] != defaults[key]:
                 raise ParameterError(
                     f"{where}: its attribute model_fields changes the layout of "

@@ -6,19 +6,25 @@ which model it ran and how to build that model again:
 
 ``model``
     ``planetary`` for a gear set (or a model built from one), else the model's name;
-``gearset_toml``
-    the gear set's TOML text, empty for any other model;
-``model_parameters``
-    the model's ``repr`` (empty for a gear set, whose TOML says it all);
 ``model_class``, ``model_fields``
-    what :func:`~gearchaos.model.loading.rebuild_model` needs to build a model that is no gear
-    set again (:func:`~gearchaos.model.loading.model_reference`; absent where it cannot).
+    the model reference, what :func:`~gearchaos.model.loading.rebuild_model` needs to build
+    the model again (:func:`~gearchaos.model.loading.model_reference`; absent where it
+    cannot): for a gear set the planetary model and, as its fields, the gear set's TOML
+    (:mod:`gearchaos.model.gearset_record`);
+``gearset_toml``
+    the gear set's TOML text again, empty for any other model: the previous release (and
+    every file written before gear sets recorded their model reference) reads the gear set
+    from here only, so files written now stay readable by it;
+``model_parameters``
+    the model's ``repr`` (empty for a gear set, whose TOML says it all).
 
 :func:`target_record` writes them for what a sweep or basin scan ran on, :func:`model_record`
 for the model a :class:`~gearchaos.model.System` runs, :func:`record_problem` says what is
-wrong with a stored record, and :func:`recorded_target` turns a record back into a target
-(:mod:`gearchaos.model.target`), from which :func:`~gearchaos.model.target.model_for` builds
-the model; the layers above then ask the model's
+wrong with a stored record, and :func:`recorded_target`, the one reader of every record (new
+or old), turns a record back into a target (:mod:`gearchaos.model.target`), from which
+:func:`~gearchaos.model.target.model_for` builds the model (:func:`recorded_gearset` is its
+gear set alone, never needing the user's consent, and :func:`recorded_parameters` the values
+of a model that is no gear set, for titles); the layers above then ask the model's
 :class:`~gearchaos.model.capabilities.Capabilities` (its contacts, symbols, quantities,
 scales, names), never which kind of record it was. :func:`model_title` is how a title names a
 model, and :func:`sidebands` where a spectrum marks the sidebands of its forcing.
@@ -26,13 +32,15 @@ model, and :func:`sidebands` where a spectrum marks the sidebands of its forcing
 
 from __future__ import annotations
 
+import json
 from collections.abc import Mapping
 from typing import Any
 
 from ..errors import ParameterError
 from ..gearset import GearSet
 from .contract import Capabilities
-from .loading import model_reference
+from .gearset_record import PLANETARY_MODEL, gearset_fields, gearset_problem, recorded_gearset
+from .loading import LAYOUT_FIELDS, model_reference, rebuild_model
 from .system import System
 from .target import Target
 
@@ -42,6 +50,8 @@ __all__ = [
     "model_title",
     "parameter_value",
     "record_problem",
+    "recorded_gearset",
+    "recorded_parameters",
     "recorded_target",
     "sidebands",
     "target_record",
@@ -53,16 +63,28 @@ PLANETARY = "planetary"
 
 
 def _gearset_record(gs: GearSet) -> dict[str, str]:
-    return {"model": PLANETARY, "gearset_toml": gs.to_toml(), "model_parameters": ""}
+    """The record of a gear set: the reference of the planetary model built from it (whose
+    fields are the gear set: :func:`~gearchaos.model.loading.model_reference` of that model)
+    and, for the previous release, the same TOML in ``gearset_toml``."""
+    return {
+        "model": PLANETARY,
+        "gearset_toml": gs.to_toml(),
+        "model_parameters": "",
+        "model_class": PLANETARY_MODEL,
+        "model_fields": gearset_fields(gs),
+    }
 
 
 def target_record(target: Target) -> dict[str, str]:
-    """The record of what a sweep or basin scan ran on: a gear set records its TOML (the
-    store's fixed values apply to it); a :class:`System` records its model by name,
-    ``repr`` and, where it can, the reference that builds it again (the store's fixed values
-    are fields of that model)."""
+    """The record of what a sweep or basin scan ran on: a gear set (or a
+    :class:`System` of a model built from one) records the planetary model's reference and
+    the gear set's TOML (the store's fixed values apply to the gear set); any other
+    :class:`System` records its model by name, ``repr`` and, where it can, the reference that
+    builds it again (the store's fixed values are fields of that model)."""
     if isinstance(target, GearSet):
         return _gearset_record(target)
+    if target.capabilities.gearset is not None:
+        return _gearset_record(target.capabilities.gearset)
     model = target.model
     return {
         "model": str(model.name),
@@ -74,28 +96,37 @@ def target_record(target: Target) -> dict[str, str]:
 
 def model_record(system: System) -> dict[str, str]:
     """The record of the model ``system`` runs, as built: a model built from a gear set
-    records that gear set (its TOML, every value applied), any other model itself
+    records that gear set (every value applied), any other model itself
     (:func:`target_record`)."""
-    gs = system.capabilities.gearset
-    return _gearset_record(gs) if gs is not None else target_record(system)
+    return target_record(system)
 
 
 def record_problem(attrs: Mapping[str, Any]) -> str | None:
     """What is wrong with the record in a file's attributes ``attrs``, in words, or ``None``:
     ``model`` must name the model, ``gearset_toml`` be text, a valid gear set for a
-    ``planetary`` file and empty for any other."""
+    ``planetary`` file and empty for any other; ``model_class`` (where there is one) must be
+    a name with ``model_fields`` text beside it, and ``model_fields`` have a ``model_class``;
+    the planetary model's ``model_fields`` must be a valid gear set, the one of
+    ``gearset_toml`` (:func:`~gearchaos.model.gearset_record.gearset_problem`). The fields of
+    any other model are checked when it is built (it may need the user's consent)."""
     model, gtext = attrs.get("model"), attrs.get("gearset_toml")
+    spec, fields = attrs.get("model_class"), attrs.get("model_fields")
     if not isinstance(model, str) or not model:
         return f"the attribute model must name the model: got {_short(model)}"
     if not isinstance(gtext, str):
         return f"the attribute gearset_toml must be text: got {_short(gtext)}"
+    if spec is not None and (not isinstance(spec, str) or not spec):
+        return f"the attribute model_class must name the model's class: got {_short(spec)}"
+    if spec is None and fields is not None:
+        return "the attribute model_fields has no model_class beside it"
+    if spec is not None and not isinstance(fields, str):
+        return f"the attribute model_fields must be JSON text: got {_short(fields)}"
+    problem = gearset_problem(attrs)
+    if problem is not None:
+        return problem
     if model == PLANETARY:
         if not gtext.strip():
             return "the attribute gearset_toml (the gear set) is empty"
-        try:
-            GearSet.from_toml_string(gtext)
-        except ParameterError as exc:
-            return f"the stored gear set (gearset_toml) is invalid: {exc}"
     elif gtext:
         return f"a {model} store carries a gear set (gearset_toml)"
     return None
@@ -108,7 +139,9 @@ def _short(value: Any) -> str:
 
 def recorded_target(attrs: Any, given: Any = None, *, where: str = "the file") -> Any:
     """The target a file's attributes ``attrs`` record: ``given`` when there is one (a gear
-    set with a store's fixed values applied), else the gear set of ``gearset_toml``, else a
+    set with a store's fixed values applied), else the gear set of a planetary model's
+    reference (or of ``gearset_toml`` in a file written before gear sets recorded one:
+    :func:`~gearchaos.model.gearset_record.recorded_gearset`), else a
     :class:`~gearchaos.model.System` at Ω = 1 of the model that ``model_class`` and
     ``model_fields`` describe (:func:`~gearchaos.model.loading.rebuild_model`); ``None`` when
     the file records neither.
@@ -117,17 +150,43 @@ def recorded_target(attrs: Any, given: Any = None, *, where: str = "the file") -
     ------
     ModelConsentError
         The file needs a model the user has not named (``where`` names the file).
+    ParameterError
+        The record is damaged: no valid gear set, two gear sets that differ, fields the model
+        refuses (``where`` names the file).
     """
     if given is not None:
         return given
-    text = str(attrs.get("gearset_toml", "") or "")
-    if text:
-        return GearSet.from_toml_string(text)
-    from .loading import rebuild_model
-    from .system import System
-
+    gearset = recorded_gearset(attrs, where=where)
+    if gearset is not None:
+        return gearset
     model = rebuild_model(attrs, where=where)
     return None if model is None else System(model, 1.0)
+
+
+def recorded_parameters(attrs: Mapping[str, Any]) -> dict[str, Any]:
+    """The parameter values a file records for a model that is no gear set: its
+    ``model_fields`` without the fields of its layout (kind, name, sizes, state and
+    observable names), read without building the model; ``{}`` for a gear set (the gear
+    set's registry names its parameters) or a file without ``model_fields``.
+
+    Raises
+    ------
+    ParameterError
+        ``model_fields`` is no JSON object.
+    """
+    fields = attrs.get("model_fields")
+    if fields is None or attrs.get("model_class") == PLANETARY_MODEL:
+        return {}
+    try:
+        values = json.loads(str(fields))
+    except ValueError:
+        values = None
+    if not isinstance(values, dict):
+        raise ParameterError(
+            f"the attribute model_fields must be a JSON object of the model's fields: got "
+            f"{_short(fields)}"
+        )
+    return {str(k): v for k, v in values.items() if k not in LAYOUT_FIELDS}
 
 
 def model_title(model: Any) -> tuple[str, str]:

@@ -201,17 +201,11 @@ def conclusion_2(stores: Stores) -> Verdict:
     """Every model ingredient is present in the gear set and excited in the runs."""
     from ..sweep.result import SweepResult
 
-    ds = next(
-        (
-            d
-            for d in stores.values()
-            if d.attrs.get("gearset_toml")  # gear-set switch: a seed's conclusion on gear sets
-        ),
-        None,
-    )
-    if ds is None:
+    recorded = (SweepResult.of(d).base_gearset for d in stores.values())
+    # gear-set switch: a seed's conclusion on gear sets
+    gs = next((gs for gs in recorded if gs is not None), None)
+    if gs is None:  # gear-set switch: a seed's conclusion on gear sets
         return _missing(2, ["any figure with its gear set"])
-    gs = SweepResult.of(ds).base_gearset
     st, te, bl = gs.stiffness, gs.transmission_error, gs.backlash
     parts = {
         "time-varying mesh stiffness": st.sun_planet_alternating > 0

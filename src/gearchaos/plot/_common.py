@@ -125,14 +125,13 @@ def figure_text(text: Any) -> str:
 
 
 def stored_gearset(attrs: Any) -> Any:
-    """The gear set a store, branch or curve file records (attribute ``gearset_toml``), or
-    ``None`` (a reference system)."""
-    text = str(attrs.get("gearset_toml", "") or "")
-    if not text:
-        return None
-    from ..gearset.io import from_toml_string
+    """The gear set a store, branch or curve file records (the fields of its planetary model,
+    or ``gearset_toml`` in an older file: :func:`~gearchaos.model.record.recorded_gearset`),
+    or ``None`` (any other model). A damaged record is refused
+    (:class:`~gearchaos.errors.ParameterError`)."""
+    from ..model.record import recorded_gearset
 
-    return from_toml_string(text)
+    return recorded_gearset(attrs)
 
 
 def stored_fixed(attrs: Any) -> dict[str, Any]:
@@ -263,7 +262,7 @@ def parameter_symbols(attrs: Any) -> Mapping[str, str]:
 def stored_target(attrs: Any, gearset: Any = None) -> Any:
     """What a store's, branch file's or curve file's attributes record as computed on
     (:func:`~gearchaos.model.record.recorded_target`: ``gearset`` when given, else the gear
-    set of ``gearset_toml``, else a :class:`~gearchaos.model.System` of the model of
+    set it records, else a :class:`~gearchaos.model.System` of the model of
     ``model_class``/``model_fields``), built once per record; ``None`` when they record
     neither, when it is the user's own model and the user has not named it (``--model``: a
     file's record never imports anything) or when it cannot be built."""

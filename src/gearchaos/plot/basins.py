@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
+from ..model.record import recorded_parameters
 from ._common import (
     axis_label,
     edges,
@@ -297,11 +298,8 @@ def basins_figure(ds: Any) -> Any:
     else:
         plt.close(fig)
         raise ParameterError(f"not a basin store: kind {kind!r}")
-    fields = ds.attrs.get("model_fields")
-    if isinstance(fields, str):  # a model that is not a gear set: its parameters
-        layout = {"kind", "name", "n_state", "n_track", "n_contact_forces"}
-        layout |= {"state_names", "obs_names"}
-        shown = {k: v for k, v in json.loads(fields).items() if k not in layout}
+    shown = recorded_parameters(ds.attrs)  # a model that is not a gear set: its parameters
+    if shown:
         title += "\n" + ", ".join(given(k, v, psym) for k, v in shown.items())
     ax.set_title(title, fontsize="medium")
     return fig

@@ -172,25 +172,25 @@ def open_result(source: Any) -> Any:
 def _gearset_of(ds: Any, kind: str) -> tuple[Any, dict[str, Any]]:
     """(the result's gear set with its fixed values applied, or ``None`` for a model's
     result; the fixed values of a sweep)."""
-    from ..gearset import GearSet
     from ..gearset.schema import OMEGA
+    from ..model.record import recorded_gearset
     from .result import SweepResult
 
     if kind in ("sweep", "response"):
         res = SweepResult(ds)
         return res.gearset, res.fixed
-    text = ds.attrs.get("gearset_toml")
-    if not isinstance(text, str) or not text.strip():
-        return None, {}
-    try:
-        gs = GearSet.from_toml_string(text)
+    try:  # the one reader of records: a damaged one is refused (ParameterError)
+        gs = recorded_gearset(ds.attrs, where="the result")
+        changes: dict[str, Any] = {}
         if kind in ("basins", "basin_fractions"):
             spec = json.loads(str(ds.attrs.get("basin_spec", "{}")))
             values = spec.get("values", {}) if isinstance(spec, dict) else {}
             changes = {k: v for k, v in dict(values).items() if k != OMEGA}
-            gs = gs.evolve(changes) if changes else gs
-    except (ParameterError, ValueError, TypeError) as exc:
-        raise StoreError(f"the result's gear set (gearset_toml) is invalid: {exc}") from None
+        # gear-set switch: a model's basin values are its fields, not the gear set's
+        if changes and gs is not None:
+            gs = gs.evolve(changes)
+    except (ValueError, TypeError) as exc:  # ParameterError is a ValueError
+        raise StoreError(str(exc)) from None
     return gs, {}
 
 

@@ -1,7 +1,8 @@
 """The read side of a sweep store: :class:`SweepResult`.
 
 A sweep store's attributes say what it holds — the sweep specification (``sweep_toml``), the
-gear set (``gearset_toml``), fixed values, Ω when it is not swept, the clearances, the regime
+model (``model_class``, ``model_fields``: for a gear set, the gear set itself, also in
+``gearset_toml``), fixed values, Ω when it is not swept, the clearances, the regime
 table. :class:`SweepResult` parses them once and answers the questions every reader asks
 (which dimension is the family, what is the forcing period or the clearance of a variable at
 each point, how many points failed), so plots, the classifier, the paper's checks and the
@@ -64,7 +65,9 @@ class SweepResult:
         The :class:`~gearchaos.sweep.spec.SweepSpec` stored in ``sweep_toml`` (``None`` for a
         dataset without one).
     base_gearset
-        The gear set stored in ``gearset_toml`` (``None`` for reference systems).
+        The gear set the store records (the fields of its planetary model, or
+        ``gearset_toml`` in an older store: :func:`~gearchaos.model.record.recorded_gearset`);
+        ``None`` for any other model.
     """
 
     spec: Any
@@ -96,17 +99,12 @@ class SweepResult:
         if text is not None and not isinstance(text, str):
             raise StoreError(f"the store's sweep_toml attribute must be text: got {text!r}")
         self.spec = SweepSpec.from_toml(text) if text else None
-        gtext = attrs.get("gearset_toml")
-        if gtext is not None and not isinstance(gtext, str):
-            raise StoreError(f"the store's gearset_toml attribute must be text: got {gtext!r}")
-        self.base_gearset = None
-        if gtext:
-            from ..gearset import GearSet
+        from ..model.record import recorded_gearset
 
-            try:
-                self.base_gearset = GearSet.from_toml_string(gtext)
-            except ParameterError as exc:
-                raise StoreError(f"the store's gear set (gearset_toml) is invalid: {exc}") from None
+        try:  # the planetary model's reference, or gearset_toml in an older store
+            self.base_gearset = recorded_gearset(attrs, where="the sweep store")
+        except ParameterError as exc:
+            raise StoreError(str(exc)) from None
         self._reference = _UNSET
         self._target = _UNSET
         self._model = _UNSET
@@ -183,9 +181,10 @@ class SweepResult:
 
     @property
     def base_model(self) -> Any:
-        """The model a store that is not of a gear set records how to build again
-        (``model_class``, ``model_fields``; :func:`~gearchaos.model.loading.rebuild_model`),
-        or ``None``."""
+        """The model the store records how to build again, without its fixed values
+        (``model_class``, ``model_fields``; :func:`~gearchaos.model.loading.rebuild_model`):
+        the planetary model of its gear set, or another model; ``None`` when it records
+        none."""
         if self._model is _UNSET:
             from ..model.loading import rebuild_model
 
@@ -386,28 +385,35 @@ class SweepResult:
 
     def _model_clearance(self, var: str) -> tuple[np.ndarray, str] | None:
         """The clearance of a contact judged on ``var`` (a model that records how to build it
-        again): the model at every point, with its swept and fixed values, says it."""
-        import dataclasses
+        again): the model at every point, with its swept and fixed values, says it (Ω and the
+        speeds change no clearance)."""
+        from ..gearset.schema import SPEEDS
+        from ..model.target import model_for, parameter_names
 
         try:
-            model = self.base_model
+            target = self.base_target
         except ParameterError:
             return None
-        if model is None:
+        if target is None:
             return None
-        caps = Capabilities.of(model)
+        caps = Capabilities.of(model_for(target, {}))
         found = [c for c in caps.contacts if caps.obs_names[c.column] == var]
         if not found:
             return None
         column = found[0].column
-        fields = {f.name for f in dataclasses.fields(model)}
-        fixed = {k: v for k, v in self.fixed.items() if k in fields}
-        swept = {d: self.values(d) for d in self.lead_dims if d in fields}
+        names = set(parameter_names(target)) - {OMEGA, *SPEEDS}
+        fixed = {k: v for k, v in self.fixed.items() if k in names}
+        swept = {d: self.values(d) for d in self.lead_dims if d in names}
         out = np.empty(self.shape)
+        known: dict[tuple[float, ...], float] = {}
         for idx in np.ndindex(*self.shape):
-            point = {**fixed, **{d: float(v[idx]) for d, v in swept.items()}}
-            at = dataclasses.replace(model, **point) if point else model
-            out[idx] = next(c.clearance for c in at.contacts if c.column == column)
+            key = tuple(float(v[idx]) for v in swept.values())
+            if key not in known:
+                at = Capabilities.of(
+                    model_for(target, {**fixed, **dict(zip(swept, key, strict=True))})
+                )
+                known[key] = next(c.clearance for c in at.contacts if c.column == column)
+            out[idx] = known[key]
         return out, rf"b_{{\mathrm{{{found[0].name.replace('_', ' ')}}}}}"
 
     def _to_bar(self, parameter: str, value: np.ndarray) -> np.ndarray:

@@ -33,9 +33,9 @@ events
 attributes
     ``parameter``, ``period``, ``range_start``, ``range_stop``, ``vary``, ``fixed`` (JSON of the
     fixed values), ``stop_reason``, ``start`` (how the branch started), ``tol``, the step
-    settings, the solver settings, the model's provenance (``model``, ``gearset_toml``,
-    ``model_parameters``, scales, clearances) and the versions (``version``, ``numba_version``
-    …), as sweeps carry them.
+    settings, the solver settings, the model's provenance (``model``, ``model_class``,
+    ``model_fields``, ``gearset_toml``, ``model_parameters``, scales, clearances) and the
+    versions (``version``, ``numba_version`` …), as sweeps carry them.
 """
 
 from __future__ import annotations

@@ -322,8 +322,9 @@ def minimal_period(sections: np.ndarray, tol: float) -> int:
 
 
 def model_attrs(system: System) -> dict[str, Any]:
-    """The model's provenance: ``model``, ``gearset_toml``, ``model_parameters``, scales and
-    clearances (the attributes sweeps and simulations carry)."""
+    """The model's provenance: ``model``, its reference (``model_class``, ``model_fields``),
+    ``gearset_toml``, ``model_parameters``, scales and clearances (the attributes sweeps and
+    simulations carry: :func:`~gearchaos.model.record.model_record`)."""
     return {**model_record(system), **scale_attrs(system.model)}
 
 
