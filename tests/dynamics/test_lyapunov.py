@@ -24,9 +24,9 @@ import time
 import numpy as np
 import pytest
 import scipy.linalg
-from gear_reference import damping_trace
 
 import gearchaos as gc
+from gear_reference import damping_trace
 from gearchaos.analysis.contact import contact_regimes
 from gearchaos.dynamics.lyapunov import lyapunov_spectrum, max_lyapunov
 
