@@ -11,9 +11,10 @@ interrupted store; copies are damaged in generated ways:
   consolidated metadata does not list;
 - attributes (written consistently into ``.zattrs`` and ``.zmetadata``, as a careless script
   would): ``sweep_toml`` missing, an int, junk TOML or another sweep; ``gearset_toml`` a list,
-  junk or empty; ``omega_fixed`` 0, negative, a string or missing; ``periods`` missing, a
-  string or another number; the ``status`` array missing; ``model``, ``dims``, ``complete``,
-  ``rtol``, ``regime_table`` junk;
+  junk or empty; its model reference (``model_fields`` forged, junk or missing, ``model_class``
+  junk, missing or another model's); ``omega_fixed`` 0, negative, a string or missing;
+  ``periods`` missing, a string or another number; the ``status`` array missing; ``model``,
+  ``dims``, ``complete``, ``rtol``, ``regime_table`` junk;
 - the chunk manifest ``_manifest.json``: junk bytes, other JSON, a manifest of nothing, an
   entry of the wrong shape;
 - an interrupted store: a chunk of a finished task damaged.
@@ -180,6 +181,9 @@ _OTHER_SPEC = SweepSpec.build("omega=1:2:3", transient_periods=10, periods=8).to
 ATTRIBUTES: dict[str, list[Any]] = {
     "sweep_toml": ["<delete>", 5, "x = [1", "", _OTHER_SPEC, ["a"]],
     "gearset_toml": [[1, 2], "junk =", "", 5, "[teeth]\nsun = -1\n"],
+    # the gear set's model reference (issue 36): forged fields, another class, half of it
+    "model_fields": ["{}", '{"gearset": 5}', 5, "<delete>", '{"gearset": "x = 1"}', "{junk"],
+    "model_class": [5, "", "<delete>", "gearchaos.model.library:Duffing"],
     "omega_fixed": [0, -1.5, "1.5", "<delete>", True, None, [1.5]],
     "periods": ["<delete>", "8", 9, 8.5, True, None],
     "transient_periods": ["<delete>", 11.0, "10"],
