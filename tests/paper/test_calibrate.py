@@ -369,8 +369,6 @@ def test_a_study_resumes_after_kill_9_without_losing_a_finished_trial(tmp_path: 
             ):
                 break
             time.sleep(0.05)
-        before = {t.number: t.values for t in trials if t.state.name == "COMPLETE"}
-        running = trials[2]
         proc.send_signal(signal.SIGKILL)
         proc.wait(timeout=30)
     finally:
@@ -379,7 +377,13 @@ def test_a_study_resumes_after_kill_9_without_losing_a_finished_trial(tmp_path: 
             proc.wait(timeout=30)
         if proc.stderr:
             proc.stderr.close()
-    assert _trials(url, cal.STUDY)[2].state.name == "RUNNING"  # left behind by the kill
+    # what the kill left, read once the storage no longer changes: a read while the
+    # calibration ran could see a trial's user attributes without its parameters (Optuna reads
+    # them in separate SQLite statements, each its own snapshot)
+    trials = _trials(url, cal.STUDY)
+    before = {t.number: t.values for t in trials if t.state.name == "COMPLETE"}
+    running = trials[2]
+    assert running.state.name == "RUNNING" and running.params  # left behind by the kill
     res = calibrate(out=out, storage=url, objective=Stub(), max_candidates=6)
     assert res.retried == [2] and res.reused == 2 and res.evaluated == 4
     trials = _trials(url, cal.STUDY)
