@@ -114,7 +114,7 @@ def test_sweep_store_rebuilds_the_model_for_starts_and_the_explorer(
     out = _json(runner, ["orbit", "--from", str(store), "--at", "omega=1.2", "--model", model_file])
     ref = gc.periodic_orbit(_builtin(1.2, 0.3), period=out["period"])
     assert out["converged"] and ref.converged
-    np.testing.assert_allclose(out["x_sp1"], ref.section("x"), atol=1e-8)
+    np.testing.assert_allclose(out["section"], ref.section("x"), atol=1e-8)
     # the explorer recomputes the point from the model the store names
     from gearchaos.explore.compute import compute_point
 

@@ -25,7 +25,8 @@ KEYS = {
     "stability_margin",
     "max_multiplier",
     "multipliers",
-    "x_sp1",
+    "section_variable",
+    "section",
     "contact",
     "message",
 }
@@ -58,7 +59,7 @@ def test_orbit_json_has_exactly_the_documented_keys(runner: CliRunner) -> None:
     z = np.array([complex(mu["re"], mu["im"]) for mu in mus])
     assert np.sort_complex(z) == pytest.approx(np.sort_complex(np.conj(z)), abs=1e-9)
     # a period-1 orbit has one section value per planet at the section
-    assert len(out["x_sp1"]) == 1
+    assert len(out["section"]) == 1
 
 
 @pytest.mark.parametrize("period", ["0", "65"])

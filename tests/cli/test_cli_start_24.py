@@ -60,7 +60,7 @@ def test_orbit_period_two_at_3_5_settles_to_the_stable_2t_orbit(runner: CliRunne
     # alternate between the orbit's two X̄_sp1 values (|μ| ≈ 0.97: settled after 800 periods)
     sim = gc.simulate(gc.preset("sheng2016-v1"), omega=3.5, transient_periods=800, periods=8)
     x = sim.section("delta_sp")[:, 0]
-    orbit_x = np.array(out["x_sp1"])
+    orbit_x = np.array(out["section"])
     for k, value in enumerate(x):
         assert np.min(np.abs(orbit_x - value)) < 1e-5, (k, value, orbit_x)
     assert abs(x[0] - x[1]) > 1e-2  # truly period 2 at the section
@@ -117,7 +117,7 @@ def test_orbit_from_a_store_point_is_the_orbit_at_that_point(
     rest = json.loads(_ok(runner, ["orbit", *V1, "--set", "omega=1.5", "--json"]))
     assert here["converged"] and rest["converged"]
     # the same orbit, reached from two different guesses
-    np.testing.assert_allclose(here["x_sp1"], rest["x_sp1"], atol=1e-8)
+    np.testing.assert_allclose(here["section"], rest["section"], atol=1e-8)
     assert here["max_multiplier"] == pytest.approx(rest["max_multiplier"], abs=1e-6)
 
 
@@ -139,7 +139,7 @@ def test_orbit_file_round_trip_starts_a_branch_on_that_orbit(
     ds = gc.open_branch(branch)
     assert float(ds["omega"].values[0]) == pytest.approx(1.5)
     np.testing.assert_allclose(ds["orbit_state"].values[0], saved["orbit_state"].values, atol=1e-8)
-    np.testing.assert_allclose(ds["delta_sp"].values[0, 0, 0], first["x_sp1"][0], atol=1e-8)
+    np.testing.assert_allclose(ds["delta_sp"].values[0, 0, 0], first["section"][0], atol=1e-8)
 
 
 def test_orbit_from_a_branch_point(runner: CliRunner, tmp_path: Path) -> None:
@@ -152,7 +152,7 @@ def test_orbit_from_a_branch_point(runner: CliRunner, tmp_path: Path) -> None:
         _ok(runner, ["orbit", "--from", str(branch), "--at", f"omega={value!r}", "--json"])
     )
     assert out["converged"]
-    np.testing.assert_allclose(out["x_sp1"][0], ds["delta_sp"].values[k, 0, 0], atol=1e-7)
+    np.testing.assert_allclose(out["section"][0], ds["delta_sp"].values[k, 0, 0], atol=1e-7)
 
 
 def test_continue_from_a_store_point_in_another_parameter(

@@ -336,7 +336,7 @@ def test_a_users_model_runs_with_the_users_consent_only(
     out = json.loads(result.stdout)
     ref = gc.periodic_orbit(DUFFING, period=out["period"], **TINY)
     assert out["converged"] and ref.converged
-    assert out["x_sp1"] == pytest.approx(list(ref.section("x")), abs=1e-8)
+    assert out["section"] == pytest.approx(list(ref.section("x")), abs=1e-8)
 
 
 # ------------------------------------------------------------------ 2. ours by a mark only

@@ -33,6 +33,7 @@ __all__ = [
     "pairs_table",
     "plain_symbol",
     "regime_table",
+    "section_symbol",
     "summary_labels",
     "sweep_summary",
     "sweep_table",
@@ -393,6 +394,21 @@ def _group_name(label: str, contacts: Sequence[str]) -> str:
     return stems.pop() if numbered and len(stems) == 1 else label
 
 
+def section_symbol(system: System | None, name: str) -> str:
+    """The section variable ``name`` of ``system`` as tables write it: its symbol from the
+    model's capabilities as plain text when it is the model's section variable
+    (:meth:`~gearchaos.model.System.section_pair`: the planetary model's ``delta_sp_1`` is
+    X̄_sp1, the two-stage train's ``x_1`` is q̄_1), else ``name`` itself."""
+    if system is None:
+        return name
+    caps = system.capabilities
+    entry = caps.symbols.get(caps.default_observables[0])
+    if entry is None or system.section_pair(1)[0] != name:
+        return name
+    sym = entry[0] % 1 if "%d" in entry[0] else entry[0]  # its first member's
+    return plain_symbol(sym) or name
+
+
 def summary_labels(summary: Mapping[str, Any], system: System | None = None) -> dict[str, str]:
     """The row label of each key of ``summary`` that its table shows, in the table's order,
     in the words of the model of ``system`` (a :class:`~gearchaos.model.System`: its
@@ -403,10 +419,7 @@ def summary_labels(summary: Mapping[str, Any], system: System | None = None) -> 
     groups: dict[str, tuple[str, ...]] = {}
     if system is not None:
         caps = system.capabilities
-        entry = caps.symbols.get(caps.default_observables[0])
-        if entry is not None and system.section_pair(1)[0] == section:
-            sym = entry[0] % 1 if "%d" in entry[0] else entry[0]  # its first member's
-            section = plain_symbol(sym) or section
+        section = section_symbol(system, section)
         if caps.period_factor == 1.0:  # Ω is the frequency of its period
             frequency = f"{caps.period_name} frequency [Hz]"
         groups = mesh_contacts(system)

@@ -20,7 +20,7 @@ from ..dynamics.orbits.stability import STABILITY_MARGIN
 from ..errors import IntegrationError, ParameterError
 from ..gearset.schema import OMEGA, SPEEDS
 from . import _common as c
-from ._render import pairs_table
+from ._render import pairs_table, section_symbol
 from ._speeds import speed_note, speed_range, speeds_per_omega
 
 PeriodOpt = Annotated[
@@ -131,8 +131,10 @@ def orbit(
     every |μ| < 1 − 10⁻⁴ (the motion verdict's criterion; a multiplier equal to 1 for a
     structural reason, a free direction, is set aside). **--json** prints exactly {period,
     minimal_period, converged, residual, stable, stability_margin, max_multiplier,
-    multipliers: [{re, im, abs}], x_sp1: [...], contact: [...], message}; a period-2
-    shooting that converges on a 1T orbit says minimal_period 1.
+    multipliers: [{re, im, abs}], section_variable, section: [...], contact: [...],
+    message}, section being the orbit's values of the model's section variable (the planetary
+    model's delta_sp_1, X̄_sp1); a period-2 shooting that converges on a 1T orbit says
+    minimal_period 1.
 
     The guess is a simulation from rest of --transient mesh periods, settled longer (up to
     16 times) while the shooting lands on no orbit or an unstable one; or the state of a
@@ -179,8 +181,11 @@ def orbit(
     table.add_row(f"stable (|μ| < 1 − {STABILITY_MARGIN:g})", "yes" if orb.stable else "no")
     table.add_row("largest |μ|", f"{orb.max_multiplier:.6g}")
     table.add_row("minimal period", str(orb.minimal_period))
-    xs = summary["x_sp1"]
-    table.add_row("X̄_sp1 at the section", escape(", ".join(f"{x:.6g}" for x in xs)))
+    xs = summary["section"]
+    table.add_row(
+        f"{section_symbol(orb.system, summary['section_variable'])} at the section",
+        escape(", ".join(f"{x:.6g}" for x in xs)),
+    )
     for item in summary["contact"]:
         table.add_row(f"contact {item['contact']}", escape(str(item["regime"])))
     out.print(table)
@@ -444,8 +449,10 @@ def attractors(
     exponent λ₁) and labelled as a sweep labels its points; runs that end on the same
     attractor are grouped. A periodic attractor is confirmed by shooting its orbit, whose
     Floquet multipliers say how stable it is; a chaotic or quasi-periodic one by a last window
-    of at least CONFIRM_PERIODS periods (2000). **--json** prints a list of {label, lle, starts,
-    x_sp1, orbit: {period, converged, residual, max_multiplier, stable} or null}.
+    of at least CONFIRM_PERIODS periods (2000). **--json** prints a list of {label, lle,
+    lle_error, evidence, starts, section_variable, section, orbit: {period, converged, residual,
+    max_multiplier, stable} or null}, section being the distinct values of the model's section
+    variable (the planetary model's delta_sp_1, X̄_sp1) on the attractor, or their range.
 
     Example (a stable 1T orbit beside a chaotic attractor): **gearchaos attractors --set
     omega=1.5**
@@ -475,10 +482,14 @@ def attractors(
         f"{speed_note(gs, omega)} from {starts} starts",
         title_justify="left",
     )
-    for col in ("motion", "λ₁", "starts (0: at rest)", "X̄_sp1 at the section", "orbit"):
-        table.add_column(col)
+    symbol = (
+        section_symbol(found[0].system, items[0]["section_variable"]) if found else "section"
+    )  # every attractor is of the same system: its section variable
+    section = f"{symbol} at the section"
+    for col in ("motion", "λ₁", "starts (0: at rest)", section, "orbit"):
+        table.add_column(escape(col))
     for a, item in zip(found, items, strict=True):
-        xs = item["x_sp1"]
+        xs = item["section"]
         xs_text = ", ".join(f"{x:.5g}" for x in xs) if a.period else f"{xs[0]:.5g} … {xs[-1]:.5g}"
         orb = item["orbit"]
         orbit_text = (

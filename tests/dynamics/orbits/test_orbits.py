@@ -202,7 +202,7 @@ def test_orbit_api_section_values_contacts_and_summary(sheng: gc.GearSet) -> Non
     summary = orbit.summary()
     assert list(summary) == [
         "period", "minimal_period", "converged", "max_multiplier", "residual", "stable",
-        "stability_margin", "multipliers", "x_sp1", "contact", "message",
+        "stability_margin", "multipliers", "section_variable", "section", "contact", "message",
     ]  # fmt: skip
     assert summary["minimal_period"] == 1  # issue 24: the JSON says the orbit's own period
     # the stated criterion (issue 32: one margin, 10⁻⁴ as documented): with five planets no
@@ -212,7 +212,8 @@ def test_orbit_api_section_values_contacts_and_summary(sheng: gc.GearSet) -> Non
         m["abs"] < 1 - summary["stability_margin"] for m in summary["multipliers"]
     )
     assert summary["max_multiplier"] == pytest.approx(max(m["abs"] for m in summary["multipliers"]))
-    assert summary["x_sp1"] == pytest.approx([float(x[0, 0])])
+    assert summary["section_variable"] == "delta_sp_1"
+    assert summary["section"] == pytest.approx([float(x[0, 0])])
     assert len(summary["multipliers"]) == 16
     m0 = summary["multipliers"][0]
     assert m0["abs"] == pytest.approx(math.hypot(m0["re"], m0["im"]))

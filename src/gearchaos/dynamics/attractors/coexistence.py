@@ -113,10 +113,13 @@ class Attractor:
         return np.asarray(ob.take(self.section_states, self.sections))
 
     def summary(self) -> dict[str, Any]:
-        """A JSON-serialisable summary: ``label``, ``lle``, ``starts``, ``x_sp1`` (the distinct
-        section values of the first observable, at most 8, else its range), ``orbit`` (period,
-        converged, residual, max_multiplier, stable) or None."""
-        x = self.sections[:, 0]
+        """A JSON-serialisable summary: ``label``, ``lle``, ``lle_error``, ``evidence``,
+        ``starts``, ``section_variable`` (the model's section variable:
+        :meth:`~gearchaos.model.System.section_pair`, the planetary model's ``delta_sp_1``),
+        ``section`` (its distinct section values of the first run, at most 8, else its range),
+        ``orbit`` (period, converged, residual, max_multiplier, stable) or None."""
+        first = self.system.section_pair()[0]
+        x = self.section(first)
         distinct = np.unique(np.round(x, 6))
         out: dict[str, Any] = {
             "label": self.label,
@@ -124,7 +127,8 @@ class Attractor:
             "lle_error": None if self.verdict is None else self.verdict.to_dict()["lle_error"],
             "evidence": None if self.verdict is None else self.verdict.evidence,
             "starts": [int(s) for s in self.starts],
-            "x_sp1": [float(v) for v in distinct]
+            "section_variable": first,
+            "section": [float(v) for v in distinct]
             if distinct.size <= 8
             else [float(np.min(x)), float(np.max(x))],
             "orbit": None,

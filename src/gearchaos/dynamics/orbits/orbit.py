@@ -215,9 +215,10 @@ class PeriodicOrbit:
         orbit's own: a period-2 shooting may converge on a 1T orbit), ``converged``,
         ``residual``, ``stable``, ``stability_margin`` (stable: every non-structural
         |μ| < 1 − margin), ``max_multiplier``, ``multipliers`` ([{re, im, abs}]),
-        ``x_sp1`` (the section values of X̄_sp1, or of the first tracked observable of a
-        reference system), ``contact`` ([{contact, regime}]) and ``message`` (how it converged
-        or why not; how long the guess settled)."""
+        ``section_variable`` (the model's section variable:
+        :meth:`~gearchaos.model.System.section_pair`, the planetary model's ``delta_sp_1``),
+        ``section`` (its n section values), ``contact`` ([{contact, regime}]) and ``message``
+        (how it converged or why not; how long the guess settled)."""
         first = self.system.section_pair()[0]
         return {
             "period": int(self.period),
@@ -231,7 +232,8 @@ class PeriodicOrbit:
                 {"re": float(m.real), "im": float(m.imag), "abs": float(abs(m))}
                 for m in self.multipliers
             ],
-            "x_sp1": [float(v) for v in self.section(first)],
+            "section_variable": first,
+            "section": [float(v) for v in self.section(first)],
             "contact": [{"contact": k, "regime": v} for k, v in self.contact.items()],
             "message": self.message,
         }
@@ -503,15 +505,16 @@ def _settled_note(orbit: PeriodicOrbit, tried: Sequence[PeriodicOrbit]) -> Perio
     lo = tried[0].settings.transient_periods
     hi = tried[-1].settings.transient_periods
     used = orbit.settings.transient_periods
+    periods = f"{orbit.system.capabilities.period_name} periods"  # the model's (mesh periods)
     if orbit.stable:
-        why = f"guess after {used:g} mesh periods from rest (tried {lo:g}–{hi:g})"
+        why = f"guess after {used:g} {periods} from rest (tried {lo:g}–{hi:g})"
     elif orbit.converged:
         why = (
-            f"no stable period-{orbit.period} orbit reached from rest in {lo:g}–{hi:g} mesh "
-            f"periods; this unstable one is from the {used:g}-period guess"
+            f"no stable period-{orbit.period} orbit reached from rest in {lo:g}–{hi:g} "
+            f"{periods}; this unstable one is from the {used:g}-period guess"
         )
     else:
-        why = f"{orbit.message} (guesses after {lo:g}–{hi:g} mesh periods from rest)"
+        why = f"{orbit.message} (guesses after {lo:g}–{hi:g} {periods} from rest)"
     return replace(orbit, message=(f"converged; {why}" if orbit.converged else why))
 
 
