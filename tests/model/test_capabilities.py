@@ -114,6 +114,8 @@ def test_a_user_model_gets_the_defaults_of_what_it_does_not_give() -> None:
     assert dict(caps.quantities) == {} and dict(caps.symbols) == {}
     assert dict(caps.parameter_symbols) == {}
     assert (caps.period_name, caps.member_name) == ("forcing", "member")
+    # contacts and groups are written by their names
+    assert dict(caps.contact_words) == {} and caps.in_words("stage_1") == "stage_1"
     assert caps.gearset is None and caps.result_dataset is None
     assert caps.static_mesh_force is None and caps.warn_for is None
     # every optional member has its default, and only the required ones have none
@@ -283,6 +285,12 @@ def test_the_planetary_quantities_are_lengths_velocities_and_forces() -> None:
     assert {"delta_sp", "delta_rp", "x_s", "y_s", "p", "sigma"} <= set(q)
     assert (caps.period_name, caps.member_name) == ("mesh", "planet")
     assert caps.gearset is not None and caps.result_dataset is not None
+    # the meshes' contact groups in words, a member by its group's words and number; the
+    # bearing's contacts (sun_bearing_x, _y) are written by their names
+    assert [caps.in_words(n) for n in ("sun_planet", "planet_ring", "sun_planet_1")] == [
+        "sun–planet", "planet–ring", "sun–planet_1",
+    ]  # fmt: skip
+    assert caps.in_words("sun_bearing_x") == "sun_bearing_x"
 
 
 @numba.njit(cache=True)

@@ -235,6 +235,14 @@ class Capabilities:
             "`member`",
         ),
     )
+    contact_words: Mapping[str, str] = field(
+        default_factory=_empty,
+        metadata=_doc(
+            "how figures and tables write a contact or a group of contacts in words: name → "
+            "words (`sun_planet`, the group of `sun_planet_1 … sun_planet_N`, → `sun–planet`)",
+            "contacts and groups written by their names",
+        ),
+    )
     gearset: Any = field(
         default=None,
         repr=False,
@@ -342,6 +350,16 @@ class Capabilities:
         except ParameterError as exc:
             raise ParameterError(f"{what}.{exc}") from None
 
+    def in_words(self, name: str) -> str:
+        """A contact or group of contacts as figures and tables write it: its
+        :attr:`contact_words`, a member of a group by the group's words and its number
+        (``sun_planet_1`` → ``sun–planet_1``), else ``name`` itself."""
+        words = self.contact_words
+        if name in words:
+            return words[name]
+        head, _, tail = name.rpartition("_")
+        return f"{words[head]}_{tail}" if tail.isdigit() and head in words else name
+
     @property
     def has_scales(self) -> bool:
         """Whether the model converts to SI units (it gives ``scales``)."""
@@ -354,6 +372,7 @@ _MAPS = {
     "quantities": "variable names to quantities",
     "symbols": "variable names to figure symbols",
     "parameter_symbols": "field names to mathtext symbols",
+    "contact_words": "contact or group names to words",
 }
 #: How many models' records :meth:`Capabilities.of` keeps.
 RECENT_MODELS = 256

@@ -142,6 +142,9 @@ class UserModel:
       and tables (``mesh``: mesh periods, harmonics of the mesh frequency f_m).
     * ``member_name`` (otherwise: ``member``): what one member of a variable group is called
       (``planet``: ``delta_sp_1 … delta_sp_N`` are the planets' deflections).
+    * ``contact_words`` (otherwise: contacts and groups written by their names): how figures and
+      tables write a contact or a group of contacts in words: name → words (``sun_planet``, the
+      group of ``sun_planet_1 … sun_planet_N``, → ``sun–planet``).
     * ``gearset`` (otherwise: none): the gear set the model was built from: speeds in rpm and Hz,
       eccentricity warnings, the gear set's TOML in stores.
     * ``result_dataset(self, result, attrs, series)`` (otherwise: one variable per state and

@@ -398,6 +398,10 @@ class PlanetaryModel:
     #: What one forcing period is called (axes: "mesh periods", ω/ω_m) and a group member.
     period_name = "mesh"
     member_name = "planet"
+    #: The meshes' contact groups in words (the summary figure's load factors and regimes).
+    contact_words: ClassVar[Mapping[str, str]] = MappingProxyType(
+        {"sun_planet": "sun–planet", "planet_ring": "planet–ring"}
+    )
     #: Mesh types whose contact forces are tracked: (label, force group, deflection group).
     force_groups = (("sp", "contact_force_sp", "delta_sp"), ("rp", "contact_force_rp", "delta_rp"))
 

@@ -45,11 +45,6 @@ def _contact_groups(names: list[str]) -> list[str]:
     return [s if s and stems.count(s) > 1 else n for s, n in zip(stems, names, strict=True)]
 
 
-def _words(group: str) -> str:
-    """A contact group as the text panel writes it (``sun_planet`` → ``sun–planet``)."""
-    return group.replace("sun_planet", "sun–planet").replace("planet_ring", "planet–ring")
-
-
 def _text_lines(result: Any, summary: dict[str, Any]) -> list[str]:
     what, name = model_title(result.system.model)
     owner = f"{what}: {name}"
@@ -91,7 +86,8 @@ def _text_lines(result: Any, summary: dict[str, Any]) -> list[str]:
         parts = []
         for m, value in loads.items():  # a mesh type by the group of its contacts
             found = {group_of.get(n, m) for n in meshes[m]}
-            parts.append(f"{_words(found.pop()) if len(found) == 1 else m} {_fmt(value, '.3g')}")
+            group = found.pop() if len(found) == 1 else m
+            parts.append(f"{caps.in_words(group)} {_fmt(value, '.3g')}")
         lines.append(f"max load factor: {', '.join(parts)}")
     contact = summary.get("contact", [])
     if contact:
@@ -102,7 +98,7 @@ def _text_lines(result: Any, summary: dict[str, Any]) -> list[str]:
         for group, c in zip(_contact_groups([c["mesh"] for c in contact]), contact, strict=True):
             regimes_of.setdefault(group, []).append(_REGIME_SHORT.get(c["regime"], c["regime"]))
         for group, regimes in regimes_of.items():
-            lines.append(f"   {_words(group)}: {', '.join(regimes)}")
+            lines.append(f"   {caps.in_words(group)}: {', '.join(regimes)}")
     lines.append(
         f"status: {summary['status']}  (steps {summary['steps_accepted']} accepted, "
         f"{summary['steps_rejected']} rejected)"
