@@ -246,3 +246,40 @@ def test_time_axes_count_the_models_declared_period() -> None:
     draw(fig)
     for text in _texts(fig):
         assert not PLANETARY.search(text), text
+
+
+def test_the_spectrum_counts_the_models_declared_period() -> None:
+    """The two-frequency train (stage 1 forced at Ω, stage 2 at 3Ω/5, T = 5·2π/Ω) has its
+    spectrum in multiples of its period's frequency 2π/T = Ω/5, as the axis says: the line of
+    stage 1 lies at 5 (Ω = 5·2π/T), labelled Ω, and the line of stage 2 at 3 (3Ω/5), labelled
+    3Ω/5, each at the frequency in Hz that Ω ω_0/2π gives. Each line's height is the amplitude
+    of a cosine fitted to the record at that frequency."""
+    from gearchaos.plot.timeseries import HARMONIC_GID
+    from two_frequency_train import PERIOD_FACTOR, TwoFrequencyTrain
+
+    omega = 0.5  # both stages settle on their forcing's period (at 1.2 stage 1 halves it)
+    res = gc.simulate(
+        System(TwoFrequencyTrain(), omega), transient_periods=40, periods=8, samples_per_period=64
+    )
+    hz = omega * OMEGA_0 / (2 * math.pi)  # the frequency of Ω in Hz
+    for var, line_at, forced in (("x_1", 5.0, omega), ("x_2", 3.0, 0.6 * omega)):
+        ax = gc.plot.spectrum(res, var, max_harmonic=6.0)
+        assert "multiples of the train frequency" in ax.get_xlabel()
+        assert r"2\pi/T = \Omega/5" in ax.get_xlabel()
+        ratio, amp = ax.get_lines()[0].get_data()
+        k = int(np.argmax(amp))
+        assert ratio[k] == pytest.approx(line_at)
+        assert ratio[k] == pytest.approx(forced * PERIOD_FACTOR / omega)
+        # the amplitude at the forced frequency, by least squares on the record itself
+        tau, x = res.tau, res.series(var)
+        basis = np.column_stack([np.cos(forced * tau), np.sin(forced * tau), np.ones_like(tau)])
+        coef = np.linalg.lstsq(basis, x, rcond=None)[0]
+        assert amp[k] == pytest.approx(math.hypot(coef[0], coef[1]), rel=1e-6)
+        labels = {
+            round(t.get_position()[0]): t.get_text()
+            for t in ax.texts
+            if t.get_gid() == HARMONIC_GID
+        }
+        assert labels[3] == rf"$3\Omega/5$ = {3 * hz / PERIOD_FACTOR:.0f} Hz"
+        assert labels[5] == rf"$\Omega$ = {hz:.0f} Hz"
+        assert _secondaries(ax) == pytest.approx({"frequency [Hz]": hz / PERIOD_FACTOR})

@@ -419,6 +419,33 @@ def period_name(result: Any) -> str:
     return result.system.capabilities.period_name
 
 
+def frequency_axis(result: Any) -> tuple[str, str]:
+    """(mathtext symbol, words) of a spectrum's frequency axis, in multiples of the frequency
+    2π/T of the model's forcing period T = ``period_factor``·2π/Ω, so that the harmonics of
+    its period lie at the integers: ω/ω_m (the mesh frequency), ω/Ω for a period 2π/Ω, else
+    ωT/2π (a period of 5·2π/Ω: multiples of Ω/5)."""
+    caps = result.system.capabilities
+    name, factor = caps.period_name, caps.period_factor
+    if name == "mesh":
+        return r"\omega/\omega_m", "multiples of the mesh frequency $f_m$"
+    if factor == 1.0:
+        return r"\omega/\Omega", f"multiples of the {name} frequency"
+    words = rf"multiples of the {name} frequency $2\pi/T = {omega_times(1.0 / factor)}$"
+    return r"\omega T/2\pi", words
+
+
+def omega_times(ratio: float) -> str:
+    """``ratio``·Ω in mathtext without ``$``: ``\\Omega``, ``2\\Omega``, ``3\\Omega/5`` for a
+    fraction of small terms, else ``0.417\\Omega``."""
+    from fractions import Fraction
+
+    fr = Fraction(ratio).limit_denominator(1000)
+    if not math.isclose(float(fr), ratio, rel_tol=1e-9):
+        return rf"{ratio:.3g}\Omega"
+    num = "" if fr.numerator == 1 else str(fr.numerator)
+    return rf"{num}\Omega" + ("" if fr.denominator == 1 else f"/{fr.denominator}")
+
+
 def has_physical_scales(result: Any) -> bool:
     """Whether the model converts to SI units (a gear set's ω_n, b_c …)."""
     return result.system.capabilities.has_scales

@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from ._common import axis_symbol, fmt, message, period_name, variable
+from ._common import axis_symbol, fmt, frequency_axis, message, variable
 from .phase import phase_portrait, poincare_map
 from .regimes import regime_colour, regime_legend_below
 from .timeseries import spectrum
@@ -201,8 +201,7 @@ def poincare_gallery(
                     message(ex, str(e))
             elif result.samples_per_period >= 4:
                 spectrum(result, var, planet, ax=ex)
-                mesh = period_name(result) == "mesh"
-                ex.set_xlabel(r"$\omega/\omega_m$" if mesh else r"$\omega/\Omega$")
+                ex.set_xlabel(f"${frequency_axis(result)[0]}$")
                 ex.set_ylabel("amplitude")
                 ex.set_title("amplitude spectrum", fontsize="x-small", loc="left")
             else:

@@ -10,8 +10,10 @@ import numpy as np
 from ..errors import ParameterError
 from ._common import (
     clearance_lines,
+    frequency_axis,
     get_ax,
     has_physical_scales,
+    omega_times,
     period_axis_label,
     period_name,
     sample_window,
@@ -206,17 +208,20 @@ def amplitude_spectrum(
     The recorded window spans an integer number P of forcing periods sampled uniformly with
     ``s = samples_per_period`` samples each, so with the default rectangular window the FFT
     bins fall exactly on multiples 1/P of the forcing frequency 2π/T and a periodic response
-    has leakage-free lines at its harmonics: for x_j = a cos(kΩτ_j + φ) the bin at ω/Ω = k
-    holds amplitude ``a`` (a model whose forcing period is T = f·2π/Ω, ``period_factor`` f,
-    has bins at multiples 1/(fP) of Ω). The mean is removed first. ``window="hann"`` applies
+    has leakage-free lines at its harmonics: for x_j = a cos(2πkτ_j/T + φ) the bin at
+    ωT/2π = k holds amplitude ``a``. For a period T = 2π/Ω (the planetary model's mesh period)
+    that is ω/Ω = k; a model whose forcing period is T = f·2π/Ω (``period_factor`` f) has its
+    line at Ω at k = f (the two-frequency train's lines at Ω and 3Ω/5 at 5 and 3). The mean is
+    removed first. ``window="hann"`` applies
     a Hann window (amplitudes divided by the window's mean, so lines keep their height) for
     non-periodic motion.
 
     Returns
     -------
     (ratio, amplitude)
-        ``ratio = ω/Ω`` (multiples of the mesh frequency for the planetary model) for bins
-        1 … Ps/2 and the amplitudes, in the units of the variable.
+        ``ratio = ωT/2π``, in multiples of the frequency of the model's forcing period (ω/Ω,
+        multiples of the mesh frequency, for the planetary model), for bins 1 … Ps/2 and the
+        amplitudes, in the units of the variable.
     """
     info = variable(result, var, planet)
     s = result.samples_per_period
@@ -243,10 +248,7 @@ def amplitude_spectrum(
         raise ParameterError(f"window must be 'boxcar' or 'hann': got {window!r}")
     amp = 2.0 * np.abs(np.fft.rfft(x * w)) / w.sum()
     k = np.arange(amp.size)
-    ratio = k / n_periods  # multiples of 1/T
-    factor = result.system.capabilities.period_factor  # T = factor·2π/Ω
-    if factor != 1.0:
-        ratio = ratio / factor
+    ratio = k / n_periods  # multiples of the period's frequency 2π/T
     if x.size % 2 == 0:
         amp[-1] /= 2.0  # the Nyquist bin is not doubled
     return ratio[1:], amp[1:]
@@ -263,8 +265,11 @@ def spectrum(
 ) -> Any:
     """Plot the amplitude spectrum of a variable on a log scale (see :func:`amplitude_spectrum`).
 
-    The frequency axis is ω/ω_m, in multiples of the mesh frequency (forcing frequency for
-    other systems), shown up to ``max_harmonic`` (or the Nyquist limit s/2). Raises
+    The frequency axis is in multiples of the frequency 2π/T of the model's forcing period T
+    (:func:`~gearchaos.plot._common.frequency_axis`: ω/ω_m, multiples of the mesh frequency,
+    for the planetary model; ωT/2π for a period T = 5·2π/Ω, whose line at Ω lies at 5), shown
+    up to ``max_harmonic`` of them (or the Nyquist limit s/2); each whole multiple is marked
+    and labelled (``3Ω/5``, in Hz too for a model with scales). Raises
     :class:`~gearchaos.errors.ParameterError` unless ``samples_per_period >= 4``.
     """
     info = variable(result, var, planet)
@@ -281,11 +286,18 @@ def spectrum(
         lo = max(float(np.min(shown[shown > 0])) if np.any(shown > 0) else floor, top * 1e-9)
         ax.set_ylim(lo / 2.0, top * 3.0)
     scales = PhysicalScales.of_result(result) if has_physical_scales(result) else PhysicalScales()
-    f_m = float(result.omega) * scales.omega_n / (2.0 * math.pi) if scales.omega_n else None
+    factor = result.system.capabilities.period_factor  # T = factor·2π/Ω
+    # 2π/T in Hz: the frequency of one multiple on the axis
+    f_t = None
+    if scales.omega_n:
+        f_t = float(result.omega) * scales.omega_n / (2.0 * math.pi * factor)
     for h in range(1, math.floor(hi) + 1):
         ax.axvline(h, color="0.8", lw=0.6, zorder=0)
-        base = "$f_m$" if period_name(result) == "mesh" else r"$\Omega$"
-        label = f"{h}{base}" if f_m is None else f"{h}{base} = {h * f_m:.0f} Hz"
+        if period_name(result) == "mesh":
+            base = f"{h}$f_m$"
+        else:  # h·2π/T as a multiple of Ω (3Ω/5 for T = 5·2π/Ω)
+            base = f"${omega_times(h / factor)}$"
+        label = base if f_t is None else f"{base} = {h * f_t:.0f} Hz"
         ax.text(
             h,
             0.98,
@@ -305,11 +317,9 @@ def spectrum(
             for r in (h - side, h + side):
                 if 0.0 < r <= hi:
                     ax.axvline(r, color="0.85", lw=0.5, ls=":", zorder=0, gid=HARMONIC_GID)
-    if period_name(result) == "mesh":
-        ax.set_xlabel(r"$\omega/\omega_m$ (multiples of the mesh frequency $f_m$)")
-    else:
-        ax.set_xlabel(rf"$\omega/\Omega$ (multiples of the {period_name(result)} frequency)")
-    if f_m is not None:  # a model with scales: the frequency in Hz opposite
-        linear_axis(ax, "x", f_m, "frequency [Hz]")
+    symbol, words = frequency_axis(result)
+    ax.set_xlabel(f"${symbol}$ ({words})")
+    if f_t is not None:  # a model with scales: the frequency in Hz opposite
+        linear_axis(ax, "x", f_t, "frequency [Hz]")
     ax.set_ylabel(f"amplitude of ${info.symbol}$")
     return ax
