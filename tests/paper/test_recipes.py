@@ -169,9 +169,13 @@ def test_paper_protocol_is_the_seeds_zero_start_and_record_labels(tmp_path):
     ds = xr.open_zarr(res["store"]).load()
     spec = SweepResult.of(ds).spec
     assert spec.solver.perturbation == 0.0 and spec.verdicts is False and spec.lyapunov is False
-    assert "verdict" not in ds.data_vars and "lle" not in ds.data_vars
     ok = ds["status"].values == 0
     assert ok.all()
+    # labels from the record alone (evidence record), no λ₁ recorded nor measured
+    from gearchaos.dynamics.verdict.evidence import EVIDENCE
+
+    assert np.all(ds["verdict"].values == EVIDENCE["record"])
+    assert np.all(np.isnan(ds["lle"].values)) and np.all(np.isnan(ds["max_multiplier"].values))
     # from the exact zero state the identical in-phase planets never leave their symmetric
     # subspace (every mesh deflects alike) and the sun stays centred: the start was exact
     dmin = ds["delta_sp_min"].values

@@ -44,7 +44,33 @@ VERSION_ATTRS = frozenset(
 PLANETARY_MODEL = "gearchaos.model.planetary:PlanetaryModel"
 
 
+#: Evidence codes added to the flag legend of ``verdict`` since the references were written
+#: (issue 36: ``record``, the labels of sweeps without verdicts): a reference store holds none
+#: of them, and its legend is the new one without them.
+ADDED_EVIDENCE = {"record": 8}
+
+
+def _legend_of_reference(a: dict[str, object], b: dict[str, object]) -> dict[str, object]:
+    """The attributes ``a`` of a new ``verdict`` array with the added evidence codes taken
+    out of its legend, where the reference ``b`` lacks them (the legend otherwise equal)."""
+    values, meanings = a.get("flag_values"), a.get("flag_meanings")
+    if not isinstance(values, list) or not isinstance(meanings, str):
+        return a
+    pairs = [
+        (v, m)
+        for v, m in zip(values, meanings.split(), strict=True)
+        if not (ADDED_EVIDENCE.get(m) == v and m not in str(b.get("flag_meanings")).split())
+    ]
+    return {
+        **a,
+        "flag_values": [v for v, _ in pairs],
+        "flag_meanings": " ".join(m for _, m in pairs),
+    }
+
+
 def _same_attrs(a: dict[str, object], b: dict[str, object], where: str) -> None:
+    if where == "verdict":
+        a = _legend_of_reference(a, b)
     if "model_class" not in b and b.get("gearset_toml"):  # a gear set's file, written before
         a = dict(a)
         assert a.pop("model_class") == PLANETARY_MODEL, f"{where}: model_class"

@@ -276,6 +276,7 @@ def add_motion_rows(table: Table, summary: Mapping[str, Any]) -> None:
 def gallery_rows_table(rows: Sequence[Mapping[str, Any]], param: str, *, title: str) -> Table:
     """One row per value: value, motion (in its palette colour), what decided it, max |μ|,
     λ₁ ± its error, K, agree, points."""
+    from ..dynamics.verdict.evidence import evidence_words
     from ..plot.regimes import regime_colour
 
     table = Table(title=escape(title), title_justify="left")
@@ -294,7 +295,7 @@ def gallery_rows_table(rows: Sequence[Mapping[str, Any]], param: str, *, title: 
         table.add_row(
             f"{float(r['value']):g}",
             Text("■ ", style=regime_colour(motion)) + Text(motion),
-            str(r.get("evidence", "record")),
+            evidence_words(str(r.get("evidence", "record"))),
             "—" if r.get("max_multiplier") is None else f"{r['max_multiplier']:.4g}",
             format_exponent(lle, r.get("lle_error")),
             "—" if k01 is None else f"{k01:.3f}",

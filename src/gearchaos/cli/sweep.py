@@ -294,9 +294,11 @@ def classify(
     stored section sequence), QP or chaos (by the stored largest Lyapunov exponent when the
     sweep ran with --lyapunov, confirmed by the 0–1 test and the spectrum), unresolved, failed.
 
-    Rewrites the store's motion, period, k01 and indicators_agree variables and its
-    regime_table attribute, and prints the regime table: the fraction of the swept points in
-    each regime, per family value. **--json** prints that table as a dictionary
+    Rewrites the period and indicators_agree variables and the regime_table attribute, and
+    the motion and k01 of a store labelled from its record (--no-verdict: evidence record,
+    decided again with these tolerances; a store's confirmed verdicts are never rewritten),
+    and prints the regime table: the fraction of the swept points in each regime, per family
+    value. **--json** prints that table as a dictionary
     (family value → regime → fraction).
 
     Example: **gearchaos classify fig4.zarr --period-rtol 1e-4**

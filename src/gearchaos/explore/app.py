@@ -521,11 +521,14 @@ def _stack(*figs: Any) -> Any:
 
 
 def _computed_text(out: Mapping[str, Any]) -> str:
+    from ..dynamics.verdict.evidence import evidence_words
+
     summary = out.get("summary") or {}
     lle = format_exponent(out.get("lle"), summary.get("lle_error"))
     lines = [
         f"**computed at {', '.join(f'{k} = {v:.6g}' for k, v in out['values'].items())}**: "
-        f"motion **{out['motion']}** (decided by {summary.get('evidence', 'record')}), "
+        f"motion **{out['motion']}** "
+        f"(decided by {evidence_words(summary.get('evidence', 'record'))}), "
         f"λ₁ = {lle} per unit τ, "
         f"{out['distinct']} distinct section points, status {out['status']} "
         "(simulated from rest with the store's protocol)"

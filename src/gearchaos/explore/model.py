@@ -300,14 +300,16 @@ class ExploreModel:
         return v if math.isfinite(v) else None
 
     def evidence(self, point: Point) -> str:
-        """What decided the stored label (the verdict's flag and max |μ|), or ``""`` for a
-        store labelled from its records alone."""
-        from ..dynamics.verdict.evidence import EVIDENCE
+        """What decided the stored label (the verdict's flag and max |μ|; a label from the
+        record alone says it is not confirmed), or ``""`` for a store of an earlier version
+        labelled from its records alone without verdict columns."""
+        from ..dynamics.verdict.evidence import EVIDENCE, evidence_words
 
         if "verdict" not in self.full.ds.data_vars:
             return ""
         names = {v: k for k, v in EVIDENCE.items()}
-        text = f"decided by {names.get(int(self._at('verdict', point)), 'unknown')}"
+        key = names.get(int(self._at("verdict", point)), "unknown")
+        text = f"decided by {evidence_words(key)}"
         mu = float(self._at("max_multiplier", point))
         if math.isfinite(mu):
             text += f", max |μ| = {mu:.6g}"

@@ -30,6 +30,7 @@ from ..analysis.motion import LABEL_DTYPE, Motion
 from ..errors import ParameterError, Status, StoreError
 from .result import SweepResult
 from .store import SweepStore, consolidate, foreign_files_ignored, open_sweep, set_attributes
+from .verdicts import VERDICT_COLUMNS
 
 __all__ = ["classify_dataset", "classify_store"]
 
@@ -58,21 +59,50 @@ def _section_pair(res: SweepResult) -> np.ndarray:
 def classify_dataset(
     ds: Any, *, period_rtol: float = PERIOD_RTOL, max_period: int = MAX_PERIOD
 ) -> dict[str, Any]:
-    """Labels and indicators for every point of a sweep dataset (nothing written)."""
+    """Labels and indicators for every point of a sweep dataset (nothing written).
+
+    Every store written since sweeps store their verdicts holds the verdict columns
+    (:mod:`gearchaos.sweep.verdicts`): a store decided by the confirming verdict has its labels
+    read as stored (never re-decided); a store labelled from the record alone (evidence
+    ``record``, ``verdicts=False``) is decided again by the same record mode with these
+    tolerances (``record_verdicts`` holds the new verdicts). A store of an earlier version
+    without verdict columns is labelled by :func:`_old_layout_labels`.
+    """
+    res = SweepResult.of(ds)
+    if "verdict" not in res.ds.data_vars:
+        return _old_layout_labels(res, period_rtol=period_rtol, max_period=max_period)
+    if _record_mode(res):
+        return _from_record(res, period_rtol=period_rtol, max_period=max_period)
+    return _from_verdicts(res)
+
+
+def _lle_inputs(res: SweepResult) -> dict[str, Any]:
+    """The λ₁ a sweep recorded (``lyapunov`` without verdicts), with the record's length in
+    periods and the forcing period of every point (its bound), or nothing."""
+    ds = res.ds
+    if "lle" not in ds.data_vars:
+        return {}
+    spec = res.spec
+    return {
+        "lle": np.asarray(ds["lle"].transpose(*res.lead_dims).values, dtype=float),
+        "run_periods": int(spec.solver.periods if spec is not None else ds.attrs["periods"]),
+        "forcing_period": res.forcing_period(),
+    }
+
+
+def _old_layout_labels(res: SweepResult, *, period_rtol: float, max_period: int) -> dict[str, Any]:
+    """The labels of a store written before every sweep stored its verdicts (no verdict
+    columns: a sweep without verdicts, labelled after it ran): from its section values with
+    :func:`~gearchaos.analysis.classify.classify_sections`, exactly as those versions did."""
     from ..analysis.classify import classify_sections
 
-    res = SweepResult.of(ds)
-    ds = res.ds
     lead_dims, shape = res.lead_dims, res.shape
-    if "verdict" in ds.data_vars:
-        return _from_verdicts(res)
     pts = _section_pair(res)
     kw: dict[str, Any] = {"details": True, "rtol": period_rtol, "max_period": max_period}
-    if "lle" in ds.data_vars:
-        kw["lle"] = np.asarray(ds["lle"].values, dtype=float)
-        spec = res.spec
-        kw["run_periods"] = int(spec.solver.periods if spec is not None else ds.attrs["periods"])
-        kw["forcing_period"] = res.forcing_period()
+    lle = _lle_inputs(res)
+    if lle:
+        kw["lle"] = np.asarray(res.ds["lle"].values, dtype=float)
+        kw.update(run_periods=lle["run_periods"], forcing_period=lle["forcing_period"])
     details = classify_sections(pts, **kw)
     status = res.status()
     labels = np.empty(shape, dtype=LABEL_DTYPE)
@@ -93,6 +123,61 @@ def classify_dataset(
         "k01": k01,
         "indicators_agree": agree,
         "regime_table": _regime_table(res, labels),
+    }
+
+
+def _record_mode(res: SweepResult) -> bool:
+    """Whether a store's verdicts are all from the record alone (a sweep without verdicts):
+    every point's evidence ``record``, ``failed`` or not computed yet. A store of the
+    confirming verdict never is, so its Floquet and Lyapunov verdicts are never re-decided."""
+    from ..dynamics.verdict.evidence import EVIDENCE
+
+    spec = res.spec
+    if spec is not None and spec.verdicts:
+        return False
+    codes = {int(c) for c in np.unique(np.asarray(res.ds["verdict"].values))}
+    return codes <= {EVIDENCE["record"], EVIDENCE["failed"], EVIDENCE["not_computed"]}
+
+
+def _from_record(res: SweepResult, *, period_rtol: float, max_period: int) -> dict[str, Any]:
+    """A record-mode store decided again, by the record mode of the verdict
+    (:func:`~gearchaos.dynamics.verdict.record.decide_from_record`) with these tolerances:
+    the labels the sweep stored at the default ones, or new ones with others."""
+    from ..dynamics.verdict.record import decide_from_record
+
+    lead_dims, shape = res.lead_dims, res.shape
+    status = res.status()
+    pairs = _section_pair(res)
+    pts = pairs.reshape(-1, *pairs.shape[-2:])
+    lle = _lle_inputs(res)
+    verdicts = decide_from_record(
+        pts,
+        (status == 0).reshape(-1),
+        lle=lle["lle"].reshape(-1) if lle else None,
+        run_periods=lle.get("run_periods"),
+        forcing_period=np.asarray(lle["forcing_period"]).reshape(-1) if lle else None,
+        period_rtol=period_rtol,
+        longest_period=max_period,
+    )
+    labels = np.empty(shape, dtype=LABEL_DTYPE)
+    period = np.zeros(shape, dtype=np.int16)
+    k01 = np.full(shape, np.nan)
+    agree = np.ones(shape, dtype=bool)
+    for i, idx in enumerate(np.ndindex(*shape)):
+        v = verdicts[i]
+        labels[idx] = _status_label(int(status[idx])) or v.label
+        period[idx] = v.period
+        k01[idx] = v.k01
+        agree[idx] = v.agree
+    return {
+        "dims": lead_dims,
+        **_contact(res),
+        "motion": labels,
+        "period": period,
+        "k01": k01,
+        "indicators_agree": agree,
+        "regime_table": _regime_table(res, labels),
+        "record_verdicts": verdicts,
     }
 
 
@@ -331,9 +416,15 @@ def classify_store(
             "k01": ("0–1 test for chaos K (Gottwald & Melbourne)", np.nan),
             "indicators_agree": ("whether every available indicator agrees with the label", False),
         }
-        verdicts = "verdict" in ds.data_vars
+        if "verdict" in ds.data_vars:  # the verdict columns' own descriptions
+            docs["motion"] = (VERDICT_COLUMNS["motion"].long_name, "")
+            docs["k01"] = (VERDICT_COLUMNS["k01"].long_name, np.nan)
+        # a confirming verdict's labels are never rewritten here; a record-mode store's are
+        # the record mode's again, with these tolerances (verdict, lle and the rest unchanged:
+        # they do not depend on them)
+        protected = "verdict" in ds.data_vars and "record_verdicts" not in res
         for name, (doc, fill) in docs.items():
-            if verdicts and name in ("motion", "k01"):
+            if protected and name in ("motion", "k01"):
                 continue  # written by every task with its verdict: never rewritten in place
             values = res[name]
             arr = g.create_array(

@@ -37,7 +37,7 @@ from .spec import SweepSpec, sweep_keywords
 from .speeds import given_speed, omega_spec, speed_coords
 from .store import SweepStore
 from .variables import ORBIT_VARIABLES, SKIPPED, STEP_COUNTS, status_attrs
-from .verdicts import VERDICT_VARIABLES, task_verdicts, verdict_attrs
+from .verdicts import RECORD_MODE, VERDICT_VARIABLES, task_verdicts, verdict_attrs
 
 __all__ = ["bifurcation", "run_sweep"]
 
@@ -109,10 +109,13 @@ class _Layout:
                 },
             )
             chunks["lle"] = ch
-        if spec.verdicts:
-            for nm, (doc, dtype, fill) in VERDICT_VARIABLES.items():
-                var[nm] = (lead, (shp, dtype), fill, {"long_name": doc, **verdict_attrs(nm)})
-                chunks[nm] = ch
+        # every sweep stores its verdicts: confirmed, or from the record alone without
+        # verdicts (evidence record), whose λ₁ is the one recorded above
+        for nm, (doc, dtype, fill) in VERDICT_VARIABLES.items():
+            if nm == "lle" and spec.recorded_lyapunov:
+                continue
+            var[nm] = (lead, (shp, dtype), fill, {"long_name": doc, **verdict_attrs(nm)})
+            chunks[nm] = ch
         if spec.orbits:
             for nm, (doc, dtype, fill) in ORBIT_VARIABLES.items():
                 extra = status_attrs() if nm == "orbit_status" else {}
@@ -189,8 +192,7 @@ class _Layout:
             data["final_state"][pos] = out.final_state[c, j, :n_st]
             if spec.recorded_lyapunov:
                 data["lle"][pos] = lle[c, j, 0]
-        if spec.verdicts:
-            task_verdicts(self, task, out, data)
+        task_verdicts(self, task, out, data, None if spec.verdicts else RECORD_MODE)
         if spec.orbits:
             data.update(task_orbits(self.grid, self.observed, task, run, data))
         return data
@@ -314,6 +316,7 @@ def _run_locked(
         if st.attrs().get("complete"):
             st.clear_stale_progress()
             return st.open()
+        st.check_resumable(layout.variables()[0])
     elif st.path is not None and os.path.lexists(st.path):
         raise StoreError(
             f"{st.path!r} exists and is not a gearchaos sweep store: it is never replaced, "

@@ -19,7 +19,7 @@ import json
 import os
 import shutil
 import warnings
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from typing import Any
 
 import numpy as np
@@ -207,6 +207,20 @@ class SweepStore:
                 f"{self.path} holds a sweep with other settings ("
                 + "; ".join(diffs)
                 + "). Use another output path, or overwrite=True (--overwrite) to replace it."
+            )
+
+    def check_resumable(self, variables: Iterable[str]) -> None:
+        """Refuse to resume an interrupted store that lacks ``variables`` this version writes
+        (one written before every sweep stored its verdicts), naming them."""
+        import zarr
+
+        g = zarr.open_group(self.zarr_store, mode="r", use_consolidated=False)
+        missing = sorted(set(variables) - {name for name, _ in g.arrays()})
+        if missing:
+            raise StoreError(
+                f"{self.path} is an interrupted sweep written by an earlier version, without "
+                f"the variables {', '.join(missing)} that every sweep now stores: it cannot "
+                "be resumed; run the sweep again with --overwrite (overwrite=True)"
             )
 
     def remove(self) -> None:

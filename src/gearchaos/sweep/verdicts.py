@@ -1,8 +1,10 @@
-"""The motion verdict of every sweep point (``verdicts=True``, the default).
+"""The motion verdict of every sweep point.
 
 Each task decides its points with :func:`gearchaos.dynamics.verdict.decide.decide_motion` right
-after
-integrating them (in the worker, all points of a period together), and writes per point
+after integrating them (in the worker, all points of a period together): with ``verdicts=True``
+(the default) by the confirming procedure, with ``verdicts=False`` in its record mode (every
+label from the point's stored section values alone, evidence ``record``, nothing integrated:
+:mod:`gearchaos.dynamics.verdict.record`). Either way it writes per point
 
 * ``motion`` — the label (1T … nT, QP, chaos, unresolved, failed);
 * ``verdict`` — what decided it, a flag (:data:`~gearchaos.dynamics.verdict.decide.EVIDENCE`);
@@ -48,9 +50,11 @@ from ..dynamics.verdict.extension import RECORD_SOURCES
 
 __all__ = [
     "NOT_STORED",
+    "RECORD_MODE",
     "VERDICT_COLUMNS",
     "VERDICT_VARIABLES",
     "VerdictColumn",
+    "record_sections",
     "task_verdicts",
     "verdict_attrs",
     "verdict_row",
@@ -146,6 +150,8 @@ NOT_STORED: Mapping[str, str] = MappingProxyType(
         "record": "replaces the point's section values and final state; its source is record",
         "orbit_state": "the confirmed orbit's state: an orbit store (--orbits) holds orbits",
         "coexisting": "the stable orbits beside the motion: reported by attractors",
+        "agree": "a record-mode label's indicators against it: indicators_agree, written by "
+        "the store's classification (sweep.classify), which re-reads the record",
     }
 )
 
@@ -169,6 +175,21 @@ def verdict_row(v: Any) -> dict[str, Any]:
     return {name: getattr(v, col.source) for name, col in VERDICT_COLUMNS.items()}
 
 
+#: The verdict settings of a sweep without verdicts (``verdicts=False``): the record mode.
+RECORD_MODE = VerdictSettings(mode="record")
+
+
+def record_sections(observed: Any, blocks: list[np.ndarray]) -> np.ndarray:
+    """The section values a label is read from in record mode: the first two observed
+    section variables (their first observed planet) as (..., section, 2), from their arrays
+    ``blocks`` in the order of ``observed`` — in a task's block arrays and in a stored
+    sweep alike (:func:`gearchaos.sweep.classify.section_pair`)."""
+    cols = []
+    for ob, v in list(zip(observed, blocks, strict=True))[:2]:
+        cols.append(np.asarray(v[..., 0] if ob.per_planet else v, dtype=float))
+    return np.stack(cols, axis=-1)
+
+
 def task_verdicts(
     layout: Any,
     task: Any,
@@ -179,19 +200,29 @@ def task_verdicts(
     """Decide the motion of a task's points from the kernel outputs ``out`` and write the
     verdict variables into its block arrays ``data`` (replacing the record — sections,
     tracked extrema, final state — where the verdict replaced it). ``layout`` is the sweep's
-    store layout (its grid, observed and tracked variables)."""
+    store layout (its grid, observed and tracked variables). In record mode
+    (:data:`RECORD_MODE`) the labels are read from the section values already in ``data``
+    and the λ₁ the sweep recorded (``lle``), nothing is integrated nor replaced."""
     grid, observed = layout.grid, layout.observed
     spec = grid.spec
     where = task.points()
     systems = [grid.system(idx) for _, _, idx, _ in where]
-    values = [grid.values_at(idx) for _, _, idx, _ in where]
+    ok = [int(out.status[c, j]) == 0 for c, j, *_ in where]
     n = systems[0].n_state
     spp = int(spec.solver.samples_per_period)
-    sections = np.stack([out.states[c, j][::spp, :n] for c, j, *_ in where])
-    finals = np.stack([out.final_state[c, j, :n] for c, j, *_ in where])
-    ok = [int(out.status[c, j]) == 0 for c, j, *_ in where]
+    lle = None
+    if verdict is not None and verdict.mode == "record":
+        blocks = [[data[ob.name][pos] for ob in observed] for *_, pos in where]
+        sections = np.stack([record_sections(observed, b) for b in blocks])
+        finals = np.stack([data["final_state"][pos] for *_, pos in where])
+        if "lle" in data:
+            lle = np.array([data["lle"][pos] for *_, pos in where], dtype=float)
+    else:
+        sections = np.stack([out.states[c, j][::spp, :n] for c, j, *_ in where])
+        finals = np.stack([out.final_state[c, j, :n] for c, j, *_ in where])
+    values = [grid.values_at(idx) for _, _, idx, _ in where]
     verdicts = decide_motion(
-        grid.target, values, systems, sections, finals, ok, spec.solver, verdict
+        grid.target, values, systems, sections, finals, ok, spec.solver, verdict, lle=lle
     )
     for name, col in VERDICT_COLUMNS.items():
         if name not in data:

@@ -68,6 +68,7 @@ from .periodic import (
     measure_periods,
     shoot_candidates,
 )
+from .record import decide_from_record
 from .rules import SectionTests, Window, decide_by_exponent
 from .settings import CONFIRM_PERIODS, VerdictSettings, confirmed_settings
 
@@ -250,8 +251,13 @@ def decide_motion(
     ok: Sequence[bool] | np.ndarray,
     settings: SolverSettings,
     verdict: VerdictSettings | None = None,
+    *,
+    lle: Sequence[float] | np.ndarray | None = None,
 ) -> list[Verdict]:
-    """The motion verdict of K points (see the module docstring).
+    """The motion verdict of K points (see the module docstring), or, with
+    ``VerdictSettings(mode="record")``, their labels from the record alone (evidence
+    ``record``: :func:`~gearchaos.dynamics.verdict.record.decide_from_record`, nothing
+    integrated).
 
     Parameters
     ----------
@@ -259,7 +265,9 @@ def decide_motion(
         The gear set or system, each point's parameter values by name, and its resolved
         :class:`~gearchaos.model.System` (one kind and layout).
     sections
-        (K, m, n_state) the recorded section states of every point.
+        (K, m, n_state) the recorded section states of every point; in record mode, the
+        section values the label is read from ((K, m, d), a sweep's first two observed
+        section variables).
     final_states
         (K, n_state) the state at the end of the record, on the section of ``settings``.
     ok
@@ -268,6 +276,9 @@ def decide_motion(
         The solver settings of the record (tolerances, section).
     verdict
         :class:`VerdictSettings` (default: the defaults).
+    lle
+        (K,) the λ₁ the run recorded (NaN: none), read by the record mode only: the
+        confirming mode measures its own.
 
     Returns
     -------
@@ -277,6 +288,14 @@ def decide_motion(
     vs = VerdictSettings() if verdict is None else verdict
     if not isinstance(vs, VerdictSettings):
         raise ParameterError(f"verdict must be a VerdictSettings: got {type(vs).__name__}")
+    if vs.mode == "record":
+        return _from_record(systems, sections, ok, settings, vs, lle)
+    if lle is not None:
+        raise ParameterError(
+            "lle (a recorded λ₁) is read only by the record mode (VerdictSettings(mode="
+            "'record')): the confirming verdict measures λ₁ itself",
+            name="lle",
+        )
     K = len(systems)
     sec = np.asarray(sections, dtype=np.float64)
     if sec.ndim != 3 or sec.shape[0] != K:
@@ -369,6 +388,32 @@ def decide_motion(
             break
         _extend(todo, pts, done, systems, settings, vs, length)
     return [done[k] for k in range(K)]
+
+
+def _from_record(
+    systems: Sequence[System],
+    sections: np.ndarray,
+    ok: Sequence[bool] | np.ndarray,
+    settings: SolverSettings,
+    vs: VerdictSettings,
+    lle: Sequence[float] | np.ndarray | None,
+) -> list[Verdict]:
+    """The record mode: each point's label from its section values, the λ₁ bound counting
+    the record's periods of its system's forcing period."""
+    sec = np.asarray(sections, dtype=np.float64)
+    K = len(systems)
+    if sec.ndim != 3 or sec.shape[0] != K:
+        raise ParameterError(f"sections must have shape ({K}, m, d): got {sec.shape}")
+    return decide_from_record(
+        sec,
+        ok,
+        lle=None if lle is None else np.asarray(lle, dtype=np.float64).reshape(K),
+        run_periods=int(settings.periods),
+        forcing_period=np.array([s.period for s in systems], dtype=np.float64),
+        period_rtol=vs.period_rtol,
+        longest_period=vs.longest_period,
+        lle_c=vs.lle_c,
+    )
 
 
 def _extend(

@@ -15,7 +15,7 @@ from ...analysis.motion import Motion, MotionKind
 from ...errors import ParameterError
 from .extension import RECORD_SOURCES, VerdictRecord
 
-__all__ = ["EVIDENCE", "Verdict"]
+__all__ = ["EVIDENCE", "UNCONFIRMED", "Verdict", "evidence_words"]
 
 #: What decided a label (the flag values of a store's ``verdict`` variable).
 EVIDENCE = {
@@ -28,7 +28,20 @@ EVIDENCE = {
     "unstable_orbit": 5,  # unresolved: near an unstable orbit, not left within the budget
     "failed": 6,  # the integration failed
     "converging": 7,  # unresolved: approaching a stable orbit, not reached within the budget
+    "record": 8,  # any label: from the record alone (mode "record"), nothing confirmed
 }
+
+#: Evidence codes whose label was read from the record alone, never checked by shooting or a
+#: Lyapunov window: shown as such, never as confirmed.
+UNCONFIRMED = frozenset({"record"})
+
+
+def evidence_words(evidence: str) -> str:
+    """What decided a label, in words for a table or the explorer: the :data:`EVIDENCE` key,
+    and for a label read from the record alone that it is not confirmed."""
+    if evidence in UNCONFIRMED:
+        return "record (not confirmed)"
+    return evidence
 
 
 @dataclass(frozen=True, eq=False)
@@ -69,6 +82,10 @@ class Verdict:
     coexisting
         ((period, max |μ|), …) the stable orbits found by shooting that the recorded motion
         does not approach: attractors beside it, evidence and not its label.
+    agree
+        False when an indicator of the record contradicts a label read from the record alone
+        (evidence ``record``: :attr:`gearchaos.analysis.classify.MotionClass.agree`); True for
+        the other evidence, which is its own check.
     """
 
     label: str
@@ -85,6 +102,7 @@ class Verdict:
     window_start: int = -1
     window_periods: int = 0
     coexisting: tuple[tuple[int, float], ...] = ()
+    agree: bool = True
 
     def __post_init__(self) -> None:
         motion = Motion.parse(self.label)

@@ -9,12 +9,17 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from ..._checks import check_int, check_real
+from ..._checks import check_choice, check_int, check_real
 from ...analysis.classify import LLE_C
 from ..lyapunov import LYAPUNOV_BLOCKS
 from ..orbits.stability import STABILITY_MARGIN
 
-__all__ = ["CONFIRM_PERIODS", "VerdictSettings", "confirmed_settings"]
+__all__ = ["CONFIRM_PERIODS", "MODES", "VerdictSettings", "confirmed_settings"]
+
+#: The verdict's modes: ``confirm`` (labels checked by shooting, Floquet multipliers and
+#: Lyapunov windows) and ``record`` (labels from the record alone, evidence ``record``:
+#: :mod:`~gearchaos.dynamics.verdict.record`).
+MODES = ("confirm", "record")
 
 #: Default length of the last window behind a chaos or QP entry of ``attractors``, ``basins``
 #: and ``basin_fractions``: a long continuation that a chaotic transient rarely survives.
@@ -27,6 +32,11 @@ class VerdictSettings:
 
     Parameters
     ----------
+    mode
+        ``confirm`` (default): the procedure of :mod:`~gearchaos.dynamics.verdict.decide`;
+        ``record``: every label read from the record alone, with evidence ``record``
+        (:func:`~gearchaos.dynamics.verdict.record.decide_from_record`, with ``period_rtol``,
+        ``longest_period`` and ``lle_c``; the other settings do not apply), nothing integrated.
     max_period
         Longest period confirmed by shooting (Newton with the full monodromy over n periods).
     longest_period
@@ -89,6 +99,7 @@ class VerdictSettings:
         Seed of the random initial tangent vectors.
     """
 
+    mode: str = "confirm"
     max_period: int = 8
     longest_period: int = 64
     period_rtol: float = 1e-3
@@ -115,6 +126,7 @@ class VerdictSettings:
     seed: int = 0
 
     def __post_init__(self) -> None:
+        check_choice("mode", self.mode, MODES)
         check_int("max_period", self.max_period, lo=1, hi=64)
         check_int("longest_period", self.longest_period, lo=self.max_period, hi=10_000)
         check_real("period_rtol", self.period_rtol, lo=0.0, hi=0.5, lo_open=True)
