@@ -22,6 +22,7 @@ from fuzz_helpers import cli_refused, hsettings, refused
 from hypothesis import strategies as st
 
 import gearchaos as gc
+from forged_files import forge_nc
 from gearchaos.dynamics.orbits.file import save_orbit
 
 DUFFING = gc.duffing(1.2)
@@ -54,24 +55,6 @@ def files(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
         transient_periods=2, periods=2,
     )  # fmt: skip
     return {"orbit": root / "orb.nc", "branch": root / "br.nc", "store": root / "st.zarr"}
-
-
-def _forge_nc(src: Path, dst: Path, **attrs: Any) -> Path:
-    """A copy of the netCDF file ``src`` with its attributes changed (``None`` removes one)."""
-    import warnings
-
-    import xarray as xr
-
-    ds = xr.load_dataset(src, engine="h5netcdf")
-    for key, value in attrs.items():
-        if value is None:
-            ds.attrs.pop(key, None)
-        else:
-            ds.attrs[key] = value
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # "invalid netcdf features": as gearchaos writes them
-        ds.to_netcdf(dst, engine="h5netcdf", invalid_netcdf=True)
-    return dst
 
 
 def _forge_store(src: Path, dst: Path, **attrs: Any) -> Path:
@@ -134,7 +117,7 @@ def test_refused_a_forged_model_class_never_runs_the_module_beside_the_file(
     if kind == "store":
         path = _forge_store(files["store"], tmp_path / "forged.zarr", model_class=spec)
     else:
-        path = _forge_nc(files[kind], tmp_path / "forged.nc", **forged)
+        path = forge_nc(files[kind], tmp_path / "forged.nc", **forged)
     args = [str(path) if a == "FILE" else a for a in command]
     # a store whose metadata was edited may also be called damaged: refused either way
     culprits = (CONSENT, "damaged") if kind == "store" else (CONSENT,)
@@ -164,7 +147,7 @@ def test_refused_a_module_or_class_named_only_by_the_file(
     monkeypatch.chdir(tmp_path)
     marker = tmp_path / "OWNED"
     text = json.dumps(fields).replace("{marker}", str(marker))
-    path = _forge_nc(files["orbit"], tmp_path / "forged.nc", model_class=spec, model_fields=text)
+    path = forge_nc(files["orbit"], tmp_path / "forged.nc", model_class=spec, model_fields=text)
     out = cli_refused("orbit --from forged module", ["orbit", "--from", str(path)], CONSENT,
                       watch=tmp_path)  # fmt: skip
     assert spec in out
@@ -182,7 +165,7 @@ def test_refused_a_forged_planetary_record_names_its_fields(
     marker = tmp_path / "OWNED"
     spec = "gearchaos.model.planetary:PlanetaryModel"
     text = json.dumps(fields).replace("{marker}", str(marker))
-    path = _forge_nc(files["orbit"], tmp_path / "forged.nc", model_class=spec, model_fields=text)
+    path = forge_nc(files["orbit"], tmp_path / "forged.nc", model_class=spec, model_fields=text)
     out = cli_refused("orbit --from forged planetary", ["orbit", "--from", str(path)],
                       "model_fields", watch=tmp_path)  # fmt: skip
     assert spec in out or "gear set" in out
@@ -205,7 +188,7 @@ def test_drawn_a_figure_of_a_forged_file_uses_names_and_runs_nothing(
     if kind == "store":
         path = _forge_store(files["store"], tmp_path / "forged.zarr", model_class=spec)
     else:
-        path = _forge_nc(files["branch"], tmp_path / "forged.nc", model_class=spec)
+        path = forge_nc(files["branch"], tmp_path / "forged.nc", model_class=spec)
     result = CliRunner().invoke(app, ["plot", str(path), "-o", "fig.png"])
     assert not marker.exists()
     assert "Traceback" not in result.output
@@ -317,7 +300,7 @@ def test_a_users_model_runs_with_the_users_consent_only(
     (tmp_path / "mine" / "consented_well_moved.py").write_text(MOVED)
     # the Duffing oscillator's own values: the orbit file's state is the user model's orbit
     fields = json.dumps({"delta": 0.1, "alpha": 1.0, "beta": 1.0, "gamma": 0.5})
-    orbit = _forge_nc(files["orbit"], tmp_path / "mine.nc", model_fields=fields,
+    orbit = forge_nc(files["orbit"], tmp_path / "mine.nc", model_fields=fields,
                       model_class="/gone/consented_well.py:ConsentedWell")  # fmt: skip
     args = ["orbit", "--from", str(orbit), "--json"]
     text = cli_refused("orbit --from own model", args, "--model FILE.py:ConsentedWell",
@@ -532,7 +515,7 @@ def test_every_writer_replaces_what_it_wrote_and_not_once_edited(
         zattrs["title"] = zattrs.get("title", "") + " (mine now)"
         (path / ".zattrs").write_text(json.dumps(zattrs))
     elif kind == "netcdf":  # an attribute edited
-        _forge_nc(path, tmp_path / "edited.nc", title="mine now")
+        forge_nc(path, tmp_path / "edited.nc", title="mine now")
         (tmp_path / "edited.nc").replace(path)
     else:  # one byte in the middle changed
         raw = bytearray(path.read_bytes())
@@ -581,7 +564,7 @@ def test_escaped_a_gear_set_name_from_a_file_never_reaches_the_terminal_raw(
     assert forged_toml != toml
     # both copies of the gear set (the model's fields and gearset_toml), as a forger would
     fields = json.dumps({"gearset": forged_toml})
-    path = _forge_nc(
+    path = forge_nc(
         gearset_orbit, tmp_path / "named.nc", gearset_toml=forged_toml, model_fields=fields
     )
     result = CliRunner().invoke(app, ["orbit", "--from", str(path)])

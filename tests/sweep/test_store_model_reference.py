@@ -16,6 +16,7 @@ import pytest
 from typer.testing import CliRunner
 
 import gearchaos as gc
+from forged_files import forge_nc
 from gearchaos.cli import app
 from gearchaos.dynamics.orbits.file import save_orbit
 from gearchaos.errors import StoreError
@@ -127,33 +128,16 @@ def orbit_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return path
 
 
-def _forge_nc(src: Path, dst: Path, **attrs: Any) -> Path:
-    import warnings
-
-    import xarray as xr
-
-    ds = xr.load_dataset(src, engine="h5netcdf")
-    for key, value in attrs.items():
-        if value is None:
-            ds.attrs.pop(key, None)
-        else:
-            ds.attrs[key] = value
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # "invalid netcdf features": as gearchaos writes them
-        ds.to_netcdf(dst, engine="h5netcdf", invalid_netcdf=True)
-    return dst
-
-
 def test_an_orbit_file_starts_from_its_recorded_gear_set_new_or_old(
     orbit_file: Path, tmp_path: Path
 ) -> None:
     from gearchaos.cli._start import load_start
 
     gs = gc.preset("sheng2016-v1")
-    old = _forge_nc(orbit_file, tmp_path / "old.nc", model_class=None, model_fields=None)
+    old = forge_nc(orbit_file, tmp_path / "old.nc", model_class=None, model_fields=None)
     for path in (orbit_file, old):
         assert load_start(str(path), None).gearset == gs
     other = json.dumps({"gearset": gc.preset("hindawi2021").to_toml()})
-    damaged = _forge_nc(orbit_file, tmp_path / "damaged.nc", model_fields=other)
+    damaged = forge_nc(orbit_file, tmp_path / "damaged.nc", model_fields=other)
     with pytest.raises(StoreError, match=r"--from .*damaged\.nc is damaged: .*gearset_toml"):
         load_start(str(damaged), None)

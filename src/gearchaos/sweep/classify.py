@@ -96,7 +96,6 @@ def _old_layout_labels(res: SweepResult, *, period_rtol: float, max_period: int)
     :func:`~gearchaos.analysis.classify.classify_sections`, exactly as those versions did."""
     from ..analysis.classify import classify_sections
 
-    lead_dims, shape = res.lead_dims, res.shape
     pts = _section_pair(res)
     kw: dict[str, Any] = {"details": True, "rtol": period_rtol, "max_period": max_period}
     lle = _lle_inputs(res)
@@ -104,26 +103,7 @@ def _old_layout_labels(res: SweepResult, *, period_rtol: float, max_period: int)
         kw["lle"] = np.asarray(res.ds["lle"].values, dtype=float)
         kw.update(run_periods=lle["run_periods"], forcing_period=lle["forcing_period"])
     details = classify_sections(pts, **kw)
-    status = res.status()
-    labels = np.empty(shape, dtype=LABEL_DTYPE)
-    period = np.zeros(shape, dtype=np.int16)
-    k01 = np.full(shape, np.nan)
-    agree = np.ones(shape, dtype=bool)
-    for idx in np.ndindex(*shape):
-        mc: Any = details[idx]
-        labels[idx] = _status_label(int(status[idx])) or mc.label
-        period[idx] = mc.period or 0
-        k01[idx] = np.nan if mc.k01 is None else mc.k01
-        agree[idx] = bool(mc.agree)
-    return {
-        "dims": lead_dims,
-        **_contact(res),
-        "motion": labels,
-        "period": period,
-        "k01": k01,
-        "indicators_agree": agree,
-        "regime_table": _regime_table(res, labels),
-    }
+    return _tabulate(res, [details[idx] for idx in np.ndindex(*res.shape)])
 
 
 def _record_mode(res: SweepResult) -> bool:
@@ -145,7 +125,6 @@ def _from_record(res: SweepResult, *, period_rtol: float, max_period: int) -> di
     the labels the sweep stored at the default ones, or new ones with others."""
     from ..dynamics.verdict.record import decide_from_record
 
-    lead_dims, shape = res.lead_dims, res.shape
     status = res.status()
     pairs = _section_pair(res)
     pts = pairs.reshape(-1, *pairs.shape[-2:])
@@ -159,25 +138,31 @@ def _from_record(res: SweepResult, *, period_rtol: float, max_period: int) -> di
         period_rtol=period_rtol,
         longest_period=max_period,
     )
+    return {**_tabulate(res, verdicts), "record_verdicts": verdicts}
+
+
+def _tabulate(res: SweepResult, decided: list[Any]) -> dict[str, Any]:
+    """The label arrays of a store from one decision per point (in ``np.ndindex`` order of
+    its grid: the record classification's details or the record-mode verdicts, which have
+    ``label``, ``period``, ``k01`` and ``agree``); a failed integration labels its point."""
+    shape, status = res.shape, res.status()
     labels = np.empty(shape, dtype=LABEL_DTYPE)
     period = np.zeros(shape, dtype=np.int16)
     k01 = np.full(shape, np.nan)
     agree = np.ones(shape, dtype=bool)
-    for i, idx in enumerate(np.ndindex(*shape)):
-        v = verdicts[i]
-        labels[idx] = _status_label(int(status[idx])) or v.label
-        period[idx] = v.period
-        k01[idx] = v.k01
-        agree[idx] = v.agree
+    for d, idx in zip(decided, np.ndindex(*shape), strict=True):
+        labels[idx] = _status_label(int(status[idx])) or d.label
+        period[idx] = d.period or 0
+        k01[idx] = np.nan if d.k01 is None else d.k01
+        agree[idx] = bool(d.agree)
     return {
-        "dims": lead_dims,
+        "dims": res.lead_dims,
         **_contact(res),
         "motion": labels,
         "period": period,
         "k01": k01,
         "indicators_agree": agree,
         "regime_table": _regime_table(res, labels),
-        "record_verdicts": verdicts,
     }
 
 
