@@ -30,7 +30,6 @@ from .._marks import hdf5_is_marked, mark_hdf5
 from .._output import check_replaceable, write_file
 from .._version import provenance
 from ..errors import ParameterError, StoreError
-from ..model.loading import model_reference
 from ..model.record import model_record
 from .trajectory import Trajectory
 
@@ -79,7 +78,8 @@ class SimulationResult(Trajectory):
             ),
             **provenance(),
         }
-        attrs["gearset_toml"] = model_record(self.system)["gearset_toml"]
+        record = model_record(self.system)
+        attrs["gearset_toml"] = record["gearset_toml"]
         caps = self.system.capabilities
         sc = caps.scales
         if sc is not None:
@@ -90,8 +90,8 @@ class SimulationResult(Trajectory):
             attrs[f"clearance_{k}"] = v
         if caps.period_factor != 1.0:
             attrs["period_factor"] = caps.period_factor
-        # to build the model again (not a gear set)
-        attrs.update(model_reference(self.system.model))
+        # to build the model again: the reference in the same record
+        attrs.update({k: record[k] for k in ("model_class", "model_fields") if k in record})
         return attrs
 
     def to_dataset(self) -> Any:

@@ -9,7 +9,7 @@ as it records any other (:func:`~gearchaos.model.loading.model_reference`):
     class, which the record alone builds again (a built-in, never imported by the recorded
     name);
 ``model_fields``
-    the JSON object ``{"gearset": TOML}`` (:func:`gearset_fields`): the gear set's TOML text,
+    the JSON object ``{"gearset": TOML}`` (:func:`gearset_reference`): the gear set's TOML text,
     which :meth:`~gearchaos.gearset.GearSet.from_toml_string` reads back to an equal gear set
     and validates against the gear-set schema, exactly as the text of a gear-set file.
 
@@ -32,8 +32,8 @@ from .planetary import PlanetaryModel
 __all__ = [
     "GEARSET_FIELD",
     "PLANETARY_MODEL",
-    "gearset_fields",
     "gearset_problem",
+    "gearset_reference",
     "recorded_gearset",
 ]
 
@@ -43,10 +43,13 @@ PLANETARY_MODEL = f"{PlanetaryModel.__module__}:{PlanetaryModel.__qualname__}"
 GEARSET_FIELD = "gearset"
 
 
-def gearset_fields(gs: GearSet) -> str:
-    """The ``model_fields`` of the planetary model built from ``gs``: the JSON object
-    ``{"gearset": gs.to_toml()}`` (the TOML text reads back to a gear set equal to ``gs``)."""
-    return json.dumps({GEARSET_FIELD: gs.to_toml()})
+def gearset_reference(gs: GearSet, toml: str | None = None) -> dict[str, str]:
+    """The reference of the planetary model built from ``gs``: ``model_class``
+    :data:`PLANETARY_MODEL` and ``model_fields`` the JSON object ``{"gearset": TOML}`` (the
+    TOML text reads back to a gear set equal to ``gs``); ``toml`` is ``gs.to_toml()`` when the
+    caller has it already."""
+    text = gs.to_toml() if toml is None else toml
+    return {"model_class": PLANETARY_MODEL, "model_fields": json.dumps({GEARSET_FIELD: text})}
 
 
 def _short(value: Any) -> str:

@@ -36,7 +36,7 @@ from typing import Any
 from .._text import escape_text
 from ..errors import ParameterError
 from .contract import Capabilities, UserModel, check_model
-from .gearset_record import PLANETARY_MODEL, gearset_fields, recorded_gearset
+from .gearset_record import PLANETARY_MODEL, gearset_reference, recorded_gearset
 from .library import BacklashOscillator, Duffing, LinearSystem, Lorenz
 from .planetary import PlanetaryModel
 
@@ -258,12 +258,11 @@ def model_reference(model: Any) -> dict[str, str]:
     """What a store or branch file records to build ``model`` again (:func:`rebuild_model`):
     ``model_class`` (:func:`model_spec`) and ``model_fields`` (JSON of its dataclass fields).
     A model built from a gear set records the planetary model and, as its fields, that gear
-    set (:data:`~gearchaos.model.gearset_record.PLANETARY_MODEL`,
-    :func:`~gearchaos.model.gearset_record.gearset_fields`); a model that is no dataclass of
-    JSON values records nothing."""
+    set (:func:`~gearchaos.model.gearset_record.gearset_reference`); a model that is no
+    dataclass of JSON values records nothing."""
     gearset = Capabilities.of(model).gearset
     if gearset is not None:
-        return {"model_class": PLANETARY_MODEL, "model_fields": gearset_fields(gearset)}
+        return gearset_reference(gearset)
     if not dataclasses.is_dataclass(model):
         return {}
     fields = {f.name: getattr(model, f.name) for f in dataclasses.fields(model) if f.init}

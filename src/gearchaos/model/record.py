@@ -39,7 +39,7 @@ from typing import Any
 from ..errors import ParameterError
 from ..gearset import GearSet
 from .contract import Capabilities
-from .gearset_record import PLANETARY_MODEL, gearset_fields, gearset_problem, recorded_gearset
+from .gearset_record import PLANETARY_MODEL, gearset_problem, gearset_reference, recorded_gearset
 from .loading import LAYOUT_FIELDS, model_reference, rebuild_model
 from .system import System
 from .target import Target
@@ -66,12 +66,12 @@ def _gearset_record(gs: GearSet) -> dict[str, str]:
     """The record of a gear set: the reference of the planetary model built from it (whose
     fields are the gear set: :func:`~gearchaos.model.loading.model_reference` of that model)
     and, for the previous release, the same TOML in ``gearset_toml``."""
+    text = gs.to_toml()
     return {
         "model": PLANETARY,
-        "gearset_toml": gs.to_toml(),
+        "gearset_toml": text,
         "model_parameters": "",
-        "model_class": PLANETARY_MODEL,
-        "model_fields": gearset_fields(gs),
+        **gearset_reference(gs, text),
     }
 
 
