@@ -101,3 +101,20 @@ def test_the_planetary_attractors_keep_their_symbol(runner: CliRunner) -> None:
     assert found and all(a["section_variable"] == "delta_sp_1" for a in found)
     table = _run(runner, *args)
     assert "X̄_sp1 at the section" in table
+
+
+def test_a_user_models_bifurcation_counts_its_own_periods(
+    runner: CliRunner, tmp_path: Path
+) -> None:
+    """The bifurcation table's protocol line counts the train's periods T = 5·2π/Ω ("train
+    periods"), not a gear set's mesh periods, and names nothing planetary; the store holds two
+    points, each with the protocol's 20 section points."""
+    store = tmp_path / "train.zarr"
+    text = _run(
+        runner, "bifurcation", "--model", MODEL, "--vary", "omega=0.5:0.6:2",
+        "--transient", "20", "--periods", "20", "--no-verdicts", "-o", str(store),
+    )  # fmt: skip
+    assert "20 transient + 20 recorded train periods" in text
+    assert not PLANETARY.search(text), text
+    ds = gc.open_sweep(store)
+    assert ds.sizes["omega"] == 2 and ds["x"].sizes["section"] == 20

@@ -246,7 +246,7 @@ RECORDED_MODEL = Target().offering(
 
 @dataclass(frozen=True)
 class Protocol(OptionGroup):
-    """How long a run is and what it records: transient and recorded mesh periods, samples
+    """How long a run is and what it records: transient and recorded forcing periods, samples
     per period, early end of the transient and the perturbation of the start from rest."""
 
     panel: ClassVar[str | None] = "Protocol and solver"

@@ -28,7 +28,8 @@ PeriodOpt = Annotated[
     typer.Option(
         "--period",
         "-n",
-        help="Period n of the orbit, in mesh periods (default: the period --from knows, else 1).",
+        help="Period n of the orbit, in forcing periods (a gear set's mesh periods; default: the "
+        "period --from knows, else 1).",
         show_default=False,
     ),
 ]
@@ -136,7 +137,7 @@ def orbit(
     model's delta_sp_1, X̄_sp1); a period-2 shooting that converges on a 1T orbit says
     minimal_period 1.
 
-    The guess is a simulation from rest of --transient mesh periods, settled longer (up to
+    The guess is a simulation from rest of --transient forcing periods, settled longer (up to
     16 times) while the shooting lands on no orbit or an unstable one; or the state of a
     sweep point, branch point or orbit file (**--from FILE --at NAME=VALUE**).
 
@@ -445,7 +446,7 @@ def attractors(
 ) -> None:
     """List the distinct attractors at one operating point, from several initial conditions.
 
-    Each start is simulated (TRANSIENT + PERIODS mesh periods, with the largest Lyapunov
+    Each start is simulated (TRANSIENT + PERIODS forcing periods, with the largest Lyapunov
     exponent λ₁) and labelled as a sweep labels its points; runs that end on the same
     attractor are grouped. A periodic attractor is confirmed by shooting its orbit, whose
     Floquet multipliers say how stable it is; a chaotic or quasi-periodic one by a last window

@@ -12,6 +12,8 @@ from rich.text import Text
 from .._text import escape_path
 from ..errors import ParameterError
 from ..gearset.parsing import parse_int
+from ..model.contract import Capabilities
+from ..model.target import model_for
 from ..sweep.classify import MAX_PERIOD, PERIOD_RTOL
 from ..sweep.spec import SWEEP_SOLVER
 from . import _common as c
@@ -248,10 +250,11 @@ def bifurcation(
     table.add_row("store", escape(str(path)))
     out = c.stdout()
     out.print(table)
+    period = Capabilities.of(model_for(gs, {})).period_name  # mesh: a gear set's
     out.print(
         Text(
-            f"{protocol.transient:g} transient + {protocol.periods} recorded mesh periods, {ic} "
-            f"initial conditions, rtol {solver.rtol:g}, atol {solver.atol:g}"
+            f"{protocol.transient:g} transient + {protocol.periods} recorded {period} periods, "
+            f"{ic} initial conditions, rtol {solver.rtol:g}, atol {solver.atol:g}"
             + (", largest Lyapunov exponents" if lyapunov else "")
             + (", nT labels checked by periodic orbits" if orbits else ""),
             style="dim",
