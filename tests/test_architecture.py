@@ -600,3 +600,56 @@ def test_dynamics_is_split_by_concept_and_its_rooms_import_one_way() -> None:
     assert not bad, "imports between the rooms of dynamics against their order:\n" + "\n".join(
         sorted(bad)
     )
+
+
+def _calls(tree: ast.AST, name: str) -> list[int]:
+    """Lines of the calls of ``name`` (by its bare or attribute name) in ``tree``."""
+    return [
+        node.lineno
+        for node in ast.walk(tree)
+        if isinstance(node, ast.Call)
+        and (
+            (isinstance(node.func, ast.Name) and node.func.id == name)
+            or (isinstance(node.func, ast.Attribute) and node.func.attr == name)
+        )
+    ]
+
+
+def test_one_newton_corrector_and_no_per_point_parallel_arrays() -> None:
+    """Issue 36, item 5: the orbits and continuation rooms solve Pⁿ_λ(y) − y = 0 with one
+    corrector over K points (``dynamics/orbits/corrector.py``): no other module there evaluates
+    the map (``shoot``) or takes a Newton step of an orbit, and ``periodic_orbits`` keeps no
+    per-point state in parallel arrays (no element assignments ``a[k] = …`` in it). The
+    boundary curves' corrector (``curves/tracing.py``) solves another system (the orbit and a
+    test function in two parameters) and is not counted here."""
+    shooters, steppers = [], []
+    for room in ("orbits", "continuation"):
+        for path in sorted((ROOT / "dynamics" / room).glob("*.py")):
+            tree = ast.parse(path.read_text(encoding="utf-8"))
+            name = f"{room}/{path.name}"
+            if _calls(tree, "shoot") and name != "orbits/corrector.py":
+                shooters.append(name)
+            if _calls(tree, "newton_step") and name not in (
+                "orbits/corrector.py",
+                "continuation/arclength.py",  # the branch's tangent: one linear solve
+            ):
+                steppers.append(name)
+    assert not shooters, f"map evaluations outside the corrector: {shooters}"
+    assert not steppers, f"Newton steps outside the corrector: {steppers}"
+    arclength = ast.parse((ROOT / "dynamics/continuation/arclength.py").read_text("utf-8"))
+    assert len(_calls(arclength, "newton_step")) == 1
+    batch = ast.parse((ROOT / "dynamics/orbits/batch.py").read_text(encoding="utf-8"))
+    (fn,) = [
+        n for n in ast.walk(batch) if isinstance(n, ast.FunctionDef) and n.name == "periodic_orbits"
+    ]
+    element_writes = [
+        node.lineno
+        for node in ast.walk(fn)
+        if isinstance(node, (ast.Assign, ast.AugAssign))
+        and any(
+            isinstance(t, ast.Subscript)
+            for t in (node.targets if isinstance(node, ast.Assign) else [node.target])
+        )
+    ]
+    assert not element_writes, f"per-point arrays written in periodic_orbits: {element_writes}"
+    assert _calls(fn, "correct_points"), "periodic_orbits does not call the corrector"

@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import Status
 from ..integrate.settings import SolverSettings
 from ..model.target import Target
 from .classify import label_periods
@@ -98,7 +99,7 @@ def orbit_checks(
         )
         for k, orb in zip(good, orbits, strict=True):
             out["orbit_period"][k] = n
-            if orb.message == "integration failed" or not np.isfinite(orb.residual):
+            if orb.status != Status.OK or not np.isfinite(orb.residual):
                 out["orbit_status"][k] = ORBIT_STATUS["failed"]
                 continue
             out["orbit_residual"][k] = orb.residual

@@ -11,7 +11,7 @@ tangent t_k the predictor is z_k + Δs t_k and the corrector solves, by Newton's
     G(y, λ) = 0,    ⟨t_k, z − z_k − Δs t_k⟩_W = 0
 
 (Keller's pseudo-arclength; the second equation fixes the position along the branch, so folds
-are passed), by the quasi-Newton corrector of :mod:`gearchaos.dynamics.orbits.shooting` with the
+are passed), by the quasi-Newton corrector of :mod:`gearchaos.dynamics.orbits.corrector` with the
 bordered Jacobian [[M − I, G_λ], [W t_kᵀ]]: M = DPⁿ from the variational equations, G_λ by a
 forward difference (two chains of one compiled call), both started from the previous point's,
 extrapolated along the branch. The next tangent solves [[M − I, G_λ], [W t_kᵀ]] t = (0, 1)
@@ -47,6 +47,7 @@ from ...errors import IntegrationError, ParameterError
 from ...integrate.settings import SolverSettings, split_keywords
 from ...model.system import System
 from ...model.target import OMEGA, Target, resolve
+from ..orbits.corrector import Problem, Solution, Start, correct
 from ..orbits.orbit import (
     ORBIT_SETTINGS,
     PeriodicOrbit,
@@ -56,7 +57,7 @@ from ..orbits.orbit import (
     settled_orbit,
     solve_orbit,
 )
-from ..orbits.shooting import Problem, Solution, correct, newton_step
+from ..orbits.shooting import newton_step
 from . import events as ev
 from .cascade import check_cascade
 from .locate import detect
@@ -158,7 +159,7 @@ class _Branch:
         self.switched = False
         self._slopes: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         self.prob = Problem(
-            self.system, n, cfg, tol, steps.max_corrector, 1e-6 * max(1.0, abs(lo), abs(hi))
+            n, cfg, tol, steps.max_corrector, fd_step=1e-6 * max(1.0, abs(lo), abs(hi))
         )
 
     # -- systems and the weighted norm ----------------------------------------------
@@ -202,7 +203,7 @@ class _Branch:
             if slope is not None:
                 mono = mono + sigma * slope[0]
                 g_lam = g_lam + sigma * slope[1]
-        sol, why = correct(self.prob, z, normal, offset, monodromy=mono, g_lam=g_lam)
+        sol, why = correct(self.prob, Start(self.system, z, normal, offset, mono, g_lam))
         if sol is not None:
             self.evals += sol.evals
             self.jacobians += sol.jacobians
@@ -389,7 +390,8 @@ def continuation(
         Initial, smallest and largest arclength step (parameter units; defaults: range/200,
         range·1e-6, range/100).
     max_points, max_corrector
-        Most branch points, and map evaluations per corrector solve.
+        Most branch points, and rounds of the corrector per solve (a trial step, the damped
+        steps of one step, or a fresh Jacobian each).
     tol
         Residual tolerance of every point (default 100·rtol, at least 1e-10).
     event_tol

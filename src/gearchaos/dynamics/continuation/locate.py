@@ -30,8 +30,8 @@ from typing import Any
 import numpy as np
 
 from ...integrate.settings import RTOL_RANGE
+from ..orbits.corrector import Solution, Start, correct
 from ..orbits.orbit import contact_levels, default_tol, orbit_contacts
-from ..orbits.shooting import Solution, correct
 from . import events as ev
 
 __all__ = ["CHECK_FACTOR", "detect", "location_uncertainty"]
@@ -162,7 +162,7 @@ def check_point(br: Any, p: Solution, pt: Solution) -> Solution | None:
     assert p.tangent is not None
     normal = br.weight(p.tangent)
     z = pt.z
-    sol, _ = correct(prob, z, normal, float(normal @ z), monodromy=pt.monodromy, g_lam=pt.g_lam)
+    sol, _ = correct(prob, Start(br.system, z, normal, float(normal @ z), pt.monodromy, pt.g_lam))
     if sol is not None:
         br.evals += sol.evals
         br.jacobians += sol.jacobians

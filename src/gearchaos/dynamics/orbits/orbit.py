@@ -7,7 +7,7 @@ fixed point of the n-th iterate,
     G(y) = Pⁿ(y) − y = 0,
 
 solved by Newton's method with a backtracking (damped) step
-(:func:`gearchaos.dynamics.orbits.shooting.correct`). The Jacobian is the monodromy
+(:func:`gearchaos.dynamics.orbits.corrector.correct`). The Jacobian is the monodromy
 matrix M = DPⁿ(y) = Φ_{n−1} ⋯ Φ_1 Φ_0, the product of the one-period fundamental solutions
 Φ_k = ∂y(τ_s + (k+1)T)/∂y(τ_s + kT) of the variational equations V' = J(τ, y) V that the
 compiled kernel integrates with the orbit (the tangent vectors start as the identity at each
@@ -22,7 +22,8 @@ tr J = −tr(M⁻¹C).
 
 Two levels (STYLE principle 8): :func:`periodic_orbit` for users;
 :mod:`gearchaos.dynamics.orbits.shooting` (C shootings in one compiled
-:func:`~gearchaos.integrate._chains.run_chains` call, and the corrector) for the continuation.
+:func:`~gearchaos.integrate._chains.run_chains` call) and :mod:`gearchaos.dynamics.orbits.corrector`
+(the Newton corrector over K points) for batches and the continuation.
 """
 
 from __future__ import annotations
@@ -43,7 +44,8 @@ from ...integrate.settings import SolverSettings, split_keywords
 from ...model.record import model_record
 from ...model.system import System
 from ...model.target import Target, resolve, scale_attrs
-from .shooting import Problem, Solution, correct, section_time
+from .corrector import Problem, Solution, Start, correct
+from .shooting import section_time
 from .stability import STABILITY_MARGIN, stability_of, structural_multipliers
 
 __all__ = [
@@ -391,11 +393,12 @@ def periodic_orbit(
 
     Solves G(y) = Pⁿ(y) − y = 0 for the stroboscopic map P over one forcing period T = 2π/Ω
     by Newton's method, y ← y + λ d with (M − I) d = −G(y) and M = DPⁿ(y) from the
-    variational equations: a quasi-Newton iteration (M updated by Broyden's formula while
-    ‖G‖ falls at least tenfold per step, evaluated afresh otherwise), λ = 1 or the longest of
-    ½ … 1/16 that lowers ‖G‖ (evaluated together in one compiled call), every step at most
-    ten times the size of the state. The multipliers are always those of the returned state
-    (a last evaluation with tangents there).
+    variational equations (the corrector of :mod:`~gearchaos.dynamics.orbits.corrector`, K = 1):
+    a quasi-Newton iteration (M updated by Broyden's formula while ‖G‖ falls at least tenfold
+    per step, evaluated afresh otherwise), λ = 1 or the longest of ½ … 1/16 that lowers ‖G‖
+    (evaluated together in one compiled call), every step at most ten times the size of the
+    state. The multipliers are those of an evaluation with tangents within ``tol`` of the
+    returned state.
 
     Parameters
     ----------
@@ -419,7 +422,8 @@ def periodic_orbit(
         Tolerance of the residual ‖G(y)‖_∞ / max(1, ‖y‖_∞) and of the last Newton correction
         (relative to max(1, ‖y‖_∞)); default rtol/10, at least 1e-12.
     max_iterations
-        Map evaluations allowed (with and without tangents, trial steps included).
+        Rounds of the Newton iteration allowed (each a trial step, the damped steps of one
+        step, or a fresh Jacobian; ``iterations`` counts the map evaluations they took).
     settle
         With ``guess=None``: the most mesh periods simulated from rest for the guess (default
         16 × ``transient_periods``). While the shooting ends on no orbit or on an unstable one
@@ -528,31 +532,17 @@ def solve_orbit(
     *,
     values: Mapping[str, Any] | None = None,
 ) -> PeriodicOrbit:
-    """Damped chord–Newton on Pⁿ(y) − y = 0 from y0 at fixed parameters (the kernel of
-    :func:`periodic_orbit`)."""
-    prob = Problem(lambda _lam: system, n, cfg, tol, max_iterations)
-    m = system.n_state
-    normal = np.zeros(m + 1)
-    normal[-1] = 1.0
-    sol, why = correct(prob, np.append(np.asarray(y0, dtype=float), 0.0), normal, 0.0)
-    common = {"period": n, "settings": cfg, "tol": tol, "values": dict(values or {})}
-    if sol is not None:
-        return orbit_from(system, sol, converged=True, message="converged", **common)
-    # not converged: report the start with the reason
-    from .shooting import multipliers_of, residual_of, shoot
-
-    shot = shoot([system], np.asarray(y0, dtype=float)[None], n, cfg)
-    y = np.asarray(y0, dtype=float)
-    r = residual_of(shot.end[0] - y, y) if shot.ok(0) else math.inf
-    assert shot.monodromy is not None
-    fake = Solution(
-        y, 0.0, shot, np.zeros(m), r, max_iterations, 0, multipliers_of(shot.monodromy[0])
-    )
-    return orbit_from(system, fake, converged=False, message=why, **common)
+    """The Newton corrector of :mod:`.corrector` on Pⁿ(y) − y = 0 from y0 at fixed parameters
+    (the kernel of :func:`periodic_orbit`): one point, Broyden-updated M, damped steps
+    evaluated together; an orbit that did not converge is its best state."""
+    prob = Problem(n, cfg, tol, max_iterations, keep_failed=True)
+    sol, _ = correct(prob, Start.fixed(system, y0))
+    assert sol is not None  # keep_failed
+    return orbit_from(system, sol, period=n, settings=cfg, tol=tol, values=dict(values or {}))
 
 
 def orbit_from(system: System, sol: Solution, **kw: Any) -> PeriodicOrbit:
-    """A :class:`PeriodicOrbit` from a corrector :class:`~.shooting.Solution`."""
+    """A :class:`PeriodicOrbit` from a corrector :class:`~.corrector.Solution`."""
     shot = sol.shot
     return PeriodicOrbit(
         system=system,
@@ -565,6 +555,8 @@ def orbit_from(system: System, sol: Solution, **kw: Any) -> PeriodicOrbit:
         section_obs=shot.section_obs[0],
         obs_min=shot.obs_min[0],
         obs_max=shot.obs_max[0],
-        status=Status(int(shot.status[0])),
+        converged=sol.converged,
+        message=sol.message,
+        status=sol.status,
         **kw,
     )
