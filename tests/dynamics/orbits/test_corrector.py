@@ -29,14 +29,16 @@ SETTINGS = SolverSettings(rtol=1e-11, atol=1e-13, transient_periods=50)
 GUESS = np.array([0.05, -0.05])
 
 
-def scipy_map(y: np.ndarray, omega: float) -> tuple[np.ndarray, np.ndarray]:
+def scipy_map(
+    y: np.ndarray, omega: float, alpha: float = ALPHA, gamma: float = GAMMA
+) -> tuple[np.ndarray, np.ndarray]:
     """P(y) and DP(y) over one forcing period from τ = 0 (the section of ``SETTINGS``)."""
 
     def f(t: float, u: np.ndarray) -> np.ndarray:
         x, v = u[0], u[1]
         phi = u[2:].reshape(2, 2, order="F")
-        a = np.array([[0.0, 1.0], [-(ALPHA + 3.0 * BETA * x * x), -DELTA]])
-        du = [v, GAMMA * np.cos(omega * t) - DELTA * v - ALPHA * x - BETA * x**3]
+        a = np.array([[0.0, 1.0], [-(alpha + 3.0 * BETA * x * x), -DELTA]])
+        du = [v, gamma * np.cos(omega * t) - DELTA * v - alpha * x - BETA * x**3]
         return np.concatenate([du, (a @ phi).ravel(order="F")])
 
     u0 = np.concatenate([y, np.eye(2).ravel(order="F")])
@@ -141,3 +143,23 @@ def test_every_door_goes_through_the_one_corrector(monkeypatch: pytest.MonkeyPat
     branch = gc.continuation(system(1.0), "omega=1.0:1.05", max_points=4)
     assert branch.sizes["point"] >= 2
     assert calls and set(calls) == {("broyden", 4)}
+
+
+def test_a_poor_guess_off_a_chaotic_attractor_still_reaches_the_unstable_orbit() -> None:
+    """The twin-well Duffing oscillator (α = −1, γ = 0.5) at Ω = 1.15, whose attractor is
+    chaotic: the default guesses (50–800 forcing periods from rest) lie off the unstable 1T by
+    the orbit's size. Its first Newton steps, from a fresh M, lower max|G| only slowly; the
+    corrector keeps that matrix (Broyden-updated) for the next step instead of evaluating M
+    afresh at every slow step, and so reaches the orbit from the 400-period guess, as the
+    corrector before the unified one did (the unified one at first did from none). The orbit
+    is checked against scipy: a fixed point of its map, with its multipliers (one outside the
+    unit circle)."""
+    system = gc.duffing(1.15, delta=DELTA, alpha=-1.0, beta=BETA, gamma=0.5)
+    orbit = gc.periodic_orbit(system, period=1)
+    assert orbit.converged, orbit.message
+    p, m = scipy_map(orbit.state, 1.15, alpha=-1.0, gamma=0.5)
+    assert np.max(np.abs(p - orbit.state)) < 1e-7
+    mu = np.linalg.eigvals(m)
+    rows, cols = linear_sum_assignment(np.abs(orbit.multipliers[:, None] - mu[None, :]))
+    assert np.max(np.abs(orbit.multipliers[rows] - mu[cols])) < 1e-6
+    assert np.max(np.abs(mu)) > 1.0 and not orbit.stable
