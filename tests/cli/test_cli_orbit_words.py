@@ -118,3 +118,11 @@ def test_a_user_models_bifurcation_counts_its_own_periods(
     assert not PLANETARY.search(text), text
     ds = gc.open_sweep(store)
     assert ds.sizes["omega"] == 2 and ds["x"].sizes["section"] == 20
+    # its tables name the members stages (x_stage1), not planets (x_p1)
+    assert ds.attrs["member_name"] == "stage"
+    _run(runner, "export", str(store), "-o", str(tmp_path / "train.csv"))
+    header = (tmp_path / "train.csv").read_text().splitlines()[0].split(",")
+    assert "x_max_stage1" in header and "x_min_stage2" in header
+    assert not [c for c in header if c.endswith(("_p1", "_p2"))], header
+    sections = (tmp_path / "train.sections.csv").read_text().splitlines()[0].split(",")
+    assert "x_stage1" in sections and "x_p1" not in sections

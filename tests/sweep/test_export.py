@@ -316,6 +316,32 @@ def test_names_never_forge_a_row(store: Path, tmp_path: Path) -> None:
     assert '"1T\\n9.99,INJECTED,0\\r\\x1b[2J"' in out.read_text()
 
 
+def test_member_columns_take_the_stores_member_word_and_a_forged_one_is_refused(
+    store: Path, tmp_path: Path
+) -> None:
+    """Issue 36: a store records ``member_name`` where its model's group members are not
+    planets, and the tables name the member columns by it (``_stage1`` for ``_p1``); a value that
+    is not a word (a forged row, a control sequence) is refused naming the attribute."""
+    ds = gc.open_sweep(store).load()
+    planetary = pd.read_csv(gc.export(ds, tmp_path / "planets.csv"))
+    members = [c for c in planetary.columns if c.endswith(("_p1", "_p3"))]
+    assert members  # the planets' columns, e.g. the contact regimes per planet
+    ds.attrs["member_name"] = "stage"
+    out = gc.export(ds, tmp_path / "stages.csv")
+    renamed = pd.read_csv(out)
+    assert [c for c in renamed.columns if c.endswith(("_stage1", "_stage3"))] == [
+        c[: -len("p1")] + "stage" + c[-1] for c in members
+    ]
+    assert not [c for c in renamed.columns if c.endswith(("_p1", "_p3"))]
+    sections = pd.read_csv(tmp_path / "stages.sections.csv")
+    assert any(c.endswith("_stage1") for c in sections.columns)
+    for forged in ("p1,INJECTED\n9.99", "\x1b[2Jstage", "", "1stage", 3):
+        ds.attrs["member_name"] = forged
+        with pytest.raises(StoreError, match="member_name must be a word") as err:
+            gc.export(ds, tmp_path / "forged.csv")
+        assert "\n" not in str(err.value) and "\x1b" not in str(err.value)
+
+
 # ----------------------------------------------------------------------------- ownership
 def test_an_export_replaces_only_its_own_files(store: Path, tmp_path: Path) -> None:
     out = tmp_path / "run.csv"

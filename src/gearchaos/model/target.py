@@ -17,6 +17,7 @@ from __future__ import annotations
 import dataclasses
 import difflib
 import functools
+import re
 from collections.abc import Mapping
 from typing import Any
 
@@ -30,11 +31,13 @@ from .system import System
 
 __all__ = [
     "DEFAULT_OMEGA",
+    "MEMBER_WORD",
     "OMEGA",
     "SPEEDS",
     "Target",
     "check_names",
     "check_one_operating_point",
+    "member_word",
     "model_for",
     "operating_omega",
     "parameter_names",
@@ -262,18 +265,33 @@ def resolve(
     return System(model_for(target, changes), omega)
 
 
-def scale_attrs(model: Any) -> dict[str, float]:
+def scale_attrs(model: Any) -> dict[str, float | str]:
     """A model's scales and clearances as store attributes: ``omega_n_rad_s`` (ω_n),
     ``characteristic_length_m`` (b_c) where the model has physical scales,
-    ``clearance_<name>`` for each of its clearances, and ``period_factor`` where its forcing
-    period is not 2π/Ω."""
+    ``clearance_<name>`` for each of its clearances, ``period_factor`` where its forcing
+    period is not 2π/Ω, and ``member_name`` (a word: :func:`member_word`) where a member of
+    its variable groups is not a planet (the stores' member dimensions are named ``planet``
+    and ``planet_all`` for every model; tables name their columns by this word)."""
     caps = Capabilities.of(model)
-    a: dict[str, float] = {}
+    a: dict[str, float | str] = {}
     if caps.period_factor != 1.0:
         a["period_factor"] = caps.period_factor
+    if caps.member_name != "planet":
+        a["member_name"] = member_word(caps.member_name)
     if caps.scales is not None:
         a["omega_n_rad_s"] = float(caps.scales.omega_n)
         a["characteristic_length_m"] = float(caps.scales.length)
     for k, v in caps.clearances.items():
         a[f"clearance_{k}"] = float(v)
     return a
+
+
+#: A member word as a store records it (and a table's column names use it).
+MEMBER_WORD = re.compile(r"[A-Za-z][A-Za-z0-9]{0,31}")
+
+
+def member_word(name: str) -> str:
+    """``name`` as a word for column names: its letters and digits (``planet gear`` →
+    ``planetgear``), at most 32, starting with a letter; ``member`` when none is left."""
+    word = re.sub(r"[^A-Za-z0-9]", "", str(name)).lstrip("0123456789")[:32]
+    return word if MEMBER_WORD.fullmatch(word) else "member"

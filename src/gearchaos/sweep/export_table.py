@@ -13,7 +13,8 @@ basin-fraction store, a simulation file) into two lists of :class:`Column` s:
   ``contact_sp`` …) are written as their meanings (``ok``, ``floquet``, ``single_sided``).
 * **sections** — one row per point and section sample: the point's lead columns (the same
   names, so both tables join on them), ``section`` (and ``tau`` for a simulation), then the
-  section values, one column per observed planet (``delta_sp_p1``).
+  section values, one column per observed planet (``delta_sp_p1``; a user model's members by
+  its ``member_name``, ``x_stage1``).
 
 A column name carries its unit when the unit is physical: ``sun_rpm``, ``mesh_hz``,
 ``torque.input_Nm``, ``force_peak_sp_p1_N``; a swept clearance gets both its value in units of
@@ -39,6 +40,7 @@ import numpy as np
 from .._text import escape_text
 from ..errors import StoreError
 from ..gearset.schema import FIELDS, MODULE_BOUNDED, OMEGA, UNITS, XI, describe
+from ..model.target import MEMBER_WORD
 
 __all__ = ["Column", "ExportTables", "export_tables", "lead_dims"]
 
@@ -274,8 +276,18 @@ def _ordered(ds: Any) -> list[str]:
     return [*first, *coded, *response, *(n for n in names if n not in done)]
 
 
-def _wide_label(dim: str, label: Any) -> str:
-    return f"p{label}" if dim in ("planet_all", "planet") else escape_text(label)
+def _wide_label(ds: Any, dim: str, label: Any) -> str:
+    """A member column's suffix: the store's ``member_name`` and the member's number
+    (``stage1``; ``p1`` for planets and stores without one), a state component by its name."""
+    if dim not in ("planet_all", "planet"):
+        return escape_text(label)
+    raw = ds.attrs.get("member_name", "p")
+    if not isinstance(raw, str) or not MEMBER_WORD.fullmatch(raw):
+        raise StoreError(
+            "the store's member_name must be a word of at most 32 letters and digits, starting "
+            f"with a letter: got {escape_text(repr(raw))}"
+        )
+    return f"{raw}{label}"
 
 
 def _point_columns(ds: Any, lead: tuple[str, ...], phys: _Physics) -> list[Column]:
@@ -304,7 +316,7 @@ def _point_columns(ds: Any, lead: tuple[str, ...], phys: _Physics) -> list[Colum
         for k, label in enumerate(_coord(ds, dim)):
             values, meanings = _decoded(_flat(block[:, k]), var.attrs)
             unit = "" if values.dtype == object else "1"
-            name_k = f"{escape_text(name)}_{_wide_label(dim, label)}"
+            name_k = f"{escape_text(name)}_{_wide_label(ds, dim, label)}"
             group.append(Column(name_k, values, unit, desc, meanings))
         twins = [_physical_twin(name, col, phys) for col in group]
         cols += group + [t for t in twins if t is not None]
@@ -341,7 +353,7 @@ def _section_columns(
         block = np.asarray(var.transpose(*lead, "section", dim).values)
         block = block.reshape(-1, var.sizes[dim])
         for k, label in enumerate(_coord(ds, dim)):
-            name_k = f"{escape_text(name)}_{_wide_label(dim, label)}"
+            name_k = f"{escape_text(name)}_{_wide_label(ds, dim, label)}"
             cols.append(Column(name_k, _flat(block[:, k]), "1", desc))
     return cols
 
