@@ -30,7 +30,7 @@ from ..analysis.motion import LABEL_DTYPE, Motion
 from ..errors import ParameterError, Status, StoreError
 from .result import SweepResult
 from .store import SweepStore, consolidate, foreign_files_ignored, open_sweep, set_attributes
-from .verdicts import VERDICT_COLUMNS
+from .verdicts import RECORD_VARIABLES, VERDICT_COLUMNS
 
 __all__ = ["classify_dataset", "classify_store"]
 
@@ -57,7 +57,11 @@ def _section_pair(res: SweepResult) -> np.ndarray:
 
 
 def classify_dataset(
-    ds: Any, *, period_rtol: float = PERIOD_RTOL, max_period: int = MAX_PERIOD
+    ds: Any,
+    *,
+    period_rtol: float = PERIOD_RTOL,
+    max_period: int = MAX_PERIOD,
+    decide: bool = True,
 ) -> dict[str, Any]:
     """Labels and indicators for every point of a sweep dataset (nothing written).
 
@@ -65,13 +69,17 @@ def classify_dataset(
     (:mod:`gearchaos.sweep.verdicts`): a store decided by the confirming verdict has its labels
     read as stored (never re-decided); a store labelled from the record alone (evidence
     ``record``, ``verdicts=False``) is decided again by the same record mode with these
-    tolerances (``record_verdicts`` holds the new verdicts). A store of an earlier version
+    tolerances (``record_verdicts`` holds the new verdicts) unless ``decide`` is False: a
+    sweep's own classification at its end, whose tasks labelled every point by the same record
+    mode with the same tolerances, reads their labels as stored. A store of an earlier version
     without verdict columns is labelled by :func:`_old_layout_labels`.
     """
     res = SweepResult.of(ds)
     if "verdict" not in res.ds.data_vars:
         return _old_layout_labels(res, period_rtol=period_rtol, max_period=max_period)
     if _record_mode(res):
+        if not decide:
+            return _record_as_stored(res)
         return _from_record(res, period_rtol=period_rtol, max_period=max_period)
     return _from_verdicts(res)
 
@@ -139,6 +147,28 @@ def _from_record(res: SweepResult, *, period_rtol: float, max_period: int) -> di
         longest_period=max_period,
     )
     return {**_tabulate(res, verdicts), "record_verdicts": verdicts}
+
+
+def _record_as_stored(res: SweepResult) -> dict[str, Any]:
+    """A record-mode store's labels, periods, K and indicator agreement as its tasks stored
+    them (a failed or not-run point labelled by its status), with its contact regimes and
+    regime table."""
+    ds, lead = res.ds, res.lead_dims
+    if not all(name in ds.data_vars for name in RECORD_VARIABLES):  # earlier record stores
+        return _from_record(res, period_rtol=PERIOD_RTOL, max_period=MAX_PERIOD)
+    labels = np.asarray(ds["motion"].transpose(*lead).values).astype(LABEL_DTYPE)
+    status = res.status()
+    for idx in np.ndindex(*labels.shape):
+        labels[idx] = _status_label(int(status[idx])) or labels[idx]
+    return {
+        "dims": lead,
+        **_contact(res),
+        "motion": labels,
+        "period": np.asarray(ds["period"].transpose(*lead).values, dtype=np.int16),
+        "k01": np.asarray(ds["k01"].transpose(*lead).values, dtype=float),
+        "indicators_agree": np.asarray(ds["indicators_agree"].transpose(*lead).values, dtype=bool),
+        "regime_table": _regime_table(res, labels),
+    }
 
 
 def _tabulate(res: SweepResult, decided: list[Any]) -> dict[str, Any]:
@@ -333,12 +363,14 @@ def classify_store(
     *,
     period_rtol: float = PERIOD_RTOL,
     max_period: int = MAX_PERIOD,
+    decide: bool = True,
 ) -> dict[str, Any]:
     """Label every point of a sweep store in place; returns the regime table.
 
     ``period_rtol`` is the tolerance of period detection relative to the attractor's size
     (:func:`~gearchaos.analysis.periodicity.detect_period`), ``max_period`` the longest period
-    recognised as nT.
+    recognised as nT; ``decide`` False reads a record-mode store's labels as its tasks stored
+    them (:func:`classify_dataset`).
     """
     import xarray as xr
     import zarr
@@ -362,7 +394,7 @@ def classify_store(
         raise StoreError(
             f"{zstore!r} is not a readable sweep store ({type(exc).__name__}: {exc})"
         ) from None
-    res = classify_dataset(ds, period_rtol=period_rtol, max_period=max_period)
+    res = classify_dataset(ds, period_rtol=period_rtol, max_period=max_period, decide=decide)
     # on disk the new arrays are written beside the store first and swapped in by renames,
     # so a full disk or a kill leaves the store as it was, never half rewritten
     try:
@@ -397,9 +429,9 @@ def classify_store(
             arr[...] = res[name]
         docs = {
             "motion": ("1T…nT, QP, chaos, unresolved or failed", ""),
-            "period": ("period n of the section sequence (0: none ≤ max_period)", 0),
+            "period": (RECORD_VARIABLES["period"][0], 0),
             "k01": ("0–1 test for chaos K (Gottwald & Melbourne)", np.nan),
-            "indicators_agree": ("whether every available indicator agrees with the label", False),
+            "indicators_agree": (RECORD_VARIABLES["indicators_agree"][0], False),
         }
         if "verdict" in ds.data_vars:  # the verdict columns' own descriptions
             docs["motion"] = (VERDICT_COLUMNS["motion"].long_name, "")

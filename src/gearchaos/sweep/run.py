@@ -9,7 +9,6 @@ result as an :class:`xarray.Dataset`.
 from __future__ import annotations
 
 import contextlib
-import itertools
 import os
 import signal
 import threading
@@ -24,9 +23,9 @@ from ..errors import ParameterError, Status, StoreError
 from ..integrate._chains import ChainOutput, ChainRun
 from ..integrate.interface import Info
 from ..integrate.settings import SolverSettings, check_params, renamed_keyword
-from ..integrate.threads import abandon, resume
 from ..model.record import target_record
 from ..model.target import Target, resolve, scale_attrs
+from ._drive import run_in_process, run_pool
 from ._response_store import response_extract, response_variables
 from .execute import EXECUTION_OPTIONS, Execution, InProcess, executor
 from .grid import Grid, Task
@@ -37,7 +36,13 @@ from .spec import SweepSpec, sweep_keywords
 from .speeds import given_speed, omega_spec, speed_coords
 from .store import SweepStore
 from .variables import ORBIT_VARIABLES, SKIPPED, STEP_COUNTS, status_attrs
-from .verdicts import RECORD_MODE, VERDICT_VARIABLES, task_verdicts, verdict_attrs
+from .verdicts import (
+    RECORD_MODE,
+    RECORD_VARIABLES,
+    VERDICT_VARIABLES,
+    task_verdicts,
+    verdict_attrs,
+)
 
 __all__ = ["bifurcation", "run_sweep"]
 
@@ -111,7 +116,10 @@ class _Layout:
             chunks["lle"] = ch
         # every sweep stores its verdicts: confirmed, or from the record alone without
         # verdicts (evidence record), whose λ₁ is the one recorded above
-        for nm, (doc, dtype, fill) in VERDICT_VARIABLES.items():
+        for nm, (doc, dtype, fill) in {
+            **VERDICT_VARIABLES,
+            **({} if spec.verdicts else RECORD_VARIABLES),
+        }.items():
             if nm == "lle" and spec.recorded_lyapunov:
                 continue
             var[nm] = (lead, (shp, dtype), fill, {"long_name": doc, **verdict_attrs(nm)})
@@ -339,15 +347,16 @@ def _run_locked(
     ):
         bar.describe(desc)
         if isinstance(ex, InProcess):
-            _run_in_process(todo, grid, layout, st, fn, bar)
+            run_in_process(todo, grid, layout, st, fn, bar)
         else:
             ex_ = execution or Execution()
-            _run_pool(todo, grid, layout, st, ex, fn, bar, ex_.workers or ex_.dask_local or 8)
-    # every task is written (its marker says so): label the points, then finish the store
+            run_pool(todo, grid, layout, st, ex, fn, bar, ex_.workers or ex_.dask_local or 8)
+    # every task is written (its marker says so) with its labels (record-mode ones decided
+    # with the defaults, so not again): contact regimes and regime table, then finish the store
     if classify:
         from .classify import classify_store
 
-        classify_store(st.zarr_store)
+        classify_store(st.zarr_store, decide=False)
     st.finish()
     return st.open()
 
@@ -381,111 +390,6 @@ def _check_sizes(grid: Grid, variables: dict[str, Any], path: str | None) -> Non
             f"the sweep store {path} may need up to {total / 2**30:.3g} GiB but the disk has "
             f"{free / 2**30:.3g} GiB free; record fewer periods or points, or write elsewhere"
         )
-
-
-def _groups(todo: list[Task], want: int) -> Iterator[list[Task]]:
-    """Consecutive tasks of equal chain length, grouped until a group has ``want`` chains."""
-    i = 0
-    while i < len(todo):
-        group = [todo[i]]
-        chains = len(todo[i].chains)
-        L = max(len(c) for c in todo[i].chains)
-        i += 1
-        while i < len(todo) and chains < want and max(len(c) for c in todo[i].chains) == L:
-            group.append(todo[i])
-            chains += len(todo[i].chains)
-            i += 1
-        yield group
-
-
-#: Driver threads of an in-process sweep: each integrates and extracts (verdicts included) one
-#: group of tasks, so one group's Python work overlaps another's integration.
-_DRIVERS = 3
-
-
-def _run_in_process(
-    todo: list[Task], grid: Grid, layout: _Layout, st: SweepStore, fn: Any, bar: Any
-) -> None:
-    """Run the groups of tasks here: two driver threads each integrate a group (on the
-    kernel's threads) and extract it (the verdicts included), while this thread writes the
-    finished groups to the store in order, so the writes cost no integration time and one
-    group's Python work overlaps the other's integration. An interrupt loses at most the groups
-    in flight; everything written stays."""
-    import collections
-    import concurrent.futures as cf
-
-    import numba
-
-    def compute(group: list[Task]) -> list[tuple[Task, dict[str, np.ndarray], int]]:
-        runs = [grid.task_run(t) for t in group]
-        res = fn(ChainRun.concat(runs))
-        parts = res.split([len(t.chains) for t in group])
-        return [
-            (t, layout.extract(t, run, part), int(np.sum(part.status != 0)))
-            for t, run, part in zip(group, runs, parts, strict=True)
-        ]
-
-    groups = _groups(todo, 2 * numba.get_num_threads())
-    width = _DRIVERS
-    driver = cf.ThreadPoolExecutor(width, thread_name_prefix="gearchaos-sweep")
-    pending: collections.deque[cf.Future[Any]] = collections.deque()
-    resume()
-    try:
-        for group in itertools.islice(groups, width):
-            pending.append(driver.submit(compute, group))
-        while pending:
-            done = pending.popleft().result()
-            nxt = next(groups, None)
-            if nxt is not None:
-                pending.append(driver.submit(compute, nxt))
-            for t, data, failed in done:
-                st.write(t.index, t.block, data)
-                bar.advance(t.n_points, failed)
-    except BaseException:
-        abandon()  # the drivers stop waiting for their blocks: the process can exit at once
-        raise
-    finally:
-        driver.shutdown(wait=False, cancel_futures=True)
-
-
-def _run_pool(
-    todo: list[Task],
-    grid: Grid,
-    layout: _Layout,
-    st: SweepStore,
-    ex: Any,
-    fn: Any,
-    bar: Any,
-    width: int,
-) -> None:
-    import concurrent.futures as cf
-
-    it = iter(todo)
-    inflight: dict[Any, tuple[Task, ChainRun]] = {}
-
-    def submit_next() -> bool:
-        t = next(it, None)
-        if t is None:
-            return False
-        run = grid.task_run(t)
-        inflight[ex.submit(fn, run)] = (t, run)
-        return True
-
-    for _ in range(2 * int(width)):
-        if not submit_next():
-            break
-    try:
-        while inflight:
-            finished, _ = cf.wait(list(inflight), return_when=cf.FIRST_COMPLETED)
-            for fut in finished:
-                t, run = inflight.pop(fut)
-                res = fut.result()
-                st.write(t.index, t.block, layout.extract(t, run, res))
-                bar.advance(t.n_points, int(np.sum(res.status != 0)))
-                submit_next()
-    finally:
-        for fut in inflight:
-            fut.cancel()
 
 
 def _default_observe(target: Target) -> tuple[str, ...]:

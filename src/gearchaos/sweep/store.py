@@ -271,8 +271,9 @@ class SweepStore:
             g = zarr.open_group(target, mode="a", zarr_format=2)
             for name, (dims, shape_dtype, fill, vattrs) in variables.items():
                 shape, dtype = shape_dtype
-                # integers and strings (labels) carry no fill value, so xarray keeps their type
-                written = np.issubdtype(np.dtype(dtype), np.integer) or np.dtype(dtype).kind == "U"
+                # integers, flags and strings (labels) carry no fill value, so xarray keeps
+                # their type
+                written = np.dtype(dtype).kind in "iubU"
                 arr = g.create_array(
                     name,
                     shape=shape,

@@ -51,6 +51,7 @@ from ..dynamics.verdict.extension import RECORD_SOURCES
 __all__ = [
     "NOT_STORED",
     "RECORD_MODE",
+    "RECORD_VARIABLES",
     "VERDICT_COLUMNS",
     "VERDICT_VARIABLES",
     "VerdictColumn",
@@ -161,10 +162,26 @@ VERDICT_VARIABLES: Mapping[str, tuple[str, str, Any]] = MappingProxyType(
 )
 
 
+#: What the record mode also stores per point (name → long name, dtype, fill value): the
+#: period of the section sequence and whether the indicators agree with the label, which a
+#: sweep's classification at its end then reads instead of deciding every point again.
+RECORD_VARIABLES: Mapping[str, tuple[str, str, Any]] = MappingProxyType(
+    {
+        "period": ("period n of the section sequence (0: none ≤ max_period)", "int16", 0),
+        "indicators_agree": (
+            "whether every available indicator agrees with the label",
+            "bool",
+            False,
+        ),
+    }
+)
+
+
 def verdict_attrs(name: str) -> dict[str, Any]:
     """Extra attributes of a verdict variable (the flag legends of ``verdict`` and
     ``record``)."""
-    flags = VERDICT_COLUMNS[name].flags
+    column = VERDICT_COLUMNS.get(name)
+    flags = None if column is None else column.flags
     if flags is None:
         return {}
     return {"flag_values": list(flags.values()), "flag_meanings": " ".join(flags)}
@@ -227,9 +244,14 @@ def task_verdicts(
     for name, col in VERDICT_COLUMNS.items():
         if name not in data:
             data[name] = np.full(task.shape, col.fill, dtype=col.dtype)
+    record_mode = verdict is not None and verdict.mode == "record"
+    for name, (_, dtype, fill) in RECORD_VARIABLES.items() if record_mode else ():
+        data[name] = np.full(task.shape, fill, dtype=dtype)
     for (*_, pos), v in zip(where, verdicts, strict=True):
         for name, value in verdict_row(v).items():
             data[name][pos] = value
+        if record_mode:
+            data["period"][pos], data["indicators_agree"][pos] = v.period, bool(v.agree)
         rec = v.record
         if rec is None or spp != 1:  # a record sampled more than once a period is not replaced
             data["record"][pos] = RECORD_SOURCES["protocol"]
