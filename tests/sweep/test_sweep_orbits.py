@@ -111,15 +111,16 @@ def test_orbit_variables_resume_with_their_task(tmp_path, monkeypatch) -> None:
     kw = {"orbits": True, "progress": False, "transient_periods": 300, "periods": 16}
     whole = gc.bifurcation(*args, **kw)
     path = tmp_path / "run.zarr"
-    original = SweepStore.write
+    original = SweepStore.write_tasks
     calls = []
 
-    def write_then_stop(self, task_index, block, data):
-        original(self, task_index, block, data)
-        calls.append(task_index)
+    def write_then_stop(self, tasks):
+        # the first task of the first write (writes are batched since issue 36), then stop
+        original(self, tasks[:1])
+        calls.append(tasks[0][0])
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(SweepStore, "write", write_then_stop)
+    monkeypatch.setattr(SweepStore, "write_tasks", write_then_stop)
     with pytest.raises(KeyboardInterrupt):
         gc.bifurcation(*args, store=path, **kw)
     monkeypatch.undo()

@@ -112,13 +112,13 @@ def interrupt(path, sig: int, rng: random.Random, window: float) -> bool:
 def resume_recording_writes(path, monkeypatch) -> list[int]:
     """Run the same sweep to completion here, recording which tasks it computes."""
     written: list[int] = []
-    original = SweepStore.write
+    original = SweepStore.write_tasks
 
-    def write(self, task_index, block, data):
-        written.append(task_index)
-        return original(self, task_index, block, data)
+    def write_tasks(self, tasks):
+        written.extend(index for index, _, _ in tasks)
+        return original(self, tasks)
 
-    monkeypatch.setattr(SweepStore, "write", write)
+    monkeypatch.setattr(SweepStore, "write_tasks", write_tasks)
     kw = dict(KILL_SWEEP)
     gc.bifurcation(gc.preset("hindawi2021"), kw.pop("vary"), store=path, progress=False, **kw)
     monkeypatch.undo()

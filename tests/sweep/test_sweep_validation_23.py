@@ -21,16 +21,19 @@ OSC = gc.backlash_oscillator(1.0, zeta=0.05, b=1.0, f_mean=0.1, f_alt=0.2)
 
 def _interrupted(path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """A sweep killed after its first task was written (Ctrl-C)."""
-    original = SweepStore.write
+    original = SweepStore.write_tasks
     calls = []
 
-    def write(self, task_index, block, data):  # type: ignore[no-untyped-def]
+    def write_tasks(self, tasks):  # type: ignore[no-untyped-def]
+        # the first task of the first write, then Ctrl-C (writes are batched since issue 36)
         if calls:
             raise KeyboardInterrupt
-        calls.append(task_index)
-        original(self, task_index, block, data)
+        calls.append(tasks[0][0])
+        original(self, tasks[:1])
+        if len(tasks) > 1:
+            raise KeyboardInterrupt
 
-    monkeypatch.setattr(SweepStore, "write", write)
+    monkeypatch.setattr(SweepStore, "write_tasks", write_tasks)
     with pytest.raises(KeyboardInterrupt):
         gc.bifurcation(
             OSC, "omega=0.5:2:120", store=path, transient_periods=3, periods=4, progress=False

@@ -1,11 +1,13 @@
 """How a sweep's tasks are run and written: in this process, on driver threads that overlap one
 group's Python work with another's integration (:func:`run_in_process`), or on a pool of
 workers or a Dask cluster (:func:`run_pool`); each finished task is written to the store,
-which marks it done (:meth:`~gearchaos.sweep.store.SweepStore.write`)."""
+which marks it done (:meth:`~gearchaos.sweep.store.SweepStore.write_tasks`)."""
 
 from __future__ import annotations
 
+import contextlib
 import itertools
+import time
 from collections.abc import Iterator
 from typing import Any
 
@@ -16,7 +18,7 @@ from ..integrate.threads import abandon, resume
 from .grid import Grid, Task
 from .store import SweepStore
 
-__all__ = ["run_in_process", "run_pool"]
+__all__ = ["WRITE_SECONDS", "run_in_process", "run_pool"]
 
 
 def _groups(todo: list[Task], want: int) -> Iterator[list[Task]]:
@@ -34,6 +36,9 @@ def _groups(todo: list[Task], want: int) -> Iterator[list[Task]]:
         yield group
 
 
+#: Seconds between the writes of an in-process sweep's finished tasks.
+WRITE_SECONDS = 0.5
+
 #: Driver threads of an in-process sweep: each integrates and extracts (verdicts included) one
 #: group of tasks, so one group's Python work overlaps another's integration.
 _DRIVERS = 3
@@ -44,9 +49,11 @@ def run_in_process(
 ) -> None:
     """Run the groups of tasks here: driver threads each integrate a group (on the kernel's
     threads) and extract it (the verdicts included), while this thread writes the finished
-    groups to the store in order, so the writes cost no integration time and one group's
-    Python work overlaps another's integration. An interrupt loses at most the groups in
-    flight; everything written stays."""
+    tasks in order, together every :data:`WRITE_SECONDS` (one assignment per variable: each
+    costs about a millisecond, and this thread's writes take the interpreter from the
+    drivers) and at the end. An interrupt or a failed group writes the finished tasks first
+    and loses at most the groups in flight, a kill also the last :data:`WRITE_SECONDS`'
+    tasks; everything written stays."""
     import collections
     import concurrent.futures as cf
 
@@ -65,20 +72,35 @@ def run_in_process(
     width = _DRIVERS
     driver = cf.ThreadPoolExecutor(width, thread_name_prefix="gearchaos-sweep")
     pending: collections.deque[cf.Future[Any]] = collections.deque()
+    finished: list[tuple[Task, dict[str, np.ndarray], int]] = []
+    written, writing = time.monotonic(), False
+
+    def write() -> None:
+        nonlocal written, writing
+        writing = True
+        st.write_tasks([(t.index, t.block, data) for t, data, _ in finished])
+        writing = False
+        for t, _, failed in finished:
+            bar.advance(t.n_points, failed)
+        finished.clear()
+        written = time.monotonic()
+
     resume()
     try:
         for group in itertools.islice(groups, width):
             pending.append(driver.submit(compute, group))
         while pending:
-            done = pending.popleft().result()
+            finished.extend(pending.popleft().result())
             nxt = next(groups, None)
             if nxt is not None:
                 pending.append(driver.submit(compute, nxt))
-            for t, data, failed in done:
-                st.write(t.index, t.block, data)
-                bar.advance(t.n_points, failed)
+            if not pending or time.monotonic() - written >= WRITE_SECONDS:
+                write()
     except BaseException:
         abandon()  # the drivers stop waiting for their blocks: the process can exit at once
+        if finished and not writing:  # what was computed is kept (a failed write is not redone)
+            with contextlib.suppress(Exception):
+                write()
         raise
     finally:
         driver.shutdown(wait=False, cancel_futures=True)
