@@ -156,10 +156,7 @@ def _record_as_stored(res: SweepResult) -> dict[str, Any]:
     ds, lead = res.ds, res.lead_dims
     if not all(name in ds.data_vars for name in RECORD_VARIABLES):  # earlier record stores
         return _from_record(res, period_rtol=PERIOD_RTOL, max_period=MAX_PERIOD)
-    labels = np.asarray(ds["motion"].transpose(*lead).values).astype(LABEL_DTYPE)
-    status = res.status()
-    for idx in np.ndindex(*labels.shape):
-        labels[idx] = _status_label(int(status[idx])) or labels[idx]
+    labels = _stored_labels(res)
     return {
         "dims": lead,
         **_contact(res),
@@ -169,6 +166,15 @@ def _record_as_stored(res: SweepResult) -> dict[str, Any]:
         "indicators_agree": np.asarray(ds["indicators_agree"].transpose(*lead).values, dtype=bool),
         "regime_table": _regime_table(res, labels),
     }
+
+
+def _stored_labels(res: SweepResult) -> np.ndarray:
+    """The labels a store's tasks wrote, a failed or not-run point labelled by its status."""
+    labels = np.asarray(res.ds["motion"].transpose(*res.lead_dims).values).astype(LABEL_DTYPE)
+    status = res.status()
+    for idx in np.ndindex(*labels.shape):
+        labels[idx] = _status_label(int(status[idx])) or labels[idx]
+    return labels
 
 
 def _tabulate(res: SweepResult, decided: list[Any]) -> dict[str, Any]:
@@ -209,10 +215,7 @@ def _from_verdicts(res: SweepResult) -> dict[str, Any]:
     """The stored verdicts' labels (:mod:`gearchaos.sweep.verdicts`): nothing is re-decided;
     the period follows from the label, and the contact regimes and regime table are added."""
     ds = res.ds
-    labels = np.asarray(ds["motion"].transpose(*res.lead_dims).values).astype(LABEL_DTYPE)
-    status = res.status()
-    for idx in np.ndindex(*labels.shape):
-        labels[idx] = _status_label(int(status[idx])) or labels[idx]
+    labels = _stored_labels(res)
     period = np.zeros(labels.shape, dtype=np.int16)
     for idx in np.ndindex(*labels.shape):
         period[idx] = Motion.parse(str(labels[idx])).period

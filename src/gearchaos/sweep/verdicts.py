@@ -151,8 +151,8 @@ NOT_STORED: Mapping[str, str] = MappingProxyType(
         "record": "replaces the point's section values and final state; its source is record",
         "orbit_state": "the confirmed orbit's state: an orbit store (--orbits) holds orbits",
         "coexisting": "the stable orbits beside the motion: reported by attractors",
-        "agree": "a record-mode label's indicators against it: indicators_agree, written by "
-        "the store's classification (sweep.classify), which re-reads the record",
+        "agree": "a record-mode label's indicators against it: indicators_agree, one of the "
+        "RECORD_VARIABLES a record-mode task writes beside the verdict columns",
     }
 )
 
@@ -228,7 +228,8 @@ def task_verdicts(
     n = systems[0].n_state
     spp = int(spec.solver.samples_per_period)
     lle = None
-    if verdict is not None and verdict.mode == "record":
+    record_mode = verdict is not None and verdict.mode == "record"
+    if record_mode:
         blocks = [[data[ob.name][pos] for ob in observed] for *_, pos in where]
         sections = np.stack([record_sections(observed, b) for b in blocks])
         finals = np.stack([data["final_state"][pos] for *_, pos in where])
@@ -244,7 +245,6 @@ def task_verdicts(
     for name, col in VERDICT_COLUMNS.items():
         if name not in data:
             data[name] = np.full(task.shape, col.fill, dtype=col.dtype)
-    record_mode = verdict is not None and verdict.mode == "record"
     for name, (_, dtype, fill) in RECORD_VARIABLES.items() if record_mode else ():
         data[name] = np.full(task.shape, fill, dtype=dtype)
     for (*_, pos), v in zip(where, verdicts, strict=True):
